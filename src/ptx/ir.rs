@@ -1,0 +1,464 @@
+//! The typed, validated intermediate representation that the simulator executes.
+//!
+//! Names are resolved to indices, literals to bit patterns of the instruction's
+//! type, labels to instruction indices, parameters and variables to offsets in
+//! their state space. Nothing here knows how instructions execute.
+
+use super::types::Ty;
+
+/// Index of a data register in a function's register file.
+pub type RegId = u16;
+
+/// Index of a predicate register. 0 is the constant `false`, 1 the constant `true`.
+pub type PredId = u16;
+
+/// The predicate register that always holds false.
+pub const PRED_FALSE: PredId = 0;
+/// The predicate register that always holds true.
+pub const PRED_TRUE: PredId = 1;
+
+/// A special (read-only) register.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum SpecialReg {
+    Tid(u8),
+    Ntid(u8),
+    Ctaid(u8),
+    Nctaid(u8),
+    LaneId,
+    WarpId,
+    NWarpId,
+    SmId,
+    NSmId,
+    GridId,
+    LaneMaskEq,
+    LaneMaskLe,
+    LaneMaskLt,
+    LaneMaskGe,
+    LaneMaskGt,
+    Clock,
+    Clock64,
+}
+
+/// A source operand.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Src {
+    /// A data register.
+    Reg(RegId),
+    /// An immediate, as the bits of the instruction's type.
+    Imm(u64),
+    /// A special register.
+    Special(SpecialReg),
+    /// The local-space address of the current frame's local area plus an offset.
+    LocalAddr(u32),
+    /// The global address of a module variable (index into [`Program::globals`]) plus an offset.
+    GlobalAddr(u32, u32),
+}
+
+/// A destination data register. `mask` is the register's width mask: results are truncated to it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Dst {
+    /// The register; [`Dst::SINK`] discards the value (`_`).
+    pub reg: RegId,
+    /// All-ones in the register's declared width.
+    pub mask: u64,
+}
+
+impl Dst {
+    /// Register index used for the `_` sink.
+    pub const SINK: RegId = RegId::MAX;
+}
+
+/// A predicate source, possibly negated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PredSrc {
+    /// Predicate register.
+    pub reg: PredId,
+    /// `!p`
+    pub neg: bool,
+}
+
+/// A memory state space as the simulator distinguishes it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[allow(missing_docs)]
+pub enum MemSpace {
+    Global,
+    Shared,
+    Local,
+    Const,
+    /// Kernel parameters (uniform across the grid).
+    KernelParam,
+    /// Per-thread parameter area of a function frame (call arguments, returns).
+    FrameParam,
+    /// A generic address resolved per lane at run time.
+    Generic,
+}
+
+/// A memory address: base plus byte offset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Address {
+    /// Base value (`Imm(0)` for an absolute address).
+    pub base: Src,
+    /// Byte offset added to the base.
+    pub offset: i64,
+}
+
+/// Floating-point rounding modes, and integer rounding of floats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum Rounding {
+    Rn,
+    Rz,
+    Rm,
+    Rp,
+    /// Round to nearest integer, ties to even.
+    Rni,
+    Rzi,
+    Rmi,
+    Rpi,
+}
+
+/// Comparison operators of `setp`/`set`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum Cmp {
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Lo,
+    Ls,
+    Hi,
+    Hs,
+    Equ,
+    Neu,
+    Ltu,
+    Leu,
+    Gtu,
+    Geu,
+    Num,
+    Nan,
+}
+
+/// Boolean combiners of `setp.CMP.BOOL` and predicate logic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum BoolOp {
+    And,
+    Or,
+    Xor,
+}
+
+/// Arithmetic and logic operations with up to three sources.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum ArithOp {
+    Add,
+    Sub,
+    /// `mul.lo` (and float `mul`).
+    Mul,
+    MulHi,
+    /// `mul.wide`: the instruction type is the source type; the result has twice the width.
+    MulWide,
+    /// `mad.lo` / float `mad`, `fma`.
+    Mad,
+    MadHi,
+    MadWide,
+    Mul24Lo,
+    Mul24Hi,
+    Mad24Lo,
+    Mad24Hi,
+    Div,
+    Rem,
+    Abs,
+    Neg,
+    Min,
+    Max,
+    And,
+    Or,
+    Xor,
+    Not,
+    Cnot,
+    Shl,
+    Shr,
+    Popc,
+    Clz,
+    Brev,
+    Bfe,
+    Prmt,
+    Sqrt,
+    Rsqrt,
+    Rcp,
+    Sin,
+    Cos,
+    Ex2,
+    Lg2,
+    Copysign,
+}
+
+/// Floating-point and saturation modifiers of an arithmetic instruction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FloatMode {
+    /// Rounding mode (`None`: the instruction's default).
+    pub rnd: Option<Rounding>,
+    /// `.ftz`: flush subnormal inputs and results to zero.
+    pub ftz: bool,
+    /// `.sat`: clamp floats to [0, 1] (integers to their range).
+    pub sat: bool,
+    /// `.approx` (or `.full` for `div`): an approximation, not correctly rounded.
+    pub approx: bool,
+}
+
+/// Atomic operations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[allow(missing_docs)]
+pub enum AtomOp {
+    Add,
+    Min,
+    Max,
+    Inc,
+    Dec,
+    Exch,
+    Cas,
+    And,
+    Or,
+    Xor,
+}
+
+/// `vote.sync` modes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum VoteMode {
+    All,
+    Any,
+    Uni,
+    Ballot,
+}
+
+/// `shfl.sync` modes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum ShflMode {
+    Up,
+    Down,
+    Bfly,
+    Idx,
+}
+
+/// Broad instruction classes, for counters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum InstClass {
+    /// Integer, logic, moves, conversions and float add/mul/fma.
+    Alu,
+    /// Special-function unit: transcendental approximations, reciprocals, square roots.
+    Sfu,
+    /// Loads, stores and atomics.
+    Memory,
+    /// Branches, calls, returns, exits, barriers.
+    Control,
+    /// Warp-level communication: votes and shuffles.
+    Warp,
+}
+
+/// One decoded instruction. Operand names follow PTX: `d` destination, `a`, `b`, `c`
+/// sources in order, `p`/`q` predicate destinations.
+#[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
+pub enum Kind {
+    /// `mov` of data (also `cvta` between equal windows is not this).
+    Mov { d: Dst, a: Src },
+    /// `mov.bN d, {a, b, ...}`: concatenate `parts` of `part_bits` each, lowest first.
+    Pack { d: Dst, parts: Vec<Src>, part_bits: u32 },
+    /// `mov.bN {a, b, ...}, s`: split.
+    Unpack { ds: Vec<Dst>, a: Src, part_bits: u32 },
+    /// Arithmetic on `ty`.
+    Arith { op: ArithOp, ty: Ty, mode: FloatMode, d: Dst, a: Src, b: Src, c: Src },
+    /// `setp.cmp[.bool].ty p[|q], a, b[, c]`.
+    Setp { cmp: Cmp, ty: Ty, p: PredId, q: Option<PredId>, a: Src, b: Src, comb: Option<(BoolOp, PredSrc)>, ftz: bool },
+    /// `set.cmp[.bool].dty.sty d, a, b[, c]`.
+    Set { cmp: Cmp, dty: Ty, sty: Ty, d: Dst, a: Src, b: Src, comb: Option<(BoolOp, PredSrc)>, ftz: bool },
+    /// `bfi.ty d, a, b, c, e`: insert `e` bits of `a` into `b` at position `c`.
+    Bfi { ty: Ty, d: Dst, a: Src, b: Src, c: Src, e: Src },
+    /// `selp.ty d, a, b, p`.
+    Selp { d: Dst, a: Src, b: Src, p: PredSrc },
+    /// Predicate logic: `and/or/xor.pred d, a, b` (`op = None` with `b` ignored is `mov`/`not`).
+    PredLogic { op: Option<BoolOp>, d: PredId, a: PredSrc, b: PredSrc },
+    /// `cvt.[rnd][.ftz][.sat].dty.sty d, a`.
+    Cvt { dty: Ty, sty: Ty, mode: FloatMode, d: Dst, a: Src },
+    /// `cvta[.to].space.size d, a`.
+    Cvta { to_generic: bool, space: MemSpace, d: Dst, a: Src },
+    /// `ld`: `vec` elements of `ty` into `ds`.
+    Ld { space: MemSpace, ty: Ty, ds: Vec<Dst>, addr: Address, nc: bool, volatile: bool },
+    /// `st`: `vals` of `ty`.
+    St { space: MemSpace, ty: Ty, vals: Vec<Src>, addr: Address, volatile: bool },
+    /// `atom`/`red` (`d == None` for `red`).
+    Atom { space: MemSpace, op: AtomOp, ty: Ty, d: Option<Dst>, addr: Address, b: Src, c: Src },
+    /// `bra target` (an instruction index); `uni` as written.
+    Bra { target: u32, uni: bool },
+    /// `call` of a function: copy `args` (caller offset → callee offset, size) in, `rets` back.
+    Call { func: u32, args: Vec<(u32, u32, u32)>, rets: Vec<(u32, u32, u32)> },
+    /// `ret`
+    Ret,
+    /// `exit`
+    Exit,
+    /// `bar.sync id[, count]` / `barrier.sync`.
+    Bar { id: Src, count: Option<Src> },
+    /// `vote.sync.mode`: a ballot writes `d`, the others write predicate `p`.
+    Vote { mode: VoteMode, d: Option<Dst>, p: PredId, a: PredSrc, membermask: Src },
+    /// `shfl.sync.mode.b32 d[|p], a, b, c, membermask`.
+    Shfl { mode: ShflMode, d: Dst, p: Option<PredId>, a: Src, b: Src, c: Src, membermask: Src },
+    /// `membar` / `fence`.
+    Membar,
+    /// An instruction with no effect in the model (`prefetch`, `pmevent`...).
+    Nop,
+    /// `trap`: a fault.
+    Trap,
+}
+
+/// One instruction with its guard.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inst {
+    /// `@p` / `@!p`; `None` when unguarded.
+    pub guard: Option<PredSrc>,
+    /// What it does.
+    pub kind: Kind,
+}
+
+/// A CUDA source position from `.loc`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub struct SrcLoc {
+    /// Index into [`Program::files`].
+    pub file: u32,
+    /// 1-based line (0 = compiler-generated).
+    pub line: u32,
+    /// 1-based column.
+    pub col: u32,
+}
+
+/// Where an instruction came from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InstInfo {
+    /// Line in the PTX file.
+    pub ptx_line: u32,
+    /// Column in the PTX file.
+    pub ptx_col: u32,
+    /// CUDA source position from the last `.loc`.
+    pub src: Option<SrcLoc>,
+    /// The opcode as written, e.g. `ld.global.nc.f32`.
+    pub opcode: String,
+    /// Its class, for counters.
+    pub class: InstClass,
+}
+
+/// A kernel parameter or function parameter.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Param {
+    /// Its name.
+    pub name: String,
+    /// Its type (`.b8` arrays keep `B8` with `size` > 1).
+    pub ty: Ty,
+    /// Byte offset in the parameter area.
+    pub offset: u32,
+    /// Size in bytes.
+    pub size: u32,
+}
+
+/// A lowered function or kernel.
+#[derive(Debug, Clone)]
+pub struct Function {
+    /// Its name.
+    pub name: String,
+    /// True for `.entry`.
+    pub is_entry: bool,
+    /// Parameters with offsets (kernel param area for entries, frame area otherwise).
+    pub params: Vec<Param>,
+    /// Return parameters (frame area).
+    pub returns: Vec<Param>,
+    /// Size of the per-thread frame parameter area (formals, returns, call arguments).
+    pub frame_param_size: u32,
+    /// Size of the kernel parameter area (entries only).
+    pub kernel_param_size: u32,
+    /// Bytes of local memory of one frame.
+    pub local_size: u32,
+    /// Alignment of the local frame.
+    pub local_align: u32,
+    /// Width mask of each data register.
+    pub reg_masks: Vec<u64>,
+    /// Register names, for inspection.
+    pub reg_names: Vec<String>,
+    /// Number of predicate registers including the two constants.
+    pub num_preds: u16,
+    /// Predicate register names (index 0, 1 are `false`, `true`).
+    pub pred_names: Vec<String>,
+    /// The instructions.
+    pub insts: Vec<Inst>,
+    /// Source information, parallel to `insts`.
+    pub info: Vec<InstInfo>,
+    /// Labels and their instruction indices.
+    pub labels: Vec<(String, u32)>,
+    /// 32-bit registers the PTX declares (a `.b64` counts two), for occupancy.
+    pub declared_reg_words: u32,
+}
+
+/// A module-scope `.global` variable.
+#[derive(Debug, Clone)]
+pub struct GlobalVar {
+    /// Its name.
+    pub name: String,
+    /// Size in bytes.
+    pub size: u64,
+    /// Alignment.
+    pub align: u32,
+    /// Initial contents (zeros when absent).
+    pub init: Vec<u8>,
+}
+
+/// A shared variable's placement.
+#[derive(Debug, Clone)]
+pub struct SharedVar {
+    /// Its name.
+    pub name: String,
+    /// Offset in the CTA's shared memory.
+    pub offset: u32,
+    /// Size in bytes (0 for the dynamic `extern` array).
+    pub size: u32,
+}
+
+/// A complete validated module.
+#[derive(Debug, Clone)]
+pub struct Program {
+    /// Name of the PTX file it came from.
+    pub source_name: String,
+    /// The PTX source lines, for listings.
+    pub ptx_lines: Vec<String>,
+    /// `.target` words.
+    pub target: Vec<String>,
+    /// `.version`.
+    pub version: String,
+    /// Files of `.loc` (index = [`SrcLoc::file`]).
+    pub files: Vec<String>,
+    /// Functions and kernels.
+    pub functions: Vec<Function>,
+    /// Module `.global` variables.
+    pub globals: Vec<GlobalVar>,
+    /// The `.const` bank image.
+    pub const_bank: Vec<u8>,
+    /// Shared variables with offsets.
+    pub shared_vars: Vec<SharedVar>,
+    /// Static shared memory per CTA in bytes (dynamic shared starts here, 16-aligned).
+    pub static_shared_size: u32,
+}
+
+impl Program {
+    /// Finds a kernel (an `.entry`) by name.
+    pub fn kernel(&self, name: &str) -> Option<u32> {
+        self.functions.iter().position(|f| f.is_entry && f.name == name).map(|i| i as u32)
+    }
+
+    /// Names of all kernels.
+    pub fn kernel_names(&self) -> Vec<&str> {
+        self.functions.iter().filter(|f| f.is_entry).map(|f| f.name.as_str()).collect()
+    }
+}

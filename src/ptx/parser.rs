@@ -1,0 +1,552 @@
+//! Tokens → syntax tree ([`super::ast`]).
+
+use super::ast::*;
+use super::error::{Pos, PtxErrorKind};
+use super::lexer::{Tok, Token};
+use super::types::{Space, Ty};
+
+type PResult<T> = Result<T, (Pos, PtxErrorKind)>;
+
+/// Parses a token stream into a module.
+pub fn parse(tokens: &[Token]) -> PResult<Module> {
+    let mut p = Parser { t: tokens, i: 0 };
+    p.module()
+}
+
+struct Parser<'a> {
+    t: &'a [Token],
+    i: usize,
+}
+
+fn syntax<T>(pos: Pos, msg: impl Into<String>) -> PResult<T> {
+    Err((pos, PtxErrorKind::Syntax(msg.into())))
+}
+
+impl<'a> Parser<'a> {
+    fn peek(&self) -> Option<&'a Tok> {
+        self.t.get(self.i).map(|t| &t.tok)
+    }
+    fn peek_at(&self, k: usize) -> Option<&'a Tok> {
+        self.t.get(self.i + k).map(|t| &t.tok)
+    }
+    fn pos(&self) -> Pos {
+        self.t
+            .get(self.i)
+            .or_else(|| self.t.last())
+            .map(|t| t.pos)
+            .unwrap_or(Pos { line: 1, col: 1 })
+    }
+    fn next(&mut self) -> PResult<&'a Token> {
+        let t = self.t.get(self.i);
+        match t {
+            Some(t) => {
+                self.i += 1;
+                Ok(t)
+            }
+            None => syntax(self.pos(), "unexpected end of file"),
+        }
+    }
+    fn is_punct(&self, c: char) -> bool {
+        self.peek() == Some(&Tok::Punct(c))
+    }
+    fn eat_punct(&mut self, c: char) -> bool {
+        if self.is_punct(c) {
+            self.i += 1;
+            true
+        } else {
+            false
+        }
+    }
+    fn expect_punct(&mut self, c: char) -> PResult<()> {
+        if self.eat_punct(c) {
+            Ok(())
+        } else {
+            syntax(self.pos(), format!("expected `{c}`, found {}", self.describe()))
+        }
+    }
+    fn describe(&self) -> String {
+        match self.peek() {
+            None => "end of file".into(),
+            Some(Tok::Ident(s)) => format!("`{s}`"),
+            Some(Tok::Dot(s)) => format!("`.{s}`"),
+            Some(Tok::Punct(c)) => format!("`{c}`"),
+            Some(Tok::Str(s)) => format!("\"{s}\""),
+            Some(t) => format!("{t:?}"),
+        }
+    }
+    fn expect_ident(&mut self) -> PResult<String> {
+        let pos = self.pos();
+        match self.next()?.tok {
+            Tok::Ident(ref s) => Ok(s.clone()),
+            _ => {
+                self.i -= 1;
+                syntax(pos, format!("expected a name, found {}", self.describe()))
+            }
+        }
+    }
+    fn expect_int(&mut self) -> PResult<u64> {
+        let pos = self.pos();
+        match self.next()?.tok {
+            Tok::Int(v) => Ok(v),
+            _ => {
+                self.i -= 1;
+                syntax(pos, format!("expected an integer, found {}", self.describe()))
+            }
+        }
+    }
+    fn peek_dot(&self) -> Option<&'a str> {
+        match self.peek() {
+            Some(Tok::Dot(s)) => Some(s.as_str()),
+            _ => None,
+        }
+    }
+
+    fn module(&mut self) -> PResult<Module> {
+        let mut m = Module { address_size: 64, ..Default::default() };
+        while let Some(tok) = self.peek() {
+            let pos = self.pos();
+            let Tok::Dot(d) = tok else {
+                return syntax(pos, format!("expected a directive, found {}", self.describe()));
+            };
+            match d.as_str() {
+                "version" => {
+                    self.i += 1;
+                    m.version = match &self.next()?.tok {
+                        Tok::Float(f) => format!("{f}"),
+                        Tok::Int(a) => {
+                            let mut v = a.to_string();
+                            if let Some(Tok::Dot(_)) = self.peek() {
+                                // `7.8` lexes as a float; this branch is defensive.
+                                v.push('.');
+                            }
+                            v
+                        }
+                        _ => return syntax(pos, "bad .version"),
+                    };
+                }
+                "target" => {
+                    self.i += 1;
+                    m.target.push(self.expect_ident()?);
+                    while self.eat_punct(',') {
+                        m.target.push(self.expect_ident()?);
+                    }
+                }
+                "address_size" => {
+                    self.i += 1;
+                    m.address_size = self.expect_int()? as u32;
+                    if m.address_size != 64 && m.address_size != 32 {
+                        return syntax(pos, "address_size must be 32 or 64");
+                    }
+                }
+                "file" => {
+                    self.i += 1;
+                    let id = self.expect_int()? as u32;
+                    let name = match &self.next()?.tok {
+                        Tok::Str(s) => s.clone(),
+                        _ => return syntax(pos, "expected a file name string"),
+                    };
+                    let mut full = name;
+                    // `.file 1 "dir" "name"` (DWARF 5) or `.file 1 "name", time, size`
+                    if let Some(Tok::Str(s)) = self.peek() {
+                        full = format!("{full}/{s}");
+                        self.i += 1;
+                    }
+                    while self.eat_punct(',') {
+                        self.expect_int()?;
+                    }
+                    m.files.push((id, full));
+                }
+                "section" => {
+                    self.i += 1;
+                    self.next()?; // section name
+                    self.skip_braced()?;
+                }
+                "pragma" => {
+                    self.i += 1;
+                    self.next()?;
+                    self.expect_punct(';')?;
+                }
+                _ => self.module_item(&mut m)?,
+            }
+        }
+        Ok(m)
+    }
+
+    fn skip_braced(&mut self) -> PResult<()> {
+        self.expect_punct('{')?;
+        let mut depth = 1;
+        while depth > 0 {
+            match self.next()?.tok {
+                Tok::Punct('{') => depth += 1,
+                Tok::Punct('}') => depth -= 1,
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn module_item(&mut self, m: &mut Module) -> PResult<()> {
+        let mut is_extern = false;
+        loop {
+            match self.peek_dot() {
+                Some("visible") | Some("weak") | Some("common") => self.i += 1,
+                Some("extern") => {
+                    is_extern = true;
+                    self.i += 1
+                }
+                _ => break,
+            }
+        }
+        let pos = self.pos();
+        match self.peek_dot() {
+            Some("entry") | Some("func") => {
+                let f = self.function()?;
+                m.functions.push(f);
+                Ok(())
+            }
+            Some(s) if Space::parse(s).is_some() => {
+                let mut v = self.var_decl()?;
+                v.is_extern = is_extern;
+                self.expect_punct(';')?;
+                m.vars.push(v);
+                Ok(())
+            }
+            Some(s) => Err((pos, PtxErrorKind::UnsupportedDirective(format!(".{s}")))),
+            None => syntax(pos, format!("expected a directive, found {}", self.describe())),
+        }
+    }
+
+    /// `.space [.align n] [.vN] .type name[<n>][dims] [= init]`
+    fn var_decl(&mut self) -> PResult<VarDecl> {
+        let pos = self.pos();
+        let space = match &self.next()?.tok {
+            Tok::Dot(s) => Space::parse(s).ok_or((pos, PtxErrorKind::Syntax(format!("`.{s}` is no state space"))))?,
+            _ => return syntax(pos, "expected a state space"),
+        };
+        let (mut align, mut vector, mut ty) = (None, None, None);
+        while let Some(d) = self.peek_dot() {
+            let p = self.pos();
+            self.i += 1;
+            match d {
+                "align" => align = Some(self.expect_int()? as u32),
+                "v2" => vector = Some(2),
+                "v4" => vector = Some(4),
+                "ptr" | "global" | "shared" | "local" | "const" => {} // `.ptr.global.align` attributes of params
+                _ => match Ty::parse(d) {
+                    Some(t) => ty = Some(t),
+                    None => return Err((p, PtxErrorKind::UnsupportedDirective(format!(".{d}")))),
+                },
+            }
+        }
+        let ty = ty.ok_or((pos, PtxErrorKind::Syntax("declaration without a type".into())))?;
+        let name = self.expect_ident()?;
+        let mut range = None;
+        if self.eat_punct('<') {
+            range = Some(self.expect_int()? as u32);
+            self.expect_punct('>')?;
+        }
+        let mut dims = Vec::new();
+        while self.eat_punct('[') {
+            if self.eat_punct(']') {
+                dims.push(None);
+            } else {
+                dims.push(Some(self.expect_int()?));
+                self.expect_punct(']')?;
+            }
+        }
+        let mut init = None;
+        if self.eat_punct('=') {
+            let mut vals = Vec::new();
+            self.initializer(&mut vals)?;
+            if dims.len() == 1 && dims[0].is_none() {
+                dims[0] = Some(vals.len() as u64 / vector.unwrap_or(1) as u64);
+            }
+            init = Some(vals);
+        }
+        Ok(VarDecl { space, align, vector, ty, name, range, dims, init, is_extern: false, pos })
+    }
+
+    fn initializer(&mut self, out: &mut Vec<Literal>) -> PResult<()> {
+        if self.eat_punct('{') {
+            if !self.is_punct('}') {
+                self.initializer(out)?;
+                while self.eat_punct(',') {
+                    self.initializer(out)?;
+                }
+            }
+            self.expect_punct('}')
+        } else {
+            let pos = self.pos();
+            match self.literal()? {
+                Some(l) => {
+                    out.push(l);
+                    Ok(())
+                }
+                None => Err((pos, PtxErrorKind::Unsupported(format!("initializer {}", self.describe())))),
+            }
+        }
+    }
+
+    fn literal(&mut self) -> PResult<Option<Literal>> {
+        let neg = self.eat_punct('-');
+        let lit = match self.peek() {
+            Some(Tok::Int(v)) => Literal::Int(if neg { v.wrapping_neg() } else { *v }),
+            Some(Tok::F32Bits(b)) => Literal::F32(if neg { b ^ 0x8000_0000 } else { *b }),
+            Some(Tok::F64Bits(b)) => Literal::F64(if neg { b ^ (1 << 63) } else { *b }),
+            Some(Tok::Float(f)) => Literal::Float(if neg { -f } else { *f }),
+            _ => {
+                if neg {
+                    self.i -= 1;
+                }
+                return Ok(None);
+            }
+        };
+        self.i += 1;
+        Ok(Some(lit))
+    }
+
+    fn function(&mut self) -> PResult<Function> {
+        let pos = self.pos();
+        let kind = match self.next()?.tok {
+            Tok::Dot(ref s) if s == "entry" => FunctionKind::Entry,
+            _ => FunctionKind::Func,
+        };
+        let mut returns = Vec::new();
+        if kind == FunctionKind::Func && self.is_punct('(') {
+            returns = self.param_list()?;
+        }
+        let name = self.expect_ident()?;
+        let mut params = Vec::new();
+        if self.is_punct('(') {
+            params = self.param_list()?;
+        }
+        // performance directives
+        while let Some(d) = self.peek_dot() {
+            match d {
+                "maxntid" | "reqntid" | "minnctapersm" | "maxnreg" | "maxnctapersm" | "noreturn" | "pragma"
+                | "explicitcluster" | "reqnctapercluster" | "maxclusterrank" => {
+                    self.i += 1;
+                    loop {
+                        match self.peek() {
+                            Some(Tok::Int(_)) | Some(Tok::Str(_)) => self.i += 1,
+                            _ => break,
+                        }
+                        if !self.eat_punct(',') {
+                            break;
+                        }
+                    }
+                    self.eat_punct(';');
+                }
+                _ => {
+                    return Err((self.pos(), PtxErrorKind::UnsupportedDirective(format!(".{d}"))));
+                }
+            }
+        }
+        if self.eat_punct(';') {
+            return Ok(Function { kind, name, returns, params, body: None, pos });
+        }
+        self.expect_punct('{')?;
+        let body = self.block_body()?;
+        Ok(Function { kind, name, returns, params, body: Some(body), pos })
+    }
+
+    fn param_list(&mut self) -> PResult<Vec<VarDecl>> {
+        self.expect_punct('(')?;
+        let mut v = Vec::new();
+        if self.eat_punct(')') {
+            return Ok(v);
+        }
+        loop {
+            v.push(self.var_decl()?);
+            if self.eat_punct(')') {
+                return Ok(v);
+            }
+            self.expect_punct(',')?;
+        }
+    }
+
+    /// Statements up to and including the closing `}`.
+    fn block_body(&mut self) -> PResult<Vec<Stmt>> {
+        let mut out = Vec::new();
+        loop {
+            let pos = self.pos();
+            match self.peek() {
+                None => return syntax(pos, "missing `}` at end of function"),
+                Some(Tok::Punct('}')) => {
+                    self.i += 1;
+                    return Ok(out);
+                }
+                Some(Tok::Punct('{')) => {
+                    self.i += 1;
+                    out.push(Stmt::Block(self.block_body()?));
+                }
+                Some(Tok::Dot(d)) => match d.as_str() {
+                    "loc" => {
+                        self.i += 1;
+                        let file = self.expect_int()? as u32;
+                        let line = self.expect_int()? as u32;
+                        let col = self.expect_int()? as u32;
+                        // DWARF extras (`, function_name ..., inlined_at ...`) stay on the line.
+                        while self.peek().is_some() && self.pos().line == pos.line {
+                            self.i += 1;
+                        }
+                        out.push(Stmt::Loc { file, line, col });
+                    }
+                    "pragma" => {
+                        self.i += 1;
+                        self.next()?;
+                        self.expect_punct(';')?;
+                    }
+                    s if Space::parse(s).is_some() => {
+                        let v = self.var_decl()?;
+                        self.expect_punct(';')?;
+                        out.push(Stmt::Decl(v));
+                    }
+                    _ => return Err((pos, PtxErrorKind::UnsupportedDirective(format!(".{d}")))),
+                },
+                Some(Tok::Ident(name)) if self.peek_at(1) == Some(&Tok::Punct(':')) => {
+                    self.i += 2;
+                    out.push(Stmt::Label(name.clone(), pos));
+                }
+                Some(Tok::Ident(_)) | Some(Tok::Punct('@')) => out.push(Stmt::Inst(self.instruction()?)),
+                _ => return syntax(pos, format!("expected an instruction, found {}", self.describe())),
+            }
+        }
+    }
+
+    fn instruction(&mut self) -> PResult<Instruction> {
+        let pos = self.pos();
+        let mut guard = None;
+        if self.eat_punct('@') {
+            let neg = self.eat_punct('!');
+            guard = Some((neg, self.expect_ident()?));
+        }
+        let opcode = self.expect_ident()?;
+        let mut mods = Vec::new();
+        while let Some(Token { tok: Tok::Dot(m), glued: true, .. }) = self.t.get(self.i) {
+            mods.push(m.clone());
+            self.i += 1;
+        }
+        let mut operands = Vec::new();
+        if !self.eat_punct(';') {
+            loop {
+                operands.push(self.operand()?);
+                if self.eat_punct(';') {
+                    break;
+                }
+                if !self.eat_punct(',') {
+                    return syntax(self.pos(), format!("expected `,` or `;`, found {}", self.describe()));
+                }
+            }
+        }
+        Ok(Instruction { guard, opcode, mods, operands, pos })
+    }
+
+    fn name_with_component(&mut self) -> PResult<String> {
+        let mut n = self.expect_ident()?;
+        if n.starts_with('%')
+            && let Some(Token { tok: Tok::Dot(c), glued: true, .. }) = self.t.get(self.i)
+        {
+            n.push('.');
+            n.push_str(c);
+            self.i += 1;
+        }
+        Ok(n)
+    }
+
+    fn operand(&mut self) -> PResult<Operand> {
+        let pos = self.pos();
+        match self.peek() {
+            Some(Tok::Punct('[')) => {
+                self.i += 1;
+                let mut base = None;
+                let mut off: i64 = 0;
+                if let Some(Tok::Ident(_)) = self.peek() {
+                    base = Some(self.name_with_component()?);
+                    if self.eat_punct('+') {
+                        let neg = self.eat_punct('-');
+                        let v = self.expect_int()? as i64;
+                        off = if neg { -v } else { v };
+                    } else if self.eat_punct('-') {
+                        off = -(self.expect_int()? as i64);
+                    }
+                } else {
+                    let neg = self.eat_punct('-');
+                    let v = self.expect_int()? as i64;
+                    off = if neg { -v } else { v };
+                }
+                self.expect_punct(']')?;
+                Ok(Operand::Addr(base, off))
+            }
+            Some(Tok::Punct('{')) | Some(Tok::Punct('(')) => {
+                let brace = self.is_punct('{');
+                let close = if brace { '}' } else { ')' };
+                self.i += 1;
+                let mut v = Vec::new();
+                if !self.eat_punct(close) {
+                    loop {
+                        v.push(self.operand()?);
+                        if self.eat_punct(close) {
+                            break;
+                        }
+                        self.expect_punct(',')?;
+                    }
+                }
+                Ok(if brace { Operand::Vector(v) } else { Operand::List(v) })
+            }
+            Some(Tok::Punct('!')) => {
+                self.i += 1;
+                Ok(Operand::Not(self.expect_ident()?))
+            }
+            Some(Tok::Ident(_)) => {
+                let n = self.name_with_component()?;
+                if self.eat_punct('|') {
+                    let q = self.expect_ident()?;
+                    return Ok(Operand::Pair(n, q));
+                }
+                Ok(Operand::Name(n))
+            }
+            _ => match self.literal()? {
+                Some(l) => Ok(Operand::Lit(l)),
+                None => syntax(pos, format!("expected an operand, found {}", self.describe())),
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::lexer::lex;
+    use super::*;
+
+    fn parse_str(s: &str) -> Module {
+        parse(&lex(s).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn parses_entry_with_params_and_body() {
+        let m = parse_str(
+            ".version 7.8\n.target sm_90\n.address_size 64\n\
+             .visible .entry k(.param .u64 k_p0, .param .u32 k_p1)\n{\n\
+             .reg .b32 %r<4>;\n$L1:\n @!%p1 bra $L1;\n ld.global.nc.v2.f32 {%f1, %f2}, [%rd1+-8];\n ret;\n}\n",
+        );
+        assert_eq!(m.version, "7.8");
+        assert_eq!(m.functions.len(), 1);
+        let f = &m.functions[0];
+        assert_eq!(f.params.len(), 2);
+        let body = f.body.as_ref().unwrap();
+        assert!(matches!(&body[0], Stmt::Decl(d) if d.range == Some(4)));
+        let Stmt::Inst(i) = &body[2] else { panic!() };
+        assert_eq!(i.guard, Some((true, "%p1".into())));
+        let Stmt::Inst(ld) = &body[3] else { panic!() };
+        assert_eq!(ld.full_opcode(), "ld.global.nc.v2.f32");
+        assert_eq!(ld.operands[1], Operand::Addr(Some("%rd1".into()), -8));
+    }
+
+    #[test]
+    fn reports_missing_semicolon_position() {
+        let toks = lex(".version 7.8\n.entry k()\n{\n add.s32 %r1, %r2 %r3;\n}").unwrap();
+        let e = parse(&toks).unwrap_err();
+        assert_eq!(e.0.line, 4);
+    }
+}

@@ -1,0 +1,791 @@
+//! Scalar semantics of every arithmetic, comparison, conversion and atomic
+//! operation, one lane at a time, exactly as PTX defines them.
+//!
+//! Conventions worth knowing (each has a test):
+//! - Float results that are NaN are the canonical NaN (`0x7fffffff`,
+//!   `0x7fffffffffffffff`), as NVIDIA GPUs produce; `abs`, `neg`, `copysign`,
+//!   `mov` are bit operations and keep NaN payloads.
+//! - Directed rounding (`.rz .rm .rp`) is exact: the round-to-nearest result is
+//!   corrected by the sign of the exact error (error-free transformations).
+//! - `.approx` transcendental functions are computed in f64 and rounded to f32
+//!   (within 1 ulp of the correctly rounded value; hardware is within 2 ulp).
+//! - Integer `div`/`rem` by zero give all ones / the dividend (unsigned) and
+//!   -1 / the dividend (signed), as NVIDIA hardware does; `INT_MIN / -1` wraps.
+//! - Shifts by at least the width give 0 (or the sign fill for `shr.s`).
+//! - Float → integer conversions saturate and map NaN to 0.
+
+use std::cmp::Ordering;
+
+use crate::ptx::ir::{ArithOp, AtomOp, Cmp, FloatMode, Rounding};
+use crate::ptx::types::Ty;
+
+/// The canonical f32 NaN of NVIDIA GPUs.
+pub const NAN32: u32 = 0x7FFF_FFFF;
+/// The canonical f64 NaN.
+pub const NAN64: u64 = 0x7FFF_FFFF_FFFF_FFFF;
+
+#[inline]
+fn f32of(x: u64) -> f32 {
+    f32::from_bits(x as u32)
+}
+
+#[inline]
+fn ftz32(x: f32) -> f32 {
+    if x.is_subnormal() { 0.0f32.copysign(x) } else { x }
+}
+
+#[inline]
+fn ftz64(x: f64) -> f64 {
+    if x.is_subnormal() { 0.0f64.copysign(x) } else { x }
+}
+
+#[inline]
+fn in32(x: u64, ftz: bool) -> f32 {
+    let f = f32of(x);
+    if ftz { ftz32(f) } else { f }
+}
+
+#[inline]
+fn out32(x: f32, m: FloatMode) -> u64 {
+    let mut x = if m.ftz { ftz32(x) } else { x };
+    if m.sat {
+        x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    }
+    if x.is_nan() { NAN32 as u64 } else { x.to_bits() as u64 }
+}
+
+#[inline]
+fn out64(x: f64, m: FloatMode) -> u64 {
+    let mut x = if m.ftz { ftz64(x) } else { x };
+    if m.sat {
+        x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    }
+    if x.is_nan() { NAN64 } else { x.to_bits() }
+}
+
+/// Corrects a round-to-nearest f32 result `r` for a directed rounding mode,
+/// given the sign of (exact − r).
+fn direct32(r: f32, err: Ordering, rnd: Option<Rounding>) -> f32 {
+    if r.is_nan() || err == Ordering::Equal {
+        return r;
+    }
+    match rnd {
+        Some(Rounding::Rz) | Some(Rounding::Rzi) => {
+            if err == Ordering::Less && r > 0.0 || r == f32::INFINITY {
+                r.next_down()
+            } else if err == Ordering::Greater && r < 0.0 || r == f32::NEG_INFINITY {
+                r.next_up()
+            } else {
+                r
+            }
+        }
+        Some(Rounding::Rm) | Some(Rounding::Rmi) if err == Ordering::Less => r.next_down(),
+        Some(Rounding::Rp) | Some(Rounding::Rpi) if err == Ordering::Greater => r.next_up(),
+        _ => r,
+    }
+}
+
+/// As [`direct32`] for f64.
+fn direct64(r: f64, err: Ordering, rnd: Option<Rounding>) -> f64 {
+    if r.is_nan() || err == Ordering::Equal {
+        return r;
+    }
+    match rnd {
+        Some(Rounding::Rz) | Some(Rounding::Rzi) => {
+            if err == Ordering::Less && r > 0.0 || r == f64::INFINITY {
+                r.next_down()
+            } else if err == Ordering::Greater && r < 0.0 || r == f64::NEG_INFINITY {
+                r.next_up()
+            } else {
+                r
+            }
+        }
+        Some(Rounding::Rm) | Some(Rounding::Rmi) if err == Ordering::Less => r.next_down(),
+        Some(Rounding::Rp) | Some(Rounding::Rpi) if err == Ordering::Greater => r.next_up(),
+        _ => r,
+    }
+}
+
+fn sign(x: f64) -> Ordering {
+    x.partial_cmp(&0.0).unwrap_or(Ordering::Equal)
+}
+
+/// Error-free sum: `a + b = s + e` exactly.
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    let e = (a - (s - bb)) + (b - bb);
+    (s, e)
+}
+
+/// Sign of (exact − r) where exact = s + e (error-free pair) and r an f32 result.
+fn err_vs(s: f64, e: f64, r: f32) -> Ordering {
+    if !r.is_finite() {
+        return if r.is_nan() { Ordering::Equal } else if r > 0.0 { Ordering::Less } else { Ordering::Greater };
+    }
+    let d = s - r as f64;
+    if d != 0.0 { sign(d) } else { sign(e) }
+}
+
+fn directed(rnd: Option<Rounding>) -> bool {
+    matches!(rnd, Some(Rounding::Rz | Rounding::Rm | Rounding::Rp))
+}
+
+fn add32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
+    let r = a + b;
+    if !directed(rnd) || !r.is_finite() && !(a.is_finite() && b.is_finite()) {
+        return r;
+    }
+    let (s, e) = two_sum(a as f64, b as f64);
+    direct32(r, err_vs(s, e, r), rnd)
+}
+
+fn mul32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
+    let r = a * b;
+    if !directed(rnd) || !(a.is_finite() && b.is_finite()) {
+        return r;
+    }
+    let p = a as f64 * b as f64; // exact: 48-bit significand
+    direct32(r, err_vs(p, 0.0, r), rnd)
+}
+
+fn fma32(a: f32, b: f32, c: f32, rnd: Option<Rounding>) -> f32 {
+    let r = a.mul_add(b, c);
+    if !directed(rnd) || !(a.is_finite() && b.is_finite() && c.is_finite()) {
+        return r;
+    }
+    let p = a as f64 * b as f64;
+    let (s, e) = two_sum(p, c as f64);
+    direct32(r, err_vs(s, e, r), rnd)
+}
+
+fn div32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
+    let r = a / b;
+    if !directed(rnd) || !r.is_finite() || !(a.is_finite() && b.is_finite()) || b == 0.0 {
+        return r;
+    }
+    // a - r*b is exact in f64; its sign times b's sign is the sign of (a/b − r).
+    let rem = a as f64 - r as f64 * b as f64;
+    let err = if b > 0.0 { sign(rem) } else { sign(rem).reverse() };
+    direct32(r, err, rnd)
+}
+
+fn sqrt32(a: f32, rnd: Option<Rounding>) -> f32 {
+    let r = a.sqrt();
+    if !directed(rnd) || !r.is_finite() || r == 0.0 {
+        return r;
+    }
+    let rem = a as f64 - r as f64 * r as f64;
+    direct32(r, sign(rem), rnd)
+}
+
+fn add64(a: f64, b: f64, rnd: Option<Rounding>) -> f64 {
+    let (s, e) = two_sum(a, b);
+    if !directed(rnd) || !s.is_finite() {
+        return s;
+    }
+    direct64(s, sign(e), rnd)
+}
+
+fn mul64(a: f64, b: f64, rnd: Option<Rounding>) -> f64 {
+    let p = a * b;
+    if !directed(rnd) || !p.is_finite() {
+        return p;
+    }
+    direct64(p, sign(a.mul_add(b, -p)), rnd)
+}
+
+fn fma64(a: f64, b: f64, c: f64, rnd: Option<Rounding>) -> f64 {
+    let r = a.mul_add(b, c);
+    if !directed(rnd) || !r.is_finite() {
+        return r;
+    }
+    let p = a * b;
+    let pe = a.mul_add(b, -p);
+    let (s, e1) = two_sum(p, c);
+    // exact = s + e1 + pe; r is its correct rounding, so compare against r.
+    let d = (s - r) + (e1 + pe);
+    direct64(r, sign(d), rnd)
+}
+
+fn div64(a: f64, b: f64, rnd: Option<Rounding>) -> f64 {
+    let r = a / b;
+    if !directed(rnd) || !r.is_finite() || b == 0.0 {
+        return r;
+    }
+    let rem = (-r).mul_add(b, a);
+    direct64(r, if b > 0.0 { sign(rem) } else { sign(rem).reverse() }, rnd)
+}
+
+fn sqrt64(a: f64, rnd: Option<Rounding>) -> f64 {
+    let r = a.sqrt();
+    if !directed(rnd) || !r.is_finite() || r == 0.0 {
+        return r;
+    }
+    direct64(r, sign((-r).mul_add(r, a)), rnd)
+}
+
+fn fmin<T: PartialOrd + Copy>(a: T, b: T, a_nan: bool, b_nan: bool, a_neg: bool, b_neg: bool, max: bool) -> Option<T> {
+    if a_nan && b_nan {
+        return None;
+    }
+    if a_nan {
+        return Some(b);
+    }
+    if b_nan {
+        return Some(a);
+    }
+    // -0 is below +0 for min and max
+    if a == b {
+        return Some(if (a_neg && !max) || (!a_neg && max) { a } else if (b_neg && !max) || (!b_neg && max) { b } else { a });
+    }
+    let a_less = a < b;
+    Some(if a_less != max { a } else { b })
+}
+
+fn f32op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
+    let (fa, fb, fc) = (in32(a, m.ftz), in32(b, m.ftz), in32(c, m.ftz));
+    let r = match op {
+        ArithOp::Add => add32(fa, fb, m.rnd),
+        ArithOp::Sub => add32(fa, -fb, m.rnd),
+        ArithOp::Mul => mul32(fa, fb, m.rnd),
+        ArithOp::Mad => fma32(fa, fb, fc, m.rnd),
+        ArithOp::Div => div32(fa, fb, m.rnd),
+        ArithOp::Abs => return out_bits32(fa.abs().to_bits(), m),
+        ArithOp::Neg => return out_bits32((-fa).to_bits(), m),
+        ArithOp::Copysign => return (fb.abs().to_bits() | (fa.to_bits() & 0x8000_0000)) as u64,
+        ArithOp::Min | ArithOp::Max => {
+            match fmin(fa, fb, fa.is_nan(), fb.is_nan(), fa.is_sign_negative(), fb.is_sign_negative(), op == ArithOp::Max) {
+                Some(v) => v,
+                None => f32::NAN,
+            }
+        }
+        ArithOp::Sqrt => sqrt32(fa, if m.approx { None } else { m.rnd }),
+        ArithOp::Rsqrt => (1.0 / (fa as f64).sqrt()) as f32,
+        ArithOp::Rcp => {
+            if m.approx {
+                1.0 / fa
+            } else {
+                div32(1.0, fa, m.rnd)
+            }
+        }
+        ArithOp::Sin => (fa as f64).sin() as f32,
+        ArithOp::Cos => (fa as f64).cos() as f32,
+        ArithOp::Ex2 => (fa as f64).exp2() as f32,
+        ArithOp::Lg2 => (fa as f64).log2() as f32,
+        _ => f32::NAN,
+    };
+    out32(r, m)
+}
+
+/// abs/neg keep NaN payloads (bit operations) but honour `.ftz`.
+fn out_bits32(bits: u32, m: FloatMode) -> u64 {
+    let f = f32::from_bits(bits);
+    if f.is_nan() { bits as u64 } else { out32(f, m) }
+}
+
+fn f64op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
+    let (fa, fb, fc) = (f64::from_bits(a), f64::from_bits(b), f64::from_bits(c));
+    let (fa, fb, fc) = if m.ftz { (ftz64(fa), ftz64(fb), ftz64(fc)) } else { (fa, fb, fc) };
+    let r = match op {
+        ArithOp::Add => add64(fa, fb, m.rnd),
+        ArithOp::Sub => add64(fa, -fb, m.rnd),
+        ArithOp::Mul => mul64(fa, fb, m.rnd),
+        ArithOp::Mad => fma64(fa, fb, fc, m.rnd),
+        ArithOp::Div => div64(fa, fb, m.rnd),
+        ArithOp::Abs => return if fa.is_nan() { a & !(1 << 63) } else { out64(fa.abs(), m) },
+        ArithOp::Neg => return if fa.is_nan() { a ^ (1 << 63) } else { out64(-fa, m) },
+        ArithOp::Copysign => return (fb.abs().to_bits()) | (fa.to_bits() & (1 << 63)),
+        ArithOp::Min | ArithOp::Max => {
+            match fmin(fa, fb, fa.is_nan(), fb.is_nan(), fa.is_sign_negative(), fb.is_sign_negative(), op == ArithOp::Max) {
+                Some(v) => v,
+                None => f64::NAN,
+            }
+        }
+        ArithOp::Sqrt => sqrt64(fa, m.rnd),
+        ArithOp::Rsqrt => 1.0 / fa.sqrt(),
+        ArithOp::Rcp => div64(1.0, fa, m.rnd),
+        ArithOp::Sin => fa.sin(),
+        ArithOp::Cos => fa.cos(),
+        ArithOp::Ex2 => fa.exp2(),
+        ArithOp::Lg2 => fa.log2(),
+        _ => f64::NAN,
+    };
+    out64(r, m)
+}
+
+fn wide_mask(w: u32) -> u64 {
+    if w >= 32 { u64::MAX } else { (1u64 << (2 * w)) - 1 }
+}
+
+/// Evaluates an arithmetic operation on one lane. `a`, `b`, `c` hold the
+/// operands' bits (low bits significant); the result is masked to the result width.
+pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
+    match ty {
+        Ty::F32 => return f32op(op, m, a, b, c),
+        Ty::F64 => return f64op(op, m, a, b, c),
+        _ => {}
+    }
+    let w = ty.bits();
+    let mask = ty.mask();
+    let signed = ty.is_signed();
+    let (sa, sb, sc) = (ty.extend(a) as i64, ty.extend(b) as i64, ty.extend(c) as i64);
+    let (ua, ub, uc) = (a & mask, b & mask, c & mask);
+    let r: u64 = match op {
+        ArithOp::Add if m.sat && signed => (sa as i128 + sb as i128).clamp(min_of(w), max_of(w)) as u64,
+        ArithOp::Sub if m.sat && signed => (sa as i128 - sb as i128).clamp(min_of(w), max_of(w)) as u64,
+        ArithOp::Add => ua.wrapping_add(ub),
+        ArithOp::Sub => ua.wrapping_sub(ub),
+        ArithOp::Mul => ua.wrapping_mul(ub),
+        ArithOp::MulHi => {
+            if signed {
+                ((sa as i128 * sb as i128) >> w) as u64
+            } else {
+                ((ua as u128 * ub as u128) >> w) as u64
+            }
+        }
+        ArithOp::MulWide => {
+            return if signed { (sa as i128 * sb as i128) as u64 } else { (ua as u128 * ub as u128) as u64 } & wide_mask(w);
+        }
+        ArithOp::Mad => ua.wrapping_mul(ub).wrapping_add(uc),
+        ArithOp::MadHi => {
+            let hi = if signed { ((sa as i128 * sb as i128) >> w) as u64 } else { ((ua as u128 * ub as u128) >> w) as u64 };
+            hi.wrapping_add(uc)
+        }
+        ArithOp::MadWide => {
+            let p = if signed { (sa as i128 * sb as i128) as u64 } else { (ua as u128 * ub as u128) as u64 };
+            return p.wrapping_add(c) & wide_mask(w);
+        }
+        ArithOp::Mul24Lo | ArithOp::Mul24Hi | ArithOp::Mad24Lo | ArithOp::Mad24Hi => {
+            let (x, y) = if signed {
+                (((a << 40) as i64 >> 40), ((b << 40) as i64 >> 40))
+            } else {
+                ((a & 0xFF_FFFF) as i64, (b & 0xFF_FFFF) as i64)
+            };
+            let p = x * y;
+            let part = if matches!(op, ArithOp::Mul24Hi | ArithOp::Mad24Hi) { (p >> 16) as u64 } else { p as u64 };
+            if matches!(op, ArithOp::Mad24Lo | ArithOp::Mad24Hi) { part.wrapping_add(uc) } else { part }
+        }
+        ArithOp::Div => {
+            if signed {
+                if sb == 0 { u64::MAX } else { sa.wrapping_div(sb) as u64 }
+            } else if ub == 0 {
+                u64::MAX
+            } else {
+                ua / ub
+            }
+        }
+        ArithOp::Rem => {
+            if signed {
+                if sb == 0 { sa as u64 } else { sa.wrapping_rem(sb) as u64 }
+            } else if ub == 0 {
+                ua
+            } else {
+                ua % ub
+            }
+        }
+        ArithOp::Abs => sa.wrapping_abs() as u64,
+        ArithOp::Neg => sa.wrapping_neg() as u64,
+        ArithOp::Min => {
+            if signed { sa.min(sb) as u64 } else { ua.min(ub) }
+        }
+        ArithOp::Max => {
+            if signed { sa.max(sb) as u64 } else { ua.max(ub) }
+        }
+        ArithOp::And => ua & ub,
+        ArithOp::Or => ua | ub,
+        ArithOp::Xor => ua ^ ub,
+        ArithOp::Not => !ua,
+        ArithOp::Cnot => (ua == 0) as u64,
+        ArithOp::Shl => {
+            let s = b as u32;
+            if s >= w { 0 } else { ua << s }
+        }
+        ArithOp::Shr => {
+            let s = b as u32;
+            if signed {
+                (sa >> s.min(w - 1)) as u64
+            } else if s >= w {
+                0
+            } else {
+                ua >> s
+            }
+        }
+        ArithOp::Popc => return ua.count_ones() as u64,
+        ArithOp::Clz => return (ua.leading_zeros() - (64 - w)) as u64,
+        ArithOp::Brev => ua.reverse_bits() >> (64 - w),
+        ArithOp::Bfe => {
+            let pos = (b & 0xFF) as u32;
+            let len = (c & 0xFF) as u32;
+            let msb = w - 1;
+            let sbit = if signed && len != 0 { (ua >> (pos + len - 1).min(msb)) & 1 } else { 0 };
+            let mut d = 0u64;
+            for i in 0..w {
+                let bit = if i < len && pos + i <= msb { (ua >> (pos + i)) & 1 } else { sbit };
+                d |= bit << i;
+            }
+            d
+        }
+        ArithOp::Prmt => {
+            let bytes = ((ub & 0xFFFF_FFFF) << 32) | (ua & 0xFFFF_FFFF);
+            let mut d = 0u64;
+            for i in 0..4 {
+                let sel = (c >> (4 * i)) & 0xF;
+                let byte = (bytes >> ((sel & 7) * 8)) & 0xFF;
+                let byte = if sel & 8 != 0 { if byte & 0x80 != 0 { 0xFF } else { 0 } } else { byte };
+                d |= byte << (8 * i);
+            }
+            d
+        }
+        _ => 0,
+    };
+    let _ = sc;
+    r & mask
+}
+
+fn min_of(w: u32) -> i128 {
+    -(1i128 << (w - 1))
+}
+
+fn max_of(w: u32) -> i128 {
+    (1i128 << (w - 1)) - 1
+}
+
+/// `bfi`: inserts the low `len` bits of `a` into `b` at `pos`.
+pub fn bfi(ty: Ty, a: u64, b: u64, pos: u64, len: u64) -> u64 {
+    let w = ty.bits();
+    let (pos, len) = ((pos & 0xFF) as u32, (len & 0xFF) as u32);
+    let mut f = b & ty.mask();
+    for i in 0..len {
+        if pos + i >= w {
+            break;
+        }
+        let bit = (a >> i) & 1;
+        f = (f & !(1 << (pos + i))) | (bit << (pos + i));
+    }
+    f
+}
+
+/// Evaluates a comparison.
+pub fn compare(cmp: Cmp, ty: Ty, ftz: bool, a: u64, b: u64) -> bool {
+    if ty.is_float() {
+        let (x, y) = if ty == Ty::F32 {
+            (in32(a, ftz) as f64, in32(b, ftz) as f64)
+        } else {
+            (f64::from_bits(a), f64::from_bits(b))
+        };
+        let nan = x.is_nan() || y.is_nan();
+        return match cmp {
+            Cmp::Eq => x == y,
+            Cmp::Ne => !nan && x != y,
+            Cmp::Lt | Cmp::Lo => x < y,
+            Cmp::Le | Cmp::Ls => x <= y,
+            Cmp::Gt | Cmp::Hi => x > y,
+            Cmp::Ge | Cmp::Hs => x >= y,
+            Cmp::Equ => nan || x == y,
+            Cmp::Neu => nan || x != y,
+            Cmp::Ltu => nan || x < y,
+            Cmp::Leu => nan || x <= y,
+            Cmp::Gtu => nan || x > y,
+            Cmp::Geu => nan || x >= y,
+            Cmp::Num => !nan,
+            Cmp::Nan => nan,
+        };
+    }
+    let (ua, ub) = (a & ty.mask(), b & ty.mask());
+    let (sa, sb) = (ty.extend(a) as i64, ty.extend(b) as i64);
+    let s = ty.is_signed();
+    match cmp {
+        Cmp::Eq | Cmp::Equ => ua == ub,
+        Cmp::Ne | Cmp::Neu => ua != ub,
+        Cmp::Lt | Cmp::Ltu => if s { sa < sb } else { ua < ub },
+        Cmp::Le | Cmp::Leu => if s { sa <= sb } else { ua <= ub },
+        Cmp::Gt | Cmp::Gtu => if s { sa > sb } else { ua > ub },
+        Cmp::Ge | Cmp::Geu => if s { sa >= sb } else { ua >= ub },
+        Cmp::Lo => ua < ub,
+        Cmp::Ls => ua <= ub,
+        Cmp::Hi => ua > ub,
+        Cmp::Hs => ua >= ub,
+        Cmp::Num => true,
+        Cmp::Nan => false,
+    }
+}
+
+fn round_int_f64(x: f64, rnd: Option<Rounding>) -> f64 {
+    match rnd {
+        Some(Rounding::Rni) | Some(Rounding::Rn) => x.round_ties_even(),
+        Some(Rounding::Rmi) | Some(Rounding::Rm) => x.floor(),
+        Some(Rounding::Rpi) | Some(Rounding::Rp) => x.ceil(),
+        _ => x.trunc(),
+    }
+}
+
+fn int_range(t: Ty) -> (i128, i128) {
+    let w = t.bits();
+    if t.is_signed() { (min_of(w), max_of(w)) } else { (0, (1i128 << w) - 1) }
+}
+
+/// Evaluates `cvt.mode.dty.sty` on one lane.
+pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
+    match (dty.is_float(), sty.is_float()) {
+        (false, false) => {
+            let v: i128 = if sty.is_signed() { sty.extend(a) as i64 as i128 } else { (a & sty.mask()) as i128 };
+            let v = if m.sat {
+                let (lo, hi) = int_range(dty);
+                v.clamp(lo, hi)
+            } else {
+                v
+            };
+            (v as u64) & dty.mask()
+        }
+        (false, true) => {
+            let x = if sty == Ty::F32 { in32(a, m.ftz) as f64 } else { f64::from_bits(a) };
+            if x.is_nan() {
+                return 0;
+            }
+            let r = round_int_f64(x, m.rnd);
+            let (lo, hi) = int_range(dty);
+            let v = if r <= lo as f64 {
+                lo
+            } else if r >= hi as f64 {
+                hi
+            } else {
+                r as i128
+            };
+            (v as u64) & dty.mask()
+        }
+        (true, false) => {
+            let v: i128 = if sty.is_signed() { sty.extend(a) as i64 as i128 } else { (a & sty.mask()) as i128 };
+            if dty == Ty::F32 {
+                let r = if sty.is_signed() { v as i64 as f32 } else { v as u64 as f32 };
+                let err = v.cmp(&(r as i128));
+                let r = direct32(r, err, m.rnd);
+                out32(r, m)
+            } else {
+                let r = if sty.is_signed() { v as i64 as f64 } else { v as u64 as f64 };
+                let err = v.cmp(&(r as i128));
+                out64(direct64(r, err, m.rnd), m)
+            }
+        }
+        (true, true) => {
+            let int_round = matches!(m.rnd, Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi));
+            match (dty, sty) {
+                (Ty::F32, Ty::F32) => {
+                    let x = in32(a, m.ftz);
+                    let r = if int_round { round_int_f64(x as f64, m.rnd) as f32 } else { x };
+                    out32(r, m)
+                }
+                (Ty::F64, Ty::F64) => {
+                    let x = f64::from_bits(a);
+                    out64(if int_round { round_int_f64(x, m.rnd) } else { x }, m)
+                }
+                (Ty::F64, Ty::F32) => {
+                    let x = in32(a, m.ftz) as f64;
+                    out64(if int_round { round_int_f64(x, m.rnd) } else { x }, FloatMode { ftz: false, ..m })
+                }
+                (Ty::F32, Ty::F64) => {
+                    let x = f64::from_bits(a);
+                    let x = if int_round { round_int_f64(x, m.rnd) } else { x };
+                    let r = x as f32;
+                    let err = if r.is_finite() { sign(x - r as f64) } else { err_vs(x, 0.0, r) };
+                    let r = if x.is_infinite() { r } else { direct32(r, err, m.rnd) };
+                    out32(r, m)
+                }
+                _ => a,
+            }
+        }
+    }
+}
+
+/// The new memory value of an atomic operation on one lane, given the old value.
+pub fn atom(op: AtomOp, ty: Ty, old: u64, b: u64, c: u64) -> u64 {
+    let mask = ty.mask();
+    let r = match (op, ty) {
+        (AtomOp::Add, Ty::F32) => {
+            let s = ftz32(ftz32(f32of(old)) + ftz32(f32of(b)));
+            if s.is_nan() { NAN32 as u64 } else { s.to_bits() as u64 }
+        }
+        (AtomOp::Add, Ty::F64) => {
+            let s = f64::from_bits(old) + f64::from_bits(b);
+            if s.is_nan() { NAN64 } else { s.to_bits() }
+        }
+        (AtomOp::Add, _) => old.wrapping_add(b),
+        (AtomOp::Min | AtomOp::Max, Ty::F32 | Ty::F64) => {
+            arith(if op == AtomOp::Min { ArithOp::Min } else { ArithOp::Max }, ty, FloatMode::default(), old, b, 0)
+        }
+        (AtomOp::Min, _) => {
+            if ty.is_signed() { (ty.extend(old) as i64).min(ty.extend(b) as i64) as u64 } else { (old & mask).min(b & mask) }
+        }
+        (AtomOp::Max, _) => {
+            if ty.is_signed() { (ty.extend(old) as i64).max(ty.extend(b) as i64) as u64 } else { (old & mask).max(b & mask) }
+        }
+        (AtomOp::Inc, _) => {
+            if (old & mask) >= (b & mask) { 0 } else { old + 1 }
+        }
+        (AtomOp::Dec, _) => {
+            if (old & mask) == 0 || (old & mask) > (b & mask) { b } else { old - 1 }
+        }
+        (AtomOp::Exch, _) => b,
+        (AtomOp::Cas, _) => {
+            if (old & mask) == (b & mask) { c } else { old }
+        }
+        (AtomOp::And, _) => old & b,
+        (AtomOp::Or, _) => old | b,
+        (AtomOp::Xor, _) => old ^ b,
+    };
+    r & mask
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const M: FloatMode = FloatMode { rnd: None, ftz: false, sat: false, approx: false };
+
+    fn f(x: f32) -> u64 {
+        x.to_bits() as u64
+    }
+
+    #[test]
+    fn shifts_clamp() {
+        assert_eq!(arith(ArithOp::Shl, Ty::B32, M, 1, 32, 0), 0);
+        assert_eq!(arith(ArithOp::Shl, Ty::B32, M, 1, 31, 0), 0x8000_0000);
+        assert_eq!(arith(ArithOp::Shr, Ty::U32, M, 0x8000_0000, 40, 0), 0);
+        assert_eq!(arith(ArithOp::Shr, Ty::S32, M, 0x8000_0000, 40, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Shr, Ty::S32, M, 0x4000_0000, 100, 0), 0);
+    }
+
+    #[test]
+    fn division_edge_cases() {
+        assert_eq!(arith(ArithOp::Div, Ty::U32, M, 7, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Rem, Ty::U32, M, 7, 0, 0), 7);
+        assert_eq!(arith(ArithOp::Div, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0), 0x8000_0000);
+        assert_eq!(arith(ArithOp::Rem, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0), 0);
+        assert_eq!(arith(ArithOp::Div, Ty::S32, M, (-7i32) as u32 as u64, 2, 0), (-3i32) as u32 as u64);
+        assert_eq!(arith(ArithOp::Rem, Ty::S32, M, (-7i32) as u32 as u64, 2, 0), (-1i32) as u32 as u64);
+    }
+
+    #[test]
+    fn fma_rounds_once() {
+        // a*b = 1 + 2^-23 + 2^-46 (not representable); separate rounding loses 2^-46.
+        let a = 1.0f32 + f32::EPSILON;
+        let c = -(1.0f32 + 2.0 * f32::EPSILON);
+        let fused = f32::from_bits(arith(ArithOp::Mad, Ty::F32, M, f(a), f(a), f(c)) as u32);
+        let separate = a * a + c;
+        assert_eq!(fused, f32::EPSILON * f32::EPSILON);
+        assert_eq!(separate, 0.0);
+    }
+
+    #[test]
+    fn min_max_with_nan() {
+        let nan = f(f32::NAN);
+        assert_eq!(arith(ArithOp::Min, Ty::F32, M, nan, f(2.0), 0), f(2.0));
+        assert_eq!(arith(ArithOp::Max, Ty::F32, M, f(-1.0), nan, 0), f(-1.0));
+        assert_eq!(arith(ArithOp::Min, Ty::F32, M, nan, nan, 0), NAN32 as u64);
+        assert_eq!(arith(ArithOp::Min, Ty::F32, M, f(0.0), f(-0.0), 0), f(-0.0));
+        assert_eq!(arith(ArithOp::Max, Ty::F32, M, f(-0.0), f(0.0), 0), f(0.0));
+    }
+
+    #[test]
+    fn cvt_saturates_and_maps_nan_to_zero() {
+        let rzi = FloatMode { rnd: Some(Rounding::Rzi), ..M };
+        assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(3e9)), 0x7FFF_FFFF);
+        assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(-3e9)), 0x8000_0000);
+        assert_eq!(cvt(Ty::U32, Ty::F32, rzi, f(-5.0)), 0);
+        assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(f32::NAN)), 0);
+        assert_eq!(cvt(Ty::U8, Ty::F32, rzi, f(300.0)), 255);
+        let rni = FloatMode { rnd: Some(Rounding::Rni), ..M };
+        assert_eq!(cvt(Ty::S32, Ty::F32, rni, f(2.5)), 2);
+        assert_eq!(cvt(Ty::S32, Ty::F32, rni, f(3.5)), 4);
+        let sat = FloatMode { sat: true, ..M };
+        assert_eq!(cvt(Ty::U8, Ty::S32, sat, (-4i32) as u32 as u64), 0);
+        assert_eq!(cvt(Ty::S8, Ty::S32, sat, 1000), 127);
+        assert_eq!(cvt(Ty::F32, Ty::F32, sat, f(f32::NAN)), 0);
+        assert_eq!(cvt(Ty::F32, Ty::F32, sat, f(7.0)), f(1.0));
+    }
+
+    #[test]
+    fn cvt_directed_int_to_float() {
+        let v = (1u64 << 24) + 1; // not representable in f32
+        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
+        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
+        assert_eq!(cvt(Ty::F32, Ty::U32, rz, v), f(16777216.0));
+        assert_eq!(cvt(Ty::F32, Ty::U32, rp, v), f(16777218.0));
+        let rm = FloatMode { rnd: Some(Rounding::Rm), ..M };
+        assert_eq!(cvt(Ty::F32, Ty::S32, rm, (-(v as i64)) as u64), f(-16777218.0));
+    }
+
+    #[test]
+    fn cvt_f64_to_f32_directed() {
+        let x = 1.0f64 + 2f64.powi(-30);
+        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
+        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
+        assert_eq!(cvt(Ty::F32, Ty::F64, rp, x.to_bits()), f(1.0f32.next_up()));
+        assert_eq!(cvt(Ty::F32, Ty::F64, rz, x.to_bits()), f(1.0));
+        assert_eq!(cvt(Ty::F32, Ty::F64, rz, 1e300f64.to_bits()), f(f32::MAX));
+    }
+
+    #[test]
+    fn directed_add() {
+        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
+        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
+        let tiny = 2f32.powi(-30);
+        assert_eq!(arith(ArithOp::Add, Ty::F32, rz, f(1.0), f(tiny), 0), f(1.0));
+        assert_eq!(arith(ArithOp::Add, Ty::F32, rp, f(1.0), f(tiny), 0), f(1.0f32.next_up()));
+        assert_eq!(arith(ArithOp::Add, Ty::F32, rz, f(-1.0), f(-tiny), 0), f(-1.0));
+    }
+
+    #[test]
+    fn nan_results_are_canonical() {
+        assert_eq!(arith(ArithOp::Add, Ty::F32, M, f(f32::INFINITY), f(f32::NEG_INFINITY), 0), NAN32 as u64);
+        assert_eq!(arith(ArithOp::Mul, Ty::F64, M, 0f64.to_bits(), f64::INFINITY.to_bits(), 0), NAN64);
+    }
+
+    #[test]
+    fn integer_bit_ops() {
+        assert_eq!(arith(ArithOp::Popc, Ty::B32, M, 0xF0F0, 0, 0), 8);
+        assert_eq!(arith(ArithOp::Clz, Ty::B32, M, 1, 0, 0), 31);
+        assert_eq!(arith(ArithOp::Clz, Ty::B64, M, 0, 0, 0), 64);
+        assert_eq!(arith(ArithOp::Brev, Ty::B32, M, 1, 0, 0), 0x8000_0000);
+        assert_eq!(arith(ArithOp::Bfe, Ty::S32, M, 0xF0, 4, 4), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Bfe, Ty::U32, M, 0xF0, 4, 4), 0xF);
+        assert_eq!(bfi(Ty::B32, 0xF, 0, 28, 8), 0xF000_0000);
+        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x3210), 0x4433_2211);
+        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x7654), 0x8877_6655);
+        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x0000_0080, 0, 0x8888), 0xFFFF_FFFF);
+    }
+
+    #[test]
+    fn mul_variants() {
+        assert_eq!(arith(ArithOp::MulHi, Ty::U32, M, 0xFFFF_FFFF, 0xFFFF_FFFF, 0), 0xFFFF_FFFE);
+        assert_eq!(arith(ArithOp::MulHi, Ty::S32, M, (-2i32) as u32 as u64, 3, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::MulWide, Ty::S32, M, (-2i32) as u32 as u64, 3, 0), (-6i64) as u64);
+        assert_eq!(arith(ArithOp::MulWide, Ty::U32, M, 0xFFFF_FFFF, 2, 0), 0x1_FFFF_FFFE);
+        assert_eq!(arith(ArithOp::Mul24Lo, Ty::U32, M, 0x0100_0003, 2, 0), 6);
+        assert_eq!(arith(ArithOp::Mul24Hi, Ty::U32, M, 0xFF_FFFF, 0xFF_FFFF, 0), 0xFFFF_FE00);
+        assert_eq!(arith(ArithOp::Add, Ty::S32, FloatMode { sat: true, ..M }, 0x7FFF_FFFF, 1, 0), 0x7FFF_FFFF);
+    }
+
+    #[test]
+    fn atomics_inc_dec_cas() {
+        assert_eq!(atom(AtomOp::Inc, Ty::U32, 5, 5, 0), 0);
+        assert_eq!(atom(AtomOp::Inc, Ty::U32, 4, 5, 0), 5);
+        assert_eq!(atom(AtomOp::Dec, Ty::U32, 0, 5, 0), 5);
+        assert_eq!(atom(AtomOp::Dec, Ty::U32, 9, 5, 0), 5);
+        assert_eq!(atom(AtomOp::Dec, Ty::U32, 3, 5, 0), 2);
+        assert_eq!(atom(AtomOp::Cas, Ty::B32, 3, 3, 9), 9);
+        assert_eq!(atom(AtomOp::Cas, Ty::B32, 4, 3, 9), 4);
+        assert_eq!(atom(AtomOp::Min, Ty::S32, 5, (-1i32) as u32 as u64, 0), 0xFFFF_FFFF);
+    }
+
+    #[test]
+    fn compare_unordered() {
+        let nan = f(f32::NAN);
+        assert!(!compare(Cmp::Ne, Ty::F32, false, nan, f(1.0)));
+        assert!(compare(Cmp::Neu, Ty::F32, false, nan, f(1.0)));
+        assert!(compare(Cmp::Nan, Ty::F32, false, nan, f(1.0)));
+        assert!(!compare(Cmp::Num, Ty::F32, false, nan, f(1.0)));
+        assert!(compare(Cmp::Lt, Ty::S32, false, 0xFFFF_FFFF, 0));
+        assert!(!compare(Cmp::Lo, Ty::S32, false, 0xFFFF_FFFF, 0));
+    }
+}

@@ -1,0 +1,269 @@
+//! A CTA (thread block): its warps, shared memory, barriers, and the warp
+//! scheduler that interleaves its warps.
+//!
+//! Scheduling policy (documented in `docs/scheduler.md`): loose round robin.
+//! The scheduler keeps issuing from the current warp for up to `warp_slice`
+//! instructions, or until it blocks (barrier, global atomic, fence) or
+//! finishes, then moves to the next ready warp in index order. A barrier
+//! completes when every warp that has not finished waits at it (or, with a
+//! thread count, when that many threads wait).
+
+use super::cfg::EXIT_PC;
+use super::counters::{Counters, InstProfile};
+use super::exec::{self, Ctx, CtaMut, Effect, PendingAtomic};
+use super::fault::FaultKind;
+use super::simt_stack::{SimtEntry, SimtStack};
+use super::warp::{Frame, Warp, WarpState};
+
+/// One executed warp instruction, as reported to a stepper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Issued {
+    /// Warp index.
+    pub warp: u32,
+    /// Function index.
+    pub func: u32,
+    /// Instruction index.
+    pub pc: u32,
+    /// Active lanes when issued.
+    pub mask: u32,
+}
+
+/// A fault inside a CTA, before the launch adds its names.
+#[derive(Debug, Clone)]
+pub struct CtaFault {
+    /// What.
+    pub kind: FaultKind,
+    /// Warp.
+    pub warp: u32,
+    /// Function.
+    pub func: u32,
+    /// PC.
+    pub pc: u32,
+    /// Lane.
+    pub lane: Option<u32>,
+}
+
+/// Why a CTA stopped issuing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stall {
+    /// All warps finished.
+    Finished,
+    /// Some warps wait for global atomics (resolved at the round's end).
+    WaitingForRound,
+}
+
+/// A resident CTA.
+#[derive(Debug)]
+pub struct Cta {
+    /// Index (x, y, z).
+    pub id: [u32; 3],
+    /// Linear index (x fastest).
+    pub linear: u32,
+    /// Its warps.
+    pub warps: Vec<Warp>,
+    /// Shared memory.
+    pub shared: Vec<u8>,
+    /// Counters.
+    pub counters: Counters,
+    /// Per-instruction counts.
+    pub profile: InstProfile,
+    /// Global atomics to apply at the round's end.
+    pub pending: Vec<PendingAtomic>,
+    /// A fault that stopped the CTA.
+    pub fault: Option<CtaFault>,
+    cur: usize,
+    slice_left: u32,
+    slice: u32,
+}
+
+impl Cta {
+    /// Creates CTA `linear` of the launch, with every warp at the kernel's first instruction.
+    pub fn new(ctx: &Ctx, kernel: u32, linear: u32, shared_size: usize, slice: u32) -> Cta {
+        let [gx, gy, _] = ctx.grid;
+        let id = [linear % gx, (linear / gx) % gy, linear / (gx * gy)];
+        let threads = ctx.block[0] * ctx.block[1] * ctx.block[2];
+        let nwarps = threads.div_ceil(32);
+        let f = &ctx.prog.functions[kernel as usize];
+        let warps = (0..nwarps)
+            .map(|w| {
+                let n = (threads - w * 32).min(32);
+                let lanes = if n == 32 { u32::MAX } else { (1u32 << n) - 1 };
+                let mut warp = Warp {
+                    id: w,
+                    frames: vec![Frame::new(kernel, f, 0, 0, 0)],
+                    stack: SimtStack { entries: vec![SimtEntry { pc: 0, rpc: EXIT_PC, mask: lanes }] },
+                    lanes,
+                    live: lanes,
+                    state: WarpState::Ready,
+                    local: Vec::new(),
+                    local_top: f.local_size,
+                };
+                warp.ensure_local(f.local_size);
+                warp
+            })
+            .collect();
+        let mut counters = Counters { ctas: 1, warps: nwarps as u64, ..Default::default() };
+        counters.rounds = 0;
+        Cta {
+            id,
+            linear,
+            warps,
+            shared: vec![0u8; shared_size],
+            counters,
+            profile: InstProfile::new(ctx.prog),
+            pending: Vec::new(),
+            fault: None,
+            cur: 0,
+            slice_left: slice,
+            slice: slice.max(1),
+        }
+    }
+
+    /// True when every warp finished.
+    pub fn finished(&self) -> bool {
+        self.warps.iter().all(|w| w.state == WarpState::Done)
+    }
+
+    /// Picks the warp to issue from next, releasing barriers when possible.
+    fn pick(&mut self) -> Result<Option<usize>, Stall> {
+        let n = self.warps.len();
+        if self.slice_left > 0 && self.warps[self.cur].state == WarpState::Ready {
+            return Ok(Some(self.cur));
+        }
+        for attempt in 0..2 {
+            for k in 1..=n {
+                let i = (self.cur + k) % n;
+                if self.warps[i].state == WarpState::Ready {
+                    self.cur = i;
+                    self.slice_left = self.slice;
+                    return Ok(Some(i));
+                }
+            }
+            if attempt == 0 && !self.try_release() {
+                break;
+            }
+        }
+        if self.warps.iter().all(|w| w.state == WarpState::Done) {
+            return Err(Stall::Finished);
+        }
+        if self.warps.iter().any(|w| w.state == WarpState::WaitAtomic) {
+            return Err(Stall::WaitingForRound);
+        }
+        Ok(None) // barrier deadlock: reported by the caller
+    }
+
+    /// Completes every barrier whose condition holds. Returns true if any did.
+    fn try_release(&mut self) -> bool {
+        let alive = self.warps.iter().filter(|w| w.state != WarpState::Done).count();
+        let mut released = false;
+        let mut ids: Vec<u32> = self
+            .warps
+            .iter()
+            .filter_map(|w| match w.state {
+                WarpState::Barrier { id, .. } => Some(id),
+                _ => None,
+            })
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        for id in ids {
+            let waiting: Vec<usize> = (0..self.warps.len())
+                .filter(|&i| matches!(self.warps[i].state, WarpState::Barrier { id: b, .. } if b == id))
+                .collect();
+            let count = waiting.iter().find_map(|&i| match self.warps[i].state {
+                WarpState::Barrier { count, .. } => count,
+                _ => None,
+            });
+            let threads: u32 = waiting.iter().map(|&i| self.warps[i].lanes.count_ones()).sum();
+            let done = match count {
+                Some(c) => threads >= c,
+                None => waiting.len() == alive,
+            };
+            if done {
+                for i in waiting {
+                    self.warps[i].state = WarpState::Ready;
+                }
+                self.counters.barriers += 1;
+                released = true;
+            }
+        }
+        released
+    }
+
+    /// Issues one warp instruction. `Ok(None)` means the CTA cannot issue now
+    /// (see [`Cta::stall`]).
+    pub fn step(&mut self, ctx: &Ctx) -> Result<Option<Issued>, CtaFault> {
+        let w = match self.pick() {
+            Ok(Some(w)) => w,
+            Ok(None) => {
+                let waiting = self
+                    .warps
+                    .iter()
+                    .filter_map(|w| match w.state {
+                        WarpState::Barrier { id, .. } => Some((w.id, id)),
+                        _ => None,
+                    })
+                    .collect();
+                let (wi, func, pc) = self
+                    .warps
+                    .iter()
+                    .find(|w| w.state != WarpState::Done)
+                    .map(|w| (w.id, w.frame().func, w.stack.top().map(|t| t.pc.saturating_sub(1)).unwrap_or(0)))
+                    .unwrap_or((0, 0, 0));
+                let f = CtaFault { kind: FaultKind::BarrierDeadlock { waiting }, warp: wi, func, pc, lane: None };
+                self.fault = Some(f.clone());
+                return Err(f);
+            }
+            Err(_) => return Ok(None),
+        };
+        let warp = &mut self.warps[w];
+        let mask = warp.stack.top().map(|t| t.mask).unwrap_or(0);
+        let mut cm = CtaMut {
+            cta_id: self.id,
+            cta_linear: self.linear,
+            shared: &mut self.shared,
+            counters: &mut self.counters,
+            profile: &mut self.profile,
+            pending: &mut self.pending,
+        };
+        let (func, pc, r) = exec::step(ctx, warp, &mut cm);
+        self.slice_left = self.slice_left.saturating_sub(1);
+        match r {
+            Ok(Effect::Continue) => {}
+            Ok(Effect::Blocked) => {
+                self.slice_left = 0;
+                if matches!(warp.state, WarpState::Barrier { .. } | WarpState::Done) {
+                    self.try_release();
+                }
+            }
+            Err(e) => {
+                let f = CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane };
+                self.fault = Some(f.clone());
+                return Err(f);
+            }
+        }
+        Ok(Some(Issued { warp: w as u32, func, pc, mask }))
+    }
+
+    /// Why the CTA cannot issue (meaningful after `step` returned `Ok(None)`).
+    pub fn stall(&self) -> Stall {
+        if self.finished() { Stall::Finished } else { Stall::WaitingForRound }
+    }
+
+    /// Issues up to `quantum` warp instructions, stopping early when blocked.
+    pub fn run_round(&mut self, ctx: &Ctx, quantum: u64) -> Result<u64, CtaFault> {
+        let mut n = 0;
+        while n < quantum {
+            match self.step(ctx)? {
+                Some(_) => n += 1,
+                None => break,
+            }
+        }
+        Ok(n)
+    }
+
+    /// Applies this CTA's pending global atomics and wakes their warps.
+    pub fn commit_atomics(&mut self, ctx: &Ctx) {
+        exec::apply_pending(ctx, &mut self.warps, &mut self.pending);
+    }
+}

@@ -1,0 +1,437 @@
+//! The public face of the simulator: a [`Device`] with memory, [`Module`]s
+//! loaded on it, and kernel launches.
+//!
+//! ```
+//! use warplight::sim::{Arg, Device, LaunchConfig};
+//! let ptx = r#"
+//! .version 7.8
+//! .target sm_90
+//! .address_size 64
+//! .visible .entry twice(.param .u64 p)
+//! {
+//!   .reg .b32 %r<3>;
+//!   .reg .b64 %rd<4>;
+//!   ld.param.u64 %rd1, [p];
+//!   mov.u32 %r1, %tid.x;
+//!   mul.wide.u32 %rd2, %r1, 4;
+//!   add.s64 %rd3, %rd1, %rd2;
+//!   shl.b32 %r2, %r1, 1;
+//!   st.global.u32 [%rd3], %r2;
+//!   ret;
+//! }
+//! "#;
+//! let mut dev = Device::new();
+//! let module = dev.load_ptx(ptx, "twice.ptx").unwrap();
+//! let out = dev.alloc_zeroed::<u32>(32);
+//! let stats = dev.launch(&module, "twice", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap();
+//! assert_eq!(dev.read::<u32>(out, 32)[5], 10);
+//! assert_eq!(stats.totals.warp_instructions, 7);
+//! ```
+
+use std::collections::HashMap;
+
+use super::cfg::Cfg;
+use super::counters::LaunchStats;
+use super::exec::Ctx;
+use super::fault::Fault;
+use super::grid::{GridRun, Schedule};
+use super::memory::DeviceMemory;
+use crate::ptx::{self, Program, PtxError};
+
+/// Errors of loading and launching.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The PTX did not load.
+    #[error("{0}")]
+    Ptx(#[from] PtxError),
+    /// No kernel of that name.
+    #[error("no kernel `{name}` in {file}; kernels: {available}")]
+    UnknownKernel {
+        /// Requested name.
+        name: String,
+        /// PTX file.
+        file: String,
+        /// Comma-separated kernel names.
+        available: String,
+    },
+    /// Wrong number of arguments.
+    #[error("kernel `{kernel}` takes {expected} argument(s), {got} given")]
+    ArgCount {
+        /// Kernel.
+        kernel: String,
+        /// Parameters declared.
+        expected: usize,
+        /// Arguments given.
+        got: usize,
+    },
+    /// An argument of the wrong size.
+    #[error("argument {index} of `{kernel}` (`{param}`, .{ty}) takes {expected} bytes, the value given has {got}")]
+    ArgSize {
+        /// Kernel.
+        kernel: String,
+        /// 0-based argument index.
+        index: usize,
+        /// Parameter name.
+        param: String,
+        /// Parameter type.
+        ty: String,
+        /// Parameter size.
+        expected: u32,
+        /// Argument size.
+        got: usize,
+    },
+    /// An impossible launch configuration.
+    #[error("bad launch configuration: {0}")]
+    BadLaunch(String),
+    /// A device pointer that is not the start of an allocation, or an access past its end.
+    #[error("bad device memory access: {0}")]
+    BadPointer(String),
+    /// The kernel faulted.
+    #[error("{0}")]
+    Fault(Box<Fault>),
+}
+
+/// A device address returned by [`Device::alloc`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct DevicePtr(pub u64);
+
+/// Plain values that device memory holds.
+pub trait Element: Copy + Default {
+    /// Size in bytes.
+    const SIZE: usize;
+    /// Little-endian bytes.
+    fn to_bytes(self, out: &mut [u8]);
+    /// From little-endian bytes.
+    fn from_bytes(b: &[u8]) -> Self;
+}
+
+macro_rules! element {
+    ($($t:ty),*) => {$(
+        impl Element for $t {
+            const SIZE: usize = std::mem::size_of::<$t>();
+            fn to_bytes(self, out: &mut [u8]) {
+                out.copy_from_slice(&self.to_le_bytes());
+            }
+            fn from_bytes(b: &[u8]) -> Self {
+                <$t>::from_le_bytes(b.try_into().expect("element size"))
+            }
+        }
+    )*};
+}
+element!(u8, u16, u32, u64, i8, i16, i32, i64, f32, f64);
+
+/// Converts a slice of elements to bytes.
+pub fn to_bytes<T: Element>(v: &[T]) -> Vec<u8> {
+    let mut out = vec![0u8; v.len() * T::SIZE];
+    for (x, chunk) in v.iter().zip(out.chunks_mut(T::SIZE)) {
+        x.to_bytes(chunk);
+    }
+    out
+}
+
+/// Converts bytes to elements.
+pub fn from_bytes<T: Element>(b: &[u8]) -> Vec<T> {
+    b.chunks_exact(T::SIZE).map(T::from_bytes).collect()
+}
+
+/// A kernel argument.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Arg {
+    /// A device pointer (8 bytes).
+    Ptr(DevicePtr),
+    /// 32-bit unsigned.
+    U32(u32),
+    /// 32-bit signed.
+    I32(i32),
+    /// 64-bit unsigned.
+    U64(u64),
+    /// 64-bit signed.
+    I64(i64),
+    /// f32.
+    F32(f32),
+    /// f64.
+    F64(f64),
+    /// Raw bytes (structures passed by value).
+    Bytes(Vec<u8>),
+}
+
+impl Arg {
+    fn bytes(&self) -> Vec<u8> {
+        match self {
+            Arg::Ptr(p) => p.0.to_le_bytes().to_vec(),
+            Arg::U32(v) => v.to_le_bytes().to_vec(),
+            Arg::I32(v) => v.to_le_bytes().to_vec(),
+            Arg::U64(v) => v.to_le_bytes().to_vec(),
+            Arg::I64(v) => v.to_le_bytes().to_vec(),
+            Arg::F32(v) => v.to_le_bytes().to_vec(),
+            Arg::F64(v) => v.to_le_bytes().to_vec(),
+            Arg::Bytes(b) => b.clone(),
+        }
+    }
+}
+
+/// Grid and CTA shape of a launch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LaunchConfig {
+    /// CTAs per dimension.
+    pub grid: [u32; 3],
+    /// Threads per CTA per dimension.
+    pub block: [u32; 3],
+    /// Dynamic shared memory per CTA in bytes.
+    pub dynamic_shared: u32,
+}
+
+impl LaunchConfig {
+    /// A 1-D launch of `ctas` CTAs of `threads` threads.
+    pub fn linear(ctas: u32, threads: u32) -> Self {
+        LaunchConfig { grid: [ctas, 1, 1], block: [threads, 1, 1], dynamic_shared: 0 }
+    }
+}
+
+/// Settings of the simulator (host threads and the simulated machine's scheduling).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SimConfig {
+    /// Host threads running CTAs (0 = all cores). Never changes results.
+    pub threads: usize,
+    /// Scheduling parameters; these define the simulated machine and so the results
+    /// of kernels whose CTAs communicate.
+    pub schedule: Schedule,
+    /// Simulated SMs (`%smid` = CTA index mod this).
+    pub num_sms: u32,
+    /// Local memory per thread (call stack and local arrays) in bytes.
+    pub local_limit: u32,
+    /// Largest CTA.
+    pub max_threads_per_cta: u32,
+    /// Largest shared memory per CTA.
+    pub max_shared_per_cta: u32,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            threads: 0,
+            schedule: Schedule {
+                warp_slice: 1,
+                round_quantum: 20_000,
+                max_resident_ctas: 240,
+                max_warp_instructions: 1 << 36,
+            },
+            num_sms: 30,
+            local_limit: 64 * 1024,
+            max_threads_per_cta: 1024,
+            max_shared_per_cta: 228 * 1024,
+        }
+    }
+}
+
+/// A program loaded on a device: its CFGs and the addresses of its `.global` variables.
+#[derive(Debug)]
+pub struct Module {
+    /// The program.
+    pub prog: Program,
+    /// CFG of each function.
+    pub cfgs: Vec<Cfg>,
+    globals: Vec<u64>,
+}
+
+impl Module {
+    /// The device address of a module-scope `.global` variable.
+    pub fn global(&self, name: &str) -> Option<DevicePtr> {
+        self.prog.globals.iter().position(|g| g.name == name).map(|i| DevicePtr(self.globals[i]))
+    }
+}
+
+/// A simulated GPU: memory plus a host thread pool.
+pub struct Device {
+    mem: DeviceMemory,
+    config: SimConfig,
+    pool: Option<rayon::ThreadPool>,
+    sizes: HashMap<u64, u64>,
+}
+
+impl Default for Device {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Device {
+    /// A device with the default configuration.
+    pub fn new() -> Self {
+        Self::with_config(SimConfig::default())
+    }
+
+    /// A device with `config`.
+    pub fn with_config(config: SimConfig) -> Self {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(config.threads).build().ok();
+        Device { mem: DeviceMemory::new(), config, pool, sizes: HashMap::new() }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SimConfig {
+        &self.config
+    }
+
+    /// Device memory.
+    pub fn memory(&self) -> &DeviceMemory {
+        &self.mem
+    }
+
+    /// Allocates `bytes` zeroed bytes.
+    pub fn alloc_bytes(&mut self, bytes: u64, name: &str) -> DevicePtr {
+        let p = self.mem.alloc(bytes, name);
+        self.sizes.insert(p, bytes);
+        DevicePtr(p)
+    }
+
+    /// Allocates `n` zeroed elements.
+    pub fn alloc_zeroed<T: Element>(&mut self, n: usize) -> DevicePtr {
+        self.alloc_bytes((n * T::SIZE) as u64, "buffer")
+    }
+
+    /// Allocates and fills with `data`.
+    pub fn alloc_from<T: Element>(&mut self, data: &[T]) -> DevicePtr {
+        let p = self.alloc_zeroed::<T>(data.len());
+        self.write(p, data).expect("fresh allocation fits");
+        p
+    }
+
+    /// Writes elements at `p`.
+    pub fn write<T: Element>(&mut self, p: DevicePtr, data: &[T]) -> Result<(), SimError> {
+        let bytes = to_bytes(data);
+        let (al, off) = self
+            .mem
+            .find(p.0, bytes.len() as u64)
+            .ok_or_else(|| SimError::BadPointer(format!("{} bytes at {:#x}", bytes.len(), p.0)))?;
+        al.write_bytes(off, &bytes);
+        Ok(())
+    }
+
+    /// Reads `n` elements at `p`.
+    pub fn read<T: Element>(&self, p: DevicePtr, n: usize) -> Vec<T> {
+        self.try_read(p, n).expect("read within an allocation")
+    }
+
+    /// Reads `n` elements at `p`, or an error if out of bounds.
+    pub fn try_read<T: Element>(&self, p: DevicePtr, n: usize) -> Result<Vec<T>, SimError> {
+        let len = (n * T::SIZE) as u64;
+        let (al, off) =
+            self.mem.find(p.0, len).ok_or_else(|| SimError::BadPointer(format!("{len} bytes at {:#x}", p.0)))?;
+        let mut b = vec![0u8; len as usize];
+        al.read_bytes(off, &mut b);
+        Ok(from_bytes(&b))
+    }
+
+    /// Size of the allocation starting at `p`.
+    pub fn size_of(&self, p: DevicePtr) -> Option<u64> {
+        self.sizes.get(&p.0).copied()
+    }
+
+    /// Parses, validates and loads PTX text, allocating its `.global` variables.
+    pub fn load_ptx(&mut self, src: &str, name: &str) -> Result<Module, SimError> {
+        let prog = ptx::load(src, name)?;
+        Ok(self.load(prog))
+    }
+
+    /// Loads a validated program.
+    pub fn load(&mut self, prog: Program) -> Module {
+        let cfgs = prog.functions.iter().map(Cfg::build).collect();
+        let mut globals = Vec::new();
+        for g in &prog.globals {
+            let p = self.alloc_bytes(g.size.max(1), &g.name);
+            if let Some((al, off)) = self.mem.find(p.0, g.init.len() as u64) {
+                al.write_bytes(off, &g.init);
+            }
+            globals.push(p.0);
+        }
+        Module { prog, cfgs, globals }
+    }
+
+    fn prepare(&self, m: &Module, kernel: &str, cfg: &LaunchConfig, args: &[Arg]) -> Result<(u32, Vec<u8>, usize), SimError> {
+        let k = m.prog.kernel(kernel).ok_or_else(|| SimError::UnknownKernel {
+            name: kernel.to_string(),
+            file: m.prog.source_name.clone(),
+            available: m.prog.kernel_names().join(", "),
+        })?;
+        let f = &m.prog.functions[k as usize];
+        if args.len() != f.params.len() {
+            return Err(SimError::ArgCount { kernel: kernel.into(), expected: f.params.len(), got: args.len() });
+        }
+        let mut kp = vec![0u8; f.kernel_param_size as usize];
+        for (i, (a, p)) in args.iter().zip(&f.params).enumerate() {
+            let b = a.bytes();
+            if b.len() != p.size as usize {
+                return Err(SimError::ArgSize {
+                    kernel: kernel.into(),
+                    index: i,
+                    param: p.name.clone(),
+                    ty: p.ty.to_string(),
+                    expected: p.size,
+                    got: b.len(),
+                });
+            }
+            kp[p.offset as usize..p.offset as usize + b.len()].copy_from_slice(&b);
+        }
+        if cfg.grid.contains(&0) || cfg.block.contains(&0) {
+            return Err(SimError::BadLaunch(format!("grid {:?} and block {:?} must be non-zero", cfg.grid, cfg.block)));
+        }
+        let threads = cfg.block.iter().map(|&x| x as u64).product::<u64>();
+        if threads > self.config.max_threads_per_cta as u64 {
+            return Err(SimError::BadLaunch(format!(
+                "{threads} threads per CTA; at most {} allowed",
+                self.config.max_threads_per_cta
+            )));
+        }
+        let ctas = cfg.grid.iter().map(|&x| x as u64).product::<u64>();
+        if ctas > u32::MAX as u64 {
+            return Err(SimError::BadLaunch(format!("{ctas} CTAs is too many")));
+        }
+        let shared = m.prog.static_shared_size.div_ceil(16) as usize * 16 + cfg.dynamic_shared as usize;
+        if shared > self.config.max_shared_per_cta as usize {
+            return Err(SimError::BadLaunch(format!(
+                "{shared} bytes of shared memory per CTA; at most {} allowed",
+                self.config.max_shared_per_cta
+            )));
+        }
+        Ok((k, kp, shared))
+    }
+
+    fn ctx<'a>(&'a self, m: &'a Module, kp: Vec<u8>, cfg: &LaunchConfig) -> Ctx<'a> {
+        Ctx {
+            prog: &m.prog,
+            cfgs: &m.cfgs,
+            mem: &self.mem,
+            kparams: kp,
+            global_addrs: &m.globals,
+            grid: cfg.grid,
+            block: cfg.block,
+            num_sms: self.config.num_sms.max(1),
+            local_limit: self.config.local_limit,
+        }
+    }
+
+    /// Runs a kernel to completion. On a fault, memory keeps what the kernel wrote
+    /// before it, and the error names the instruction, CTA, warp and lane.
+    pub fn launch(&mut self, m: &Module, kernel: &str, cfg: LaunchConfig, args: &[Arg]) -> Result<LaunchStats, SimError> {
+        let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
+        let ctx = self.ctx(m, kp, &cfg);
+        let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
+        run.run(self.pool.as_ref()).map_err(|f| SimError::Fault(Box::new(f)))
+    }
+
+    /// Starts a launch for stepping one warp instruction at a time.
+    pub fn stepper<'a>(
+        &'a self,
+        m: &'a Module,
+        kernel: &str,
+        cfg: LaunchConfig,
+        args: &[Arg],
+    ) -> Result<super::stepper::Stepper<'a>, SimError> {
+        let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
+        Ok(super::stepper::Stepper::new(self, m, k, kp, shared, cfg))
+    }
+
+    pub(crate) fn make_run<'a>(&'a self, m: &'a Module, k: u32, kp: Vec<u8>, shared: usize, cfg: &LaunchConfig) -> GridRun<'a> {
+        GridRun::new(self.ctx(m, kp, cfg), k, shared, self.config.schedule.clone())
+    }
+}

@@ -1,0 +1,233 @@
+//! The grid scheduler: CTAs become resident in index order, run in parallel on
+//! host threads in *rounds*, and meet between rounds, where global atomics are
+//! applied in a fixed order. Results and counters are therefore the same for
+//! any number of host threads.
+//!
+//! A round: every resident CTA issues until all its warps are blocked or
+//! finished, or it has issued `round_quantum` warp instructions. Then, one CTA
+//! after another in index order, each CTA's global atomics are applied in issue
+//! order (lanes in lane order), finished CTAs retire and new ones become
+//! resident. Plain global loads and stores go straight to memory; CTAs that
+//! race on the same global address without atomics see each other's writes in
+//! an order that may depend on host timing, as on a GPU.
+
+use rayon::prelude::*;
+
+use super::counters::{Counters, InstProfile, LaunchStats};
+use super::cta::{Cta, CtaFault, Issued};
+use super::exec::Ctx;
+use super::fault::{Fault, FaultKind};
+use crate::ptx::ir::Program;
+
+/// Scheduling parameters of the simulated machine (not of the host).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Schedule {
+    /// Warp instructions a warp issues before the CTA scheduler moves on.
+    pub warp_slice: u32,
+    /// Warp instructions a CTA issues per round at most.
+    pub round_quantum: u64,
+    /// CTAs resident at once.
+    pub max_resident_ctas: u32,
+    /// Launch-wide warp-instruction budget (runaway detection).
+    pub max_warp_instructions: u64,
+}
+
+/// An executing grid.
+pub struct GridRun<'a> {
+    /// Launch context.
+    pub ctx: Ctx<'a>,
+    kernel: u32,
+    kernel_name: String,
+    total_ctas: u32,
+    next_cta: u32,
+    /// Resident CTAs in index order.
+    pub resident: Vec<Cta>,
+    shared_size: usize,
+    sched: Schedule,
+    totals: Counters,
+    profile: InstProfile,
+    retired_instructions: u64,
+    /// Stepping position: index into `resident` and instructions issued by it this round.
+    step_cta: usize,
+    step_issued: u64,
+}
+
+impl<'a> GridRun<'a> {
+    /// Prepares a launch.
+    pub fn new(ctx: Ctx<'a>, kernel: u32, shared_size: usize, sched: Schedule) -> Self {
+        let total_ctas = ctx.grid[0] * ctx.grid[1] * ctx.grid[2];
+        let profile = InstProfile::new(ctx.prog);
+        let kernel_name = ctx.prog.functions[kernel as usize].name.clone();
+        let mut g = GridRun {
+            ctx,
+            kernel,
+            kernel_name,
+            total_ctas,
+            next_cta: 0,
+            resident: Vec::new(),
+            shared_size,
+            sched,
+            totals: Counters::default(),
+            profile,
+            retired_instructions: 0,
+            step_cta: 0,
+            step_issued: 0,
+        };
+        g.admit();
+        g
+    }
+
+    fn admit(&mut self) {
+        while (self.resident.len() as u32) < self.sched.max_resident_ctas.max(1) && self.next_cta < self.total_ctas {
+            let c = Cta::new(&self.ctx, self.kernel, self.next_cta, self.shared_size, self.sched.warp_slice);
+            self.resident.push(c);
+            self.next_cta += 1;
+        }
+    }
+
+    /// True when every CTA finished.
+    pub fn done(&self) -> bool {
+        self.resident.is_empty() && self.next_cta >= self.total_ctas
+    }
+
+    /// Turns a CTA fault into a located [`Fault`].
+    pub fn locate(&self, cta: &Cta, f: &CtaFault) -> Fault {
+        make_fault(self.ctx.prog, &self.kernel_name, cta.id, f)
+    }
+
+    /// Runs one round on `pool` (or the current thread).
+    pub fn round(&mut self, pool: Option<&rayon::ThreadPool>) -> Result<(), Fault> {
+        let ctx = &self.ctx;
+        let q = self.sched.round_quantum.max(1);
+        let run = |c: &mut Cta| {
+            let _ = c.run_round(ctx, q);
+        };
+        match pool {
+            Some(p) if self.resident.len() > 1 => p.install(|| self.resident.par_iter_mut().for_each(run)),
+            _ => self.resident.iter_mut().for_each(run),
+        }
+        self.commit()
+    }
+
+    /// The between-rounds phase: faults, atomics, retirement, admission, budget.
+    fn commit(&mut self) -> Result<(), Fault> {
+        self.totals.rounds += 1;
+        if let Some(c) = self.resident.iter().find(|c| c.fault.is_some()) {
+            let f = c.fault.clone().expect("fault");
+            return Err(self.locate(c, &f));
+        }
+        for c in &mut self.resident {
+            c.commit_atomics(&self.ctx);
+        }
+        let mut i = 0;
+        while i < self.resident.len() {
+            if self.resident[i].finished() && self.resident[i].pending.is_empty() {
+                let c = self.resident.remove(i);
+                self.retired_instructions += c.counters.warp_instructions;
+                self.totals.merge(&c.counters);
+                self.profile.merge(&c.profile);
+            } else {
+                i += 1;
+            }
+        }
+        self.admit();
+        let issued: u64 =
+            self.retired_instructions + self.resident.iter().map(|c| c.counters.warp_instructions).sum::<u64>();
+        if issued > self.sched.max_warp_instructions
+            && let Some(c) = self.resident.first()
+        {
+            let w = c.warps.iter().find(|w| w.state != super::warp::WarpState::Done);
+            let (warp, func, pc) = w
+                .map(|w| (w.id, w.frame().func, w.stack.top().map(|t| t.pc).unwrap_or(0)))
+                .unwrap_or((0, self.kernel, 0));
+            let f = CtaFault { kind: FaultKind::Runaway { budget: self.sched.max_warp_instructions }, warp, func, pc, lane: None };
+            return Err(self.locate(c, &f));
+        }
+        Ok(())
+    }
+
+    /// Runs the whole grid.
+    pub fn run(mut self, pool: Option<&rayon::ThreadPool>) -> Result<LaunchStats, Fault> {
+        while !self.done() {
+            self.round(pool)?;
+        }
+        Ok(self.finish())
+    }
+
+    /// Final statistics (CTAs still resident are included).
+    pub fn finish(mut self) -> LaunchStats {
+        for c in std::mem::take(&mut self.resident) {
+            self.totals.merge(&c.counters);
+            self.profile.merge(&c.profile);
+        }
+        LaunchStats { kernel: self.kernel_name, totals: self.totals, profile: self.profile }
+    }
+
+    /// Issues exactly one warp instruction, following the same round structure
+    /// as [`GridRun::round`] with CTAs taken one after another. Returns the CTA
+    /// position and what was issued, or `None` when the grid finished.
+    pub fn step_one(&mut self) -> Result<Option<(usize, Issued)>, Fault> {
+        loop {
+            if self.done() {
+                return Ok(None);
+            }
+            if self.step_cta >= self.resident.len() {
+                self.commit()?;
+                self.step_cta = 0;
+                self.step_issued = 0;
+                continue;
+            }
+            let k = self.step_cta;
+            if self.step_issued < self.sched.round_quantum.max(1) {
+                let ctx = &self.ctx;
+                match self.resident[k].step(ctx) {
+                    Ok(Some(i)) => {
+                        self.step_issued += 1;
+                        return Ok(Some((k, i)));
+                    }
+                    Ok(None) => {}
+                    Err(f) => {
+                        let c = &self.resident[k];
+                        return Err(self.locate(c, &f));
+                    }
+                }
+            }
+            self.step_cta += 1;
+            self.step_issued = 0;
+        }
+    }
+
+    /// Counters so far (retired CTAs plus resident ones).
+    pub fn counters_so_far(&self) -> Counters {
+        let mut t = self.totals.clone();
+        for c in &self.resident {
+            t.merge(&c.counters);
+        }
+        t
+    }
+}
+
+/// Builds a located fault.
+pub fn make_fault(prog: &Program, kernel: &str, cta: [u32; 3], f: &CtaFault) -> Fault {
+    let func = &prog.functions[f.func as usize];
+    let info = func.info.get(f.pc as usize);
+    let ptx_line = info.map(|i| i.ptx_line).unwrap_or(0);
+    let ptx_text = prog.ptx_lines.get(ptx_line.saturating_sub(1) as usize).cloned().unwrap_or_default();
+    let source = info
+        .and_then(|i| i.src)
+        .filter(|s| s.line > 0)
+        .map(|s| (prog.files.get(s.file as usize).cloned().unwrap_or_default(), s.line));
+    Fault {
+        kind: f.kind.clone(),
+        kernel: kernel.to_string(),
+        function: func.name.clone(),
+        pc: f.pc,
+        ptx_file: prog.source_name.clone(),
+        ptx_line,
+        ptx_text,
+        source,
+        cta,
+        warp: f.warp,
+        lane: f.lane,
+    }
+}

@@ -1,0 +1,24 @@
+//! The SIMT simulator: CFG and reconvergence ([`cfg`], [`simt_stack`]), warps
+//! ([`warp`]), instruction semantics ([`exec`], [`alu`]), CTAs and their warp
+//! scheduler ([`cta`]), the grid scheduler ([`grid`]), device memory
+//! ([`memory`]), faults ([`fault`]), counters ([`counters`]), stepping
+//! ([`stepper`]) and the public [`Device`] API ([`device`]).
+
+pub mod alu;
+pub mod cfg;
+pub mod counters;
+pub mod cta;
+pub mod device;
+pub mod exec;
+pub mod fault;
+pub mod grid;
+pub mod memory;
+pub mod simt_stack;
+pub mod stepper;
+pub mod warp;
+
+pub use counters::{Counters, LaunchStats};
+pub use device::{Arg, Device, DevicePtr, Element, LaunchConfig, Module, SimConfig, SimError};
+pub use fault::{Fault, FaultKind};
+pub use grid::Schedule;
+pub use stepper::{StepEvent, Stepper, WarpView};

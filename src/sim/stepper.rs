@@ -1,0 +1,196 @@
+//! Stepping through a launch one warp instruction at a time, with the same
+//! scheduling (and so the same results) as a normal launch. For debuggers and
+//! the teaching views.
+
+use super::counters::Counters;
+use super::device::{Device, LaunchConfig, Module};
+use super::fault::Fault;
+use super::grid::GridRun;
+use super::simt_stack::SimtEntry;
+use super::warp::WarpState;
+
+/// One issued warp instruction.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StepEvent {
+    /// CTA index.
+    pub cta: [u32; 3],
+    /// Position of the CTA among resident CTAs (for inspection calls).
+    pub cta_slot: usize,
+    /// Warp within the CTA.
+    pub warp: u32,
+    /// Function name.
+    pub function: String,
+    /// Instruction index.
+    pub pc: u32,
+    /// Its PTX line.
+    pub ptx_line: u32,
+    /// Its CUDA source line, when known.
+    pub source_line: Option<u32>,
+    /// The opcode.
+    pub opcode: String,
+    /// Active lanes.
+    pub mask: u32,
+}
+
+/// A snapshot of a warp.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct WarpView {
+    /// Warp index.
+    pub id: u32,
+    /// Scheduling state.
+    pub state: WarpState,
+    /// Current function.
+    pub function: String,
+    /// Next PC of the running path (None when finished).
+    pub next_pc: Option<u32>,
+    /// PTX line of the next instruction.
+    pub next_ptx_line: Option<u32>,
+    /// Lanes of the running path.
+    pub active: u32,
+    /// Lanes not exited.
+    pub live: u32,
+    /// SIMT stack, bottom first.
+    pub stack: Vec<SimtEntry>,
+    /// Call depth (1 = in the kernel).
+    pub call_depth: usize,
+}
+
+/// A launch in progress, advanced by hand.
+pub struct Stepper<'a> {
+    run: GridRun<'a>,
+    module: &'a Module,
+    finished: bool,
+}
+
+impl<'a> Stepper<'a> {
+    pub(crate) fn new(dev: &'a Device, m: &'a Module, k: u32, kp: Vec<u8>, shared: usize, cfg: LaunchConfig) -> Self {
+        Stepper { run: dev.make_run(m, k, kp, shared, &cfg), module: m, finished: false }
+    }
+
+    /// Issues one warp instruction; `None` when the grid has finished.
+    pub fn step(&mut self) -> Result<Option<StepEvent>, Fault> {
+        if self.finished {
+            return Ok(None);
+        }
+        match self.run.step_one()? {
+            None => {
+                self.finished = true;
+                Ok(None)
+            }
+            Some((slot, i)) => {
+                let prog = &self.module.prog;
+                let f = &prog.functions[i.func as usize];
+                let info = &f.info[i.pc as usize];
+                Ok(Some(StepEvent {
+                    cta: self.run.resident[slot].id,
+                    cta_slot: slot,
+                    warp: i.warp,
+                    function: f.name.clone(),
+                    pc: i.pc,
+                    ptx_line: info.ptx_line,
+                    source_line: info.src.map(|s| s.line),
+                    opcode: info.opcode.clone(),
+                    mask: i.mask,
+                }))
+            }
+        }
+    }
+
+    /// Steps until some warp's next instruction is on PTX line `line` (it has not
+    /// executed yet), or the grid finishes. Returns the last event.
+    pub fn run_to_ptx_line(&mut self, line: u32, max_steps: u64) -> Result<Option<StepEvent>, Fault> {
+        self.run_until(max_steps, |s, ev| {
+            s.warp(ev.cta_slot, ev.warp).and_then(|w| w.next_ptx_line) == Some(line)
+        })
+    }
+
+    /// Steps until `stop(self, event)` holds after an instruction, at most `max_steps`.
+    pub fn run_until(
+        &mut self,
+        max_steps: u64,
+        mut stop: impl FnMut(&Self, &StepEvent) -> bool,
+    ) -> Result<Option<StepEvent>, Fault> {
+        let mut last = None;
+        for _ in 0..max_steps {
+            match self.step()? {
+                None => return Ok(last),
+                Some(ev) => {
+                    let hit = stop(self, &ev);
+                    last = Some(ev);
+                    if hit {
+                        break;
+                    }
+                }
+            }
+        }
+        Ok(last)
+    }
+
+    /// True once every CTA finished.
+    pub fn finished(&self) -> bool {
+        self.finished || self.run.done()
+    }
+
+    /// Indices of resident CTAs, by slot.
+    pub fn resident_ctas(&self) -> Vec<[u32; 3]> {
+        self.run.resident.iter().map(|c| c.id).collect()
+    }
+
+    /// Number of warps in each CTA.
+    pub fn warps_per_cta(&self) -> usize {
+        self.run.resident.first().map(|c| c.warps.len()).unwrap_or(0)
+    }
+
+    /// A warp's state.
+    pub fn warp(&self, slot: usize, warp: u32) -> Option<WarpView> {
+        let c = self.run.resident.get(slot)?;
+        let w = c.warps.get(warp as usize)?;
+        let prog = &self.module.prog;
+        let f = &prog.functions[w.frame().func as usize];
+        let top = w.stack.top().copied();
+        let next_pc = top.map(|t| t.pc).filter(|&pc| (pc as usize) < f.insts.len());
+        Some(WarpView {
+            id: w.id,
+            state: w.state,
+            function: f.name.clone(),
+            next_pc,
+            next_ptx_line: next_pc.map(|pc| f.info[pc as usize].ptx_line),
+            active: top.map(|t| t.mask).unwrap_or(0),
+            live: w.live,
+            stack: w.stack.entries.clone(),
+            call_depth: w.frames.len(),
+        })
+    }
+
+    /// Per-lane values of a register (data or predicate, by PTX name) in the warp's current frame.
+    pub fn register(&self, slot: usize, warp: u32, name: &str) -> Option<[u64; 32]> {
+        let c = self.run.resident.get(slot)?;
+        let w = c.warps.get(warp as usize)?;
+        let fr = w.frame();
+        let f = &self.module.prog.functions[fr.func as usize];
+        if let Some(i) = f.reg_names.iter().position(|n| n == name) {
+            return Some(fr.regs[i]);
+        }
+        let p = f.pred_names.iter().position(|n| n == name)?;
+        let bits = fr.preds[p];
+        Some(std::array::from_fn(|l| (bits >> l & 1) as u64))
+    }
+
+    /// Register names of the warp's current function.
+    pub fn register_names(&self, slot: usize, warp: u32) -> Vec<String> {
+        let Some(c) = self.run.resident.get(slot) else { return Vec::new() };
+        let Some(w) = c.warps.get(warp as usize) else { return Vec::new() };
+        let f = &self.module.prog.functions[w.frame().func as usize];
+        f.reg_names.iter().chain(f.pred_names.iter().skip(2)).cloned().collect()
+    }
+
+    /// A CTA's shared memory.
+    pub fn shared(&self, slot: usize) -> Option<&[u8]> {
+        self.run.resident.get(slot).map(|c| c.shared.as_slice())
+    }
+
+    /// Counters so far.
+    pub fn counters(&self) -> Counters {
+        self.run.counters_so_far()
+    }
+}
