@@ -51,7 +51,10 @@ pub fn lex(src: &str) -> Result<Vec<Token>, (Pos, PtxErrorKind)> {
     let mut glued = false;
     while i < b.len() {
         let c = b[i];
-        let pos = Pos { line, col: (i - line_start + 1) as u32 };
+        let pos = Pos {
+            line,
+            col: (i - line_start + 1) as u32,
+        };
         if c == b'\n' {
             i += 1;
             line += 1;
@@ -130,7 +133,10 @@ pub fn lex(src: &str) -> Result<Vec<Token>, (Pos, PtxErrorKind)> {
             Tok::Punct(c as char)
         } else {
             let ch = src[i..].chars().next().unwrap_or('?');
-            return Err((pos, PtxErrorKind::Lex(format!("unexpected character {ch:?}"))));
+            return Err((
+                pos,
+                PtxErrorKind::Lex(format!("unexpected character {ch:?}")),
+            ));
         };
         out.push(Token { tok, pos, glued });
         glued = true;
@@ -156,11 +162,18 @@ fn lex_number(src: &str, i: &mut usize) -> Result<Tok, String> {
             let is_f = p == b'f' || p == b'F';
             let want = if is_f { 8 } else { 16 };
             if digits.len() != want {
-                return Err(format!("float literal `{}` needs {want} hex digits", &src[start..end]));
+                return Err(format!(
+                    "float literal `{}` needs {want} hex digits",
+                    &src[start..end]
+                ));
             }
             let v = u64::from_str_radix(digits, 16)
                 .map_err(|_| format!("bad hex float literal `{}`", &src[start..end]))?;
-            return Ok(if is_f { Tok::F32Bits(v as u32) } else { Tok::F64Bits(v) });
+            return Ok(if is_f {
+                Tok::F32Bits(v as u32)
+            } else {
+                Tok::F64Bits(v)
+            });
         }
         if p == b'x' || p == b'X' {
             let end = word_end(start + 2);
@@ -213,7 +226,10 @@ fn lex_number(src: &str, i: &mut usize) -> Result<Tok, String> {
     let text = &src[start..j];
     if is_float {
         *i = j;
-        return text.parse::<f64>().map(Tok::Float).map_err(|_| format!("bad float literal `{text}`"));
+        return text
+            .parse::<f64>()
+            .map(Tok::Float)
+            .map_err(|_| format!("bad float literal `{text}`"));
     }
     let mut end = j;
     if end < b.len() && (b[end] == b'U' || b[end] == b'u') {
@@ -225,7 +241,9 @@ fn lex_number(src: &str, i: &mut usize) -> Result<Tok, String> {
             .map(Tok::Int)
             .map_err(|_| format!("bad octal literal `{text}`"));
     }
-    text.parse::<u64>().map(Tok::Int).map_err(|_| format!("integer literal `{text}` out of range"))
+    text.parse::<u64>()
+        .map(Tok::Int)
+        .map_err(|_| format!("integer literal `{text}` out of range"))
 }
 
 #[cfg(test)]

@@ -61,7 +61,10 @@ impl<'a> Parser<'a> {
         if self.eat_punct(c) {
             Ok(())
         } else {
-            syntax(self.pos(), format!("expected `{c}`, found {}", self.describe()))
+            syntax(
+                self.pos(),
+                format!("expected `{c}`, found {}", self.describe()),
+            )
         }
     }
     fn describe(&self) -> String {
@@ -90,7 +93,10 @@ impl<'a> Parser<'a> {
             Tok::Int(v) => Ok(v),
             _ => {
                 self.i -= 1;
-                syntax(pos, format!("expected an integer, found {}", self.describe()))
+                syntax(
+                    pos,
+                    format!("expected an integer, found {}", self.describe()),
+                )
             }
         }
     }
@@ -102,11 +108,17 @@ impl<'a> Parser<'a> {
     }
 
     fn module(&mut self) -> PResult<Module> {
-        let mut m = Module { address_size: 64, ..Default::default() };
+        let mut m = Module {
+            address_size: 64,
+            ..Default::default()
+        };
         while let Some(tok) = self.peek() {
             let pos = self.pos();
             let Tok::Dot(d) = tok else {
-                return syntax(pos, format!("expected a directive, found {}", self.describe()));
+                return syntax(
+                    pos,
+                    format!("expected a directive, found {}", self.describe()),
+                );
             };
             match d.as_str() {
                 "version" => {
@@ -212,7 +224,10 @@ impl<'a> Parser<'a> {
                 Ok(())
             }
             Some(s) => Err((pos, PtxErrorKind::UnsupportedDirective(format!(".{s}")))),
-            None => syntax(pos, format!("expected a directive, found {}", self.describe())),
+            None => syntax(
+                pos,
+                format!("expected a directive, found {}", self.describe()),
+            ),
         }
     }
 
@@ -220,7 +235,10 @@ impl<'a> Parser<'a> {
     fn var_decl(&mut self) -> PResult<VarDecl> {
         let pos = self.pos();
         let space = match &self.next()?.tok {
-            Tok::Dot(s) => Space::parse(s).ok_or((pos, PtxErrorKind::Syntax(format!("`.{s}` is no state space"))))?,
+            Tok::Dot(s) => Space::parse(s).ok_or((
+                pos,
+                PtxErrorKind::Syntax(format!("`.{s}` is no state space")),
+            ))?,
             _ => return syntax(pos, "expected a state space"),
         };
         let (mut align, mut vector, mut ty) = (None, None, None);
@@ -238,7 +256,10 @@ impl<'a> Parser<'a> {
                 },
             }
         }
-        let ty = ty.ok_or((pos, PtxErrorKind::Syntax("declaration without a type".into())))?;
+        let ty = ty.ok_or((
+            pos,
+            PtxErrorKind::Syntax("declaration without a type".into()),
+        ))?;
         let name = self.expect_ident()?;
         let mut range = None;
         if self.eat_punct('<') {
@@ -263,7 +284,18 @@ impl<'a> Parser<'a> {
             }
             init = Some(vals);
         }
-        Ok(VarDecl { space, align, vector, ty, name, range, dims, init, is_extern: false, pos })
+        Ok(VarDecl {
+            space,
+            align,
+            vector,
+            ty,
+            name,
+            range,
+            dims,
+            init,
+            is_extern: false,
+            pos,
+        })
     }
 
     fn initializer(&mut self, out: &mut Vec<Literal>) -> PResult<()> {
@@ -282,7 +314,10 @@ impl<'a> Parser<'a> {
                     out.push(l);
                     Ok(())
                 }
-                None => Err((pos, PtxErrorKind::Unsupported(format!("initializer {}", self.describe())))),
+                None => Err((
+                    pos,
+                    PtxErrorKind::Unsupported(format!("initializer {}", self.describe())),
+                )),
             }
         }
     }
@@ -323,8 +358,9 @@ impl<'a> Parser<'a> {
         // performance directives
         while let Some(d) = self.peek_dot() {
             match d {
-                "maxntid" | "reqntid" | "minnctapersm" | "maxnreg" | "maxnctapersm" | "noreturn" | "pragma"
-                | "explicitcluster" | "reqnctapercluster" | "maxclusterrank" => {
+                "maxntid" | "reqntid" | "minnctapersm" | "maxnreg" | "maxnctapersm"
+                | "noreturn" | "pragma" | "explicitcluster" | "reqnctapercluster"
+                | "maxclusterrank" => {
                     self.i += 1;
                     loop {
                         match self.peek() {
@@ -338,16 +374,33 @@ impl<'a> Parser<'a> {
                     self.eat_punct(';');
                 }
                 _ => {
-                    return Err((self.pos(), PtxErrorKind::UnsupportedDirective(format!(".{d}"))));
+                    return Err((
+                        self.pos(),
+                        PtxErrorKind::UnsupportedDirective(format!(".{d}")),
+                    ));
                 }
             }
         }
         if self.eat_punct(';') {
-            return Ok(Function { kind, name, returns, params, body: None, pos });
+            return Ok(Function {
+                kind,
+                name,
+                returns,
+                params,
+                body: None,
+                pos,
+            });
         }
         self.expect_punct('{')?;
         let body = self.block_body()?;
-        Ok(Function { kind, name, returns, params, body: Some(body), pos })
+        Ok(Function {
+            kind,
+            name,
+            returns,
+            params,
+            body: Some(body),
+            pos,
+        })
     }
 
     fn param_list(&mut self) -> PResult<Vec<VarDecl>> {
@@ -408,8 +461,15 @@ impl<'a> Parser<'a> {
                     self.i += 2;
                     out.push(Stmt::Label(name.clone(), pos));
                 }
-                Some(Tok::Ident(_)) | Some(Tok::Punct('@')) => out.push(Stmt::Inst(self.instruction()?)),
-                _ => return syntax(pos, format!("expected an instruction, found {}", self.describe())),
+                Some(Tok::Ident(_)) | Some(Tok::Punct('@')) => {
+                    out.push(Stmt::Inst(self.instruction()?))
+                }
+                _ => {
+                    return syntax(
+                        pos,
+                        format!("expected an instruction, found {}", self.describe()),
+                    );
+                }
             }
         }
     }
@@ -423,7 +483,12 @@ impl<'a> Parser<'a> {
         }
         let opcode = self.expect_ident()?;
         let mut mods = Vec::new();
-        while let Some(Token { tok: Tok::Dot(m), glued: true, .. }) = self.t.get(self.i) {
+        while let Some(Token {
+            tok: Tok::Dot(m),
+            glued: true,
+            ..
+        }) = self.t.get(self.i)
+        {
             mods.push(m.clone());
             self.i += 1;
         }
@@ -435,17 +500,30 @@ impl<'a> Parser<'a> {
                     break;
                 }
                 if !self.eat_punct(',') {
-                    return syntax(self.pos(), format!("expected `,` or `;`, found {}", self.describe()));
+                    return syntax(
+                        self.pos(),
+                        format!("expected `,` or `;`, found {}", self.describe()),
+                    );
                 }
             }
         }
-        Ok(Instruction { guard, opcode, mods, operands, pos })
+        Ok(Instruction {
+            guard,
+            opcode,
+            mods,
+            operands,
+            pos,
+        })
     }
 
     fn name_with_component(&mut self) -> PResult<String> {
         let mut n = self.expect_ident()?;
         if n.starts_with('%')
-            && let Some(Token { tok: Tok::Dot(c), glued: true, .. }) = self.t.get(self.i)
+            && let Some(Token {
+                tok: Tok::Dot(c),
+                glued: true,
+                ..
+            }) = self.t.get(self.i)
         {
             n.push('.');
             n.push_str(c);
@@ -492,7 +570,11 @@ impl<'a> Parser<'a> {
                         self.expect_punct(',')?;
                     }
                 }
-                Ok(if brace { Operand::Vector(v) } else { Operand::List(v) })
+                Ok(if brace {
+                    Operand::Vector(v)
+                } else {
+                    Operand::List(v)
+                })
             }
             Some(Tok::Punct('!')) => {
                 self.i += 1;
@@ -508,7 +590,10 @@ impl<'a> Parser<'a> {
             }
             _ => match self.literal()? {
                 Some(l) => Ok(Operand::Lit(l)),
-                None => syntax(pos, format!("expected an operand, found {}", self.describe())),
+                None => syntax(
+                    pos,
+                    format!("expected an operand, found {}", self.describe()),
+                ),
             },
         }
     }

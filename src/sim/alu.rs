@@ -31,12 +31,20 @@ fn f32of(x: u64) -> f32 {
 
 #[inline]
 fn ftz32(x: f32) -> f32 {
-    if x.is_subnormal() { 0.0f32.copysign(x) } else { x }
+    if x.is_subnormal() {
+        0.0f32.copysign(x)
+    } else {
+        x
+    }
 }
 
 #[inline]
 fn ftz64(x: f64) -> f64 {
-    if x.is_subnormal() { 0.0f64.copysign(x) } else { x }
+    if x.is_subnormal() {
+        0.0f64.copysign(x)
+    } else {
+        x
+    }
 }
 
 #[inline]
@@ -51,7 +59,11 @@ fn out32(x: f32, m: FloatMode) -> u64 {
     if m.sat {
         x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
     }
-    if x.is_nan() { NAN32 as u64 } else { x.to_bits() as u64 }
+    if x.is_nan() {
+        NAN32 as u64
+    } else {
+        x.to_bits() as u64
+    }
 }
 
 #[inline]
@@ -121,7 +133,13 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
 /// Sign of (exact − r) where exact = s + e (error-free pair) and r an f32 result.
 fn err_vs(s: f64, e: f64, r: f32) -> Ordering {
     if !r.is_finite() {
-        return if r.is_nan() { Ordering::Equal } else if r > 0.0 { Ordering::Less } else { Ordering::Greater };
+        return if r.is_nan() {
+            Ordering::Equal
+        } else if r > 0.0 {
+            Ordering::Less
+        } else {
+            Ordering::Greater
+        };
     }
     let d = s - r as f64;
     if d != 0.0 { sign(d) } else { sign(e) }
@@ -166,7 +184,11 @@ fn div32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
     }
     // a - r*b is exact in f64; its sign times b's sign is the sign of (a/b − r).
     let rem = a as f64 - r as f64 * b as f64;
-    let err = if b > 0.0 { sign(rem) } else { sign(rem).reverse() };
+    let err = if b > 0.0 {
+        sign(rem)
+    } else {
+        sign(rem).reverse()
+    };
     direct32(r, err, rnd)
 }
 
@@ -214,7 +236,15 @@ fn div64(a: f64, b: f64, rnd: Option<Rounding>) -> f64 {
         return r;
     }
     let rem = (-r).mul_add(b, a);
-    direct64(r, if b > 0.0 { sign(rem) } else { sign(rem).reverse() }, rnd)
+    direct64(
+        r,
+        if b > 0.0 {
+            sign(rem)
+        } else {
+            sign(rem).reverse()
+        },
+        rnd,
+    )
 }
 
 fn sqrt64(a: f64, rnd: Option<Rounding>) -> f64 {
@@ -225,7 +255,15 @@ fn sqrt64(a: f64, rnd: Option<Rounding>) -> f64 {
     direct64(r, sign((-r).mul_add(r, a)), rnd)
 }
 
-fn fmin<T: PartialOrd + Copy>(a: T, b: T, a_nan: bool, b_nan: bool, a_neg: bool, b_neg: bool, max: bool) -> Option<T> {
+fn fmin<T: PartialOrd + Copy>(
+    a: T,
+    b: T,
+    a_nan: bool,
+    b_nan: bool,
+    a_neg: bool,
+    b_neg: bool,
+    max: bool,
+) -> Option<T> {
     if a_nan && b_nan {
         return None;
     }
@@ -237,7 +275,13 @@ fn fmin<T: PartialOrd + Copy>(a: T, b: T, a_nan: bool, b_nan: bool, a_neg: bool,
     }
     // -0 is below +0 for min and max
     if a == b {
-        return Some(if (a_neg && !max) || (!a_neg && max) { a } else if (b_neg && !max) || (!b_neg && max) { b } else { a });
+        return Some(if (a_neg && !max) || (!a_neg && max) {
+            a
+        } else if (b_neg && !max) || (!b_neg && max) {
+            b
+        } else {
+            a
+        });
     }
     let a_less = a < b;
     Some(if a_less != max { a } else { b })
@@ -255,7 +299,15 @@ fn f32op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         ArithOp::Neg => return out_bits32((-fa).to_bits(), m),
         ArithOp::Copysign => return (fb.abs().to_bits() | (fa.to_bits() & 0x8000_0000)) as u64,
         ArithOp::Min | ArithOp::Max => {
-            match fmin(fa, fb, fa.is_nan(), fb.is_nan(), fa.is_sign_negative(), fb.is_sign_negative(), op == ArithOp::Max) {
+            match fmin(
+                fa,
+                fb,
+                fa.is_nan(),
+                fb.is_nan(),
+                fa.is_sign_negative(),
+                fb.is_sign_negative(),
+                op == ArithOp::Max,
+            ) {
                 Some(v) => v,
                 None => f32::NAN,
             }
@@ -286,18 +338,42 @@ fn out_bits32(bits: u32, m: FloatMode) -> u64 {
 
 fn f64op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
     let (fa, fb, fc) = (f64::from_bits(a), f64::from_bits(b), f64::from_bits(c));
-    let (fa, fb, fc) = if m.ftz { (ftz64(fa), ftz64(fb), ftz64(fc)) } else { (fa, fb, fc) };
+    let (fa, fb, fc) = if m.ftz {
+        (ftz64(fa), ftz64(fb), ftz64(fc))
+    } else {
+        (fa, fb, fc)
+    };
     let r = match op {
         ArithOp::Add => add64(fa, fb, m.rnd),
         ArithOp::Sub => add64(fa, -fb, m.rnd),
         ArithOp::Mul => mul64(fa, fb, m.rnd),
         ArithOp::Mad => fma64(fa, fb, fc, m.rnd),
         ArithOp::Div => div64(fa, fb, m.rnd),
-        ArithOp::Abs => return if fa.is_nan() { a & !(1 << 63) } else { out64(fa.abs(), m) },
-        ArithOp::Neg => return if fa.is_nan() { a ^ (1 << 63) } else { out64(-fa, m) },
+        ArithOp::Abs => {
+            return if fa.is_nan() {
+                a & !(1 << 63)
+            } else {
+                out64(fa.abs(), m)
+            };
+        }
+        ArithOp::Neg => {
+            return if fa.is_nan() {
+                a ^ (1 << 63)
+            } else {
+                out64(-fa, m)
+            };
+        }
         ArithOp::Copysign => return (fb.abs().to_bits()) | (fa.to_bits() & (1 << 63)),
         ArithOp::Min | ArithOp::Max => {
-            match fmin(fa, fb, fa.is_nan(), fb.is_nan(), fa.is_sign_negative(), fb.is_sign_negative(), op == ArithOp::Max) {
+            match fmin(
+                fa,
+                fb,
+                fa.is_nan(),
+                fb.is_nan(),
+                fa.is_sign_negative(),
+                fb.is_sign_negative(),
+                op == ArithOp::Max,
+            ) {
                 Some(v) => v,
                 None => f64::NAN,
             }
@@ -315,7 +391,11 @@ fn f64op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
 }
 
 fn wide_mask(w: u32) -> u64 {
-    if w >= 32 { u64::MAX } else { (1u64 << (2 * w)) - 1 }
+    if w >= 32 {
+        u64::MAX
+    } else {
+        (1u64 << (2 * w)) - 1
+    }
 }
 
 /// Evaluates an arithmetic operation on one lane. `a`, `b`, `c` hold the
@@ -329,11 +409,19 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
     let w = ty.bits();
     let mask = ty.mask();
     let signed = ty.is_signed();
-    let (sa, sb, sc) = (ty.extend(a) as i64, ty.extend(b) as i64, ty.extend(c) as i64);
+    let (sa, sb, sc) = (
+        ty.extend(a) as i64,
+        ty.extend(b) as i64,
+        ty.extend(c) as i64,
+    );
     let (ua, ub, uc) = (a & mask, b & mask, c & mask);
     let r: u64 = match op {
-        ArithOp::Add if m.sat && signed => (sa as i128 + sb as i128).clamp(min_of(w), max_of(w)) as u64,
-        ArithOp::Sub if m.sat && signed => (sa as i128 - sb as i128).clamp(min_of(w), max_of(w)) as u64,
+        ArithOp::Add if m.sat && signed => {
+            (sa as i128 + sb as i128).clamp(min_of(w), max_of(w)) as u64
+        }
+        ArithOp::Sub if m.sat && signed => {
+            (sa as i128 - sb as i128).clamp(min_of(w), max_of(w)) as u64
+        }
         ArithOp::Add => ua.wrapping_add(ub),
         ArithOp::Sub => ua.wrapping_sub(ub),
         ArithOp::Mul => ua.wrapping_mul(ub),
@@ -345,15 +433,27 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             }
         }
         ArithOp::MulWide => {
-            return if signed { (sa as i128 * sb as i128) as u64 } else { (ua as u128 * ub as u128) as u64 } & wide_mask(w);
+            return if signed {
+                (sa as i128 * sb as i128) as u64
+            } else {
+                (ua as u128 * ub as u128) as u64
+            } & wide_mask(w);
         }
         ArithOp::Mad => ua.wrapping_mul(ub).wrapping_add(uc),
         ArithOp::MadHi => {
-            let hi = if signed { ((sa as i128 * sb as i128) >> w) as u64 } else { ((ua as u128 * ub as u128) >> w) as u64 };
+            let hi = if signed {
+                ((sa as i128 * sb as i128) >> w) as u64
+            } else {
+                ((ua as u128 * ub as u128) >> w) as u64
+            };
             hi.wrapping_add(uc)
         }
         ArithOp::MadWide => {
-            let p = if signed { (sa as i128 * sb as i128) as u64 } else { (ua as u128 * ub as u128) as u64 };
+            let p = if signed {
+                (sa as i128 * sb as i128) as u64
+            } else {
+                (ua as u128 * ub as u128) as u64
+            };
             return p.wrapping_add(c) & wide_mask(w);
         }
         ArithOp::Mul24Lo | ArithOp::Mul24Hi | ArithOp::Mad24Lo | ArithOp::Mad24Hi => {
@@ -363,12 +463,24 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
                 ((a & 0xFF_FFFF) as i64, (b & 0xFF_FFFF) as i64)
             };
             let p = x * y;
-            let part = if matches!(op, ArithOp::Mul24Hi | ArithOp::Mad24Hi) { (p >> 16) as u64 } else { p as u64 };
-            if matches!(op, ArithOp::Mad24Lo | ArithOp::Mad24Hi) { part.wrapping_add(uc) } else { part }
+            let part = if matches!(op, ArithOp::Mul24Hi | ArithOp::Mad24Hi) {
+                (p >> 16) as u64
+            } else {
+                p as u64
+            };
+            if matches!(op, ArithOp::Mad24Lo | ArithOp::Mad24Hi) {
+                part.wrapping_add(uc)
+            } else {
+                part
+            }
         }
         ArithOp::Div => {
             if signed {
-                if sb == 0 { u64::MAX } else { sa.wrapping_div(sb) as u64 }
+                if sb == 0 {
+                    u64::MAX
+                } else {
+                    sa.wrapping_div(sb) as u64
+                }
             } else if ub == 0 {
                 u64::MAX
             } else {
@@ -377,7 +489,11 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         }
         ArithOp::Rem => {
             if signed {
-                if sb == 0 { sa as u64 } else { sa.wrapping_rem(sb) as u64 }
+                if sb == 0 {
+                    sa as u64
+                } else {
+                    sa.wrapping_rem(sb) as u64
+                }
             } else if ub == 0 {
                 ua
             } else {
@@ -387,10 +503,18 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         ArithOp::Abs => sa.wrapping_abs() as u64,
         ArithOp::Neg => sa.wrapping_neg() as u64,
         ArithOp::Min => {
-            if signed { sa.min(sb) as u64 } else { ua.min(ub) }
+            if signed {
+                sa.min(sb) as u64
+            } else {
+                ua.min(ub)
+            }
         }
         ArithOp::Max => {
-            if signed { sa.max(sb) as u64 } else { ua.max(ub) }
+            if signed {
+                sa.max(sb) as u64
+            } else {
+                ua.max(ub)
+            }
         }
         ArithOp::And => ua & ub,
         ArithOp::Or => ua | ub,
@@ -418,13 +542,35 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             let pos = (b & 0xFF) as u32;
             let len = (c & 0xFF) as u32;
             let msb = w - 1;
-            let sbit = if signed && len != 0 { (ua >> (pos + len - 1).min(msb)) & 1 } else { 0 };
+            let sbit = if signed && len != 0 {
+                (ua >> (pos + len - 1).min(msb)) & 1
+            } else {
+                0
+            };
             let mut d = 0u64;
             for i in 0..w {
-                let bit = if i < len && pos + i <= msb { (ua >> (pos + i)) & 1 } else { sbit };
+                let bit = if i < len && pos + i <= msb {
+                    (ua >> (pos + i)) & 1
+                } else {
+                    sbit
+                };
                 d |= bit << i;
             }
             d
+        }
+        ArithOp::ShfLWrap | ArithOp::ShfLClamp | ArithOp::ShfRWrap | ArithOp::ShfRClamp => {
+            let wrap = matches!(op, ArithOp::ShfLWrap | ArithOp::ShfRWrap);
+            let n = if wrap {
+                (c & 31) as u32
+            } else {
+                (c as u32).min(32)
+            };
+            let x = ((ub & 0xFFFF_FFFF) << 32) | (ua & 0xFFFF_FFFF);
+            if matches!(op, ArithOp::ShfLWrap | ArithOp::ShfLClamp) {
+                (x << n) >> 32
+            } else {
+                x >> n
+            }
         }
         ArithOp::Prmt => {
             let bytes = ((ub & 0xFFFF_FFFF) << 32) | (ua & 0xFFFF_FFFF);
@@ -432,7 +578,11 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             for i in 0..4 {
                 let sel = (c >> (4 * i)) & 0xF;
                 let byte = (bytes >> ((sel & 7) * 8)) & 0xFF;
-                let byte = if sel & 8 != 0 { if byte & 0x80 != 0 { 0xFF } else { 0 } } else { byte };
+                let byte = if sel & 8 != 0 {
+                    if byte & 0x80 != 0 { 0xFF } else { 0 }
+                } else {
+                    byte
+                };
                 d |= byte << (8 * i);
             }
             d
@@ -498,10 +648,34 @@ pub fn compare(cmp: Cmp, ty: Ty, ftz: bool, a: u64, b: u64) -> bool {
     match cmp {
         Cmp::Eq | Cmp::Equ => ua == ub,
         Cmp::Ne | Cmp::Neu => ua != ub,
-        Cmp::Lt | Cmp::Ltu => if s { sa < sb } else { ua < ub },
-        Cmp::Le | Cmp::Leu => if s { sa <= sb } else { ua <= ub },
-        Cmp::Gt | Cmp::Gtu => if s { sa > sb } else { ua > ub },
-        Cmp::Ge | Cmp::Geu => if s { sa >= sb } else { ua >= ub },
+        Cmp::Lt | Cmp::Ltu => {
+            if s {
+                sa < sb
+            } else {
+                ua < ub
+            }
+        }
+        Cmp::Le | Cmp::Leu => {
+            if s {
+                sa <= sb
+            } else {
+                ua <= ub
+            }
+        }
+        Cmp::Gt | Cmp::Gtu => {
+            if s {
+                sa > sb
+            } else {
+                ua > ub
+            }
+        }
+        Cmp::Ge | Cmp::Geu => {
+            if s {
+                sa >= sb
+            } else {
+                ua >= ub
+            }
+        }
         Cmp::Lo => ua < ub,
         Cmp::Ls => ua <= ub,
         Cmp::Hi => ua > ub,
@@ -522,14 +696,22 @@ fn round_int_f64(x: f64, rnd: Option<Rounding>) -> f64 {
 
 fn int_range(t: Ty) -> (i128, i128) {
     let w = t.bits();
-    if t.is_signed() { (min_of(w), max_of(w)) } else { (0, (1i128 << w) - 1) }
+    if t.is_signed() {
+        (min_of(w), max_of(w))
+    } else {
+        (0, (1i128 << w) - 1)
+    }
 }
 
 /// Evaluates `cvt.mode.dty.sty` on one lane.
 pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
     match (dty.is_float(), sty.is_float()) {
         (false, false) => {
-            let v: i128 = if sty.is_signed() { sty.extend(a) as i64 as i128 } else { (a & sty.mask()) as i128 };
+            let v: i128 = if sty.is_signed() {
+                sty.extend(a) as i64 as i128
+            } else {
+                (a & sty.mask()) as i128
+            };
             let v = if m.sat {
                 let (lo, hi) = int_range(dty);
                 v.clamp(lo, hi)
@@ -539,7 +721,11 @@ pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
             (v as u64) & dty.mask()
         }
         (false, true) => {
-            let x = if sty == Ty::F32 { in32(a, m.ftz) as f64 } else { f64::from_bits(a) };
+            let x = if sty == Ty::F32 {
+                in32(a, m.ftz) as f64
+            } else {
+                f64::from_bits(a)
+            };
             if x.is_nan() {
                 return 0;
             }
@@ -555,40 +741,85 @@ pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
             (v as u64) & dty.mask()
         }
         (true, false) => {
-            let v: i128 = if sty.is_signed() { sty.extend(a) as i64 as i128 } else { (a & sty.mask()) as i128 };
+            let v: i128 = if sty.is_signed() {
+                sty.extend(a) as i64 as i128
+            } else {
+                (a & sty.mask()) as i128
+            };
             if dty == Ty::F32 {
-                let r = if sty.is_signed() { v as i64 as f32 } else { v as u64 as f32 };
+                let r = if sty.is_signed() {
+                    v as i64 as f32
+                } else {
+                    v as u64 as f32
+                };
                 let err = v.cmp(&(r as i128));
                 let r = direct32(r, err, m.rnd);
                 out32(r, m)
             } else {
-                let r = if sty.is_signed() { v as i64 as f64 } else { v as u64 as f64 };
+                let r = if sty.is_signed() {
+                    v as i64 as f64
+                } else {
+                    v as u64 as f64
+                };
                 let err = v.cmp(&(r as i128));
                 out64(direct64(r, err, m.rnd), m)
             }
         }
         (true, true) => {
-            let int_round = matches!(m.rnd, Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi));
+            let int_round = matches!(
+                m.rnd,
+                Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi)
+            );
             match (dty, sty) {
                 (Ty::F32, Ty::F32) => {
                     let x = in32(a, m.ftz);
-                    let r = if int_round { round_int_f64(x as f64, m.rnd) as f32 } else { x };
+                    let r = if int_round {
+                        round_int_f64(x as f64, m.rnd) as f32
+                    } else {
+                        x
+                    };
                     out32(r, m)
                 }
                 (Ty::F64, Ty::F64) => {
                     let x = f64::from_bits(a);
-                    out64(if int_round { round_int_f64(x, m.rnd) } else { x }, m)
+                    out64(
+                        if int_round {
+                            round_int_f64(x, m.rnd)
+                        } else {
+                            x
+                        },
+                        m,
+                    )
                 }
                 (Ty::F64, Ty::F32) => {
                     let x = in32(a, m.ftz) as f64;
-                    out64(if int_round { round_int_f64(x, m.rnd) } else { x }, FloatMode { ftz: false, ..m })
+                    out64(
+                        if int_round {
+                            round_int_f64(x, m.rnd)
+                        } else {
+                            x
+                        },
+                        FloatMode { ftz: false, ..m },
+                    )
                 }
                 (Ty::F32, Ty::F64) => {
                     let x = f64::from_bits(a);
-                    let x = if int_round { round_int_f64(x, m.rnd) } else { x };
+                    let x = if int_round {
+                        round_int_f64(x, m.rnd)
+                    } else {
+                        x
+                    };
                     let r = x as f32;
-                    let err = if r.is_finite() { sign(x - r as f64) } else { err_vs(x, 0.0, r) };
-                    let r = if x.is_infinite() { r } else { direct32(r, err, m.rnd) };
+                    let err = if r.is_finite() {
+                        sign(x - r as f64)
+                    } else {
+                        err_vs(x, 0.0, r)
+                    };
+                    let r = if x.is_infinite() {
+                        r
+                    } else {
+                        direct32(r, err, m.rnd)
+                    };
                     out32(r, m)
                 }
                 _ => a,
@@ -603,31 +834,64 @@ pub fn atom(op: AtomOp, ty: Ty, old: u64, b: u64, c: u64) -> u64 {
     let r = match (op, ty) {
         (AtomOp::Add, Ty::F32) => {
             let s = ftz32(ftz32(f32of(old)) + ftz32(f32of(b)));
-            if s.is_nan() { NAN32 as u64 } else { s.to_bits() as u64 }
+            if s.is_nan() {
+                NAN32 as u64
+            } else {
+                s.to_bits() as u64
+            }
         }
         (AtomOp::Add, Ty::F64) => {
             let s = f64::from_bits(old) + f64::from_bits(b);
             if s.is_nan() { NAN64 } else { s.to_bits() }
         }
         (AtomOp::Add, _) => old.wrapping_add(b),
-        (AtomOp::Min | AtomOp::Max, Ty::F32 | Ty::F64) => {
-            arith(if op == AtomOp::Min { ArithOp::Min } else { ArithOp::Max }, ty, FloatMode::default(), old, b, 0)
-        }
+        (AtomOp::Min | AtomOp::Max, Ty::F32 | Ty::F64) => arith(
+            if op == AtomOp::Min {
+                ArithOp::Min
+            } else {
+                ArithOp::Max
+            },
+            ty,
+            FloatMode::default(),
+            old,
+            b,
+            0,
+        ),
         (AtomOp::Min, _) => {
-            if ty.is_signed() { (ty.extend(old) as i64).min(ty.extend(b) as i64) as u64 } else { (old & mask).min(b & mask) }
+            if ty.is_signed() {
+                (ty.extend(old) as i64).min(ty.extend(b) as i64) as u64
+            } else {
+                (old & mask).min(b & mask)
+            }
         }
         (AtomOp::Max, _) => {
-            if ty.is_signed() { (ty.extend(old) as i64).max(ty.extend(b) as i64) as u64 } else { (old & mask).max(b & mask) }
+            if ty.is_signed() {
+                (ty.extend(old) as i64).max(ty.extend(b) as i64) as u64
+            } else {
+                (old & mask).max(b & mask)
+            }
         }
         (AtomOp::Inc, _) => {
-            if (old & mask) >= (b & mask) { 0 } else { old + 1 }
+            if (old & mask) >= (b & mask) {
+                0
+            } else {
+                old + 1
+            }
         }
         (AtomOp::Dec, _) => {
-            if (old & mask) == 0 || (old & mask) > (b & mask) { b } else { old - 1 }
+            if (old & mask) == 0 || (old & mask) > (b & mask) {
+                b
+            } else {
+                old - 1
+            }
         }
         (AtomOp::Exch, _) => b,
         (AtomOp::Cas, _) => {
-            if (old & mask) == (b & mask) { c } else { old }
+            if (old & mask) == (b & mask) {
+                c
+            } else {
+                old
+            }
         }
         (AtomOp::And, _) => old & b,
         (AtomOp::Or, _) => old | b,
@@ -640,7 +904,12 @@ pub fn atom(op: AtomOp, ty: Ty, old: u64, b: u64, c: u64) -> u64 {
 mod tests {
     use super::*;
 
-    const M: FloatMode = FloatMode { rnd: None, ftz: false, sat: false, approx: false };
+    const M: FloatMode = FloatMode {
+        rnd: None,
+        ftz: false,
+        sat: false,
+        approx: false,
+    };
 
     fn f(x: f32) -> u64 {
         x.to_bits() as u64
@@ -651,7 +920,10 @@ mod tests {
         assert_eq!(arith(ArithOp::Shl, Ty::B32, M, 1, 32, 0), 0);
         assert_eq!(arith(ArithOp::Shl, Ty::B32, M, 1, 31, 0), 0x8000_0000);
         assert_eq!(arith(ArithOp::Shr, Ty::U32, M, 0x8000_0000, 40, 0), 0);
-        assert_eq!(arith(ArithOp::Shr, Ty::S32, M, 0x8000_0000, 40, 0), 0xFFFF_FFFF);
+        assert_eq!(
+            arith(ArithOp::Shr, Ty::S32, M, 0x8000_0000, 40, 0),
+            0xFFFF_FFFF
+        );
         assert_eq!(arith(ArithOp::Shr, Ty::S32, M, 0x4000_0000, 100, 0), 0);
     }
 
@@ -659,10 +931,22 @@ mod tests {
     fn division_edge_cases() {
         assert_eq!(arith(ArithOp::Div, Ty::U32, M, 7, 0, 0), 0xFFFF_FFFF);
         assert_eq!(arith(ArithOp::Rem, Ty::U32, M, 7, 0, 0), 7);
-        assert_eq!(arith(ArithOp::Div, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0), 0x8000_0000);
-        assert_eq!(arith(ArithOp::Rem, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0), 0);
-        assert_eq!(arith(ArithOp::Div, Ty::S32, M, (-7i32) as u32 as u64, 2, 0), (-3i32) as u32 as u64);
-        assert_eq!(arith(ArithOp::Rem, Ty::S32, M, (-7i32) as u32 as u64, 2, 0), (-1i32) as u32 as u64);
+        assert_eq!(
+            arith(ArithOp::Div, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0),
+            0x8000_0000
+        );
+        assert_eq!(
+            arith(ArithOp::Rem, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0),
+            0
+        );
+        assert_eq!(
+            arith(ArithOp::Div, Ty::S32, M, (-7i32) as u32 as u64, 2, 0),
+            (-3i32) as u32 as u64
+        );
+        assert_eq!(
+            arith(ArithOp::Rem, Ty::S32, M, (-7i32) as u32 as u64, 2, 0),
+            (-1i32) as u32 as u64
+        );
     }
 
     #[test]
@@ -688,13 +972,19 @@ mod tests {
 
     #[test]
     fn cvt_saturates_and_maps_nan_to_zero() {
-        let rzi = FloatMode { rnd: Some(Rounding::Rzi), ..M };
+        let rzi = FloatMode {
+            rnd: Some(Rounding::Rzi),
+            ..M
+        };
         assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(3e9)), 0x7FFF_FFFF);
         assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(-3e9)), 0x8000_0000);
         assert_eq!(cvt(Ty::U32, Ty::F32, rzi, f(-5.0)), 0);
         assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(f32::NAN)), 0);
         assert_eq!(cvt(Ty::U8, Ty::F32, rzi, f(300.0)), 255);
-        let rni = FloatMode { rnd: Some(Rounding::Rni), ..M };
+        let rni = FloatMode {
+            rnd: Some(Rounding::Rni),
+            ..M
+        };
         assert_eq!(cvt(Ty::S32, Ty::F32, rni, f(2.5)), 2);
         assert_eq!(cvt(Ty::S32, Ty::F32, rni, f(3.5)), 4);
         let sat = FloatMode { sat: true, ..M };
@@ -707,19 +997,37 @@ mod tests {
     #[test]
     fn cvt_directed_int_to_float() {
         let v = (1u64 << 24) + 1; // not representable in f32
-        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
-        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
+        let rz = FloatMode {
+            rnd: Some(Rounding::Rz),
+            ..M
+        };
+        let rp = FloatMode {
+            rnd: Some(Rounding::Rp),
+            ..M
+        };
         assert_eq!(cvt(Ty::F32, Ty::U32, rz, v), f(16777216.0));
         assert_eq!(cvt(Ty::F32, Ty::U32, rp, v), f(16777218.0));
-        let rm = FloatMode { rnd: Some(Rounding::Rm), ..M };
-        assert_eq!(cvt(Ty::F32, Ty::S32, rm, (-(v as i64)) as u64), f(-16777218.0));
+        let rm = FloatMode {
+            rnd: Some(Rounding::Rm),
+            ..M
+        };
+        assert_eq!(
+            cvt(Ty::F32, Ty::S32, rm, (-(v as i64)) as u64),
+            f(-16777218.0)
+        );
     }
 
     #[test]
     fn cvt_f64_to_f32_directed() {
         let x = 1.0f64 + 2f64.powi(-30);
-        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
-        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
+        let rp = FloatMode {
+            rnd: Some(Rounding::Rp),
+            ..M
+        };
+        let rz = FloatMode {
+            rnd: Some(Rounding::Rz),
+            ..M
+        };
         assert_eq!(cvt(Ty::F32, Ty::F64, rp, x.to_bits()), f(1.0f32.next_up()));
         assert_eq!(cvt(Ty::F32, Ty::F64, rz, x.to_bits()), f(1.0));
         assert_eq!(cvt(Ty::F32, Ty::F64, rz, 1e300f64.to_bits()), f(f32::MAX));
@@ -727,18 +1035,50 @@ mod tests {
 
     #[test]
     fn directed_add() {
-        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
-        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
+        let rz = FloatMode {
+            rnd: Some(Rounding::Rz),
+            ..M
+        };
+        let rp = FloatMode {
+            rnd: Some(Rounding::Rp),
+            ..M
+        };
         let tiny = 2f32.powi(-30);
         assert_eq!(arith(ArithOp::Add, Ty::F32, rz, f(1.0), f(tiny), 0), f(1.0));
-        assert_eq!(arith(ArithOp::Add, Ty::F32, rp, f(1.0), f(tiny), 0), f(1.0f32.next_up()));
-        assert_eq!(arith(ArithOp::Add, Ty::F32, rz, f(-1.0), f(-tiny), 0), f(-1.0));
+        assert_eq!(
+            arith(ArithOp::Add, Ty::F32, rp, f(1.0), f(tiny), 0),
+            f(1.0f32.next_up())
+        );
+        assert_eq!(
+            arith(ArithOp::Add, Ty::F32, rz, f(-1.0), f(-tiny), 0),
+            f(-1.0)
+        );
     }
 
     #[test]
     fn nan_results_are_canonical() {
-        assert_eq!(arith(ArithOp::Add, Ty::F32, M, f(f32::INFINITY), f(f32::NEG_INFINITY), 0), NAN32 as u64);
-        assert_eq!(arith(ArithOp::Mul, Ty::F64, M, 0f64.to_bits(), f64::INFINITY.to_bits(), 0), NAN64);
+        assert_eq!(
+            arith(
+                ArithOp::Add,
+                Ty::F32,
+                M,
+                f(f32::INFINITY),
+                f(f32::NEG_INFINITY),
+                0
+            ),
+            NAN32 as u64
+        );
+        assert_eq!(
+            arith(
+                ArithOp::Mul,
+                Ty::F64,
+                M,
+                0f64.to_bits(),
+                f64::INFINITY.to_bits(),
+                0
+            ),
+            NAN64
+        );
     }
 
     #[test]
@@ -750,20 +1090,69 @@ mod tests {
         assert_eq!(arith(ArithOp::Bfe, Ty::S32, M, 0xF0, 4, 4), 0xFFFF_FFFF);
         assert_eq!(arith(ArithOp::Bfe, Ty::U32, M, 0xF0, 4, 4), 0xF);
         assert_eq!(bfi(Ty::B32, 0xF, 0, 28, 8), 0xF000_0000);
-        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x3210), 0x4433_2211);
-        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x7654), 0x8877_6655);
-        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x0000_0080, 0, 0x8888), 0xFFFF_FFFF);
+        assert_eq!(
+            arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x3210),
+            0x4433_2211
+        );
+        assert_eq!(
+            arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x7654),
+            0x8877_6655
+        );
+        assert_eq!(
+            arith(ArithOp::Prmt, Ty::B32, M, 0x0000_0080, 0, 0x8888),
+            0xFFFF_FFFF
+        );
+    }
+
+    #[test]
+    fn funnel_shifts() {
+        assert_eq!(
+            arith(ArithOp::ShfLWrap, Ty::B32, M, 0x8000_0001, 0x8000_0001, 1),
+            0x0000_0003
+        );
+        assert_eq!(arith(ArithOp::ShfLWrap, Ty::B32, M, 0, 1, 33), 2);
+        assert_eq!(arith(ArithOp::ShfLClamp, Ty::B32, M, 0xAB, 1, 40), 0xAB);
+        assert_eq!(
+            arith(ArithOp::ShfRWrap, Ty::B32, M, 0x10, 0x1, 4),
+            0x1000_0001
+        );
+        assert_eq!(arith(ArithOp::ShfRClamp, Ty::B32, M, 0x10, 0x1, 99), 0x1);
     }
 
     #[test]
     fn mul_variants() {
-        assert_eq!(arith(ArithOp::MulHi, Ty::U32, M, 0xFFFF_FFFF, 0xFFFF_FFFF, 0), 0xFFFF_FFFE);
-        assert_eq!(arith(ArithOp::MulHi, Ty::S32, M, (-2i32) as u32 as u64, 3, 0), 0xFFFF_FFFF);
-        assert_eq!(arith(ArithOp::MulWide, Ty::S32, M, (-2i32) as u32 as u64, 3, 0), (-6i64) as u64);
-        assert_eq!(arith(ArithOp::MulWide, Ty::U32, M, 0xFFFF_FFFF, 2, 0), 0x1_FFFF_FFFE);
+        assert_eq!(
+            arith(ArithOp::MulHi, Ty::U32, M, 0xFFFF_FFFF, 0xFFFF_FFFF, 0),
+            0xFFFF_FFFE
+        );
+        assert_eq!(
+            arith(ArithOp::MulHi, Ty::S32, M, (-2i32) as u32 as u64, 3, 0),
+            0xFFFF_FFFF
+        );
+        assert_eq!(
+            arith(ArithOp::MulWide, Ty::S32, M, (-2i32) as u32 as u64, 3, 0),
+            (-6i64) as u64
+        );
+        assert_eq!(
+            arith(ArithOp::MulWide, Ty::U32, M, 0xFFFF_FFFF, 2, 0),
+            0x1_FFFF_FFFE
+        );
         assert_eq!(arith(ArithOp::Mul24Lo, Ty::U32, M, 0x0100_0003, 2, 0), 6);
-        assert_eq!(arith(ArithOp::Mul24Hi, Ty::U32, M, 0xFF_FFFF, 0xFF_FFFF, 0), 0xFFFF_FE00);
-        assert_eq!(arith(ArithOp::Add, Ty::S32, FloatMode { sat: true, ..M }, 0x7FFF_FFFF, 1, 0), 0x7FFF_FFFF);
+        assert_eq!(
+            arith(ArithOp::Mul24Hi, Ty::U32, M, 0xFF_FFFF, 0xFF_FFFF, 0),
+            0xFFFF_FE00
+        );
+        assert_eq!(
+            arith(
+                ArithOp::Add,
+                Ty::S32,
+                FloatMode { sat: true, ..M },
+                0x7FFF_FFFF,
+                1,
+                0
+            ),
+            0x7FFF_FFFF
+        );
     }
 
     #[test]
@@ -775,7 +1164,10 @@ mod tests {
         assert_eq!(atom(AtomOp::Dec, Ty::U32, 3, 5, 0), 2);
         assert_eq!(atom(AtomOp::Cas, Ty::B32, 3, 3, 9), 9);
         assert_eq!(atom(AtomOp::Cas, Ty::B32, 4, 3, 9), 4);
-        assert_eq!(atom(AtomOp::Min, Ty::S32, 5, (-1i32) as u32 as u64, 0), 0xFFFF_FFFF);
+        assert_eq!(
+            atom(AtomOp::Min, Ty::S32, 5, (-1i32) as u32 as u64, 0),
+            0xFFFF_FFFF
+        );
     }
 
     #[test]

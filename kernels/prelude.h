@@ -1,0 +1,118 @@
+// warplight's CUDA prelude: the CUDA keywords and device intrinsics that
+// kernels use, for clang-16 without the CUDA SDK. Under nvcc the SDK headers
+// provide the same names, and this file defines nothing.
+//
+// Every intrinsic keeps its CUDA name so one kernel source compiles with both
+// compilers. Each maps to a clang builtin that lowers to the named PTX.
+#pragma once
+
+#if !defined(__NVCC__)
+
+#define __device__ __attribute__((device))
+#define __global__ __attribute__((global))
+#define __host__ __attribute__((host))
+#define __shared__ __attribute__((shared))
+#define __constant__ __attribute__((constant))
+#define __forceinline__ __inline__ __attribute__((always_inline))
+#define __noinline__ __attribute__((noinline))
+
+// threadIdx, blockIdx, blockDim, gridDim, warpSize
+#include <__clang_cuda_builtin_vars.h>
+
+#define WL_DEV static __device__ __forceinline__
+
+// ---- warp votes and shuffles (vote.sync.*, shfl.sync.*) ----
+WL_DEV unsigned __ballot_sync(unsigned mask, int p) { return __nvvm_vote_ballot_sync(mask, p); }
+WL_DEV int __all_sync(unsigned mask, int p) { return __nvvm_vote_all_sync(mask, p); }
+WL_DEV int __any_sync(unsigned mask, int p) { return __nvvm_vote_any_sync(mask, p); }
+WL_DEV int __uni_sync(unsigned mask, int p) { return __nvvm_vote_uni_sync(mask, p); }
+WL_DEV unsigned __activemask() { return __nvvm_vote_ballot_sync(0xffffffffu, 1); }
+// c operand: clamp value in bits 0-4, segment mask in bits 8-12 (as CUDA computes it).
+WL_DEV int __shfl_sync(unsigned mask, int v, int lane, int width = 32) {
+  return __nvvm_shfl_sync_idx_i32(mask, v, lane, ((32 - width) << 8) | 0x1f);
+}
+WL_DEV int __shfl_up_sync(unsigned mask, int v, unsigned d, int width = 32) {
+  return __nvvm_shfl_sync_up_i32(mask, v, d, (32 - width) << 8);
+}
+WL_DEV int __shfl_down_sync(unsigned mask, int v, unsigned d, int width = 32) {
+  return __nvvm_shfl_sync_down_i32(mask, v, d, ((32 - width) << 8) | 0x1f);
+}
+WL_DEV int __shfl_xor_sync(unsigned mask, int v, int m, int width = 32) {
+  return __nvvm_shfl_sync_bfly_i32(mask, v, m, ((32 - width) << 8) | 0x1f);
+}
+WL_DEV float __shfl_sync(unsigned mask, float v, int lane, int width = 32) {
+  return __nvvm_shfl_sync_idx_f32(mask, v, lane, ((32 - width) << 8) | 0x1f);
+}
+WL_DEV float __shfl_down_sync(unsigned mask, float v, unsigned d, int width = 32) {
+  return __nvvm_shfl_sync_down_f32(mask, v, d, ((32 - width) << 8) | 0x1f);
+}
+WL_DEV float __shfl_xor_sync(unsigned mask, float v, int m, int width = 32) {
+  return __nvvm_shfl_sync_bfly_f32(mask, v, m, ((32 - width) << 8) | 0x1f);
+}
+
+// ---- atomics (atom.*) ----
+WL_DEV int atomicAdd(int *a, int v) { return __nvvm_atom_add_gen_i(a, v); }
+WL_DEV unsigned atomicAdd(unsigned *a, unsigned v) { return (unsigned)__nvvm_atom_add_gen_i((int *)a, (int)v); }
+WL_DEV float atomicAdd(float *a, float v) { return __nvvm_atom_add_gen_f(a, v); }
+WL_DEV int atomicMin(int *a, int v) { return __nvvm_atom_min_gen_i(a, v); }
+WL_DEV unsigned atomicMin(unsigned *a, unsigned v) { return __nvvm_atom_min_gen_ui(a, v); }
+WL_DEV int atomicMax(int *a, int v) { return __nvvm_atom_max_gen_i(a, v); }
+WL_DEV unsigned atomicMax(unsigned *a, unsigned v) { return __nvvm_atom_max_gen_ui(a, v); }
+WL_DEV unsigned atomicInc(unsigned *a, unsigned v) { return __nvvm_atom_inc_gen_ui(a, v); }
+WL_DEV unsigned atomicDec(unsigned *a, unsigned v) { return __nvvm_atom_dec_gen_ui(a, v); }
+WL_DEV int atomicExch(int *a, int v) { return __nvvm_atom_xchg_gen_i(a, v); }
+WL_DEV int atomicCAS(int *a, int c, int v) { return __nvvm_atom_cas_gen_i(a, c, v); }
+WL_DEV int atomicAnd(int *a, int v) { return __nvvm_atom_and_gen_i(a, v); }
+WL_DEV int atomicOr(int *a, int v) { return __nvvm_atom_or_gen_i(a, v); }
+WL_DEV int atomicXor(int *a, int v) { return __nvvm_atom_xor_gen_i(a, v); }
+
+// ---- memory ----
+WL_DEV float __ldg(const float *p) { return __nvvm_ldg_f(p); }
+WL_DEV int __ldg(const int *p) { return __nvvm_ldg_i(p); }
+WL_DEV unsigned __ldg(const unsigned *p) { return __nvvm_ldg_ui(p); }
+WL_DEV void __threadfence() { __nvvm_membar_gl(); }
+WL_DEV void __threadfence_block() { __nvvm_membar_cta(); }
+
+// ---- integer intrinsics ----
+WL_DEV int __popc(unsigned x) { return __builtin_popcount(x); }
+WL_DEV int __clz(int x) { return x == 0 ? 32 : __builtin_clz((unsigned)x); }
+WL_DEV unsigned __brev(unsigned x) { return __builtin_bitreverse32(x); }
+WL_DEV unsigned __umulhi(unsigned a, unsigned b) { return __nvvm_mulhi_ui(a, b); }
+WL_DEV int __mulhi(int a, int b) { return __nvvm_mulhi_i(a, b); }
+WL_DEV int __mul24(int a, int b) { return __nvvm_mul24_i(a, b); }
+WL_DEV unsigned __byte_perm(unsigned a, unsigned b, unsigned s) { return __nvvm_prmt(a, b, s); }
+
+// ---- float intrinsics ----
+WL_DEV float sqrtf(float x) { return __nvvm_sqrt_rn_f(x); }
+WL_DEV float rsqrtf(float x) { return __nvvm_rsqrt_approx_f(x); }
+WL_DEV float fminf(float a, float b) { return __nvvm_fmin_f(a, b); }
+WL_DEV float fmaxf(float a, float b) { return __nvvm_fmax_f(a, b); }
+WL_DEV float fabsf(float a) { return __nvvm_fabs_f(a); }
+WL_DEV float __fmaf_rn(float a, float b, float c) { return __nvvm_fma_rn_f(a, b, c); }
+WL_DEV float __fmul_rz(float a, float b) { return __nvvm_mul_rz_f(a, b); }
+WL_DEV float __fadd_rd(float a, float b) { return __nvvm_add_rm_f(a, b); }
+WL_DEV float __fadd_ru(float a, float b) { return __nvvm_add_rp_f(a, b); }
+WL_DEV float __frcp_rn(float a) { return __nvvm_rcp_rn_f(a); }
+WL_DEV float __sinf(float x) { return __nvvm_sin_approx_f(x); }
+WL_DEV float __cosf(float x) { return __nvvm_cos_approx_f(x); }
+WL_DEV float exp2f(float x) { return __nvvm_ex2_approx_f(x); }
+WL_DEV float __log2f(float x) { return __nvvm_lg2_approx_f(x); }
+WL_DEV float __saturatef(float x) { return __nvvm_saturate_f(x); }
+WL_DEV int __float2int_rn(float x) { return __nvvm_f2i_rn(x); }
+WL_DEV int __float2int_rz(float x) { return __nvvm_f2i_rz(x); }
+WL_DEV int __float2int_rd(float x) { return __nvvm_f2i_rm(x); }
+WL_DEV int __float2int_ru(float x) { return __nvvm_f2i_rp(x); }
+WL_DEV unsigned __float2uint_rz(float x) { return __nvvm_f2ui_rz(x); }
+WL_DEV float __int2float_rz(int x) { return __nvvm_i2f_rz(x); }
+WL_DEV float __uint2float_ru(unsigned x) { return __nvvm_ui2f_rp(x); }
+WL_DEV float __double2float_rd(double x) { return __nvvm_d2f_rm(x); }
+WL_DEV float __int_as_float(int x) { return __builtin_bit_cast(float, x); }
+WL_DEV int __float_as_int(float x) { return __builtin_bit_cast(int, x); }
+WL_DEV double __fma_rn(double a, double b, double c) { return __nvvm_fma_rn_d(a, b, c); }
+WL_DEV double sqrt(double x) { return __nvvm_sqrt_rn_d(x); }
+
+#endif // !__NVCC__
+
+// ---- warplight helpers, for both compilers ----
+// Global thread index of a 1-D launch.
+#define WL_TID (blockIdx.x * blockDim.x + threadIdx.x)
