@@ -3,31 +3,33 @@
 // the tests check against hand-derived numbers.
 #include "../prelude.h"
 
-// if/else on threadIdx.x % 2: both sides issue once per warp.
-extern "C" __global__ void if_else(int *out) {
-  int t = threadIdx.x;
-  int v;
+// if/else on threadIdx.x % 2: both sides issue once per warp. The sides store
+// to different arrays so that neither compiler turns the branch into a select.
+extern "C" __global__ void if_else(int *odd, int *even) {
+  int t = threadIdx.x, i = WL_TID;
   if (t % 2) {
-    v = t * 3;
+    odd[i] = t * 3;
+    odd[i + 1024] = t;
   } else {
-    v = t + 100;
+    even[i] = t + 100;
+    even[i + 1024] = -t;
   }
-  out[WL_TID] = v;
 }
 
-// Nested: quarter of lanes in the innermost branch.
-extern "C" __global__ void nested_if(int *out) {
-  int t = threadIdx.x;
-  int v = 0;
+// Nested: half the lanes take the outer branch, a quarter each inner side.
+extern "C" __global__ void nested_if(int *a, int *b, int *c) {
+  int t = threadIdx.x, i = WL_TID;
   if (t & 1) {
-    v = 1;
+    a[i] = 1;
+    a[i + 1024] = t;
     if (t & 2) {
-      v = 3;
+      b[i] = 3;
+      b[i + 1024] = t;
     } else {
-      v = 5;
+      c[i] = 5;
+      c[i + 1024] = t;
     }
   }
-  out[WL_TID] = v;
 }
 
 // Data-dependent loop with break and continue: thread t sums the odd numbers
@@ -51,12 +53,14 @@ extern "C" __global__ void early_return(int *out, int n) {
 }
 
 // A uniform branch (on a kernel parameter) never diverges.
-extern "C" __global__ void uniform_branch(int *out, int flag) {
+extern "C" __global__ void uniform_branch(int *yes, int *no, int flag) {
   int t = WL_TID;
   if (flag) {
-    out[t] = 1;
+    yes[t] = 1;
+    yes[t + 1024] = t;
   } else {
-    out[t] = 2;
+    no[t] = 2;
+    no[t + 1024] = t;
   }
 }
 
