@@ -65,7 +65,8 @@ fn nested_if_results_and_lane_counts() {
         let bufs: Vec<_> = (0..3).map(|_| dev.alloc_zeroed::<i32>(2048)).collect();
         let args: Vec<Arg> = bufs.iter().map(|b| Arg::Ptr(*b)).collect();
         let s = dev.launch(&m, "nested_if", LaunchConfig::linear(1, 96), &args).unwrap();
-        let (a, b, c) = (dev.read::<i32>(bufs[0], 2048), dev.read::<i32>(bufs[1], 2048), dev.read::<i32>(bufs[2], 2048));
+        let (a, b, c) =
+            (dev.read::<i32>(bufs[0], 2048), dev.read::<i32>(bufs[1], 2048), dev.read::<i32>(bufs[2], 2048));
         for t in 0..96usize {
             let ti = t as i32;
             assert_eq!(a[t], if t & 1 == 1 { 1 } else { 0 }, "{d:?} t={t}");
@@ -105,7 +106,9 @@ fn loop_with_break_and_continue() {
         let limits: Vec<i32> = (0..64).map(|t| (t * 7) % 40).collect();
         let lim = dev.alloc_from(&limits);
         let out = dev.alloc_zeroed::<i32>(64);
-        let s = dev.launch(&m, "loop_break_continue", LaunchConfig::linear(1, 64), &[Arg::Ptr(out), Arg::Ptr(lim)]).unwrap();
+        let s = dev
+            .launch(&m, "loop_break_continue", LaunchConfig::linear(1, 64), &[Arg::Ptr(out), Arg::Ptr(lim)])
+            .unwrap();
         let got = dev.read::<i32>(out, 64);
         for t in 0..64 {
             assert_eq!(got[t], loop_reference(limits[t]), "{d:?} t={t}");
@@ -141,7 +144,12 @@ fn uniform_branch_never_diverges() {
             let yes = dev.alloc_zeroed::<i32>(2048);
             let no = dev.alloc_zeroed::<i32>(2048);
             let s = dev
-                .launch(&m, "uniform_branch", LaunchConfig::linear(2, 64), &[Arg::Ptr(yes), Arg::Ptr(no), Arg::I32(flag)])
+                .launch(
+                    &m,
+                    "uniform_branch",
+                    LaunchConfig::linear(2, 64),
+                    &[Arg::Ptr(yes), Arg::Ptr(no), Arg::I32(flag)],
+                )
                 .unwrap();
             assert_eq!(s.totals.divergent_branches, 0);
             assert_eq!(s.totals.thread_instructions, 32 * s.totals.warp_instructions, "all lanes always active");

@@ -18,11 +18,7 @@ fn every_kernel_ptx_loads() {
     let mut files = Vec::new();
     ptx_files(Path::new("kernels"), &mut files);
     files.sort();
-    assert!(
-        files.len() >= 16,
-        "expected both dialects of the test kernels, found {}",
-        files.len()
-    );
+    assert!(files.len() >= 16, "expected both dialects of the test kernels, found {}", files.len());
     let mut errors = Vec::new();
     for f in &files {
         if let Err(e) = warplight::ptx::load_file(f) {

@@ -151,7 +151,8 @@ fn atomic_contention_hands_out_every_value_once() {
         let m = load(&mut dev, "atomics", d);
         let counter = dev.alloc_zeroed::<u32>(1);
         let seen = dev.alloc_zeroed::<u32>(1024);
-        let s = dev.launch(&m, "contention", LaunchConfig::linear(8, 128), &[Arg::Ptr(counter), Arg::Ptr(seen)]).unwrap();
+        let s =
+            dev.launch(&m, "contention", LaunchConfig::linear(8, 128), &[Arg::Ptr(counter), Arg::Ptr(seen)]).unwrap();
         assert_eq!(dev.read::<u32>(counter, 1)[0], 1024);
         let mut v = dev.read::<u32>(seen, 1024);
         // Deterministic order: CTA by CTA, warp by warp, lane by lane.
@@ -211,7 +212,8 @@ fn float_atomic_sum_is_reproducible() {
         for threads in [1, 2, 4] {
             let mut dev = device(threads);
             let m = load(&mut dev, "atomics", d);
-            let vals: Vec<f32> = (0..2048).map(|i| 1.0 / (i as f32 + 1.0) * if i % 3 == 0 { -1e3 } else { 1.0 }).collect();
+            let vals: Vec<f32> =
+                (0..2048).map(|i| 1.0 / (i as f32 + 1.0) * if i % 3 == 0 { -1e3 } else { 1.0 }).collect();
             let inb = dev.alloc_from(&vals);
             let sum = dev.alloc_zeroed::<f32>(1);
             dev.launch(&m, "float_sum", LaunchConfig::linear(16, 128), &[Arg::Ptr(sum), Arg::Ptr(inb)]).unwrap();
@@ -346,7 +348,8 @@ fn read_only_path_gather() {
         let idx: Vec<i32> = (0..64).map(|t| (t * 13) % 100).collect();
         let (ib, xb) = (dev.alloc_from(&input), dev.alloc_from(&idx));
         let out = dev.alloc_zeroed::<f32>(64);
-        dev.launch(&m, "ldg_gather", LaunchConfig::linear(2, 32), &[Arg::Ptr(out), Arg::Ptr(ib), Arg::Ptr(xb)]).unwrap();
+        dev.launch(&m, "ldg_gather", LaunchConfig::linear(2, 32), &[Arg::Ptr(out), Arg::Ptr(ib), Arg::Ptr(xb)])
+            .unwrap();
         let got = dev.read::<f32>(out, 64);
         for t in 0..64 {
             assert_eq!(got[t], input[idx[t] as usize]);

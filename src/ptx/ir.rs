@@ -276,117 +276,35 @@ pub enum Kind {
     /// `mov` of data (also `cvta` between equal windows is not this).
     Mov { d: Dst, a: Src },
     /// `mov.bN d, {a, b, ...}`: concatenate `parts` of `part_bits` each, lowest first.
-    Pack {
-        d: Dst,
-        parts: Vec<Src>,
-        part_bits: u32,
-    },
+    Pack { d: Dst, parts: Vec<Src>, part_bits: u32 },
     /// `mov.bN {a, b, ...}, s`: split.
-    Unpack {
-        ds: Vec<Dst>,
-        a: Src,
-        part_bits: u32,
-    },
+    Unpack { ds: Vec<Dst>, a: Src, part_bits: u32 },
     /// Arithmetic on `ty`.
-    Arith {
-        op: ArithOp,
-        ty: Ty,
-        mode: FloatMode,
-        d: Dst,
-        a: Src,
-        b: Src,
-        c: Src,
-    },
+    Arith { op: ArithOp, ty: Ty, mode: FloatMode, d: Dst, a: Src, b: Src, c: Src },
     /// `setp.cmp[.bool].ty p[|q], a, b[, c]`.
-    Setp {
-        cmp: Cmp,
-        ty: Ty,
-        p: PredId,
-        q: Option<PredId>,
-        a: Src,
-        b: Src,
-        comb: Option<(BoolOp, PredSrc)>,
-        ftz: bool,
-    },
+    Setp { cmp: Cmp, ty: Ty, p: PredId, q: Option<PredId>, a: Src, b: Src, comb: Option<(BoolOp, PredSrc)>, ftz: bool },
     /// `set.cmp[.bool].dty.sty d, a, b[, c]`.
-    Set {
-        cmp: Cmp,
-        dty: Ty,
-        sty: Ty,
-        d: Dst,
-        a: Src,
-        b: Src,
-        comb: Option<(BoolOp, PredSrc)>,
-        ftz: bool,
-    },
+    Set { cmp: Cmp, dty: Ty, sty: Ty, d: Dst, a: Src, b: Src, comb: Option<(BoolOp, PredSrc)>, ftz: bool },
     /// `bfi.ty d, a, b, c, e`: insert `e` bits of `a` into `b` at position `c`.
-    Bfi {
-        ty: Ty,
-        d: Dst,
-        a: Src,
-        b: Src,
-        c: Src,
-        e: Src,
-    },
+    Bfi { ty: Ty, d: Dst, a: Src, b: Src, c: Src, e: Src },
     /// `selp.ty d, a, b, p`.
     Selp { d: Dst, a: Src, b: Src, p: PredSrc },
     /// Predicate logic: `and/or/xor.pred d, a, b` (`op = None` with `b` ignored is `mov`/`not`).
-    PredLogic {
-        op: Option<BoolOp>,
-        d: PredId,
-        a: PredSrc,
-        b: PredSrc,
-    },
+    PredLogic { op: Option<BoolOp>, d: PredId, a: PredSrc, b: PredSrc },
     /// `cvt.[rnd][.ftz][.sat].dty.sty d, a`.
-    Cvt {
-        dty: Ty,
-        sty: Ty,
-        mode: FloatMode,
-        d: Dst,
-        a: Src,
-    },
+    Cvt { dty: Ty, sty: Ty, mode: FloatMode, d: Dst, a: Src },
     /// `cvta[.to].space.size d, a`.
-    Cvta {
-        to_generic: bool,
-        space: MemSpace,
-        d: Dst,
-        a: Src,
-    },
+    Cvta { to_generic: bool, space: MemSpace, d: Dst, a: Src },
     /// `ld`: `vec` elements of `ty` into `ds`.
-    Ld {
-        space: MemSpace,
-        ty: Ty,
-        ds: Vec<Dst>,
-        addr: Address,
-        nc: bool,
-        volatile: bool,
-    },
+    Ld { space: MemSpace, ty: Ty, ds: Vec<Dst>, addr: Address, nc: bool, volatile: bool },
     /// `st`: `vals` of `ty`.
-    St {
-        space: MemSpace,
-        ty: Ty,
-        vals: Vec<Src>,
-        addr: Address,
-        volatile: bool,
-    },
+    St { space: MemSpace, ty: Ty, vals: Vec<Src>, addr: Address, volatile: bool },
     /// `atom`/`red` (`d == None` for `red`).
-    Atom {
-        space: MemSpace,
-        op: AtomOp,
-        ty: Ty,
-        d: Option<Dst>,
-        addr: Address,
-        b: Src,
-        c: Src,
-    },
+    Atom { space: MemSpace, op: AtomOp, ty: Ty, d: Option<Dst>, addr: Address, b: Src, c: Src },
     /// `bra target` (an instruction index); `uni` as written.
     Bra { target: u32, uni: bool },
     /// `call` of a function: copy `args` (caller offset → callee offset, size) in, `rets` back.
-    Call {
-        func: u32,
-        args: Vec<(u32, u32, u32)>,
-        rets: Vec<(u32, u32, u32)>,
-    },
+    Call { func: u32, args: Vec<(u32, u32, u32)>, rets: Vec<(u32, u32, u32)> },
     /// `ret`
     Ret,
     /// `exit`
@@ -394,23 +312,9 @@ pub enum Kind {
     /// `bar.sync id[, count]` / `barrier.sync`.
     Bar { id: Src, count: Option<Src> },
     /// `vote.sync.mode`: a ballot writes `d`, the others write predicate `p`.
-    Vote {
-        mode: VoteMode,
-        d: Option<Dst>,
-        p: PredId,
-        a: PredSrc,
-        membermask: Src,
-    },
+    Vote { mode: VoteMode, d: Option<Dst>, p: PredId, a: PredSrc, membermask: Src },
     /// `shfl.sync.mode.b32 d[|p], a, b, c, membermask`.
-    Shfl {
-        mode: ShflMode,
-        d: Dst,
-        p: Option<PredId>,
-        a: Src,
-        b: Src,
-        c: Src,
-        membermask: Src,
-    },
+    Shfl { mode: ShflMode, d: Dst, p: Option<PredId>, a: Src, b: Src, c: Src, membermask: Src },
     /// `membar` / `fence`.
     Membar,
     /// An instruction with no effect in the model (`prefetch`, `pmevent`...).
@@ -556,18 +460,11 @@ pub struct Program {
 impl Program {
     /// Finds a kernel (an `.entry`) by name.
     pub fn kernel(&self, name: &str) -> Option<u32> {
-        self.functions
-            .iter()
-            .position(|f| f.is_entry && f.name == name)
-            .map(|i| i as u32)
+        self.functions.iter().position(|f| f.is_entry && f.name == name).map(|i| i as u32)
     }
 
     /// Names of all kernels.
     pub fn kernel_names(&self) -> Vec<&str> {
-        self.functions
-            .iter()
-            .filter(|f| f.is_entry)
-            .map(|f| f.name.as_str())
-            .collect()
+        self.functions.iter().filter(|f| f.is_entry).map(|f| f.name.as_str()).collect()
     }
 }

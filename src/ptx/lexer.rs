@@ -51,10 +51,7 @@ pub fn lex(src: &str) -> Result<Vec<Token>, (Pos, PtxErrorKind)> {
     let mut glued = false;
     while i < b.len() {
         let c = b[i];
-        let pos = Pos {
-            line,
-            col: (i - line_start + 1) as u32,
-        };
+        let pos = Pos { line, col: (i - line_start + 1) as u32 };
         if c == b'\n' {
             i += 1;
             line += 1;
@@ -100,7 +97,7 @@ pub fn lex(src: &str) -> Result<Vec<Token>, (Pos, PtxErrorKind)> {
                 i += 1;
             }
             Tok::Ident(src[start..i].to_string())
-        } else if c == b'.' && i + 1 < b.len() && is_ident_start(b[i + 1]) {
+        } else if c == b'.' && i + 1 < b.len() && (is_ident_start(b[i + 1]) || b[i + 1].is_ascii_digit()) {
             i += 1;
             while i < b.len() && is_ident_char(b[i]) {
                 i += 1;
@@ -133,10 +130,7 @@ pub fn lex(src: &str) -> Result<Vec<Token>, (Pos, PtxErrorKind)> {
             Tok::Punct(c as char)
         } else {
             let ch = src[i..].chars().next().unwrap_or('?');
-            return Err((
-                pos,
-                PtxErrorKind::Lex(format!("unexpected character {ch:?}")),
-            ));
+            return Err((pos, PtxErrorKind::Lex(format!("unexpected character {ch:?}"))));
         };
         out.push(Token { tok, pos, glued });
         glued = true;
@@ -162,18 +156,11 @@ fn lex_number(src: &str, i: &mut usize) -> Result<Tok, String> {
             let is_f = p == b'f' || p == b'F';
             let want = if is_f { 8 } else { 16 };
             if digits.len() != want {
-                return Err(format!(
-                    "float literal `{}` needs {want} hex digits",
-                    &src[start..end]
-                ));
+                return Err(format!("float literal `{}` needs {want} hex digits", &src[start..end]));
             }
-            let v = u64::from_str_radix(digits, 16)
-                .map_err(|_| format!("bad hex float literal `{}`", &src[start..end]))?;
-            return Ok(if is_f {
-                Tok::F32Bits(v as u32)
-            } else {
-                Tok::F64Bits(v)
-            });
+            let v =
+                u64::from_str_radix(digits, 16).map_err(|_| format!("bad hex float literal `{}`", &src[start..end]))?;
+            return Ok(if is_f { Tok::F32Bits(v as u32) } else { Tok::F64Bits(v) });
         }
         if p == b'x' || p == b'X' {
             let end = word_end(start + 2);
@@ -226,10 +213,7 @@ fn lex_number(src: &str, i: &mut usize) -> Result<Tok, String> {
     let text = &src[start..j];
     if is_float {
         *i = j;
-        return text
-            .parse::<f64>()
-            .map(Tok::Float)
-            .map_err(|_| format!("bad float literal `{text}`"));
+        return text.parse::<f64>().map(Tok::Float).map_err(|_| format!("bad float literal `{text}`"));
     }
     let mut end = j;
     if end < b.len() && (b[end] == b'U' || b[end] == b'u') {
@@ -237,13 +221,9 @@ fn lex_number(src: &str, i: &mut usize) -> Result<Tok, String> {
     }
     *i = end;
     if text.len() > 1 && text.starts_with('0') {
-        return u64::from_str_radix(&text[1..], 8)
-            .map(Tok::Int)
-            .map_err(|_| format!("bad octal literal `{text}`"));
+        return u64::from_str_radix(&text[1..], 8).map(Tok::Int).map_err(|_| format!("bad octal literal `{text}`"));
     }
-    text.parse::<u64>()
-        .map(Tok::Int)
-        .map_err(|_| format!("integer literal `{text}` out of range"))
+    text.parse::<u64>().map(Tok::Int).map_err(|_| format!("integer literal `{text}` out of range"))
 }
 
 #[cfg(test)]

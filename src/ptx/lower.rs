@@ -59,26 +59,21 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
     let mut module_syms: HashMap<String, Sym> = HashMap::new();
     let mut extern_shared = Vec::new();
     let mut shared_off: u64 = 0;
-    let mut place_shared =
-        |v: &ast::VarDecl, prog: &mut Program, extern_shared: &mut Vec<String>| -> LResult<u32> {
-            if v.is_extern || v.dims.iter().any(|d| d.is_none()) {
-                extern_shared.push(v.name.clone());
-                return Ok(u32::MAX);
-            }
-            let align = v.align.unwrap_or(v.ty.bytes()) as u64;
-            shared_off = align_up(shared_off, align);
-            let off = shared_off;
-            shared_off += v.size_bytes();
-            if shared_off > u32::MAX as u64 {
-                return invalid(v.pos, "shared memory too large");
-            }
-            prog.shared_vars.push(SharedVar {
-                name: v.name.clone(),
-                offset: off as u32,
-                size: v.size_bytes() as u32,
-            });
-            Ok(off as u32)
-        };
+    let mut place_shared = |v: &ast::VarDecl, prog: &mut Program, extern_shared: &mut Vec<String>| -> LResult<u32> {
+        if v.is_extern || v.dims.iter().any(|d| d.is_none()) {
+            extern_shared.push(v.name.clone());
+            return Ok(u32::MAX);
+        }
+        let align = v.align.unwrap_or(v.ty.bytes()) as u64;
+        shared_off = align_up(shared_off, align);
+        let off = shared_off;
+        shared_off += v.size_bytes();
+        if shared_off > u32::MAX as u64 {
+            return invalid(v.pos, "shared memory too large");
+        }
+        prog.shared_vars.push(SharedVar { name: v.name.clone(), offset: off as u32, size: v.size_bytes() as u32 });
+        Ok(off as u32)
+    };
     for v in &m.vars {
         match v.space {
             Space::Shared => {
@@ -127,11 +122,7 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
     prog.static_shared_size = shared_off as u32;
     let dyn_base = align_up(shared_off, 16) as u32;
     for name in &extern_shared {
-        prog.shared_vars.push(SharedVar {
-            name: name.clone(),
-            offset: dyn_base,
-            size: 0,
-        });
+        prog.shared_vars.push(SharedVar { name: name.clone(), offset: dyn_base, size: 0 });
     }
     let fix_extern = |off: u32| if off == u32::MAX { dyn_base } else { off };
     for s in module_syms.values_mut() {
@@ -220,13 +211,7 @@ fn init_bytes(v: &ast::VarDecl) -> LResult<Vec<u8>> {
             out.extend_from_slice(&bits.to_le_bytes()[..eb]);
         }
         if out.len() > size && size > 0 {
-            return invalid(
-                v.pos,
-                format!(
-                    "initializer of `{}` has more elements than the array",
-                    v.name
-                ),
-            );
+            return invalid(v.pos, format!("initializer of `{}` has more elements than the array", v.name));
         }
     }
     out.resize(size, 0);
@@ -253,35 +238,16 @@ fn signature(f: &ast::Function) -> LResult<Signature> {
         if v.space == Space::Reg {
             return unsupported(v.pos, ".reg parameters (use .param)");
         }
-        let size = v
-            .size_bytes()
-            .max(v.ty.bytes() as u64 * v.vector.unwrap_or(1) as u64);
-        let size = if v.dims.is_empty() {
-            v.ty.bytes() as u64 * v.vector.unwrap_or(1) as u64
-        } else {
-            size
-        };
+        let size = v.size_bytes().max(v.ty.bytes() as u64 * v.vector.unwrap_or(1) as u64);
+        let size = if v.dims.is_empty() { v.ty.bytes() as u64 * v.vector.unwrap_or(1) as u64 } else { size };
         let align = v.align.map(|a| a as u64).unwrap_or(v.ty.bytes() as u64);
         off = align_up(off, align);
-        let p = Param {
-            name: v.name.clone(),
-            ty: v.ty,
-            offset: off as u32,
-            size: size as u32,
-        };
+        let p = Param { name: v.name.clone(), ty: v.ty, offset: off as u32, size: size as u32 };
         off += size;
         Ok(p)
     };
-    let returns = f
-        .returns
-        .iter()
-        .map(&mut place)
-        .collect::<LResult<Vec<_>>>()?;
-    let params = f
-        .params
-        .iter()
-        .map(&mut place)
-        .collect::<LResult<Vec<_>>>()?;
+    let returns = f.returns.iter().map(&mut place).collect::<LResult<Vec<_>>>()?;
+    let params = f.params.iter().map(&mut place).collect::<LResult<Vec<_>>>()?;
     Ok(Signature {
         is_entry,
         has_body: f.body.is_some(),
@@ -492,14 +458,8 @@ impl<'a> FnLower<'a> {
             self.block(body)?;
             let needs_ret = !matches!(
                 self.out.insts.last(),
-                Some(Inst {
-                    guard: None,
-                    kind: Kind::Ret | Kind::Exit | Kind::Bra { .. }
-                })
-            ) || self
-                .labels
-                .values()
-                .any(|&i| i as usize == self.out.insts.len());
+                Some(Inst { guard: None, kind: Kind::Ret | Kind::Exit | Kind::Bra { .. } })
+            ) || self.labels.values().any(|&i| i as usize == self.out.insts.len());
             if needs_ret {
                 let pos = self.f.pos;
                 self.emit(Kind::Ret, None, pos, "ret".into(), InstClass::Control);
@@ -540,20 +500,12 @@ impl<'a> FnLower<'a> {
             match s {
                 Stmt::Decl(d) => self.decl(d)?,
                 Stmt::Label(name, pos) => {
-                    if self
-                        .labels
-                        .insert(name.clone(), self.out.insts.len() as u32)
-                        .is_some()
-                    {
+                    if self.labels.insert(name.clone(), self.out.insts.len() as u32).is_some() {
                         return invalid(*pos, format!("label `{name}` defined twice"));
                     }
                 }
                 Stmt::Loc { file, line, col } => {
-                    self.loc = self.file_ids.get(file).map(|&f| SrcLoc {
-                        file: f,
-                        line: *line,
-                        col: *col,
-                    });
+                    self.loc = self.file_ids.get(file).map(|&f| SrcLoc { file: f, line: *line, col: *col });
                 }
                 Stmt::Inst(i) => self.inst(i)?,
                 Stmt::Block(b) => {
@@ -609,11 +561,8 @@ impl<'a> FnLower<'a> {
                 let align = d.align.unwrap_or(d.ty.bytes()) as u64;
                 self.frame_param = align_up(self.frame_param, align);
                 let off = self.frame_param;
-                let size = if d.dims.is_empty() {
-                    d.ty.bytes() as u64 * d.vector.unwrap_or(1) as u64
-                } else {
-                    d.size_bytes()
-                };
+                let size =
+                    if d.dims.is_empty() { d.ty.bytes() as u64 * d.vector.unwrap_or(1) as u64 } else { d.size_bytes() };
                 self.frame_param += size;
                 self.declare(d.name.clone(), Sym::FrameParam(off as u32, size as u32));
             }
@@ -623,35 +572,16 @@ impl<'a> FnLower<'a> {
         Ok(())
     }
 
-    fn emit(
-        &mut self,
-        kind: Kind,
-        guard: Option<PredSrc>,
-        pos: Pos,
-        opcode: String,
-        class: InstClass,
-    ) {
+    fn emit(&mut self, kind: Kind, guard: Option<PredSrc>, pos: Pos, opcode: String, class: InstClass) {
         self.out.insts.push(Inst { guard, kind });
-        self.out.info.push(InstInfo {
-            ptx_line: pos.line,
-            ptx_col: pos.col,
-            src: self.loc,
-            opcode,
-            class,
-        });
+        self.out.info.push(InstInfo { ptx_line: pos.line, ptx_col: pos.col, src: self.loc, opcode, class });
     }
 
     fn dst(&self, op: &Operand, pos: Pos) -> LResult<Dst> {
         match op {
-            Operand::Name(n) if n == "_" => Ok(Dst {
-                reg: Dst::SINK,
-                mask: u64::MAX,
-            }),
+            Operand::Name(n) if n == "_" => Ok(Dst { reg: Dst::SINK, mask: u64::MAX }),
             Operand::Name(n) => match self.lookup(n) {
-                Some(Sym::Reg(id)) => Ok(Dst {
-                    reg: id,
-                    mask: self.out.reg_masks[id as usize],
-                }),
+                Some(Sym::Reg(id)) => Ok(Dst { reg: id, mask: self.out.reg_masks[id as usize] }),
                 Some(_) => invalid(pos, format!("`{n}` is not a data register")),
                 None => invalid(pos, format!("undeclared register `{n}`")),
             },
@@ -673,18 +603,11 @@ impl<'a> FnLower<'a> {
 
     fn pred_src(&self, op: &Operand, pos: Pos) -> LResult<PredSrc> {
         match op {
-            Operand::Not(n) => Ok(PredSrc {
-                reg: self.pred_dst(&Operand::Name(n.clone()), pos)?,
-                neg: true,
-            }),
-            Operand::Name(_) => Ok(PredSrc {
-                reg: self.pred_dst(op, pos)?,
-                neg: false,
-            }),
-            Operand::Lit(Literal::Int(v)) => Ok(PredSrc {
-                reg: if *v != 0 { PRED_TRUE } else { PRED_FALSE },
-                neg: false,
-            }),
+            Operand::Not(n) => Ok(PredSrc { reg: self.pred_dst(&Operand::Name(n.clone()), pos)?, neg: true }),
+            Operand::Name(_) => Ok(PredSrc { reg: self.pred_dst(op, pos)?, neg: false }),
+            Operand::Lit(Literal::Int(v)) => {
+                Ok(PredSrc { reg: if *v != 0 { PRED_TRUE } else { PRED_FALSE }, neg: false })
+            }
             _ => invalid(pos, "expected a predicate"),
         }
     }
@@ -704,6 +627,7 @@ impl<'a> FnLower<'a> {
                 Some(Sym::Func(_)) => unsupported(pos, format!("address of function `{n}`")),
                 None => match special_reg(n) {
                     Some(s) => Ok(Src::Special(s)),
+                    None if n.starts_with('%') => invalid(pos, format!("undeclared register `{n}`")),
                     None => invalid(pos, format!("undeclared name `{n}`")),
                 },
             },
@@ -718,13 +642,7 @@ impl<'a> FnLower<'a> {
             return invalid(pos, "expected an address `[...]`");
         };
         let Some(name) = base else {
-            return Ok((
-                Address {
-                    base: Src::Imm(0),
-                    offset: *off,
-                },
-                None,
-            ));
+            return Ok((Address { base: Src::Imm(0), offset: *off }, None));
         };
         let (b, space) = match self.lookup(name) {
             Some(Sym::Reg(id)) => (Src::Reg(id), None),
@@ -739,21 +657,11 @@ impl<'a> FnLower<'a> {
             }
             None => return invalid(pos, format!("undeclared name `{name}`")),
         };
-        Ok((
-            Address {
-                base: b,
-                offset: *off,
-            },
-            space,
-        ))
+        Ok((Address { base: b, offset: *off }, space))
     }
 
     fn mods(&self, i: &ast::Instruction) -> Mods {
-        let mut m = Mods {
-            types: Vec::new(),
-            space: None,
-            words: Vec::new(),
-        };
+        let mut m = Mods { types: Vec::new(), space: None, words: Vec::new() };
         for w in &i.mods {
             if let Some(t) = Ty::parse(w) {
                 m.types.push(t);
@@ -768,14 +676,7 @@ impl<'a> FnLower<'a> {
 
     fn operands(&self, i: &ast::Instruction, n: usize) -> LResult<()> {
         if i.operands.len() != n {
-            return invalid(
-                i.pos,
-                format!(
-                    "`{}` takes {n} operands, found {}",
-                    i.full_opcode(),
-                    i.operands.len()
-                ),
-            );
+            return invalid(i.pos, format!("`{}` takes {n} operands, found {}", i.full_opcode(), i.operands.len()));
         }
         Ok(())
     }
@@ -784,10 +685,7 @@ impl<'a> FnLower<'a> {
         match m.types.as_slice() {
             [t] => Ok(*t),
             [] => invalid(i.pos, format!("`{}` needs a type", i.full_opcode())),
-            _ => invalid(
-                i.pos,
-                format!("`{}` has more than one type", i.full_opcode()),
-            ),
+            _ => invalid(i.pos, format!("`{}` has more than one type", i.full_opcode())),
         }
     }
 
@@ -810,13 +708,8 @@ impl<'a> FnLower<'a> {
         Ok(match (declared, sym_space) {
             (MemSpace::KernelParam, Some(MemSpace::FrameParam)) => MemSpace::FrameParam,
             (MemSpace::Generic, Some(s)) => s,
-            (d, Some(s))
-                if d != s && !(d == MemSpace::FrameParam && s == MemSpace::KernelParam) =>
-            {
-                return invalid(
-                    pos,
-                    format!("symbol of the {s:?} space used with a {d:?} access"),
-                );
+            (d, Some(s)) if d != s && !(d == MemSpace::FrameParam && s == MemSpace::KernelParam) => {
+                return invalid(pos, format!("symbol of the {s:?} space used with a {d:?} access"));
             }
             (d, _) => d,
         })
@@ -826,10 +719,7 @@ impl<'a> FnLower<'a> {
         let pos = i.pos;
         let guard = match &i.guard {
             None => None,
-            Some((neg, n)) => Some(PredSrc {
-                reg: self.pred_dst(&Operand::Name(n.clone()), pos)?,
-                neg: *neg,
-            }),
+            Some((neg, n)) => Some(PredSrc { reg: self.pred_dst(&Operand::Name(n.clone()), pos)?, neg: *neg }),
         };
         let m = self.mods(i);
         let full = i.full_opcode();
@@ -837,9 +727,7 @@ impl<'a> FnLower<'a> {
         let op = i.opcode.as_str();
         let class = match op {
             "ld" | "st" | "atom" | "red" => InstClass::Memory,
-            "bra" | "call" | "ret" | "exit" | "bar" | "barrier" | "membar" | "fence" | "trap" => {
-                InstClass::Control
-            }
+            "bra" | "call" | "ret" | "exit" | "bar" | "barrier" | "membar" | "fence" | "trap" => InstClass::Control,
             "vote" | "shfl" | "activemask" => InstClass::Warp,
             "sqrt" | "rsqrt" | "rcp" | "sin" | "cos" | "ex2" | "lg2" => InstClass::Sfu,
             _ => InstClass::Alu,
@@ -854,40 +742,20 @@ impl<'a> FnLower<'a> {
                         op: None,
                         d: self.pred_dst(&ops[0], pos)?,
                         a: self.pred_src(&ops[1], pos)?,
-                        b: PredSrc {
-                            reg: PRED_FALSE,
-                            neg: false,
-                        },
+                        b: PredSrc { reg: PRED_FALSE, neg: false },
                     }
                 } else if let Operand::Vector(parts) = &ops[1] {
                     let part_bits = t.bits() / parts.len() as u32;
                     let pt = part_ty(part_bits, pos)?;
-                    let parts = parts
-                        .iter()
-                        .map(|p| self.src(p, pt, pos))
-                        .collect::<LResult<Vec<_>>>()?;
-                    Kind::Pack {
-                        d: self.dst(&ops[0], pos)?,
-                        parts,
-                        part_bits,
-                    }
+                    let parts = parts.iter().map(|p| self.src(p, pt, pos)).collect::<LResult<Vec<_>>>()?;
+                    Kind::Pack { d: self.dst(&ops[0], pos)?, parts, part_bits }
                 } else if let Operand::Vector(ds) = &ops[0] {
                     let part_bits = t.bits() / ds.len() as u32;
                     part_ty(part_bits, pos)?;
-                    let ds = ds
-                        .iter()
-                        .map(|d| self.dst(d, pos))
-                        .collect::<LResult<Vec<_>>>()?;
-                    Kind::Unpack {
-                        ds,
-                        a: self.src(&ops[1], t, pos)?,
-                        part_bits,
-                    }
+                    let ds = ds.iter().map(|d| self.dst(d, pos)).collect::<LResult<Vec<_>>>()?;
+                    Kind::Unpack { ds, a: self.src(&ops[1], t, pos)?, part_bits }
                 } else {
-                    Kind::Mov {
-                        d: self.dst(&ops[0], pos)?,
-                        a: self.src(&ops[1], t, pos)?,
-                    }
+                    Kind::Mov { d: self.dst(&ops[0], pos)?, a: self.src(&ops[1], t, pos)? }
                 }
             }
             "and" | "or" | "xor" | "not" | "cnot" if m.types.first() == Some(&Ty::Pred) => {
@@ -896,23 +764,17 @@ impl<'a> FnLower<'a> {
                 self.operands(i, n)?;
                 let d = self.pred_dst(&ops[0], pos)?;
                 let mut a = self.pred_src(&ops[1], pos)?;
-                let b = if n == 3 {
-                    self.pred_src(&ops[2], pos)?
-                } else {
-                    PredSrc {
-                        reg: PRED_FALSE,
-                        neg: false,
-                    }
-                };
+                let b = if n == 3 { self.pred_src(&ops[2], pos)? } else { PredSrc { reg: PRED_FALSE, neg: false } };
                 if op == "not" {
                     a.neg = !a.neg;
                 }
                 Kind::PredLogic { op: bop, d, a, b }
             }
-            "add" | "sub" | "mul" | "mad" | "fma" | "mul24" | "mad24" | "div" | "rem" | "abs"
-            | "neg" | "min" | "max" | "and" | "or" | "xor" | "not" | "cnot" | "shl" | "shr"
-            | "shf" | "popc" | "clz" | "brev" | "bfe" | "prmt" | "sqrt" | "rsqrt" | "rcp"
-            | "sin" | "cos" | "ex2" | "lg2" | "copysign" => self.arith(i, &m, &full)?,
+            "add" | "sub" | "mul" | "mad" | "fma" | "mul24" | "mad24" | "div" | "rem" | "abs" | "neg" | "min"
+            | "max" | "and" | "or" | "xor" | "not" | "cnot" | "shl" | "shr" | "shf" | "popc" | "clz" | "brev"
+            | "bfe" | "prmt" | "sqrt" | "rsqrt" | "rcp" | "sin" | "cos" | "ex2" | "lg2" | "copysign" => {
+                self.arith(i, &m, &full)?
+            }
             "bfi" => {
                 self.operands(i, 5)?;
                 m.only(&[], pos, &full)?;
@@ -968,27 +830,9 @@ impl<'a> FnLower<'a> {
                         ),
                         o => (self.pred_dst(o, pos)?, None),
                     };
-                    Kind::Setp {
-                        cmp,
-                        ty: sty,
-                        p,
-                        q,
-                        a,
-                        b,
-                        comb,
-                        ftz,
-                    }
+                    Kind::Setp { cmp, ty: sty, p, q, a, b, comb, ftz }
                 } else {
-                    Kind::Set {
-                        cmp,
-                        dty,
-                        sty,
-                        d: self.dst(&ops[0], pos)?,
-                        a,
-                        b,
-                        comb,
-                        ftz,
-                    }
+                    Kind::Set { cmp, dty, sty, d: self.dst(&ops[0], pos)?, a, b, comb, ftz }
                 }
             }
             "selp" => {
@@ -1013,31 +857,14 @@ impl<'a> FnLower<'a> {
                 if *dty == Ty::F16 || *sty == Ty::F16 {
                     return unsupported(pos, format!("{full} (.f16)"));
                 }
-                let mode = FloatMode {
-                    rnd: m.rounding(),
-                    ftz: m.has("ftz"),
-                    sat: m.has("sat"),
-                    approx: false,
-                };
+                let mode = FloatMode { rnd: m.rounding(), ftz: m.has("ftz"), sat: m.has("sat"), approx: false };
                 if dty.is_float()
                     && sty.is_int()
-                    && matches!(
-                        mode.rnd,
-                        Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi)
-                    )
+                    && matches!(mode.rnd, Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi))
                 {
-                    return invalid(
-                        pos,
-                        "integer rounding modifier on an int-to-float conversion",
-                    );
+                    return invalid(pos, "integer rounding modifier on an int-to-float conversion");
                 }
-                Kind::Cvt {
-                    dty: *dty,
-                    sty: *sty,
-                    mode,
-                    d: self.dst(&ops[0], pos)?,
-                    a: self.src(&ops[1], *sty, pos)?,
-                }
+                Kind::Cvt { dty: *dty, sty: *sty, mode, d: self.dst(&ops[0], pos)?, a: self.src(&ops[1], *sty, pos)? }
             }
             "cvta" => {
                 self.operands(i, 2)?;
@@ -1052,12 +879,7 @@ impl<'a> FnLower<'a> {
                     Some(Space::Param) => MemSpace::KernelParam,
                     _ => return invalid(pos, "`cvta` needs a state space"),
                 };
-                Kind::Cvta {
-                    to_generic: !to,
-                    space,
-                    d: self.dst(&ops[0], pos)?,
-                    a: self.src(&ops[1], t, pos)?,
-                }
+                Kind::Cvta { to_generic: !to, space, d: self.dst(&ops[0], pos)?, a: self.src(&ops[1], t, pos)? }
             }
             "ld" | "st" => {
                 self.operands(i, 2)?;
@@ -1095,11 +917,7 @@ impl<'a> FnLower<'a> {
                 m.only(&allowed, pos, &full)?;
                 let t = self.one_type(i, &m)?;
                 let vec = m.vec() as usize;
-                let (addr_op, val_op) = if op == "ld" {
-                    (&ops[1], &ops[0])
-                } else {
-                    (&ops[0], &ops[1])
-                };
+                let (addr_op, val_op) = if op == "ld" { (&ops[1], &ops[0]) } else { (&ops[0], &ops[1]) };
                 let (addr, sym_space) = self.address(addr_op, pos)?;
                 let space = self.mem_space(&m, sym_space, pos)?;
                 let vals: Vec<&Operand> = match val_op {
@@ -1107,38 +925,15 @@ impl<'a> FnLower<'a> {
                     o => vec![o],
                 };
                 if vals.len() != vec {
-                    return invalid(
-                        pos,
-                        format!("`{full}` moves {vec} value(s), found {}", vals.len()),
-                    );
+                    return invalid(pos, format!("`{full}` moves {vec} value(s), found {}", vals.len()));
                 }
-                let volatile =
-                    m.has("volatile") || m.has("relaxed") || m.has("acquire") || m.has("release");
+                let volatile = m.has("volatile") || m.has("relaxed") || m.has("acquire") || m.has("release");
                 if op == "ld" {
-                    let ds = vals
-                        .iter()
-                        .map(|v| self.dst(v, pos))
-                        .collect::<LResult<Vec<_>>>()?;
-                    Kind::Ld {
-                        space,
-                        ty: t,
-                        ds,
-                        addr,
-                        nc: m.has("nc"),
-                        volatile,
-                    }
+                    let ds = vals.iter().map(|v| self.dst(v, pos)).collect::<LResult<Vec<_>>>()?;
+                    Kind::Ld { space, ty: t, ds, addr, nc: m.has("nc"), volatile }
                 } else {
-                    let vs = vals
-                        .iter()
-                        .map(|v| self.src(v, t, pos))
-                        .collect::<LResult<Vec<_>>>()?;
-                    Kind::St {
-                        space,
-                        ty: t,
-                        vals: vs,
-                        addr,
-                        volatile,
-                    }
+                    let vs = vals.iter().map(|v| self.src(v, t, pos)).collect::<LResult<Vec<_>>>()?;
+                    Kind::St { space, ty: t, vals: vs, addr, volatile }
                 }
             }
             "atom" | "red" => {
@@ -1155,8 +950,7 @@ impl<'a> FnLower<'a> {
                         "and" => AtomOp::And,
                         "or" => AtomOp::Or,
                         "xor" => AtomOp::Xor,
-                        "relaxed" | "acquire" | "release" | "acq_rel" | "cta" | "gpu" | "sys"
-                        | "noftz" => continue,
+                        "relaxed" | "acquire" | "release" | "acq_rel" | "cta" | "gpu" | "sys" | "noftz" => continue,
                         _ => return unsupported(pos, format!("{full} (modifier .{w})")),
                     };
                     aop = Some(o);
@@ -1174,35 +968,13 @@ impl<'a> FnLower<'a> {
                 let k = usize::from(has_d);
                 let (addr, sym_space) = self.address(&ops[k], pos)?;
                 let space = self.mem_space(&m, sym_space, pos)?;
-                if !matches!(
-                    space,
-                    MemSpace::Global | MemSpace::Shared | MemSpace::Generic
-                ) {
-                    return invalid(
-                        pos,
-                        "atomics work on global, shared or generic addresses only",
-                    );
+                if !matches!(space, MemSpace::Global | MemSpace::Shared | MemSpace::Generic) {
+                    return invalid(pos, "atomics work on global, shared or generic addresses only");
                 }
                 let b = self.src(&ops[k + 1], t, pos)?;
-                let c = if aop == AtomOp::Cas {
-                    self.src(&ops[k + 2], t, pos)?
-                } else {
-                    Src::Imm(0)
-                };
-                let d = if has_d {
-                    Some(self.dst(&ops[0], pos)?)
-                } else {
-                    None
-                };
-                Kind::Atom {
-                    space,
-                    op: aop,
-                    ty: t,
-                    d,
-                    addr,
-                    b,
-                    c,
-                }
+                let c = if aop == AtomOp::Cas { self.src(&ops[k + 2], t, pos)? } else { Src::Imm(0) };
+                let d = if has_d { Some(self.dst(&ops[0], pos)?) } else { None };
+                Kind::Atom { space, op: aop, ty: t, d, addr, b, c }
             }
             "bra" => {
                 self.operands(i, 1)?;
@@ -1211,10 +983,7 @@ impl<'a> FnLower<'a> {
                     return invalid(pos, "`bra` needs a label");
                 };
                 self.fixups.push((self.out.insts.len(), l.clone(), pos));
-                Kind::Bra {
-                    target: u32::MAX,
-                    uni: m.has("uni"),
-                }
+                Kind::Bra { target: u32::MAX, uni: m.has("uni") }
             }
             "call" => {
                 m.only(&["uni"], pos, &full)?;
@@ -1222,11 +991,7 @@ impl<'a> FnLower<'a> {
             }
             "ret" => {
                 m.only(&["uni"], pos, &full)?;
-                if self.sigs[self.me].is_entry {
-                    Kind::Exit
-                } else {
-                    Kind::Ret
-                }
+                if self.sigs[self.me].is_entry { Kind::Exit } else { Kind::Ret }
             }
             "exit" => Kind::Exit,
             "trap" => Kind::Trap,
@@ -1239,17 +1004,10 @@ impl<'a> FnLower<'a> {
                         return unsupported(pos, full.clone());
                     }
                     if ops.is_empty() || ops.len() > 2 {
-                        return invalid(
-                            pos,
-                            format!("`{full}` takes a barrier id and an optional thread count"),
-                        );
+                        return invalid(pos, format!("`{full}` takes a barrier id and an optional thread count"));
                     }
                     let id = self.src(&ops[0], Ty::U32, pos)?;
-                    let count = if ops.len() == 2 {
-                        Some(self.src(&ops[1], Ty::U32, pos)?)
-                    } else {
-                        None
-                    };
+                    let count = if ops.len() == 2 { Some(self.src(&ops[1], Ty::U32, pos)?) } else { None };
                     Kind::Bar { id, count }
                 }
             }
@@ -1268,28 +1026,12 @@ impl<'a> FnLower<'a> {
                 };
                 let sync = m.has("sync");
                 self.operands(i, if sync { 3 } else { 2 })?;
-                let membermask = if sync {
-                    self.src(&ops[2], Ty::U32, pos)?
-                } else {
-                    Src::Imm(u32::MAX as u64)
-                };
+                let membermask = if sync { self.src(&ops[2], Ty::U32, pos)? } else { Src::Imm(u32::MAX as u64) };
                 let a = self.pred_src(&ops[1], pos)?;
                 if mode == VoteMode::Ballot {
-                    Kind::Vote {
-                        mode,
-                        d: Some(self.dst(&ops[0], pos)?),
-                        p: PRED_FALSE,
-                        a,
-                        membermask,
-                    }
+                    Kind::Vote { mode, d: Some(self.dst(&ops[0], pos)?), p: PRED_FALSE, a, membermask }
                 } else {
-                    Kind::Vote {
-                        mode,
-                        d: None,
-                        p: self.pred_dst(&ops[0], pos)?,
-                        a,
-                        membermask,
-                    }
+                    Kind::Vote { mode, d: None, p: self.pred_dst(&ops[0], pos)?, a, membermask }
                 }
             }
             "activemask" => {
@@ -1298,10 +1040,7 @@ impl<'a> FnLower<'a> {
                     mode: VoteMode::Ballot,
                     d: Some(self.dst(&ops[0], pos)?),
                     p: PRED_FALSE,
-                    a: PredSrc {
-                        reg: PRED_TRUE,
-                        neg: false,
-                    },
+                    a: PredSrc { reg: PRED_TRUE, neg: false },
                     membermask: Src::Imm(u32::MAX as u64),
                 }
             }
@@ -1334,11 +1073,7 @@ impl<'a> FnLower<'a> {
                     a: self.src(&ops[1], Ty::B32, pos)?,
                     b: self.src(&ops[2], Ty::U32, pos)?,
                     c: self.src(&ops[3], Ty::U32, pos)?,
-                    membermask: if sync {
-                        self.src(&ops[4], Ty::U32, pos)?
-                    } else {
-                        Src::Imm(u32::MAX as u64)
-                    },
+                    membermask: if sync { self.src(&ops[4], Ty::U32, pos)? } else { Src::Imm(u32::MAX as u64) },
                 }
             }
             "membar" | "fence" => Kind::Membar,
@@ -1379,10 +1114,7 @@ impl<'a> FnLower<'a> {
             return invalid(pos, format!("`{fname}` is a kernel and cannot be called"));
         }
         if !callee.has_body {
-            return unsupported(
-                pos,
-                format!("call of `{fname}`, which has no body in this module"),
-            );
+            return unsupported(pos, format!("call of `{fname}`, which has no body in this module"));
         }
         if args.len() != callee.params.len() || rets.len() != callee.returns.len() {
             return invalid(
@@ -1401,10 +1133,7 @@ impl<'a> FnLower<'a> {
             match o {
                 Operand::Name(n) => match self.lookup(n) {
                     Some(Sym::FrameParam(off, size)) => Ok((off, size)),
-                    _ => unsupported(
-                        pos,
-                        format!("call argument `{n}` that is not a .param variable"),
-                    ),
+                    _ => unsupported(pos, format!("call argument `{n}` that is not a .param variable")),
                 },
                 _ => unsupported(pos, "call argument that is not a .param variable"),
             }
@@ -1419,11 +1148,7 @@ impl<'a> FnLower<'a> {
             let (off, size) = param_var(o)?;
             r.push((p.offset, off, size.min(p.size)));
         }
-        Ok(Kind::Call {
-            func: fidx as u32,
-            args: a,
-            rets: r,
-        })
+        Ok(Kind::Call { func: fidx as u32, args: a, rets: r })
     }
 
     fn arith(&self, i: &ast::Instruction, m: &Mods, full: &str) -> LResult<Kind> {
@@ -1464,25 +1189,11 @@ impl<'a> FnLower<'a> {
             }
             "mul24" => {
                 words_ok(&["lo", "hi"])?;
-                (
-                    if m.has("hi") {
-                        ArithOp::Mul24Hi
-                    } else {
-                        ArithOp::Mul24Lo
-                    },
-                    2,
-                )
+                (if m.has("hi") { ArithOp::Mul24Hi } else { ArithOp::Mul24Lo }, 2)
             }
             "mad24" => {
                 words_ok(&["lo", "hi"])?;
-                (
-                    if m.has("hi") {
-                        ArithOp::Mad24Hi
-                    } else {
-                        ArithOp::Mad24Lo
-                    },
-                    3,
-                )
+                (if m.has("hi") { ArithOp::Mad24Hi } else { ArithOp::Mad24Lo }, 3)
             }
             "div" => (ArithOp::Div, 2),
             "rem" => (ArithOp::Rem, 2),
@@ -1533,12 +1244,7 @@ impl<'a> FnLower<'a> {
         if t.is_float() && t != Ty::F32 && t != Ty::F64 {
             return unsupported(pos, format!("{full} (.{t})"));
         }
-        if t.is_float()
-            && matches!(
-                aop,
-                ArithOp::MulHi | ArithOp::MulWide | ArithOp::MadHi | ArithOp::MadWide
-            )
-        {
+        if t.is_float() && matches!(aop, ArithOp::MulHi | ArithOp::MulWide | ArithOp::MadHi | ArithOp::MadWide) {
             return invalid(pos, format!("`{full}`: .hi/.wide apply to integers"));
         }
         let mode = FloatMode {
@@ -1552,10 +1258,7 @@ impl<'a> FnLower<'a> {
             match (aop, k) {
                 (ArithOp::Shl | ArithOp::Shr, 1) => Ty::U32,
                 (ArithOp::Bfe, 1 | 2) => Ty::U32,
-                (
-                    ArithOp::ShfLWrap | ArithOp::ShfLClamp | ArithOp::ShfRWrap | ArithOp::ShfRClamp,
-                    2,
-                ) => Ty::U32,
+                (ArithOp::ShfLWrap | ArithOp::ShfLClamp | ArithOp::ShfRWrap | ArithOp::ShfRClamp, 2) => Ty::U32,
                 (ArithOp::MadWide, 2) => wide_of(t),
                 (ArithOp::Prmt, _) => Ty::B32,
                 _ => t,
@@ -1566,15 +1269,7 @@ impl<'a> FnLower<'a> {
             s[k] = self.src(&ops[k + 1], src_ty(k), pos)?;
         }
         let d = self.dst(&ops[0], pos)?;
-        Ok(Kind::Arith {
-            op: aop,
-            ty: t,
-            mode,
-            d,
-            a: s[0],
-            b: s[1],
-            c: s[2],
-        })
+        Ok(Kind::Arith { op: aop, ty: t, mode, d, a: s[0], b: s[1], c: s[2] })
     }
 }
 

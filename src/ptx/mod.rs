@@ -24,10 +24,7 @@ pub fn load(src: &str, name: &str) -> PtxResult<Program> {
     let wrap = |(pos, kind): (Pos, PtxErrorKind)| PtxError {
         file: name.to_string(),
         pos,
-        line_text: src
-            .lines()
-            .nth(pos.line.saturating_sub(1) as usize)
-            .map(|l| l.trim().to_string()),
+        line_text: src.lines().nth(pos.line.saturating_sub(1) as usize).map(|l| l.trim().to_string()),
         kind,
     };
     let toks = lexer::lex(src).map_err(wrap)?;

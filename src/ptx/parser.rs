@@ -7,6 +7,74 @@ use super::types::{Space, Ty};
 
 type PResult<T> = Result<T, (Pos, PtxErrorKind)>;
 
+/// Opcodes the lowering decodes; a syntax error in any other instruction is
+/// reported as that instruction being unsupported.
+pub const KNOWN_OPCODES: &[&str] = &[
+    "mov",
+    "add",
+    "sub",
+    "mul",
+    "mad",
+    "fma",
+    "mul24",
+    "mad24",
+    "div",
+    "rem",
+    "abs",
+    "neg",
+    "min",
+    "max",
+    "and",
+    "or",
+    "xor",
+    "not",
+    "cnot",
+    "shl",
+    "shr",
+    "shf",
+    "popc",
+    "clz",
+    "brev",
+    "bfe",
+    "bfi",
+    "prmt",
+    "sqrt",
+    "rsqrt",
+    "rcp",
+    "sin",
+    "cos",
+    "ex2",
+    "lg2",
+    "copysign",
+    "setp",
+    "set",
+    "selp",
+    "cvt",
+    "cvta",
+    "ld",
+    "st",
+    "atom",
+    "red",
+    "bra",
+    "call",
+    "ret",
+    "exit",
+    "trap",
+    "bar",
+    "barrier",
+    "vote",
+    "activemask",
+    "shfl",
+    "membar",
+    "fence",
+    "prefetch",
+    "prefetchu",
+    "pmevent",
+    "nanosleep",
+    "brkpt",
+    "nop",
+];
+
 /// Parses a token stream into a module.
 pub fn parse(tokens: &[Token]) -> PResult<Module> {
     let mut p = Parser { t: tokens, i: 0 };
@@ -30,11 +98,7 @@ impl<'a> Parser<'a> {
         self.t.get(self.i + k).map(|t| &t.tok)
     }
     fn pos(&self) -> Pos {
-        self.t
-            .get(self.i)
-            .or_else(|| self.t.last())
-            .map(|t| t.pos)
-            .unwrap_or(Pos { line: 1, col: 1 })
+        self.t.get(self.i).or_else(|| self.t.last()).map(|t| t.pos).unwrap_or(Pos { line: 1, col: 1 })
     }
     fn next(&mut self) -> PResult<&'a Token> {
         let t = self.t.get(self.i);
@@ -61,10 +125,7 @@ impl<'a> Parser<'a> {
         if self.eat_punct(c) {
             Ok(())
         } else {
-            syntax(
-                self.pos(),
-                format!("expected `{c}`, found {}", self.describe()),
-            )
+            syntax(self.pos(), format!("expected `{c}`, found {}", self.describe()))
         }
     }
     fn describe(&self) -> String {
@@ -93,10 +154,7 @@ impl<'a> Parser<'a> {
             Tok::Int(v) => Ok(v),
             _ => {
                 self.i -= 1;
-                syntax(
-                    pos,
-                    format!("expected an integer, found {}", self.describe()),
-                )
+                syntax(pos, format!("expected an integer, found {}", self.describe()))
             }
         }
     }
@@ -108,17 +166,11 @@ impl<'a> Parser<'a> {
     }
 
     fn module(&mut self) -> PResult<Module> {
-        let mut m = Module {
-            address_size: 64,
-            ..Default::default()
-        };
+        let mut m = Module { address_size: 64, ..Default::default() };
         while let Some(tok) = self.peek() {
             let pos = self.pos();
             let Tok::Dot(d) = tok else {
-                return syntax(
-                    pos,
-                    format!("expected a directive, found {}", self.describe()),
-                );
+                return syntax(pos, format!("expected a directive, found {}", self.describe()));
             };
             match d.as_str() {
                 "version" => {
@@ -224,10 +276,7 @@ impl<'a> Parser<'a> {
                 Ok(())
             }
             Some(s) => Err((pos, PtxErrorKind::UnsupportedDirective(format!(".{s}")))),
-            None => syntax(
-                pos,
-                format!("expected a directive, found {}", self.describe()),
-            ),
+            None => syntax(pos, format!("expected a directive, found {}", self.describe())),
         }
     }
 
@@ -235,10 +284,7 @@ impl<'a> Parser<'a> {
     fn var_decl(&mut self) -> PResult<VarDecl> {
         let pos = self.pos();
         let space = match &self.next()?.tok {
-            Tok::Dot(s) => Space::parse(s).ok_or((
-                pos,
-                PtxErrorKind::Syntax(format!("`.{s}` is no state space")),
-            ))?,
+            Tok::Dot(s) => Space::parse(s).ok_or((pos, PtxErrorKind::Syntax(format!("`.{s}` is no state space"))))?,
             _ => return syntax(pos, "expected a state space"),
         };
         let (mut align, mut vector, mut ty) = (None, None, None);
@@ -256,10 +302,7 @@ impl<'a> Parser<'a> {
                 },
             }
         }
-        let ty = ty.ok_or((
-            pos,
-            PtxErrorKind::Syntax("declaration without a type".into()),
-        ))?;
+        let ty = ty.ok_or((pos, PtxErrorKind::Syntax("declaration without a type".into())))?;
         let name = self.expect_ident()?;
         let mut range = None;
         if self.eat_punct('<') {
@@ -284,18 +327,7 @@ impl<'a> Parser<'a> {
             }
             init = Some(vals);
         }
-        Ok(VarDecl {
-            space,
-            align,
-            vector,
-            ty,
-            name,
-            range,
-            dims,
-            init,
-            is_extern: false,
-            pos,
-        })
+        Ok(VarDecl { space, align, vector, ty, name, range, dims, init, is_extern: false, pos })
     }
 
     fn initializer(&mut self, out: &mut Vec<Literal>) -> PResult<()> {
@@ -314,10 +346,7 @@ impl<'a> Parser<'a> {
                     out.push(l);
                     Ok(())
                 }
-                None => Err((
-                    pos,
-                    PtxErrorKind::Unsupported(format!("initializer {}", self.describe())),
-                )),
+                None => Err((pos, PtxErrorKind::Unsupported(format!("initializer {}", self.describe())))),
             }
         }
     }
@@ -358,9 +387,8 @@ impl<'a> Parser<'a> {
         // performance directives
         while let Some(d) = self.peek_dot() {
             match d {
-                "maxntid" | "reqntid" | "minnctapersm" | "maxnreg" | "maxnctapersm"
-                | "noreturn" | "pragma" | "explicitcluster" | "reqnctapercluster"
-                | "maxclusterrank" => {
+                "maxntid" | "reqntid" | "minnctapersm" | "maxnreg" | "maxnctapersm" | "noreturn" | "pragma"
+                | "explicitcluster" | "reqnctapercluster" | "maxclusterrank" => {
                     self.i += 1;
                     loop {
                         match self.peek() {
@@ -374,33 +402,16 @@ impl<'a> Parser<'a> {
                     self.eat_punct(';');
                 }
                 _ => {
-                    return Err((
-                        self.pos(),
-                        PtxErrorKind::UnsupportedDirective(format!(".{d}")),
-                    ));
+                    return Err((self.pos(), PtxErrorKind::UnsupportedDirective(format!(".{d}"))));
                 }
             }
         }
         if self.eat_punct(';') {
-            return Ok(Function {
-                kind,
-                name,
-                returns,
-                params,
-                body: None,
-                pos,
-            });
+            return Ok(Function { kind, name, returns, params, body: None, pos });
         }
         self.expect_punct('{')?;
         let body = self.block_body()?;
-        Ok(Function {
-            kind,
-            name,
-            returns,
-            params,
-            body: Some(body),
-            pos,
-        })
+        Ok(Function { kind, name, returns, params, body: Some(body), pos })
     }
 
     fn param_list(&mut self) -> PResult<Vec<VarDecl>> {
@@ -461,14 +472,9 @@ impl<'a> Parser<'a> {
                     self.i += 2;
                     out.push(Stmt::Label(name.clone(), pos));
                 }
-                Some(Tok::Ident(_)) | Some(Tok::Punct('@')) => {
-                    out.push(Stmt::Inst(self.instruction()?))
-                }
+                Some(Tok::Ident(_)) | Some(Tok::Punct('@')) => out.push(Stmt::Inst(self.instruction()?)),
                 _ => {
-                    return syntax(
-                        pos,
-                        format!("expected an instruction, found {}", self.describe()),
-                    );
+                    return syntax(pos, format!("expected an instruction, found {}", self.describe()));
                 }
             }
         }
@@ -483,15 +489,28 @@ impl<'a> Parser<'a> {
         }
         let opcode = self.expect_ident()?;
         let mut mods = Vec::new();
-        while let Some(Token {
-            tok: Tok::Dot(m),
-            glued: true,
-            ..
-        }) = self.t.get(self.i)
-        {
+        while let Some(Token { tok: Tok::Dot(m), glued: true, .. }) = self.t.get(self.i) {
             mods.push(m.clone());
             self.i += 1;
         }
+        let operands = match self.operand_list() {
+            Ok(o) => o,
+            // Operand syntax of instructions warplight does not know (textures, tensor
+            // ops...) is not parsed: name the instruction instead.
+            Err(_) if !KNOWN_OPCODES.contains(&opcode.as_str()) => {
+                let mut full = opcode.clone();
+                for m in &mods {
+                    full.push('.');
+                    full.push_str(m);
+                }
+                return Err((pos, PtxErrorKind::Unsupported(full)));
+            }
+            Err(e) => return Err(e),
+        };
+        Ok(Instruction { guard, opcode, mods, operands, pos })
+    }
+
+    fn operand_list(&mut self) -> PResult<Vec<Operand>> {
         let mut operands = Vec::new();
         if !self.eat_punct(';') {
             loop {
@@ -500,30 +519,17 @@ impl<'a> Parser<'a> {
                     break;
                 }
                 if !self.eat_punct(',') {
-                    return syntax(
-                        self.pos(),
-                        format!("expected `,` or `;`, found {}", self.describe()),
-                    );
+                    return syntax(self.pos(), format!("expected `,` or `;`, found {}", self.describe()));
                 }
             }
         }
-        Ok(Instruction {
-            guard,
-            opcode,
-            mods,
-            operands,
-            pos,
-        })
+        Ok(operands)
     }
 
     fn name_with_component(&mut self) -> PResult<String> {
         let mut n = self.expect_ident()?;
         if n.starts_with('%')
-            && let Some(Token {
-                tok: Tok::Dot(c),
-                glued: true,
-                ..
-            }) = self.t.get(self.i)
+            && let Some(Token { tok: Tok::Dot(c), glued: true, .. }) = self.t.get(self.i)
         {
             n.push('.');
             n.push_str(c);
@@ -570,11 +576,7 @@ impl<'a> Parser<'a> {
                         self.expect_punct(',')?;
                     }
                 }
-                Ok(if brace {
-                    Operand::Vector(v)
-                } else {
-                    Operand::List(v)
-                })
+                Ok(if brace { Operand::Vector(v) } else { Operand::List(v) })
             }
             Some(Tok::Punct('!')) => {
                 self.i += 1;
@@ -590,10 +592,7 @@ impl<'a> Parser<'a> {
             }
             _ => match self.literal()? {
                 Some(l) => Ok(Operand::Lit(l)),
-                None => syntax(
-                    pos,
-                    format!("expected an operand, found {}", self.describe()),
-                ),
+                None => syntax(pos, format!("expected an operand, found {}", self.describe())),
             },
         }
     }

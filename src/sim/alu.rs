@@ -2,15 +2,18 @@
 //! operation, one lane at a time, exactly as PTX defines them.
 //!
 //! Conventions worth knowing (each has a test):
-//! - Float results that are NaN are the canonical NaN (`0x7fffffff`,
-//!   `0x7fffffffffffffff`), as NVIDIA GPUs produce; `abs`, `neg`, `copysign`,
-//!   `mov` are bit operations and keep NaN payloads.
+//! - f32 results that are NaN are the canonical NaN `0x7fffffff`, `abs` and
+//!   `neg` included, as an H100 produces (tests/fixtures/gpu_semantics.json).
+//!   f64 arithmetic propagates a NaN operand (quieted); a NaN made from
+//!   non-NaN f64 operands is `0xfff8000000000000`. Conversions between f32
+//!   and f64 keep a NaN's sign and payload. `copysign` and `mov` are bit operations.
 //! - Directed rounding (`.rz .rm .rp`) is exact: the round-to-nearest result is
 //!   corrected by the sign of the exact error (error-free transformations).
 //! - `.approx` transcendental functions are computed in f64 and rounded to f32
 //!   (within 1 ulp of the correctly rounded value; hardware is within 2 ulp).
-//! - Integer `div`/`rem` by zero give all ones / the dividend (unsigned) and
-//!   -1 / the dividend (signed), as NVIDIA hardware does; `INT_MIN / -1` wraps.
+//! - Integer `div` and `rem` by zero give all ones, signed or not, as an H100
+//!   does; `INT_MIN / -1` wraps to `INT_MIN` and `INT_MIN % -1` is 0.
+//! - `.sat` maps NaN and -0 to +0. With `.rm`, an exact zero sum is -0.
 //! - Shifts by at least the width give 0 (or the sign fill for `shr.s`).
 //! - Float → integer conversions saturate and map NaN to 0.
 
@@ -21,8 +24,10 @@ use crate::ptx::types::Ty;
 
 /// The canonical f32 NaN of NVIDIA GPUs.
 pub const NAN32: u32 = 0x7FFF_FFFF;
-/// The canonical f64 NaN.
-pub const NAN64: u64 = 0x7FFF_FFFF_FFFF_FFFF;
+/// The f64 NaN an H100 creates from non-NaN operands (e.g. inf * 0).
+pub const NAN64: u64 = 0xFFF8_0000_0000_0000;
+/// The quiet bit of an f64 NaN.
+const QUIET64: u64 = 1 << 51;
 
 #[inline]
 fn f32of(x: u64) -> f32 {
@@ -31,20 +36,12 @@ fn f32of(x: u64) -> f32 {
 
 #[inline]
 fn ftz32(x: f32) -> f32 {
-    if x.is_subnormal() {
-        0.0f32.copysign(x)
-    } else {
-        x
-    }
+    if x.is_subnormal() { 0.0f32.copysign(x) } else { x }
 }
 
 #[inline]
 fn ftz64(x: f64) -> f64 {
-    if x.is_subnormal() {
-        0.0f64.copysign(x)
-    } else {
-        x
-    }
+    if x.is_subnormal() { 0.0f64.copysign(x) } else { x }
 }
 
 #[inline]
@@ -57,20 +54,17 @@ fn in32(x: u64, ftz: bool) -> f32 {
 fn out32(x: f32, m: FloatMode) -> u64 {
     let mut x = if m.ftz { ftz32(x) } else { x };
     if m.sat {
-        x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+        // NaN and -0 saturate to +0
+        x = if x > 0.0 { x.min(1.0) } else { 0.0 };
     }
-    if x.is_nan() {
-        NAN32 as u64
-    } else {
-        x.to_bits() as u64
-    }
+    if x.is_nan() { NAN32 as u64 } else { x.to_bits() as u64 }
 }
 
 #[inline]
 fn out64(x: f64, m: FloatMode) -> u64 {
     let mut x = if m.ftz { ftz64(x) } else { x };
     if m.sat {
-        x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+        x = if x > 0.0 { x.min(1.0) } else { 0.0 };
     }
     if x.is_nan() { NAN64 } else { x.to_bits() }
 }
@@ -149,8 +143,18 @@ fn directed(rnd: Option<Rounding>) -> bool {
     matches!(rnd, Some(Rounding::Rz | Rounding::Rm | Rounding::Rp))
 }
 
+/// IEEE 754: an exact zero sum of operands of opposite signs (or of two zeros
+/// with a negative one) is -0 when rounding toward negative infinity.
+fn zero_sign_rm<T: Into<f64> + Copy>(r: f64, a: T, b: T, rnd: Option<Rounding>) -> bool {
+    let (a, b) = (a.into(), b.into());
+    r == 0.0 && rnd == Some(Rounding::Rm) && !(a == 0.0 && b == 0.0 && a.is_sign_positive() && b.is_sign_positive())
+}
+
 fn add32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
     let r = a + b;
+    if zero_sign_rm(r as f64, a, b, rnd) {
+        return -0.0;
+    }
     if !directed(rnd) || !r.is_finite() && !(a.is_finite() && b.is_finite()) {
         return r;
     }
@@ -184,11 +188,7 @@ fn div32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
     }
     // a - r*b is exact in f64; its sign times b's sign is the sign of (a/b − r).
     let rem = a as f64 - r as f64 * b as f64;
-    let err = if b > 0.0 {
-        sign(rem)
-    } else {
-        sign(rem).reverse()
-    };
+    let err = if b > 0.0 { sign(rem) } else { sign(rem).reverse() };
     direct32(r, err, rnd)
 }
 
@@ -203,6 +203,9 @@ fn sqrt32(a: f32, rnd: Option<Rounding>) -> f32 {
 
 fn add64(a: f64, b: f64, rnd: Option<Rounding>) -> f64 {
     let (s, e) = two_sum(a, b);
+    if zero_sign_rm(s, a, b, rnd) {
+        return -0.0;
+    }
     if !directed(rnd) || !s.is_finite() {
         return s;
     }
@@ -236,15 +239,7 @@ fn div64(a: f64, b: f64, rnd: Option<Rounding>) -> f64 {
         return r;
     }
     let rem = (-r).mul_add(b, a);
-    direct64(
-        r,
-        if b > 0.0 {
-            sign(rem)
-        } else {
-            sign(rem).reverse()
-        },
-        rnd,
-    )
+    direct64(r, if b > 0.0 { sign(rem) } else { sign(rem).reverse() }, rnd)
 }
 
 fn sqrt64(a: f64, rnd: Option<Rounding>) -> f64 {
@@ -255,15 +250,7 @@ fn sqrt64(a: f64, rnd: Option<Rounding>) -> f64 {
     direct64(r, sign((-r).mul_add(r, a)), rnd)
 }
 
-fn fmin<T: PartialOrd + Copy>(
-    a: T,
-    b: T,
-    a_nan: bool,
-    b_nan: bool,
-    a_neg: bool,
-    b_neg: bool,
-    max: bool,
-) -> Option<T> {
+fn fmin<T: PartialOrd + Copy>(a: T, b: T, a_nan: bool, b_nan: bool, a_neg: bool, b_neg: bool, max: bool) -> Option<T> {
     if a_nan && b_nan {
         return None;
     }
@@ -295,8 +282,8 @@ fn f32op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         ArithOp::Mul => mul32(fa, fb, m.rnd),
         ArithOp::Mad => fma32(fa, fb, fc, m.rnd),
         ArithOp::Div => div32(fa, fb, m.rnd),
-        ArithOp::Abs => return out_bits32(fa.abs().to_bits(), m),
-        ArithOp::Neg => return out_bits32((-fa).to_bits(), m),
+        ArithOp::Abs => fa.abs(),
+        ArithOp::Neg => -fa,
         ArithOp::Copysign => return (fb.abs().to_bits() | (fa.to_bits() & 0x8000_0000)) as u64,
         ArithOp::Min | ArithOp::Max => {
             match fmin(
@@ -330,19 +317,19 @@ fn f32op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
     out32(r, m)
 }
 
-/// abs/neg keep NaN payloads (bit operations) but honour `.ftz`.
-fn out_bits32(bits: u32, m: FloatMode) -> u64 {
-    let f = f32::from_bits(bits);
-    if f.is_nan() { bits as u64 } else { out32(f, m) }
-}
-
 fn f64op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
     let (fa, fb, fc) = (f64::from_bits(a), f64::from_bits(b), f64::from_bits(c));
-    let (fa, fb, fc) = if m.ftz {
-        (ftz64(fa), ftz64(fb), ftz64(fc))
-    } else {
-        (fa, fb, fc)
+    let (fa, fb, fc) = if m.ftz { (ftz64(fa), ftz64(fb), ftz64(fc)) } else { (fa, fb, fc) };
+    // f64 arithmetic propagates a NaN operand (quieted), as the GPU does.
+    let nsrc = match op {
+        ArithOp::Mad => 3,
+        ArithOp::Add | ArithOp::Sub | ArithOp::Mul | ArithOp::Div => 2,
+        ArithOp::Sqrt | ArithOp::Rsqrt | ArithOp::Rcp | ArithOp::Sin | ArithOp::Cos | ArithOp::Ex2 | ArithOp::Lg2 => 1,
+        _ => 0,
     };
+    if let Some(n) = [a, b, c][..nsrc].iter().find(|x| f64::from_bits(**x).is_nan()) {
+        return n | QUIET64;
+    }
     let r = match op {
         ArithOp::Add => add64(fa, fb, m.rnd),
         ArithOp::Sub => add64(fa, -fb, m.rnd),
@@ -350,18 +337,10 @@ fn f64op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         ArithOp::Mad => fma64(fa, fb, fc, m.rnd),
         ArithOp::Div => div64(fa, fb, m.rnd),
         ArithOp::Abs => {
-            return if fa.is_nan() {
-                a & !(1 << 63)
-            } else {
-                out64(fa.abs(), m)
-            };
+            return if fa.is_nan() { a & !(1 << 63) } else { out64(fa.abs(), m) };
         }
         ArithOp::Neg => {
-            return if fa.is_nan() {
-                a ^ (1 << 63)
-            } else {
-                out64(-fa, m)
-            };
+            return if fa.is_nan() { a ^ (1 << 63) } else { out64(-fa, m) };
         }
         ArithOp::Copysign => return (fb.abs().to_bits()) | (fa.to_bits() & (1 << 63)),
         ArithOp::Min | ArithOp::Max => {
@@ -391,11 +370,7 @@ fn f64op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
 }
 
 fn wide_mask(w: u32) -> u64 {
-    if w >= 32 {
-        u64::MAX
-    } else {
-        (1u64 << (2 * w)) - 1
-    }
+    if w >= 32 { u64::MAX } else { (1u64 << (2 * w)) - 1 }
 }
 
 /// Evaluates an arithmetic operation on one lane. `a`, `b`, `c` hold the
@@ -409,19 +384,11 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
     let w = ty.bits();
     let mask = ty.mask();
     let signed = ty.is_signed();
-    let (sa, sb, sc) = (
-        ty.extend(a) as i64,
-        ty.extend(b) as i64,
-        ty.extend(c) as i64,
-    );
+    let (sa, sb, sc) = (ty.extend(a) as i64, ty.extend(b) as i64, ty.extend(c) as i64);
     let (ua, ub, uc) = (a & mask, b & mask, c & mask);
     let r: u64 = match op {
-        ArithOp::Add if m.sat && signed => {
-            (sa as i128 + sb as i128).clamp(min_of(w), max_of(w)) as u64
-        }
-        ArithOp::Sub if m.sat && signed => {
-            (sa as i128 - sb as i128).clamp(min_of(w), max_of(w)) as u64
-        }
+        ArithOp::Add if m.sat && signed => (sa as i128 + sb as i128).clamp(min_of(w), max_of(w)) as u64,
+        ArithOp::Sub if m.sat && signed => (sa as i128 - sb as i128).clamp(min_of(w), max_of(w)) as u64,
         ArithOp::Add => ua.wrapping_add(ub),
         ArithOp::Sub => ua.wrapping_sub(ub),
         ArithOp::Mul => ua.wrapping_mul(ub),
@@ -433,27 +400,17 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             }
         }
         ArithOp::MulWide => {
-            return if signed {
-                (sa as i128 * sb as i128) as u64
-            } else {
-                (ua as u128 * ub as u128) as u64
-            } & wide_mask(w);
+            return if signed { (sa as i128 * sb as i128) as u64 } else { (ua as u128 * ub as u128) as u64 }
+                & wide_mask(w);
         }
         ArithOp::Mad => ua.wrapping_mul(ub).wrapping_add(uc),
         ArithOp::MadHi => {
-            let hi = if signed {
-                ((sa as i128 * sb as i128) >> w) as u64
-            } else {
-                ((ua as u128 * ub as u128) >> w) as u64
-            };
+            let hi =
+                if signed { ((sa as i128 * sb as i128) >> w) as u64 } else { ((ua as u128 * ub as u128) >> w) as u64 };
             hi.wrapping_add(uc)
         }
         ArithOp::MadWide => {
-            let p = if signed {
-                (sa as i128 * sb as i128) as u64
-            } else {
-                (ua as u128 * ub as u128) as u64
-            };
+            let p = if signed { (sa as i128 * sb as i128) as u64 } else { (ua as u128 * ub as u128) as u64 };
             return p.wrapping_add(c) & wide_mask(w);
         }
         ArithOp::Mul24Lo | ArithOp::Mul24Hi | ArithOp::Mad24Lo | ArithOp::Mad24Hi => {
@@ -463,24 +420,12 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
                 ((a & 0xFF_FFFF) as i64, (b & 0xFF_FFFF) as i64)
             };
             let p = x * y;
-            let part = if matches!(op, ArithOp::Mul24Hi | ArithOp::Mad24Hi) {
-                (p >> 16) as u64
-            } else {
-                p as u64
-            };
-            if matches!(op, ArithOp::Mad24Lo | ArithOp::Mad24Hi) {
-                part.wrapping_add(uc)
-            } else {
-                part
-            }
+            let part = if matches!(op, ArithOp::Mul24Hi | ArithOp::Mad24Hi) { (p >> 16) as u64 } else { p as u64 };
+            if matches!(op, ArithOp::Mad24Lo | ArithOp::Mad24Hi) { part.wrapping_add(uc) } else { part }
         }
         ArithOp::Div => {
             if signed {
-                if sb == 0 {
-                    u64::MAX
-                } else {
-                    sa.wrapping_div(sb) as u64
-                }
+                if sb == 0 { u64::MAX } else { sa.wrapping_div(sb) as u64 }
             } else if ub == 0 {
                 u64::MAX
             } else {
@@ -489,13 +434,9 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         }
         ArithOp::Rem => {
             if signed {
-                if sb == 0 {
-                    sa as u64
-                } else {
-                    sa.wrapping_rem(sb) as u64
-                }
+                if sb == 0 { u64::MAX } else { sa.wrapping_rem(sb) as u64 }
             } else if ub == 0 {
-                ua
+                u64::MAX
             } else {
                 ua % ub
             }
@@ -542,35 +483,19 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             let pos = (b & 0xFF) as u32;
             let len = (c & 0xFF) as u32;
             let msb = w - 1;
-            let sbit = if signed && len != 0 {
-                (ua >> (pos + len - 1).min(msb)) & 1
-            } else {
-                0
-            };
+            let sbit = if signed && len != 0 { (ua >> (pos + len - 1).min(msb)) & 1 } else { 0 };
             let mut d = 0u64;
             for i in 0..w {
-                let bit = if i < len && pos + i <= msb {
-                    (ua >> (pos + i)) & 1
-                } else {
-                    sbit
-                };
+                let bit = if i < len && pos + i <= msb { (ua >> (pos + i)) & 1 } else { sbit };
                 d |= bit << i;
             }
             d
         }
         ArithOp::ShfLWrap | ArithOp::ShfLClamp | ArithOp::ShfRWrap | ArithOp::ShfRClamp => {
             let wrap = matches!(op, ArithOp::ShfLWrap | ArithOp::ShfRWrap);
-            let n = if wrap {
-                (c & 31) as u32
-            } else {
-                (c as u32).min(32)
-            };
+            let n = if wrap { (c & 31) as u32 } else { (c as u32).min(32) };
             let x = ((ub & 0xFFFF_FFFF) << 32) | (ua & 0xFFFF_FFFF);
-            if matches!(op, ArithOp::ShfLWrap | ArithOp::ShfLClamp) {
-                (x << n) >> 32
-            } else {
-                x >> n
-            }
+            if matches!(op, ArithOp::ShfLWrap | ArithOp::ShfLClamp) { (x << n) >> 32 } else { x >> n }
         }
         ArithOp::Prmt => {
             let bytes = ((ub & 0xFFFF_FFFF) << 32) | (ua & 0xFFFF_FFFF);
@@ -578,11 +503,7 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             for i in 0..4 {
                 let sel = (c >> (4 * i)) & 0xF;
                 let byte = (bytes >> ((sel & 7) * 8)) & 0xFF;
-                let byte = if sel & 8 != 0 {
-                    if byte & 0x80 != 0 { 0xFF } else { 0 }
-                } else {
-                    byte
-                };
+                let byte = if sel & 8 != 0 { if byte & 0x80 != 0 { 0xFF } else { 0 } } else { byte };
                 d |= byte << (8 * i);
             }
             d
@@ -696,22 +617,14 @@ fn round_int_f64(x: f64, rnd: Option<Rounding>) -> f64 {
 
 fn int_range(t: Ty) -> (i128, i128) {
     let w = t.bits();
-    if t.is_signed() {
-        (min_of(w), max_of(w))
-    } else {
-        (0, (1i128 << w) - 1)
-    }
+    if t.is_signed() { (min_of(w), max_of(w)) } else { (0, (1i128 << w) - 1) }
 }
 
 /// Evaluates `cvt.mode.dty.sty` on one lane.
 pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
     match (dty.is_float(), sty.is_float()) {
         (false, false) => {
-            let v: i128 = if sty.is_signed() {
-                sty.extend(a) as i64 as i128
-            } else {
-                (a & sty.mask()) as i128
-            };
+            let v: i128 = if sty.is_signed() { sty.extend(a) as i64 as i128 } else { (a & sty.mask()) as i128 };
             let v = if m.sat {
                 let (lo, hi) = int_range(dty);
                 v.clamp(lo, hi)
@@ -721,11 +634,7 @@ pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
             (v as u64) & dty.mask()
         }
         (false, true) => {
-            let x = if sty == Ty::F32 {
-                in32(a, m.ftz) as f64
-            } else {
-                f64::from_bits(a)
-            };
+            let x = if sty == Ty::F32 { in32(a, m.ftz) as f64 } else { f64::from_bits(a) };
             if x.is_nan() {
                 return 0;
             }
@@ -741,85 +650,42 @@ pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
             (v as u64) & dty.mask()
         }
         (true, false) => {
-            let v: i128 = if sty.is_signed() {
-                sty.extend(a) as i64 as i128
-            } else {
-                (a & sty.mask()) as i128
-            };
+            let v: i128 = if sty.is_signed() { sty.extend(a) as i64 as i128 } else { (a & sty.mask()) as i128 };
             if dty == Ty::F32 {
-                let r = if sty.is_signed() {
-                    v as i64 as f32
-                } else {
-                    v as u64 as f32
-                };
+                let r = if sty.is_signed() { v as i64 as f32 } else { v as u64 as f32 };
                 let err = v.cmp(&(r as i128));
                 let r = direct32(r, err, m.rnd);
                 out32(r, m)
             } else {
-                let r = if sty.is_signed() {
-                    v as i64 as f64
-                } else {
-                    v as u64 as f64
-                };
+                let r = if sty.is_signed() { v as i64 as f64 } else { v as u64 as f64 };
                 let err = v.cmp(&(r as i128));
                 out64(direct64(r, err, m.rnd), m)
             }
         }
         (true, true) => {
-            let int_round = matches!(
-                m.rnd,
-                Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi)
-            );
+            let int_round = matches!(m.rnd, Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi));
             match (dty, sty) {
                 (Ty::F32, Ty::F32) => {
                     let x = in32(a, m.ftz);
-                    let r = if int_round {
-                        round_int_f64(x as f64, m.rnd) as f32
-                    } else {
-                        x
-                    };
+                    let r = if int_round { round_int_f64(x as f64, m.rnd) as f32 } else { x };
                     out32(r, m)
                 }
                 (Ty::F64, Ty::F64) => {
                     let x = f64::from_bits(a);
-                    out64(
-                        if int_round {
-                            round_int_f64(x, m.rnd)
-                        } else {
-                            x
-                        },
-                        m,
-                    )
+                    out64(if int_round { round_int_f64(x, m.rnd) } else { x }, m)
                 }
+                (Ty::F64, Ty::F32) if f32of(a).is_nan() => (f32of(a) as f64).to_bits(),
+                (Ty::F32, Ty::F64) if f64::from_bits(a).is_nan() => (f64::from_bits(a) as f32).to_bits() as u64,
                 (Ty::F64, Ty::F32) => {
                     let x = in32(a, m.ftz) as f64;
-                    out64(
-                        if int_round {
-                            round_int_f64(x, m.rnd)
-                        } else {
-                            x
-                        },
-                        FloatMode { ftz: false, ..m },
-                    )
+                    out64(if int_round { round_int_f64(x, m.rnd) } else { x }, FloatMode { ftz: false, ..m })
                 }
                 (Ty::F32, Ty::F64) => {
                     let x = f64::from_bits(a);
-                    let x = if int_round {
-                        round_int_f64(x, m.rnd)
-                    } else {
-                        x
-                    };
+                    let x = if int_round { round_int_f64(x, m.rnd) } else { x };
                     let r = x as f32;
-                    let err = if r.is_finite() {
-                        sign(x - r as f64)
-                    } else {
-                        err_vs(x, 0.0, r)
-                    };
-                    let r = if x.is_infinite() {
-                        r
-                    } else {
-                        direct32(r, err, m.rnd)
-                    };
+                    let err = if r.is_finite() { sign(x - r as f64) } else { err_vs(x, 0.0, r) };
+                    let r = if x.is_infinite() { r } else { direct32(r, err, m.rnd) };
                     out32(r, m)
                 }
                 _ => a,
@@ -834,29 +700,16 @@ pub fn atom(op: AtomOp, ty: Ty, old: u64, b: u64, c: u64) -> u64 {
     let r = match (op, ty) {
         (AtomOp::Add, Ty::F32) => {
             let s = ftz32(ftz32(f32of(old)) + ftz32(f32of(b)));
-            if s.is_nan() {
-                NAN32 as u64
-            } else {
-                s.to_bits() as u64
-            }
+            if s.is_nan() { NAN32 as u64 } else { s.to_bits() as u64 }
         }
         (AtomOp::Add, Ty::F64) => {
             let s = f64::from_bits(old) + f64::from_bits(b);
             if s.is_nan() { NAN64 } else { s.to_bits() }
         }
         (AtomOp::Add, _) => old.wrapping_add(b),
-        (AtomOp::Min | AtomOp::Max, Ty::F32 | Ty::F64) => arith(
-            if op == AtomOp::Min {
-                ArithOp::Min
-            } else {
-                ArithOp::Max
-            },
-            ty,
-            FloatMode::default(),
-            old,
-            b,
-            0,
-        ),
+        (AtomOp::Min | AtomOp::Max, Ty::F32 | Ty::F64) => {
+            arith(if op == AtomOp::Min { ArithOp::Min } else { ArithOp::Max }, ty, FloatMode::default(), old, b, 0)
+        }
         (AtomOp::Min, _) => {
             if ty.is_signed() {
                 (ty.extend(old) as i64).min(ty.extend(b) as i64) as u64
@@ -904,12 +757,7 @@ pub fn atom(op: AtomOp, ty: Ty, old: u64, b: u64, c: u64) -> u64 {
 mod tests {
     use super::*;
 
-    const M: FloatMode = FloatMode {
-        rnd: None,
-        ftz: false,
-        sat: false,
-        approx: false,
-    };
+    const M: FloatMode = FloatMode { rnd: None, ftz: false, sat: false, approx: false };
 
     fn f(x: f32) -> u64 {
         x.to_bits() as u64
@@ -920,33 +768,20 @@ mod tests {
         assert_eq!(arith(ArithOp::Shl, Ty::B32, M, 1, 32, 0), 0);
         assert_eq!(arith(ArithOp::Shl, Ty::B32, M, 1, 31, 0), 0x8000_0000);
         assert_eq!(arith(ArithOp::Shr, Ty::U32, M, 0x8000_0000, 40, 0), 0);
-        assert_eq!(
-            arith(ArithOp::Shr, Ty::S32, M, 0x8000_0000, 40, 0),
-            0xFFFF_FFFF
-        );
+        assert_eq!(arith(ArithOp::Shr, Ty::S32, M, 0x8000_0000, 40, 0), 0xFFFF_FFFF);
         assert_eq!(arith(ArithOp::Shr, Ty::S32, M, 0x4000_0000, 100, 0), 0);
     }
 
     #[test]
     fn division_edge_cases() {
         assert_eq!(arith(ArithOp::Div, Ty::U32, M, 7, 0, 0), 0xFFFF_FFFF);
-        assert_eq!(arith(ArithOp::Rem, Ty::U32, M, 7, 0, 0), 7);
-        assert_eq!(
-            arith(ArithOp::Div, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0),
-            0x8000_0000
-        );
-        assert_eq!(
-            arith(ArithOp::Rem, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0),
-            0
-        );
-        assert_eq!(
-            arith(ArithOp::Div, Ty::S32, M, (-7i32) as u32 as u64, 2, 0),
-            (-3i32) as u32 as u64
-        );
-        assert_eq!(
-            arith(ArithOp::Rem, Ty::S32, M, (-7i32) as u32 as u64, 2, 0),
-            (-1i32) as u32 as u64
-        );
+        assert_eq!(arith(ArithOp::Rem, Ty::U32, M, 7, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Rem, Ty::S32, M, 7, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Div, Ty::S32, M, 7, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Div, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0), 0x8000_0000);
+        assert_eq!(arith(ArithOp::Rem, Ty::S32, M, 0x8000_0000, 0xFFFF_FFFF, 0), 0);
+        assert_eq!(arith(ArithOp::Div, Ty::S32, M, (-7i32) as u32 as u64, 2, 0), (-3i32) as u32 as u64);
+        assert_eq!(arith(ArithOp::Rem, Ty::S32, M, (-7i32) as u32 as u64, 2, 0), (-1i32) as u32 as u64);
     }
 
     #[test]
@@ -972,19 +807,13 @@ mod tests {
 
     #[test]
     fn cvt_saturates_and_maps_nan_to_zero() {
-        let rzi = FloatMode {
-            rnd: Some(Rounding::Rzi),
-            ..M
-        };
+        let rzi = FloatMode { rnd: Some(Rounding::Rzi), ..M };
         assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(3e9)), 0x7FFF_FFFF);
         assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(-3e9)), 0x8000_0000);
         assert_eq!(cvt(Ty::U32, Ty::F32, rzi, f(-5.0)), 0);
         assert_eq!(cvt(Ty::S32, Ty::F32, rzi, f(f32::NAN)), 0);
         assert_eq!(cvt(Ty::U8, Ty::F32, rzi, f(300.0)), 255);
-        let rni = FloatMode {
-            rnd: Some(Rounding::Rni),
-            ..M
-        };
+        let rni = FloatMode { rnd: Some(Rounding::Rni), ..M };
         assert_eq!(cvt(Ty::S32, Ty::F32, rni, f(2.5)), 2);
         assert_eq!(cvt(Ty::S32, Ty::F32, rni, f(3.5)), 4);
         let sat = FloatMode { sat: true, ..M };
@@ -997,37 +826,19 @@ mod tests {
     #[test]
     fn cvt_directed_int_to_float() {
         let v = (1u64 << 24) + 1; // not representable in f32
-        let rz = FloatMode {
-            rnd: Some(Rounding::Rz),
-            ..M
-        };
-        let rp = FloatMode {
-            rnd: Some(Rounding::Rp),
-            ..M
-        };
+        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
+        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
         assert_eq!(cvt(Ty::F32, Ty::U32, rz, v), f(16777216.0));
         assert_eq!(cvt(Ty::F32, Ty::U32, rp, v), f(16777218.0));
-        let rm = FloatMode {
-            rnd: Some(Rounding::Rm),
-            ..M
-        };
-        assert_eq!(
-            cvt(Ty::F32, Ty::S32, rm, (-(v as i64)) as u64),
-            f(-16777218.0)
-        );
+        let rm = FloatMode { rnd: Some(Rounding::Rm), ..M };
+        assert_eq!(cvt(Ty::F32, Ty::S32, rm, (-(v as i64)) as u64), f(-16777218.0));
     }
 
     #[test]
     fn cvt_f64_to_f32_directed() {
         let x = 1.0f64 + 2f64.powi(-30);
-        let rp = FloatMode {
-            rnd: Some(Rounding::Rp),
-            ..M
-        };
-        let rz = FloatMode {
-            rnd: Some(Rounding::Rz),
-            ..M
-        };
+        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
+        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
         assert_eq!(cvt(Ty::F32, Ty::F64, rp, x.to_bits()), f(1.0f32.next_up()));
         assert_eq!(cvt(Ty::F32, Ty::F64, rz, x.to_bits()), f(1.0));
         assert_eq!(cvt(Ty::F32, Ty::F64, rz, 1e300f64.to_bits()), f(f32::MAX));
@@ -1035,50 +846,18 @@ mod tests {
 
     #[test]
     fn directed_add() {
-        let rz = FloatMode {
-            rnd: Some(Rounding::Rz),
-            ..M
-        };
-        let rp = FloatMode {
-            rnd: Some(Rounding::Rp),
-            ..M
-        };
+        let rz = FloatMode { rnd: Some(Rounding::Rz), ..M };
+        let rp = FloatMode { rnd: Some(Rounding::Rp), ..M };
         let tiny = 2f32.powi(-30);
         assert_eq!(arith(ArithOp::Add, Ty::F32, rz, f(1.0), f(tiny), 0), f(1.0));
-        assert_eq!(
-            arith(ArithOp::Add, Ty::F32, rp, f(1.0), f(tiny), 0),
-            f(1.0f32.next_up())
-        );
-        assert_eq!(
-            arith(ArithOp::Add, Ty::F32, rz, f(-1.0), f(-tiny), 0),
-            f(-1.0)
-        );
+        assert_eq!(arith(ArithOp::Add, Ty::F32, rp, f(1.0), f(tiny), 0), f(1.0f32.next_up()));
+        assert_eq!(arith(ArithOp::Add, Ty::F32, rz, f(-1.0), f(-tiny), 0), f(-1.0));
     }
 
     #[test]
     fn nan_results_are_canonical() {
-        assert_eq!(
-            arith(
-                ArithOp::Add,
-                Ty::F32,
-                M,
-                f(f32::INFINITY),
-                f(f32::NEG_INFINITY),
-                0
-            ),
-            NAN32 as u64
-        );
-        assert_eq!(
-            arith(
-                ArithOp::Mul,
-                Ty::F64,
-                M,
-                0f64.to_bits(),
-                f64::INFINITY.to_bits(),
-                0
-            ),
-            NAN64
-        );
+        assert_eq!(arith(ArithOp::Add, Ty::F32, M, f(f32::INFINITY), f(f32::NEG_INFINITY), 0), NAN32 as u64);
+        assert_eq!(arith(ArithOp::Mul, Ty::F64, M, 0f64.to_bits(), f64::INFINITY.to_bits(), 0), NAN64);
     }
 
     #[test]
@@ -1090,69 +869,29 @@ mod tests {
         assert_eq!(arith(ArithOp::Bfe, Ty::S32, M, 0xF0, 4, 4), 0xFFFF_FFFF);
         assert_eq!(arith(ArithOp::Bfe, Ty::U32, M, 0xF0, 4, 4), 0xF);
         assert_eq!(bfi(Ty::B32, 0xF, 0, 28, 8), 0xF000_0000);
-        assert_eq!(
-            arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x3210),
-            0x4433_2211
-        );
-        assert_eq!(
-            arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x7654),
-            0x8877_6655
-        );
-        assert_eq!(
-            arith(ArithOp::Prmt, Ty::B32, M, 0x0000_0080, 0, 0x8888),
-            0xFFFF_FFFF
-        );
+        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x3210), 0x4433_2211);
+        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x7654), 0x8877_6655);
+        assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x0000_0080, 0, 0x8888), 0xFFFF_FFFF);
     }
 
     #[test]
     fn funnel_shifts() {
-        assert_eq!(
-            arith(ArithOp::ShfLWrap, Ty::B32, M, 0x8000_0001, 0x8000_0001, 1),
-            0x0000_0003
-        );
+        assert_eq!(arith(ArithOp::ShfLWrap, Ty::B32, M, 0x8000_0001, 0x8000_0001, 1), 0x0000_0003);
         assert_eq!(arith(ArithOp::ShfLWrap, Ty::B32, M, 0, 1, 33), 2);
         assert_eq!(arith(ArithOp::ShfLClamp, Ty::B32, M, 0xAB, 1, 40), 0xAB);
-        assert_eq!(
-            arith(ArithOp::ShfRWrap, Ty::B32, M, 0x10, 0x1, 4),
-            0x1000_0001
-        );
+        assert_eq!(arith(ArithOp::ShfRWrap, Ty::B32, M, 0x10, 0x1, 4), 0x1000_0001);
         assert_eq!(arith(ArithOp::ShfRClamp, Ty::B32, M, 0x10, 0x1, 99), 0x1);
     }
 
     #[test]
     fn mul_variants() {
-        assert_eq!(
-            arith(ArithOp::MulHi, Ty::U32, M, 0xFFFF_FFFF, 0xFFFF_FFFF, 0),
-            0xFFFF_FFFE
-        );
-        assert_eq!(
-            arith(ArithOp::MulHi, Ty::S32, M, (-2i32) as u32 as u64, 3, 0),
-            0xFFFF_FFFF
-        );
-        assert_eq!(
-            arith(ArithOp::MulWide, Ty::S32, M, (-2i32) as u32 as u64, 3, 0),
-            (-6i64) as u64
-        );
-        assert_eq!(
-            arith(ArithOp::MulWide, Ty::U32, M, 0xFFFF_FFFF, 2, 0),
-            0x1_FFFF_FFFE
-        );
+        assert_eq!(arith(ArithOp::MulHi, Ty::U32, M, 0xFFFF_FFFF, 0xFFFF_FFFF, 0), 0xFFFF_FFFE);
+        assert_eq!(arith(ArithOp::MulHi, Ty::S32, M, (-2i32) as u32 as u64, 3, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::MulWide, Ty::S32, M, (-2i32) as u32 as u64, 3, 0), (-6i64) as u64);
+        assert_eq!(arith(ArithOp::MulWide, Ty::U32, M, 0xFFFF_FFFF, 2, 0), 0x1_FFFF_FFFE);
         assert_eq!(arith(ArithOp::Mul24Lo, Ty::U32, M, 0x0100_0003, 2, 0), 6);
-        assert_eq!(
-            arith(ArithOp::Mul24Hi, Ty::U32, M, 0xFF_FFFF, 0xFF_FFFF, 0),
-            0xFFFF_FE00
-        );
-        assert_eq!(
-            arith(
-                ArithOp::Add,
-                Ty::S32,
-                FloatMode { sat: true, ..M },
-                0x7FFF_FFFF,
-                1,
-                0
-            ),
-            0x7FFF_FFFF
-        );
+        assert_eq!(arith(ArithOp::Mul24Hi, Ty::U32, M, 0xFF_FFFF, 0xFF_FFFF, 0), 0xFFFF_FE00);
+        assert_eq!(arith(ArithOp::Add, Ty::S32, FloatMode { sat: true, ..M }, 0x7FFF_FFFF, 1, 0), 0x7FFF_FFFF);
     }
 
     #[test]
@@ -1164,10 +903,7 @@ mod tests {
         assert_eq!(atom(AtomOp::Dec, Ty::U32, 3, 5, 0), 2);
         assert_eq!(atom(AtomOp::Cas, Ty::B32, 3, 3, 9), 9);
         assert_eq!(atom(AtomOp::Cas, Ty::B32, 4, 3, 9), 4);
-        assert_eq!(
-            atom(AtomOp::Min, Ty::S32, 5, (-1i32) as u32 as u64, 0),
-            0xFFFF_FFFF
-        );
+        assert_eq!(atom(AtomOp::Min, Ty::S32, 5, (-1i32) as u32 as u64, 0), 0xFFFF_FFFF);
     }
 
     #[test]

@@ -57,19 +57,13 @@ impl Cfg {
                     for b in &mut block_of[start..pc] {
                         *b = blocks.len() as u32;
                     }
-                    blocks.push(Block {
-                        start: start as u32,
-                        end: pc as u32,
-                        succs: Vec::new(),
-                    });
+                    blocks.push(Block { start: start as u32, end: pc as u32, succs: Vec::new() });
                 }
                 start = pc;
             }
         }
         let nb = blocks.len();
-        let block_at = |pc: u32| -> Option<usize> {
-            ((pc as usize) < n).then(|| block_of[pc as usize] as usize)
-        };
+        let block_at = |pc: u32| -> Option<usize> { ((pc as usize) < n).then(|| block_of[pc as usize] as usize) };
         for b in 0..nb {
             let last = blocks[b].end - 1;
             let inst = &f.insts[last as usize];
@@ -101,12 +95,7 @@ impl Cfg {
                 None => EXIT_PC,
             })
             .collect();
-        Cfg {
-            blocks,
-            block_of,
-            ipdom,
-            reconv,
-        }
+        Cfg { blocks, block_of, ipdom, reconv }
     }
 }
 
@@ -211,8 +200,7 @@ mod tests {
 
     #[test]
     fn loop_with_break_reconverges_after_loop() {
-        let (_, c) =
-            cfg_of("LOOP:\n add.s32 %r1, %r1, 1;\n @%p1 bra OUT;\n @%p2 bra LOOP;\nOUT:\n ret;");
+        let (_, c) = cfg_of("LOOP:\n add.s32 %r1, %r1, 1;\n @%p1 bra OUT;\n @%p2 bra LOOP;\nOUT:\n ret;");
         assert_eq!(c.reconv[1], 3);
         assert_eq!(c.reconv[2], 3);
     }

@@ -102,11 +102,7 @@ impl Counters {
         add!(barriers);
         add!(barrier_warp_arrivals);
         add!(calls);
-        for (a, b) in [
-            (&mut self.loads, &o.loads),
-            (&mut self.stores, &o.stores),
-            (&mut self.atomics, &o.atomics),
-        ] {
+        for (a, b) in [(&mut self.loads, &o.loads), (&mut self.stores, &o.stores), (&mut self.atomics, &o.atomics)] {
             a.global += b.global;
             a.shared += b.shared;
             a.local += b.local;
@@ -151,13 +147,7 @@ pub struct InstProfile {
 impl InstProfile {
     /// An all-zero profile shaped like `prog`.
     pub fn new(prog: &Program) -> Self {
-        InstProfile {
-            per_fn: prog
-                .functions
-                .iter()
-                .map(|f| vec![InstCounts::default(); f.insts.len()])
-                .collect(),
-        }
+        InstProfile { per_fn: prog.functions.iter().map(|f| vec![InstCounts::default(); f.insts.len()]).collect() }
     }
 
     /// Adds `o` into `self`.
@@ -203,11 +193,7 @@ pub struct LaunchStats {
 }
 
 impl LaunchStats {
-    fn lines_by(
-        &self,
-        prog: &Program,
-        key: impl Fn(usize, usize) -> Option<(String, u32)>,
-    ) -> Vec<LineCounts> {
+    fn lines_by(&self, prog: &Program, key: impl Fn(usize, usize) -> Option<(String, u32)>) -> Vec<LineCounts> {
         let mut map: BTreeMap<(String, u32), InstCountsSer> = BTreeMap::new();
         for (f, counts) in self.profile.per_fn.iter().enumerate() {
             for (pc, c) in counts.iter().enumerate() {
@@ -223,29 +209,19 @@ impl LaunchStats {
             }
         }
         let _ = prog;
-        map.into_iter()
-            .map(|((file, line), counts)| LineCounts { file, line, counts })
-            .collect()
+        map.into_iter().map(|((file, line), counts)| LineCounts { file, line, counts }).collect()
     }
 
     /// Counts per PTX line.
     pub fn per_ptx_line(&self, prog: &Program) -> Vec<LineCounts> {
-        self.lines_by(prog, |f, pc| {
-            Some((
-                prog.source_name.clone(),
-                prog.functions[f].info[pc].ptx_line,
-            ))
-        })
+        self.lines_by(prog, |f, pc| Some((prog.source_name.clone(), prog.functions[f].info[pc].ptx_line)))
     }
 
     /// Counts per CUDA source line (instructions without `.loc` are left out).
     pub fn per_source_line(&self, prog: &Program) -> Vec<LineCounts> {
         self.lines_by(prog, |f, pc| {
             let s = prog.functions[f].info[pc].src?;
-            Some((
-                prog.files.get(s.file as usize).cloned().unwrap_or_default(),
-                s.line,
-            ))
+            Some((prog.files.get(s.file as usize).cloned().unwrap_or_default(), s.line))
         })
     }
 }

@@ -91,13 +91,7 @@ impl Cta {
                 let mut warp = Warp {
                     id: w,
                     frames: vec![Frame::new(kernel, f, 0, 0, 0)],
-                    stack: SimtStack {
-                        entries: vec![SimtEntry {
-                            pc: 0,
-                            rpc: EXIT_PC,
-                            mask: lanes,
-                        }],
-                    },
+                    stack: SimtStack { entries: vec![SimtEntry { pc: 0, rpc: EXIT_PC, mask: lanes }] },
                     lanes,
                     live: lanes,
                     state: WarpState::Ready,
@@ -108,11 +102,7 @@ impl Cta {
                 warp
             })
             .collect();
-        let mut counters = Counters {
-            ctas: 1,
-            warps: nwarps as u64,
-            ..Default::default()
-        };
+        let mut counters = Counters { ctas: 1, warps: nwarps as u64, ..Default::default() };
         counters.rounds = 0;
         Cta {
             id,
@@ -164,11 +154,7 @@ impl Cta {
 
     /// Completes every barrier whose condition holds. Returns true if any did.
     fn try_release(&mut self) -> bool {
-        let alive = self
-            .warps
-            .iter()
-            .filter(|w| w.state != WarpState::Done)
-            .count();
+        let alive = self.warps.iter().filter(|w| w.state != WarpState::Done).count();
         let mut released = false;
         let mut ids: Vec<u32> = self
             .warps
@@ -182,18 +168,13 @@ impl Cta {
         ids.dedup();
         for id in ids {
             let waiting: Vec<usize> = (0..self.warps.len())
-                .filter(
-                    |&i| matches!(self.warps[i].state, WarpState::Barrier { id: b, .. } if b == id),
-                )
+                .filter(|&i| matches!(self.warps[i].state, WarpState::Barrier { id: b, .. } if b == id))
                 .collect();
             let count = waiting.iter().find_map(|&i| match self.warps[i].state {
                 WarpState::Barrier { count, .. } => count,
                 _ => None,
             });
-            let threads: u32 = waiting
-                .iter()
-                .map(|&i| self.warps[i].lanes.count_ones())
-                .sum();
+            let threads: u32 = waiting.iter().map(|&i| self.warps[i].lanes.count_ones()).sum();
             let done = match count {
                 Some(c) => threads >= c,
                 None => waiting.len() == alive,
@@ -227,21 +208,9 @@ impl Cta {
                     .warps
                     .iter()
                     .find(|w| w.state != WarpState::Done)
-                    .map(|w| {
-                        (
-                            w.id,
-                            w.frame().func,
-                            w.stack.top().map(|t| t.pc.saturating_sub(1)).unwrap_or(0),
-                        )
-                    })
+                    .map(|w| (w.id, w.frame().func, w.stack.top().map(|t| t.pc.saturating_sub(1)).unwrap_or(0)))
                     .unwrap_or((0, 0, 0));
-                let f = CtaFault {
-                    kind: FaultKind::BarrierDeadlock { waiting },
-                    warp: wi,
-                    func,
-                    pc,
-                    lane: None,
-                };
+                let f = CtaFault { kind: FaultKind::BarrierDeadlock { waiting }, warp: wi, func, pc, lane: None };
                 self.fault = Some(f.clone());
                 return Err(f);
             }
@@ -268,32 +237,17 @@ impl Cta {
                 }
             }
             Err(e) => {
-                let f = CtaFault {
-                    kind: e.kind,
-                    warp: w as u32,
-                    func,
-                    pc,
-                    lane: e.lane,
-                };
+                let f = CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane };
                 self.fault = Some(f.clone());
                 return Err(f);
             }
         }
-        Ok(Some(Issued {
-            warp: w as u32,
-            func,
-            pc,
-            mask,
-        }))
+        Ok(Some(Issued { warp: w as u32, func, pc, mask }))
     }
 
     /// Why the CTA cannot issue (meaningful after `step` returned `Ok(None)`).
     pub fn stall(&self) -> Stall {
-        if self.finished() {
-            Stall::Finished
-        } else {
-            Stall::WaitingForRound
-        }
+        if self.finished() { Stall::Finished } else { Stall::WaitingForRound }
     }
 
     /// Issues up to `quantum` warp instructions, stopping early when blocked.

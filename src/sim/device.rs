@@ -65,9 +65,7 @@ pub enum SimError {
         got: usize,
     },
     /// An argument of the wrong size.
-    #[error(
-        "argument {index} of `{kernel}` (`{param}`, .{ty}) takes {expected} bytes, the value given has {got}"
-    )]
+    #[error("argument {index} of `{kernel}` (`{param}`, .{ty}) takes {expected} bytes, the value given has {got}")]
     ArgSize {
         /// Kernel.
         kernel: String,
@@ -186,11 +184,7 @@ pub struct LaunchConfig {
 impl LaunchConfig {
     /// A 1-D launch of `ctas` CTAs of `threads` threads.
     pub fn linear(ctas: u32, threads: u32) -> Self {
-        LaunchConfig {
-            grid: [ctas, 1, 1],
-            block: [threads, 1, 1],
-            dynamic_shared: 0,
-        }
+        LaunchConfig { grid: [ctas, 1, 1], block: [threads, 1, 1], dynamic_shared: 0 }
     }
 }
 
@@ -243,11 +237,7 @@ pub struct Module {
 impl Module {
     /// The device address of a module-scope `.global` variable.
     pub fn global(&self, name: &str) -> Option<DevicePtr> {
-        self.prog
-            .globals
-            .iter()
-            .position(|g| g.name == name)
-            .map(|i| DevicePtr(self.globals[i]))
+        self.prog.globals.iter().position(|g| g.name == name).map(|i| DevicePtr(self.globals[i]))
     }
 }
 
@@ -273,16 +263,8 @@ impl Device {
 
     /// A device with `config`.
     pub fn with_config(config: SimConfig) -> Self {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(config.threads)
-            .build()
-            .ok();
-        Device {
-            mem: DeviceMemory::new(),
-            config,
-            pool,
-            sizes: HashMap::new(),
-        }
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(config.threads).build().ok();
+        Device { mem: DeviceMemory::new(), config, pool, sizes: HashMap::new() }
     }
 
     /// The configuration.
@@ -333,10 +315,8 @@ impl Device {
     /// Reads `n` elements at `p`, or an error if out of bounds.
     pub fn try_read<T: Element>(&self, p: DevicePtr, n: usize) -> Result<Vec<T>, SimError> {
         let len = (n * T::SIZE) as u64;
-        let (al, off) = self
-            .mem
-            .find(p.0, len)
-            .ok_or_else(|| SimError::BadPointer(format!("{len} bytes at {:#x}", p.0)))?;
+        let (al, off) =
+            self.mem.find(p.0, len).ok_or_else(|| SimError::BadPointer(format!("{len} bytes at {:#x}", p.0)))?;
         let mut b = vec![0u8; len as usize];
         al.read_bytes(off, &mut b);
         Ok(from_bytes(&b))
@@ -364,11 +344,7 @@ impl Device {
             }
             globals.push(p.0);
         }
-        Module {
-            prog,
-            cfgs,
-            globals,
-        }
+        Module { prog, cfgs, globals }
     }
 
     fn prepare(
@@ -378,21 +354,14 @@ impl Device {
         cfg: &LaunchConfig,
         args: &[Arg],
     ) -> Result<(u32, Vec<u8>, usize), SimError> {
-        let k = m
-            .prog
-            .kernel(kernel)
-            .ok_or_else(|| SimError::UnknownKernel {
-                name: kernel.to_string(),
-                file: m.prog.source_name.clone(),
-                available: m.prog.kernel_names().join(", "),
-            })?;
+        let k = m.prog.kernel(kernel).ok_or_else(|| SimError::UnknownKernel {
+            name: kernel.to_string(),
+            file: m.prog.source_name.clone(),
+            available: m.prog.kernel_names().join(", "),
+        })?;
         let f = &m.prog.functions[k as usize];
         if args.len() != f.params.len() {
-            return Err(SimError::ArgCount {
-                kernel: kernel.into(),
-                expected: f.params.len(),
-                got: args.len(),
-            });
+            return Err(SimError::ArgCount { kernel: kernel.into(), expected: f.params.len(), got: args.len() });
         }
         let mut kp = vec![0u8; f.kernel_param_size as usize];
         for (i, (a, p)) in args.iter().zip(&f.params).enumerate() {
@@ -410,10 +379,7 @@ impl Device {
             kp[p.offset as usize..p.offset as usize + b.len()].copy_from_slice(&b);
         }
         if cfg.grid.contains(&0) || cfg.block.contains(&0) {
-            return Err(SimError::BadLaunch(format!(
-                "grid {:?} and block {:?} must be non-zero",
-                cfg.grid, cfg.block
-            )));
+            return Err(SimError::BadLaunch(format!("grid {:?} and block {:?} must be non-zero", cfg.grid, cfg.block)));
         }
         let threads = cfg.block.iter().map(|&x| x as u64).product::<u64>();
         if threads > self.config.max_threads_per_cta as u64 {
@@ -426,8 +392,7 @@ impl Device {
         if ctas > u32::MAX as u64 {
             return Err(SimError::BadLaunch(format!("{ctas} CTAs is too many")));
         }
-        let shared =
-            m.prog.static_shared_size.div_ceil(16) as usize * 16 + cfg.dynamic_shared as usize;
+        let shared = m.prog.static_shared_size.div_ceil(16) as usize * 16 + cfg.dynamic_shared as usize;
         if shared > self.config.max_shared_per_cta as usize {
             return Err(SimError::BadLaunch(format!(
                 "{shared} bytes of shared memory per CTA; at most {} allowed",
@@ -463,8 +428,7 @@ impl Device {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
         let ctx = self.ctx(m, kp, &cfg);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
-        run.run(self.pool.as_ref())
-            .map_err(|f| SimError::Fault(Box::new(f)))
+        run.run(self.pool.as_ref()).map_err(|f| SimError::Fault(Box::new(f)))
     }
 
     /// Starts a launch for stepping one warp instruction at a time.
@@ -487,11 +451,6 @@ impl Device {
         shared: usize,
         cfg: &LaunchConfig,
     ) -> GridRun<'a> {
-        GridRun::new(
-            self.ctx(m, kp, cfg),
-            k,
-            shared,
-            self.config.schedule.clone(),
-        )
+        GridRun::new(self.ctx(m, kp, cfg), k, shared, self.config.schedule.clone())
     }
 }

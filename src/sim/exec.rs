@@ -7,8 +7,7 @@ use super::cfg::{Cfg, EXIT_PC};
 use super::counters::{Counters, InstProfile};
 use super::fault::FaultKind;
 use super::memory::{
-    CONST_WINDOW, DeviceMemory, GenericTarget, LOCAL_WINDOW, PARAM_WINDOW, SHARED_WINDOW,
-    decode_generic,
+    CONST_WINDOW, DeviceMemory, GenericTarget, LOCAL_WINDOW, PARAM_WINDOW, SHARED_WINDOW, decode_generic,
 };
 use super::simt_stack::{BranchOutcome, SimtEntry};
 use super::warp::{Frame, Warp, WarpState};
@@ -78,10 +77,7 @@ pub struct ExecFault {
 }
 
 fn fault(kind: FaultKind, lane: Option<usize>) -> ExecFault {
-    ExecFault {
-        kind,
-        lane: lane.map(|l| l as u32),
-    }
+    ExecFault { kind, lane: lane.map(|l| l as u32) }
 }
 
 /// What the executed instruction did to the warp's schedulability.
@@ -193,9 +189,7 @@ fn special(ctx: &Ctx, w: &Warp, cta: &CtaMut, sr: SpecialReg) -> Lanes {
         SpecialReg::LaneMaskLe => std::array::from_fn(|l| ((1u64 << (l + 1)) - 1) & 0xFFFF_FFFF),
         SpecialReg::LaneMaskLt => std::array::from_fn(|l| (1u64 << l) - 1),
         SpecialReg::LaneMaskGe => std::array::from_fn(|l| (0xFFFF_FFFFu64 << l) & 0xFFFF_FFFF),
-        SpecialReg::LaneMaskGt => {
-            std::array::from_fn(|l| (0xFFFF_FFFFu64 << (l + 1)) & 0xFFFF_FFFF)
-        }
+        SpecialReg::LaneMaskGt => std::array::from_fn(|l| (0xFFFF_FFFFu64 << (l + 1)) & 0xFFFF_FFFF),
         // A deterministic clock: the CTA's issued warp instructions.
         SpecialReg::Clock | SpecialReg::Clock64 => [cta.counters.warp_instructions; 32],
     }
@@ -283,25 +277,9 @@ fn access(
     store: Option<u64>,
 ) -> Result<u64, ExecFault> {
     let a = r.addr();
-    let oob = || {
-        fault(
-            FaultKind::OutOfBounds {
-                space: r.space(),
-                addr: a,
-                size,
-            },
-            Some(lane),
-        )
-    };
+    let oob = || fault(FaultKind::OutOfBounds { space: r.space(), addr: a, size }, Some(lane));
     if a % align as u64 != 0 {
-        return Err(fault(
-            FaultKind::Misaligned {
-                space: r.space(),
-                addr: a,
-                size: align,
-            },
-            Some(lane),
-        ));
+        return Err(fault(FaultKind::Misaligned { space: r.space(), addr: a, size: align }, Some(lane)));
     }
     match r {
         Resolved::Global(addr) => {
@@ -319,10 +297,7 @@ fn access(
             None => bytes_load(shared, off, size).ok_or_else(oob),
         },
         Resolved::Local(off) => {
-            if off
-                .checked_add(size as u64)
-                .is_none_or(|e| e > w.local_top as u64)
-            {
+            if off.checked_add(size as u64).is_none_or(|e| e > w.local_top as u64) {
                 return Err(oob());
             }
             Ok(match store {
@@ -334,21 +309,11 @@ fn access(
             })
         }
         Resolved::Const(off) => match store {
-            Some(_) => Err(fault(
-                FaultKind::ReadOnly {
-                    space: MemSpace::Const,
-                },
-                Some(lane),
-            )),
+            Some(_) => Err(fault(FaultKind::ReadOnly { space: MemSpace::Const }, Some(lane))),
             None => bytes_load(&ctx.prog.const_bank, off, size).ok_or_else(oob),
         },
         Resolved::KParam(off) => match store {
-            Some(_) => Err(fault(
-                FaultKind::ReadOnly {
-                    space: MemSpace::KernelParam,
-                },
-                Some(lane),
-            )),
+            Some(_) => Err(fault(FaultKind::ReadOnly { space: MemSpace::KernelParam }, Some(lane))),
             None => bytes_load(&ctx.kparams, off, size).ok_or_else(oob),
         },
         Resolved::FParam(off) => {
@@ -359,9 +324,7 @@ fn access(
             }
             let base = lane as u64 * ps + off;
             match store {
-                Some(v) => bytes_store(&mut f.params, base, size, v)
-                    .map(|_| 0)
-                    .ok_or_else(oob),
+                Some(v) => bytes_store(&mut f.params, base, size, v).map(|_| 0).ok_or_else(oob),
                 None => bytes_load(&f.params, base, size).ok_or_else(oob),
             }
         }
@@ -371,14 +334,7 @@ fn access(
 /// Vector accesses must be aligned to their whole size.
 fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), ExecFault> {
     if r.addr() % total as u64 != 0 {
-        return Err(fault(
-            FaultKind::Misaligned {
-                space: r.space(),
-                addr: r.addr(),
-                size: total,
-            },
-            Some(lane),
-        ));
+        return Err(fault(FaultKind::Misaligned { space: r.space(), addr: r.addr(), size: total }, Some(lane)));
     }
     Ok(())
 }
@@ -409,20 +365,11 @@ pub fn step(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut) -> (u32, u32, Result<Effe
     (func, pc, exec(ctx, w, cta, func, top))
 }
 
-fn exec(
-    ctx: &Ctx,
-    w: &mut Warp,
-    cta: &mut CtaMut,
-    func: u32,
-    top: SimtEntry,
-) -> Result<Effect, ExecFault> {
+fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, ExecFault> {
     let f = &ctx.prog.functions[func as usize];
     let pc = top.pc;
     let Some(inst) = f.insts.get(pc as usize) else {
-        return Err(fault(
-            FaultKind::Unsupported(format!("execution ran past the end of `{}`", f.name)),
-            None,
-        ));
+        return Err(fault(FaultKind::Unsupported(format!("execution ran past the end of `{}`", f.name)), None));
     };
     let mask = top.mask;
     let exec = match inst.guard {
@@ -485,11 +432,7 @@ fn exec(
             }
             return Ok(Effect::Continue);
         }
-        Kind::Call {
-            func: callee,
-            args,
-            rets: _,
-        } => {
+        Kind::Call { func: callee, args, rets: _ } => {
             advance(w);
             if exec == 0 {
                 return Ok(Effect::Continue);
@@ -498,17 +441,10 @@ fn exec(
             let cf = &ctx.prog.functions[*callee as usize];
             let caller = w.frame();
             let caller_fn = &ctx.prog.functions[caller.func as usize];
-            let lb = (caller.local_base + caller_fn.local_size).div_ceil(cf.local_align)
-                * cf.local_align;
+            let lb = (caller.local_base + caller_fn.local_size).div_ceil(cf.local_align) * cf.local_align;
             let need = lb as u64 + cf.local_size as u64;
             if need > ctx.local_limit as u64 {
-                return Err(fault(
-                    FaultKind::LocalStackOverflow {
-                        needed: need,
-                        limit: ctx.local_limit as u64,
-                    },
-                    None,
-                ));
+                return Err(fault(FaultKind::LocalStackOverflow { needed: need, limit: ctx.local_limit as u64 }, None));
             }
             let mut nf = Frame::new(*callee, cf, lb, w.stack.entries.len(), pc);
             let ps_c = caller.param_size as usize;
@@ -525,11 +461,7 @@ fn exec(
             }
             w.ensure_local(need as u32);
             w.local_top = need as u32;
-            w.stack.push(SimtEntry {
-                pc: 0,
-                rpc: EXIT_PC,
-                mask: exec,
-            });
+            w.stack.push(SimtEntry { pc: 0, rpc: EXIT_PC, mask: exec });
             w.frames.push(nf);
             return Ok(Effect::Continue);
         }
@@ -547,11 +479,7 @@ fn exec(
             let v = read(ctx, w, cta, *a);
             write(w.frames.last_mut().expect("frame"), *d, &v, exec);
         }
-        Kind::Pack {
-            d,
-            parts,
-            part_bits,
-        } => {
+        Kind::Pack { d, parts, part_bits } => {
             let mut acc = [0u64; 32];
             let pm = (1u64 << part_bits) - 1;
             for (k, p) in parts.iter().enumerate() {
@@ -571,40 +499,19 @@ fn exec(
                 write(fr, *d, &part, exec);
             }
         }
-        Kind::Arith {
-            op,
-            ty,
-            mode,
-            d,
-            a,
-            b,
-            c,
-        } => {
+        Kind::Arith { op, ty, mode, d, a, b, c } => {
             let va = read(ctx, w, cta, *a);
             let vb = read(ctx, w, cta, *b);
             let r = arith_lanes(*op, *ty, *mode, &va, &vb, || read(ctx, w, cta, *c));
             write(w.frames.last_mut().expect("frame"), *d, &r, exec);
         }
         Kind::Bfi { ty, d, a, b, c, e } => {
-            let (va, vb, vc, ve) = (
-                read(ctx, w, cta, *a),
-                read(ctx, w, cta, *b),
-                read(ctx, w, cta, *c),
-                read(ctx, w, cta, *e),
-            );
+            let (va, vb, vc, ve) =
+                (read(ctx, w, cta, *a), read(ctx, w, cta, *b), read(ctx, w, cta, *c), read(ctx, w, cta, *e));
             let r: Lanes = std::array::from_fn(|l| alu::bfi(*ty, va[l], vb[l], vc[l], ve[l]));
             write(w.frames.last_mut().expect("frame"), *d, &r, exec);
         }
-        Kind::Setp {
-            cmp,
-            ty,
-            p,
-            q,
-            a,
-            b,
-            comb,
-            ftz,
-        } => {
+        Kind::Setp { cmp, ty, p, q, a, b, comb, ftz } => {
             let (va, vb) = (read(ctx, w, cta, *a), read(ctx, w, cta, *b));
             let mut t = 0u32;
             for l in 0..32 {
@@ -625,16 +532,7 @@ fn exec(
                 set_pred(fr, *q, qv, exec);
             }
         }
-        Kind::Set {
-            cmp,
-            dty,
-            sty,
-            d,
-            a,
-            b,
-            comb,
-            ftz,
-        } => {
+        Kind::Set { cmp, dty, sty, d, a, b, comb, ftz } => {
             let (va, vb) = (read(ctx, w, cta, *a), read(ctx, w, cta, *b));
             let fr = w.frames.last_mut().expect("frame");
             let cv = comb.map(|(op, c)| (op, pred_bits(fr, c)));
@@ -668,23 +566,13 @@ fn exec(
             };
             set_pred(fr, *d, v, exec);
         }
-        Kind::Cvt {
-            dty,
-            sty,
-            mode,
-            d,
-            a,
-        } => {
+        Kind::Cvt { dty, sty, mode, d, a } => {
             let va = read(ctx, w, cta, *a);
-            let r = map1(&va, |x| alu::cvt(*dty, *sty, *mode, x));
+            // A destination register wider than the type gets the value sign- or zero-extended.
+            let r = map1(&va, |x| dty.extend(alu::cvt(*dty, *sty, *mode, x)));
             write(w.frames.last_mut().expect("frame"), *d, &r, exec);
         }
-        Kind::Cvta {
-            to_generic,
-            space,
-            d,
-            a,
-        } => {
+        Kind::Cvta { to_generic, space, d, a } => {
             let va = read(ctx, w, cta, *a);
             let win = match space {
                 MemSpace::Shared => SHARED_WINDOW,
@@ -693,20 +581,10 @@ fn exec(
                 MemSpace::KernelParam => PARAM_WINDOW,
                 _ => 0,
             };
-            let r = if *to_generic {
-                map1(&va, |x| x.wrapping_add(win))
-            } else {
-                map1(&va, |x| x.wrapping_sub(win))
-            };
+            let r = if *to_generic { map1(&va, |x| x.wrapping_add(win)) } else { map1(&va, |x| x.wrapping_sub(win)) };
             write(w.frames.last_mut().expect("frame"), *d, &r, exec);
         }
-        Kind::Ld {
-            space,
-            ty,
-            ds,
-            addr,
-            ..
-        } => {
+        Kind::Ld { space, ty, ds, addr, .. } => {
             let addrs = addresses(ctx, w, cta, addr);
             let size = ty.bytes();
             let n = ds.len() as u32;
@@ -721,8 +599,7 @@ fn exec(
                 check_vector_align(r, l, size * n)?;
                 for k in 0..n {
                     let rk = resolve(*space, addrs[l].wrapping_add((k * size) as u64));
-                    vals[k as usize][l] =
-                        ty.extend(access(ctx, w, cta.shared, rk, l, size, size, None)?);
+                    vals[k as usize][l] = ty.extend(access(ctx, w, cta.shared, rk, l, size, size, None)?);
                 }
             }
             if let Some(r) = first {
@@ -733,13 +610,7 @@ fn exec(
                 write(fr, *d, &vals[k], exec);
             }
         }
-        Kind::St {
-            space,
-            ty,
-            vals,
-            addr,
-            ..
-        } => {
+        Kind::St { space, ty, vals, addr, .. } => {
             let addrs = addresses(ctx, w, cta, addr);
             let size = ty.bytes();
             let n = vals.len() as u32;
@@ -754,50 +625,24 @@ fn exec(
                 check_vector_align(r, l, size * n)?;
                 for k in 0..n {
                     let rk = resolve(*space, addrs[l].wrapping_add((k * size) as u64));
-                    access(
-                        ctx,
-                        w,
-                        cta.shared,
-                        rk,
-                        l,
-                        size,
-                        size,
-                        Some(vs[k as usize][l] & ty.mask()),
-                    )?;
+                    access(ctx, w, cta.shared, rk, l, size, size, Some(vs[k as usize][l] & ty.mask()))?;
                 }
             }
             if let Some(r) = first {
                 count_space(&mut cta.counters.stores, r);
             }
         }
-        Kind::Atom {
-            space,
-            op,
-            ty,
-            d,
-            addr,
-            b,
-            c,
-        } => {
+        Kind::Atom { space, op, ty, d, addr, b, c } => {
             return atomic(ctx, w, cta, *space, *op, *ty, *d, addr, *b, *c, exec);
         }
         Kind::Bar { id, count } => {
             if exec != w.live {
-                return Err(fault(
-                    FaultKind::DivergentBarrier {
-                        active: exec,
-                        live: w.live,
-                    },
-                    None,
-                ));
+                return Err(fault(FaultKind::DivergentBarrier { active: exec, live: w.live }, None));
             }
             let idv = read(ctx, w, cta, *id)[lane_of_mask(exec).unwrap_or(0)] as u32;
             let cnt = count.map(|c| read(ctx, w, cta, c)[lane_of_mask(exec).unwrap_or(0)] as u32);
             cta.counters.barrier_warp_arrivals += 1;
-            w.state = WarpState::Barrier {
-                id: idv,
-                count: cnt,
-            };
+            w.state = WarpState::Barrier { id: idv, count: cnt };
             return Ok(Effect::Blocked);
         }
         Kind::Vote { mode, d, p, a, .. } => {
@@ -811,28 +656,11 @@ fn exec(
                 }
                 VoteMode::All => set_pred(fr, *p, if pv == exec { u32::MAX } else { 0 }, exec),
                 VoteMode::Any => set_pred(fr, *p, if pv != 0 { u32::MAX } else { 0 }, exec),
-                VoteMode::Uni => set_pred(
-                    fr,
-                    *p,
-                    if pv == 0 || pv == exec { u32::MAX } else { 0 },
-                    exec,
-                ),
+                VoteMode::Uni => set_pred(fr, *p, if pv == 0 || pv == exec { u32::MAX } else { 0 }, exec),
             }
         }
-        Kind::Shfl {
-            mode,
-            d,
-            p,
-            a,
-            b,
-            c,
-            ..
-        } => {
-            let (va, vb, vc) = (
-                read(ctx, w, cta, *a),
-                read(ctx, w, cta, *b),
-                read(ctx, w, cta, *c),
-            );
+        Kind::Shfl { mode, d, p, a, b, c, .. } => {
+            let (va, vb, vc) = (read(ctx, w, cta, *a), read(ctx, w, cta, *b), read(ctx, w, cta, *c));
             let mut r = [0u64; 32];
             let mut pv = 0u32;
             for lane in 0..32u32 {
@@ -890,75 +718,42 @@ fn exec(
 /// Evaluates an arithmetic instruction over 32 lanes, with fast paths for the
 /// hottest integer and f32 forms.
 #[inline]
-fn arith_lanes(
-    op: ArithOp,
-    ty: Ty,
-    mode: FloatMode,
-    a: &Lanes,
-    b: &Lanes,
-    c: impl FnOnce() -> Lanes,
-) -> Lanes {
+fn arith_lanes(op: ArithOp, ty: Ty, mode: FloatMode, a: &Lanes, b: &Lanes, c: impl FnOnce() -> Lanes) -> Lanes {
     let plain = mode == FloatMode::default();
     match (op, ty) {
         (ArithOp::Add, Ty::S32 | Ty::U32 | Ty::B32) if plain => {
             map2(a, b, |x, y| (x as u32).wrapping_add(y as u32) as u64)
         }
-        (ArithOp::Add, Ty::S64 | Ty::U64 | Ty::B64) if plain => {
-            map2(a, b, |x, y| x.wrapping_add(y))
-        }
+        (ArithOp::Add, Ty::S64 | Ty::U64 | Ty::B64) if plain => map2(a, b, |x, y| x.wrapping_add(y)),
         (ArithOp::Sub, Ty::S32 | Ty::U32 | Ty::B32) if plain => {
             map2(a, b, |x, y| (x as u32).wrapping_sub(y as u32) as u64)
         }
-        (ArithOp::Mul, Ty::S32 | Ty::U32 | Ty::B32) => {
-            map2(a, b, |x, y| (x as u32).wrapping_mul(y as u32) as u64)
-        }
+        (ArithOp::Mul, Ty::S32 | Ty::U32 | Ty::B32) => map2(a, b, |x, y| (x as u32).wrapping_mul(y as u32) as u64),
         (ArithOp::And, _) => map2(a, b, |x, y| x & y),
         (ArithOp::Or, _) => map2(a, b, |x, y| x | y),
         (ArithOp::Xor, _) => map2(a, b, |x, y| x ^ y),
-        (ArithOp::Shl, Ty::B32 | Ty::U32 | Ty::S32) => map2(a, b, |x, s| {
-            if (s as u32) >= 32 {
-                0
-            } else {
-                ((x as u32) << s) as u64
-            }
-        }),
-        (ArithOp::Shr, Ty::B32 | Ty::U32) => map2(a, b, |x, s| {
-            if (s as u32) >= 32 {
-                0
-            } else {
-                ((x as u32) >> s) as u64
-            }
-        }),
-        (ArithOp::MulWide, Ty::S32) => {
-            map2(a, b, |x, y| ((x as i32 as i64) * (y as i32 as i64)) as u64)
+        (ArithOp::Shl, Ty::B32 | Ty::U32 | Ty::S32) => {
+            map2(a, b, |x, s| if (s as u32) >= 32 { 0 } else { ((x as u32) << s) as u64 })
         }
+        (ArithOp::Shr, Ty::B32 | Ty::U32) => {
+            map2(a, b, |x, s| if (s as u32) >= 32 { 0 } else { ((x as u32) >> s) as u64 })
+        }
+        (ArithOp::MulWide, Ty::S32) => map2(a, b, |x, y| ((x as i32 as i64) * (y as i32 as i64)) as u64),
         (ArithOp::MulWide, Ty::U32) => map2(a, b, |x, y| (x & 0xFFFF_FFFF) * (y & 0xFFFF_FFFF)),
         (ArithOp::Mad, Ty::S32 | Ty::U32 | Ty::B32) => {
             let c = c();
-            map3(a, b, &c, |x, y, z| {
-                (x as u32).wrapping_mul(y as u32).wrapping_add(z as u32) as u64
-            })
+            map3(a, b, &c, |x, y, z| (x as u32).wrapping_mul(y as u32).wrapping_add(z as u32) as u64)
         }
-        (ArithOp::Add, Ty::F32) if plain => map2(a, b, |x, y| {
-            canon32(f32::from_bits(x as u32) + f32::from_bits(y as u32))
-        }),
-        (ArithOp::Mul, Ty::F32) if plain => map2(a, b, |x, y| {
-            canon32(f32::from_bits(x as u32) * f32::from_bits(y as u32))
-        }),
-        (ArithOp::Mad, Ty::F32)
-            if plain
-                || mode
-                    == (FloatMode {
-                        rnd: Some(Rounding::Rn),
-                        ..FloatMode::default()
-                    }) =>
-        {
+        (ArithOp::Add, Ty::F32) if plain => {
+            map2(a, b, |x, y| canon32(f32::from_bits(x as u32) + f32::from_bits(y as u32)))
+        }
+        (ArithOp::Mul, Ty::F32) if plain => {
+            map2(a, b, |x, y| canon32(f32::from_bits(x as u32) * f32::from_bits(y as u32)))
+        }
+        (ArithOp::Mad, Ty::F32) if plain || mode == (FloatMode { rnd: Some(Rounding::Rn), ..FloatMode::default() }) => {
             let c = c();
             map3(a, b, &c, |x, y, z| {
-                canon32(
-                    f32::from_bits(x as u32)
-                        .mul_add(f32::from_bits(y as u32), f32::from_bits(z as u32)),
-                )
+                canon32(f32::from_bits(x as u32).mul_add(f32::from_bits(y as u32), f32::from_bits(z as u32)))
             })
         }
         _ => {
@@ -987,11 +782,7 @@ fn arith_lanes(
 
 #[inline(always)]
 fn canon32(x: f32) -> u64 {
-    if x.is_nan() {
-        alu::NAN32 as u64
-    } else {
-        x.to_bits() as u64
-    }
+    if x.is_nan() { alu::NAN32 as u64 } else { x.to_bits() as u64 }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -1031,32 +822,15 @@ fn atomic(
             Resolved::Global(a) => {
                 // Check now so the fault names this instruction; apply at the round's end.
                 if a % size as u64 != 0 {
-                    return Err(fault(
-                        FaultKind::Misaligned {
-                            space: MemSpace::Global,
-                            addr: a,
-                            size,
-                        },
-                        Some(l),
-                    ));
+                    return Err(fault(FaultKind::Misaligned { space: MemSpace::Global, addr: a, size }, Some(l)));
                 }
                 if ctx.mem.find(a, size as u64).is_none() {
-                    return Err(fault(
-                        FaultKind::OutOfBounds {
-                            space: MemSpace::Global,
-                            addr: a,
-                            size,
-                        },
-                        Some(l),
-                    ));
+                    return Err(fault(FaultKind::OutOfBounds { space: MemSpace::Global, addr: a, size }, Some(l)));
                 }
                 global.push((l as u8, a, vb[l], vc[l]));
             }
             other => {
-                return Err(fault(
-                    FaultKind::Unsupported(format!("atomic on the {:?} space", other.space())),
-                    Some(l),
-                ));
+                return Err(fault(FaultKind::Unsupported(format!("atomic on the {:?} space", other.space())), Some(l)));
             }
         }
     }
@@ -1070,13 +844,7 @@ fn atomic(
     if global.is_empty() {
         return Ok(Effect::Continue);
     }
-    cta.pending.push(PendingAtomic {
-        warp: w.id,
-        op,
-        ty,
-        d,
-        lanes: global,
-    });
+    cta.pending.push(PendingAtomic { warp: w.id, op, ty, d, lanes: global });
     if d.is_some() {
         w.state = WarpState::WaitAtomic;
         return Ok(Effect::Blocked);
@@ -1097,9 +865,7 @@ fn pop_empty_frames(ctx: &Ctx, w: &mut Warp) {
 fn return_from_call(ctx: &Ctx, w: &mut Warp) {
     let callee = w.frames.pop().expect("callee frame");
     let caller = w.frames.last_mut().expect("caller frame");
-    let Kind::Call { rets, .. } =
-        &ctx.prog.functions[caller.func as usize].insts[callee.call_pc as usize].kind
-    else {
+    let Kind::Call { rets, .. } = &ctx.prog.functions[caller.func as usize].insts[callee.call_pc as usize].kind else {
         unreachable!("call_pc names a call");
     };
     let (ps_n, ps_c) = (callee.param_size as usize, caller.param_size as usize);

@@ -68,30 +68,20 @@ impl fmt::Display for FaultKind {
                 write!(f, "out-of-bounds {size}-byte {space:?} access at {addr:#x}")
             }
             FaultKind::Misaligned { space, addr, size } => {
-                write!(
-                    f,
-                    "misaligned {space:?} access at {addr:#x} (needs {size}-byte alignment)"
-                )
+                write!(f, "misaligned {space:?} access at {addr:#x} (needs {size}-byte alignment)")
             }
             FaultKind::ReadOnly { space } => write!(f, "store to read-only {space:?} space"),
-            FaultKind::DivergentBarrier { active, live } => write!(
-                f,
-                "barrier reached by part of a warp: active lanes {active:#010x}, live lanes {live:#010x}"
-            ),
+            FaultKind::DivergentBarrier { active, live } => {
+                write!(f, "barrier reached by part of a warp: active lanes {active:#010x}, live lanes {live:#010x}")
+            }
             FaultKind::BarrierDeadlock { waiting } => {
-                write!(
-                    f,
-                    "barrier deadlock: warps wait at barriers that cannot complete (warp, barrier): {waiting:?}"
-                )
+                write!(f, "barrier deadlock: warps wait at barriers that cannot complete (warp, barrier): {waiting:?}")
             }
             FaultKind::Runaway { budget } => {
                 write!(f, "runaway kernel: more than {budget} warp instructions")
             }
             FaultKind::LocalStackOverflow { needed, limit } => {
-                write!(
-                    f,
-                    "local memory (call stack) needs {needed} bytes per thread, limit is {limit}"
-                )
+                write!(f, "local memory (call stack) needs {needed} bytes per thread, limit is {limit}")
             }
             FaultKind::Trap => write!(f, "trap instruction executed"),
             FaultKind::Unsupported(s) => write!(f, "unsupported: {s}"),
@@ -132,21 +122,11 @@ impl fmt::Display for Fault {
         if self.function != self.kernel {
             write!(f, " (function `{}`)", self.function)?;
         }
-        write!(
-            f,
-            "\n  at {}:{}: {}",
-            self.ptx_file,
-            self.ptx_line,
-            self.ptx_text.trim()
-        )?;
+        write!(f, "\n  at {}:{}: {}", self.ptx_file, self.ptx_line, self.ptx_text.trim())?;
         if let Some((file, line)) = &self.source {
             write!(f, "\n  source {file}:{line}")?;
         }
-        write!(
-            f,
-            "\n  CTA ({}, {}, {}), warp {}",
-            self.cta[0], self.cta[1], self.cta[2], self.warp
-        )?;
+        write!(f, "\n  CTA ({}, {}, {}), warp {}", self.cta[0], self.cta[1], self.cta[2], self.warp)?;
         if let Some(l) = self.lane {
             write!(f, ", lane {l} (thread {} of the CTA)", self.warp * 32 + l)?;
         }

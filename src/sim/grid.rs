@@ -78,16 +78,8 @@ impl<'a> GridRun<'a> {
     }
 
     fn admit(&mut self) {
-        while (self.resident.len() as u32) < self.sched.max_resident_ctas.max(1)
-            && self.next_cta < self.total_ctas
-        {
-            let c = Cta::new(
-                &self.ctx,
-                self.kernel,
-                self.next_cta,
-                self.shared_size,
-                self.sched.warp_slice,
-            );
+        while (self.resident.len() as u32) < self.sched.max_resident_ctas.max(1) && self.next_cta < self.total_ctas {
+            let c = Cta::new(&self.ctx, self.kernel, self.next_cta, self.shared_size, self.sched.warp_slice);
             self.resident.push(c);
             self.next_cta += 1;
         }
@@ -111,9 +103,7 @@ impl<'a> GridRun<'a> {
             let _ = c.run_round(ctx, q);
         };
         match pool {
-            Some(p) if self.resident.len() > 1 => {
-                p.install(|| self.resident.par_iter_mut().for_each(run))
-            }
+            Some(p) if self.resident.len() > 1 => p.install(|| self.resident.par_iter_mut().for_each(run)),
             _ => self.resident.iter_mut().for_each(run),
         }
         self.commit()
@@ -141,32 +131,17 @@ impl<'a> GridRun<'a> {
             }
         }
         self.admit();
-        let issued: u64 = self.retired_instructions
-            + self
-                .resident
-                .iter()
-                .map(|c| c.counters.warp_instructions)
-                .sum::<u64>();
+        let issued: u64 =
+            self.retired_instructions + self.resident.iter().map(|c| c.counters.warp_instructions).sum::<u64>();
         if issued > self.sched.max_warp_instructions
             && let Some(c) = self.resident.first()
         {
-            let w = c
-                .warps
-                .iter()
-                .find(|w| w.state != super::warp::WarpState::Done);
+            let w = c.warps.iter().find(|w| w.state != super::warp::WarpState::Done);
             let (warp, func, pc) = w
-                .map(|w| {
-                    (
-                        w.id,
-                        w.frame().func,
-                        w.stack.top().map(|t| t.pc).unwrap_or(0),
-                    )
-                })
+                .map(|w| (w.id, w.frame().func, w.stack.top().map(|t| t.pc).unwrap_or(0)))
                 .unwrap_or((0, self.kernel, 0));
             let f = CtaFault {
-                kind: FaultKind::Runaway {
-                    budget: self.sched.max_warp_instructions,
-                },
+                kind: FaultKind::Runaway { budget: self.sched.max_warp_instructions },
                 warp,
                 func,
                 pc,
@@ -191,11 +166,7 @@ impl<'a> GridRun<'a> {
             self.totals.merge(&c.counters);
             self.profile.merge(&c.profile);
         }
-        LaunchStats {
-            kernel: self.kernel_name,
-            totals: self.totals,
-            profile: self.profile,
-        }
+        LaunchStats { kernel: self.kernel_name, totals: self.totals, profile: self.profile }
     }
 
     /// Issues exactly one warp instruction, following the same round structure
@@ -247,17 +218,11 @@ pub fn make_fault(prog: &Program, kernel: &str, cta: [u32; 3], f: &CtaFault) -> 
     let func = &prog.functions[f.func as usize];
     let info = func.info.get(f.pc as usize);
     let ptx_line = info.map(|i| i.ptx_line).unwrap_or(0);
-    let ptx_text = prog
-        .ptx_lines
-        .get(ptx_line.saturating_sub(1) as usize)
-        .cloned()
-        .unwrap_or_default();
-    let source = info.and_then(|i| i.src).filter(|s| s.line > 0).map(|s| {
-        (
-            prog.files.get(s.file as usize).cloned().unwrap_or_default(),
-            s.line,
-        )
-    });
+    let ptx_text = prog.ptx_lines.get(ptx_line.saturating_sub(1) as usize).cloned().unwrap_or_default();
+    let source = info
+        .and_then(|i| i.src)
+        .filter(|s| s.line > 0)
+        .map(|s| (prog.files.get(s.file as usize).cloned().unwrap_or_default(), s.line));
     Fault {
         kind: f.kind.clone(),
         kernel: kernel.to_string(),

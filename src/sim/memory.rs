@@ -73,9 +73,7 @@ impl Allocation {
         let w = (off >> 2) as usize;
         match size {
             4 => self.words[w].load(Relaxed) as u64,
-            8 => {
-                self.words[w].load(Relaxed) as u64 | (self.words[w + 1].load(Relaxed) as u64) << 32
-            }
+            8 => self.words[w].load(Relaxed) as u64 | (self.words[w + 1].load(Relaxed) as u64) << 32,
             1 => (self.words[w].load(Relaxed) >> ((off & 3) * 8)) as u64 & 0xFF,
             2 => (self.words[w].load(Relaxed) >> ((off & 3) * 8)) as u64 & 0xFFFF,
             _ => unreachable!("access size {size}"),
@@ -138,10 +136,7 @@ pub struct DeviceMemory {
 impl DeviceMemory {
     /// Creates an empty memory.
     pub fn new() -> Self {
-        DeviceMemory {
-            allocs: Vec::new(),
-            next: GLOBAL_BASE,
-        }
+        DeviceMemory { allocs: Vec::new(), next: GLOBAL_BASE }
     }
 
     /// Allocates `len` zeroed bytes and returns the base address.
@@ -211,14 +206,8 @@ mod tests {
 
     #[test]
     fn generic_windows_decode() {
-        assert_eq!(
-            decode_generic(SHARED_WINDOW + 12),
-            GenericTarget::Shared(12)
-        );
+        assert_eq!(decode_generic(SHARED_WINDOW + 12), GenericTarget::Shared(12));
         assert_eq!(decode_generic(LOCAL_WINDOW), GenericTarget::Local(0));
-        assert_eq!(
-            decode_generic(GLOBAL_BASE),
-            GenericTarget::Global(GLOBAL_BASE)
-        );
+        assert_eq!(decode_generic(GLOBAL_BASE), GenericTarget::Global(GLOBAL_BASE));
     }
 }

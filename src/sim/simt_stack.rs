@@ -82,16 +82,8 @@ impl SimtStack {
         // (With `rpc == EXIT_PC` the paths rejoin only as their lanes finish; the
         // reconvergence entry is then dropped when its last lane retires.)
         self.entries.last_mut().expect("top").pc = rpc;
-        self.entries.push(SimtEntry {
-            pc: target,
-            rpc,
-            mask: taken,
-        });
-        self.entries.push(SimtEntry {
-            pc: next,
-            rpc,
-            mask: not_taken,
-        });
+        self.entries.push(SimtEntry { pc: target, rpc, mask: taken });
+        self.entries.push(SimtEntry { pc: next, rpc, mask: not_taken });
         BranchOutcome::Diverged
     }
 
@@ -121,52 +113,23 @@ mod tests {
     #[test]
     fn divergent_branch_pushes_two_paths_then_pops_at_join() {
         let mut s = SimtStack::default();
-        s.push(SimtEntry {
-            pc: 0,
-            rpc: EXIT_PC,
-            mask: 0xFFFF_FFFF,
-        });
+        s.push(SimtEntry { pc: 0, rpc: EXIT_PC, mask: 0xFFFF_FFFF });
         let o = s.branch(0x5555_5555, 10, 1, 20);
         assert_eq!(o, BranchOutcome::Diverged);
         assert_eq!(s.entries.len(), 3);
-        assert_eq!(
-            *s.top().unwrap(),
-            SimtEntry {
-                pc: 1,
-                rpc: 20,
-                mask: 0xAAAA_AAAA
-            }
-        );
+        assert_eq!(*s.top().unwrap(), SimtEntry { pc: 1, rpc: 20, mask: 0xAAAA_AAAA });
         s.top_mut().unwrap().pc = 20;
         assert_eq!(s.reconverge(0), 1);
-        assert_eq!(
-            *s.top().unwrap(),
-            SimtEntry {
-                pc: 10,
-                rpc: 20,
-                mask: 0x5555_5555
-            }
-        );
+        assert_eq!(*s.top().unwrap(), SimtEntry { pc: 10, rpc: 20, mask: 0x5555_5555 });
         s.top_mut().unwrap().pc = 20;
         assert_eq!(s.reconverge(0), 1);
-        assert_eq!(
-            *s.top().unwrap(),
-            SimtEntry {
-                pc: 20,
-                rpc: EXIT_PC,
-                mask: 0xFFFF_FFFF
-            }
-        );
+        assert_eq!(*s.top().unwrap(), SimtEntry { pc: 20, rpc: EXIT_PC, mask: 0xFFFF_FFFF });
     }
 
     #[test]
     fn uniform_branch_moves_pc() {
         let mut s = SimtStack::default();
-        s.push(SimtEntry {
-            pc: 0,
-            rpc: EXIT_PC,
-            mask: 0xF,
-        });
+        s.push(SimtEntry { pc: 0, rpc: EXIT_PC, mask: 0xF });
         assert_eq!(s.branch(0xF, 7, 1, 3), BranchOutcome::Uniform);
         assert_eq!(s.top().unwrap().pc, 7);
     }
@@ -174,23 +137,12 @@ mod tests {
     #[test]
     fn retiring_lanes_drops_empty_paths() {
         let mut s = SimtStack::default();
-        s.push(SimtEntry {
-            pc: 0,
-            rpc: EXIT_PC,
-            mask: 0xF,
-        });
+        s.push(SimtEntry { pc: 0, rpc: EXIT_PC, mask: 0xF });
         s.branch(0x3, 10, 1, EXIT_PC);
         assert_eq!(s.entries.len(), 3);
         assert!(!s.retire_lanes(0, 0xC));
         assert_eq!(s.entries.len(), 2);
-        assert_eq!(
-            *s.top().unwrap(),
-            SimtEntry {
-                pc: 10,
-                rpc: EXIT_PC,
-                mask: 0x3
-            }
-        );
+        assert_eq!(*s.top().unwrap(), SimtEntry { pc: 10, rpc: EXIT_PC, mask: 0x3 });
         assert!(s.retire_lanes(0, 0x3));
     }
 }

@@ -63,19 +63,8 @@ pub struct Stepper<'a> {
 }
 
 impl<'a> Stepper<'a> {
-    pub(crate) fn new(
-        dev: &'a Device,
-        m: &'a Module,
-        k: u32,
-        kp: Vec<u8>,
-        shared: usize,
-        cfg: LaunchConfig,
-    ) -> Self {
-        Stepper {
-            run: dev.make_run(m, k, kp, shared, &cfg),
-            module: m,
-            finished: false,
-        }
+    pub(crate) fn new(dev: &'a Device, m: &'a Module, k: u32, kp: Vec<u8>, shared: usize, cfg: LaunchConfig) -> Self {
+        Stepper { run: dev.make_run(m, k, kp, shared, &cfg), module: m, finished: false }
     }
 
     /// Issues one warp instruction; `None` when the grid has finished.
@@ -109,14 +98,8 @@ impl<'a> Stepper<'a> {
 
     /// Steps until some warp's next instruction is on PTX line `line` (it has not
     /// executed yet), or the grid finishes. Returns the last event.
-    pub fn run_to_ptx_line(
-        &mut self,
-        line: u32,
-        max_steps: u64,
-    ) -> Result<Option<StepEvent>, Fault> {
-        self.run_until(max_steps, |s, ev| {
-            s.warp(ev.cta_slot, ev.warp).and_then(|w| w.next_ptx_line) == Some(line)
-        })
+    pub fn run_to_ptx_line(&mut self, line: u32, max_steps: u64) -> Result<Option<StepEvent>, Fault> {
+        self.run_until(max_steps, |s, ev| s.warp(ev.cta_slot, ev.warp).and_then(|w| w.next_ptx_line) == Some(line))
     }
 
     /// Steps until `stop(self, event)` holds after an instruction, at most `max_steps`.
@@ -153,11 +136,7 @@ impl<'a> Stepper<'a> {
 
     /// Number of warps in each CTA.
     pub fn warps_per_cta(&self) -> usize {
-        self.run
-            .resident
-            .first()
-            .map(|c| c.warps.len())
-            .unwrap_or(0)
+        self.run.resident.first().map(|c| c.warps.len()).unwrap_or(0)
     }
 
     /// A warp's state.
@@ -167,9 +146,7 @@ impl<'a> Stepper<'a> {
         let prog = &self.module.prog;
         let f = &prog.functions[w.frame().func as usize];
         let top = w.stack.top().copied();
-        let next_pc = top
-            .map(|t| t.pc)
-            .filter(|&pc| (pc as usize) < f.insts.len());
+        let next_pc = top.map(|t| t.pc).filter(|&pc| (pc as usize) < f.insts.len());
         Some(WarpView {
             id: w.id,
             state: w.state,
@@ -206,11 +183,7 @@ impl<'a> Stepper<'a> {
             return Vec::new();
         };
         let f = &self.module.prog.functions[w.frame().func as usize];
-        f.reg_names
-            .iter()
-            .chain(f.pred_names.iter().skip(2))
-            .cloned()
-            .collect()
+        f.reg_names.iter().chain(f.pred_names.iter().skip(2)).cloned().collect()
     }
 
     /// A CTA's shared memory.

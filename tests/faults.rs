@@ -1,0 +1,177 @@
+//! Faults and errors are values with locations, never panics; the device stays usable.
+
+mod common;
+use common::*;
+use warplight::sim::{Arg, FaultKind, LaunchConfig, SimConfig, SimError};
+
+fn fault_of(r: Result<warplight::sim::LaunchStats, SimError>) -> Box<warplight::sim::Fault> {
+    match r {
+        Err(SimError::Fault(f)) => f,
+        other => panic!("expected a fault, got {other:?}"),
+    }
+}
+
+#[test]
+fn out_of_bounds_store_names_thread_and_lines() {
+    for d in BOTH {
+        let mut dev = device(2);
+        let m = load(&mut dev, "memory", d);
+        let out = dev.alloc_zeroed::<i32>(40);
+        let f = fault_of(dev.launch(&m, "out_of_bounds", LaunchConfig::linear(2, 32), &[Arg::Ptr(out)]));
+        assert!(matches!(f.kind, FaultKind::OutOfBounds { size: 4, .. }), "{d:?}: {f}");
+        assert_eq!((f.cta, f.warp, f.lane), ([1, 0, 0], 0, Some(5)), "{d:?}: thread 37 = CTA 1 lane 5");
+        let (file, line) = f.source.clone().expect("source line from .loc");
+        assert!(file.ends_with("memory.cu"));
+        assert_eq!(line, cu_line("memory", "out[t == 37 ? 4000 : t] = t;"));
+        assert!(f.ptx_text.contains("st.global"), "{}", f.ptx_text);
+        let msg = f.to_string();
+        assert!(msg.contains("out-of-bounds") && msg.contains("lane 5"), "{msg}");
+        // Threads of CTA 0 wrote before the fault: no lost output.
+        assert_eq!(dev.read::<i32>(out, 32), (0..32).collect::<Vec<_>>());
+        // The device remains usable.
+        let ok = dev.launch(&m, "partial_warp", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]);
+        assert!(ok.is_ok());
+    }
+}
+
+#[test]
+fn barrier_in_divergent_code_is_a_fault() {
+    for d in BOTH {
+        let mut dev = device(1);
+        let m = load(&mut dev, "shared", d);
+        let out = dev.alloc_zeroed::<i32>(64);
+        let f = fault_of(dev.launch(&m, "divergent_barrier", LaunchConfig::linear(1, 64), &[Arg::Ptr(out)]));
+        match f.kind {
+            FaultKind::DivergentBarrier { active, live } => {
+                assert_eq!((active, live), (0xFF, u32::MAX), "{d:?}");
+            }
+            k => panic!("{d:?}: {k}"),
+        }
+        assert_eq!(f.warp, 0);
+    }
+}
+
+#[test]
+fn runaway_kernel_stops_at_budget() {
+    let mut cfg = SimConfig { threads: 1, ..SimConfig::default() };
+    cfg.schedule.max_warp_instructions = 50_000;
+    cfg.schedule.round_quantum = 1000;
+    let mut dev = warplight::sim::Device::with_config(cfg);
+    let m = load(&mut dev, "divergence", Dialect::Clang);
+    let flag = dev.alloc_zeroed::<i32>(1);
+    let f = fault_of(dev.launch(&m, "spin", LaunchConfig::linear(1, 32), &[Arg::Ptr(flag)]));
+    assert_eq!(f.kind, FaultKind::Runaway { budget: 50_000 });
+}
+
+#[test]
+fn launch_errors_are_clear() {
+    let mut dev = device(1);
+    let m = load(&mut dev, "memory", Dialect::Clang);
+    let out = dev.alloc_zeroed::<i32>(4);
+    let e = dev.launch(&m, "nope", LaunchConfig::linear(1, 32), &[]).unwrap_err();
+    assert!(matches!(e, SimError::UnknownKernel { .. }));
+    assert!(e.to_string().contains("partial_warp"), "lists kernels: {e}");
+    let e = dev.launch(&m, "partial_warp", LaunchConfig::linear(1, 32), &[]).unwrap_err();
+    assert!(matches!(e, SimError::ArgCount { expected: 1, got: 0, .. }), "{e}");
+    let e = dev.launch(&m, "partial_warp", LaunchConfig::linear(1, 32), &[Arg::U32(1)]).unwrap_err();
+    assert!(matches!(e, SimError::ArgSize { expected: 8, got: 4, .. }), "{e}");
+    let e = dev.launch(&m, "partial_warp", LaunchConfig::linear(1, 2048), &[Arg::Ptr(out)]).unwrap_err();
+    assert!(matches!(e, SimError::BadLaunch(_)), "{e}");
+    let e = dev.launch(&m, "partial_warp", LaunchConfig::linear(0, 32), &[Arg::Ptr(out)]).unwrap_err();
+    assert!(matches!(e, SimError::BadLaunch(_)), "{e}");
+}
+
+#[test]
+fn ptx_errors_name_file_line_and_instruction() {
+    let src = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n .reg .b32 %r<3>;\n tex.2d.v4.f32.f32 %r1, [t, {%r1, %r2}];\n ret;\n}\n";
+    let e = warplight::ptx::load(src, "bad.ptx").unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.starts_with("bad.ptx:7:2: unsupported instruction `tex.2d.v4.f32.f32`"), "{msg}");
+    assert!(msg.contains("tex.2d.v4.f32.f32 %r1"), "shows the line: {msg}");
+
+    let src =
+        ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n add.s32 %r1, %r2, 1;\n ret;\n}\n";
+    let e = warplight::ptx::load(src, "undeclared.ptx").unwrap_err();
+    assert_eq!((e.pos.line, e.pos.col), (6, 2));
+    assert!(e.to_string().contains("undeclared register `%r2`"), "{e}");
+
+    let src = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n bra.uni NOWHERE;\n}\n";
+    let e = warplight::ptx::load(src, "label.ptx").unwrap_err();
+    assert!(e.to_string().contains("undefined label `NOWHERE`"), "{e}");
+}
+
+#[test]
+fn misaligned_access_is_a_fault() {
+    let src = r#".version 7.8
+.target sm_90
+.address_size 64
+.visible .entry k(.param .u64 p)
+{
+  .reg .b32 %r<2>;
+  .reg .b64 %rd<3>;
+  ld.param.u64 %rd1, [p];
+  add.s64 %rd2, %rd1, 2;
+  ld.global.u32 %r1, [%rd2];
+  ret;
+}
+"#;
+    let mut dev = device(1);
+    let m = dev.load_ptx(src, "mis.ptx").unwrap();
+    let b = dev.alloc_zeroed::<u32>(8);
+    let f = fault_of(dev.launch(&m, "k", LaunchConfig::linear(1, 32), &[Arg::Ptr(b)]));
+    assert!(matches!(f.kind, FaultKind::Misaligned { size: 4, .. }), "{f}");
+    assert_eq!(f.ptx_line, 10);
+    assert_eq!(f.lane, Some(0));
+}
+
+#[test]
+fn barrier_deadlock_is_reported() {
+    // Warp 0 waits at barrier 1, warp 1 at barrier 2: neither can complete.
+    let src = r#".version 7.8
+.target sm_90
+.address_size 64
+.visible .entry k()
+{
+  .reg .b32 %r<3>;
+  .reg .pred %p<2>;
+  mov.u32 %r1, %tid.x;
+  setp.lt.u32 %p1, %r1, 32;
+  @%p1 bra A;
+  bar.sync 2;
+  bra.uni END;
+A:
+  bar.sync 1;
+END:
+  ret;
+}
+"#;
+    let mut dev = device(1);
+    let m = dev.load_ptx(src, "dl.ptx").unwrap();
+    let f = fault_of(dev.launch(&m, "k", LaunchConfig::linear(1, 64), &[]));
+    assert!(matches!(&f.kind, FaultKind::BarrierDeadlock { waiting } if waiting.len() == 2), "{f}");
+}
+
+#[test]
+fn recursion_past_the_local_limit_overflows() {
+    let src = r#".version 7.8
+.target sm_90
+.address_size 64
+.func f()
+{
+  .local .align 8 .b8 depot[256];
+  call.uni f, ();
+  ret;
+}
+.visible .entry k()
+{
+  call.uni f, ();
+  ret;
+}
+"#;
+    let mut cfg = SimConfig { threads: 1, ..SimConfig::default() };
+    cfg.local_limit = 4096;
+    let mut dev = warplight::sim::Device::with_config(cfg);
+    let m = dev.load_ptx(src, "rec.ptx").unwrap();
+    let f = fault_of(dev.launch(&m, "k", LaunchConfig::linear(1, 32), &[]));
+    assert!(matches!(f.kind, FaultKind::LocalStackOverflow { limit: 4096, .. }), "{f}");
+}
