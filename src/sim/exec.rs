@@ -362,7 +362,14 @@ pub fn step(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut) -> (u32, u32, Result<Effe
     let top = *w.stack.top().expect("running warp has a path");
     let func = w.frame().func;
     let pc = top.pc;
-    (func, pc, exec(ctx, w, cta, func, top))
+    let r = exec(ctx, w, cta, func, top);
+    // Pop paths that reached their reconvergence point now, so that the stack
+    // seen between instructions is the one the next instruction runs on.
+    if !w.stack.entries.is_empty() {
+        let base = w.frame().stack_base;
+        cta.counters.reconvergences += w.stack.reconverge(base) as u64;
+    }
+    (func, pc, r)
 }
 
 fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, ExecFault> {
