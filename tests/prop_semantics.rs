@@ -1,0 +1,109 @@
+//! Property tests of instruction semantics against independent definitions:
+//! directed rounding brackets the exact result, integer operations wrap as
+//! two's complement, conversions saturate.
+
+use proptest::prelude::*;
+use warplight::ptx::ir::{ArithOp, FloatMode, Rounding};
+use warplight::ptx::types::Ty;
+use warplight::sim::alu::{arith, cvt};
+
+fn mode(r: Rounding) -> FloatMode {
+    FloatMode { rnd: Some(r), ..FloatMode::default() }
+}
+
+/// f32 values whose sums and products are exact in f64.
+fn small_f32() -> impl Strategy<Value = f32> {
+    (any::<bool>(), 0u32..(1 << 23), -12i32..12).prop_map(|(neg, m, e)| {
+        let v = (1.0 + m as f32 / (1u32 << 23) as f32) * 2f32.powi(e);
+        if neg { -v } else { v }
+    })
+}
+
+/// Checks that `r` is the rounding of exact `x` in direction `rnd`.
+fn check_directed(r: f32, x: f64, rnd: Rounding) -> Result<(), TestCaseError> {
+    let rf = r as f64;
+    match rnd {
+        Rounding::Rm => prop_assert!(rf <= x && (r.next_up() as f64) > x, "rm {r} for {x}"),
+        Rounding::Rp => prop_assert!(rf >= x && (r.next_down() as f64) < x, "rp {r} for {x}"),
+        Rounding::Rz => {
+            let away = if x >= 0.0 { r.next_up() } else { r.next_down() };
+            prop_assert!(rf.abs() <= x.abs() && (away as f64).abs() > x.abs(), "rz {r} for {x}");
+        }
+        _ => prop_assert_eq!(r, x as f32),
+    }
+    Ok(())
+}
+
+fn f(x: f32) -> u64 {
+    x.to_bits() as u64
+}
+
+proptest! {
+    #[test]
+    fn add_and_mul_round_in_every_direction(a in small_f32(), b in small_f32()) {
+        for rnd in [Rounding::Rn, Rounding::Rz, Rounding::Rm, Rounding::Rp] {
+            let s = f32::from_bits(arith(ArithOp::Add, Ty::F32, mode(rnd), f(a), f(b), 0) as u32);
+            let exact = a as f64 + b as f64;
+            if exact != 0.0 {
+                check_directed(s, exact, rnd)?;
+            }
+            let p = f32::from_bits(arith(ArithOp::Mul, Ty::F32, mode(rnd), f(a), f(b), 0) as u32);
+            check_directed(p, a as f64 * b as f64, rnd)?;
+        }
+    }
+
+    #[test]
+    fn fma_rounds_once(a in small_f32(), b in small_f32(), c in small_f32()) {
+        let r = f32::from_bits(arith(ArithOp::Mad, Ty::F32, mode(Rounding::Rn), f(a), f(b), f(c)) as u32);
+        // a*b is exact in f64 and a*b + c has at most 24+24+24 bits of span here: exact in f64 when small.
+        let exact = a as f64 * b as f64 + c as f64;
+        if (exact - (a as f64 * b as f64)) == c as f64 {
+            prop_assert_eq!(r, exact as f32);
+        }
+    }
+
+    #[test]
+    fn int_to_float_rounds_in_every_direction(v in any::<i32>()) {
+        for rnd in [Rounding::Rn, Rounding::Rz, Rounding::Rm, Rounding::Rp] {
+            let r = f32::from_bits(cvt(Ty::F32, Ty::S32, mode(rnd), v as u32 as u64) as u32);
+            check_directed(r, v as f64, rnd)?;
+        }
+    }
+
+    #[test]
+    fn float_to_int_saturates(x in any::<f32>()) {
+        let rzi = cvt(Ty::S32, Ty::F32, mode(Rounding::Rzi), f(x)) as u32 as i32;
+        prop_assert_eq!(rzi, x as i32); // Rust's `as` saturates and maps NaN to 0
+        let rni = cvt(Ty::S32, Ty::F32, mode(Rounding::Rni), f(x)) as u32 as i32;
+        prop_assert_eq!(rni, x.round_ties_even() as i32);
+        let u = cvt(Ty::U32, Ty::F32, mode(Rounding::Rmi), f(x)) as u32;
+        prop_assert_eq!(u, x.floor() as u32);
+    }
+
+    #[test]
+    fn integer_ops_wrap(a in any::<u32>(), b in any::<u32>()) {
+        let m = FloatMode::default();
+        let (ai, bi) = (a as i32, b as i32);
+        let ev = |op, ty| arith(op, ty, m, a as u64, b as u64, 0) as u32;
+        prop_assert_eq!(ev(ArithOp::Add, Ty::U32), a.wrapping_add(b));
+        prop_assert_eq!(ev(ArithOp::Sub, Ty::S32), ai.wrapping_sub(bi) as u32);
+        prop_assert_eq!(ev(ArithOp::Mul, Ty::S32), ai.wrapping_mul(bi) as u32);
+        prop_assert_eq!(ev(ArithOp::MulHi, Ty::U32), ((a as u64 * b as u64) >> 32) as u32);
+        prop_assert_eq!(ev(ArithOp::MulHi, Ty::S32), ((ai as i64 * bi as i64) >> 32) as u32);
+        prop_assert_eq!(ev(ArithOp::Min, Ty::S32), ai.min(bi) as u32);
+        prop_assert_eq!(ev(ArithOp::Max, Ty::U32), a.max(b));
+        prop_assert_eq!(ev(ArithOp::Shl, Ty::B32), a.checked_shl(b).unwrap_or(0));
+        prop_assert_eq!(ev(ArithOp::Shr, Ty::U32), a.checked_shr(b).unwrap_or(0));
+        prop_assert_eq!(ev(ArithOp::Shr, Ty::S32), (ai >> b.min(31)) as u32);
+        if b != 0 {
+            prop_assert_eq!(ev(ArithOp::Div, Ty::U32), a / b);
+            prop_assert_eq!(ev(ArithOp::Rem, Ty::U32), a % b);
+            prop_assert_eq!(ev(ArithOp::Div, Ty::S32), ai.wrapping_div(bi) as u32);
+            prop_assert_eq!(ev(ArithOp::Rem, Ty::S32), ai.wrapping_rem(bi) as u32);
+        }
+        let wide = arith(ArithOp::MulWide, Ty::S32, m, a as u64, b as u64, 0);
+        prop_assert_eq!(wide as i64, ai as i64 * bi as i64);
+        prop_assert_eq!(arith(ArithOp::Popc, Ty::B32, m, a as u64, 0, 0) as u32, a.count_ones());
+        prop_assert_eq!(arith(ArithOp::Brev, Ty::B32, m, a as u64, 0, 0) as u32, a.reverse_bits());
+    }
+}
