@@ -1,3 +1,5 @@
+//! The `warplight` binary; see `warplight --help`.
+
 fn main() {
-    println!("Hello, world!");
+    std::process::exit(warplight::cli::main());
 }

@@ -1,6 +1,8 @@
 //! Divergence, reconvergence, loops, early exits, calls and recursion: results
 //! against Rust references, counters against hand-derived numbers.
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use warplight::sim::{Arg, LaunchConfig};

@@ -1,6 +1,8 @@
 //! Results and every counter are bit-identical for 1, 2 and 4 host threads and
 //! across runs, also for kernels whose CTAs communicate through global atomics.
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use warplight::sim::{Arg, Device, LaunchConfig, SimConfig};
@@ -70,7 +72,9 @@ fn many_ctas_with_barriers_are_deterministic() {
         let (ab, bb) = (dev.alloc_from(&a), dev.alloc_from(&a));
         let cb = dev.alloc_zeroed::<f32>(n * n);
         let cfg = LaunchConfig { grid: [4, 4, 1], block: [16, 16, 1], dynamic_shared: 0 };
-        let s = dev.launch(&m, "matmul_tiled", cfg, &[Arg::Ptr(cb), Arg::Ptr(ab), Arg::Ptr(bb), Arg::I32(n as i32)]).unwrap();
+        let s = dev
+            .launch(&m, "matmul_tiled", cfg, &[Arg::Ptr(cb), Arg::Ptr(ab), Arg::Ptr(bb), Arg::I32(n as i32)])
+            .unwrap();
         (bytes_of(dev, cb, n * n * 4), s)
     });
 }
@@ -82,7 +86,8 @@ fn more_ctas_than_resident_slots() {
         let m = load(dev, "atomics", Dialect::Clang);
         let counter = dev.alloc_zeroed::<u32>(1);
         let seen = dev.alloc_zeroed::<u32>(300 * 64);
-        let s = dev.launch(&m, "contention", LaunchConfig::linear(300, 64), &[Arg::Ptr(counter), Arg::Ptr(seen)]).unwrap();
+        let s =
+            dev.launch(&m, "contention", LaunchConfig::linear(300, 64), &[Arg::Ptr(counter), Arg::Ptr(seen)]).unwrap();
         assert_eq!(s.totals.ctas, 300);
         (bytes_of(dev, seen, 300 * 64 * 4), s)
     });

@@ -1,5 +1,7 @@
 //! Faults and errors are values with locations, never panics; the device stays usable.
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use warplight::sim::{Arg, FaultKind, LaunchConfig, SimConfig, SimError};

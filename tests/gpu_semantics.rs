@@ -4,6 +4,8 @@
 //! `tests/fixtures/gpu_semantics.json`. warplight must produce the same bits,
 //! from clang's PTX and from nvcc's.
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use serde_json::Value;
@@ -61,10 +63,5 @@ fn every_semantics_kernel_matches_the_gpu() {
             }
         }
     }
-    assert!(
-        mismatches.is_empty(),
-        "{} mismatches:\n{}",
-        mismatches.len(),
-        mismatches.iter().cloned().collect::<Vec<_>>().join("\n")
-    );
+    assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
 }

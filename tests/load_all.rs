@@ -1,5 +1,7 @@
 //! Every committed PTX file (both dialects) loads and validates.
 
+#![allow(clippy::needless_range_loop)]
+
 use std::path::Path;
 
 fn ptx_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {

@@ -1,6 +1,8 @@
 //! Shared memory with barriers, atomics (including a persistent-threads job
 //! queue), warp votes and shuffles, memory spaces and widths.
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use warplight::sim::{Arg, LaunchConfig};

@@ -2,6 +2,8 @@
 //! Runs when clang-16 is installed (CI installs it and sets
 //! WARPLIGHT_REQUIRE_CLANG=1, so there a missing compiler fails the test).
 
+#![allow(clippy::needless_range_loop)]
+
 use std::process::Command;
 
 #[test]

@@ -1,6 +1,8 @@
 //! Stepping one warp instruction at a time: the SIMT stack, masks, registers and
 //! shared memory are visible, and stepping to the end matches a normal launch.
 
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 use common::*;
 use warplight::sim::{Arg, LaunchConfig};

@@ -390,11 +390,8 @@ impl<'a> Parser<'a> {
                 "maxntid" | "reqntid" | "minnctapersm" | "maxnreg" | "maxnctapersm" | "noreturn" | "pragma"
                 | "explicitcluster" | "reqnctapercluster" | "maxclusterrank" => {
                     self.i += 1;
-                    loop {
-                        match self.peek() {
-                            Some(Tok::Int(_)) | Some(Tok::Str(_)) => self.i += 1,
-                            _ => break,
-                        }
+                    while let Some(Tok::Int(_)) | Some(Tok::Str(_)) = self.peek() {
+                        self.i += 1;
                         if !self.eat_punct(',') {
                             break;
                         }

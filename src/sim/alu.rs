@@ -155,7 +155,7 @@ fn add32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
     if zero_sign_rm(r as f64, a, b, rnd) {
         return -0.0;
     }
-    if !directed(rnd) || !r.is_finite() && !(a.is_finite() && b.is_finite()) {
+    if !directed(rnd) || !(r.is_finite() || a.is_finite() && b.is_finite()) {
         return r;
     }
     let (s, e) = two_sum(a as f64, b as f64);
@@ -164,7 +164,7 @@ fn add32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
 
 fn mul32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
     let r = a * b;
-    if !directed(rnd) || !(a.is_finite() && b.is_finite()) {
+    if !(directed(rnd) && a.is_finite() && b.is_finite()) {
         return r;
     }
     let p = a as f64 * b as f64; // exact: 48-bit significand
@@ -173,7 +173,7 @@ fn mul32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
 
 fn fma32(a: f32, b: f32, c: f32, rnd: Option<Rounding>) -> f32 {
     let r = a.mul_add(b, c);
-    if !directed(rnd) || !(a.is_finite() && b.is_finite() && c.is_finite()) {
+    if !(directed(rnd) && a.is_finite() && b.is_finite() && c.is_finite()) {
         return r;
     }
     let p = a as f64 * b as f64;
@@ -183,7 +183,7 @@ fn fma32(a: f32, b: f32, c: f32, rnd: Option<Rounding>) -> f32 {
 
 fn div32(a: f32, b: f32, rnd: Option<Rounding>) -> f32 {
     let r = a / b;
-    if !directed(rnd) || !r.is_finite() || !(a.is_finite() && b.is_finite()) || b == 0.0 {
+    if !(directed(rnd) && r.is_finite() && a.is_finite() && b.is_finite() && b != 0.0) {
         return r;
     }
     // a - r*b is exact in f64; its sign times b's sign is the sign of (a/b − r).
@@ -250,28 +250,20 @@ fn sqrt64(a: f64, rnd: Option<Rounding>) -> f64 {
     direct64(r, sign((-r).mul_add(r, a)), rnd)
 }
 
-fn fmin<T: PartialOrd + Copy>(a: T, b: T, a_nan: bool, b_nan: bool, a_neg: bool, b_neg: bool, max: bool) -> Option<T> {
-    if a_nan && b_nan {
-        return None;
+/// PTX `min`/`max`: a NaN operand yields the other operand, two NaNs a NaN,
+/// and -0 counts as less than +0. (f32 values convert to f64 exactly.)
+fn min_max(a: f64, b: f64, max: bool) -> f64 {
+    match (a.is_nan(), b.is_nan()) {
+        (true, true) => f64::NAN,
+        (true, false) => b,
+        (false, true) => a,
+        _ if a == b => {
+            // equal values differ only in the sign of zero
+            if (a.is_sign_negative() && !max) || (a.is_sign_positive() && max) { a } else { b }
+        }
+        _ if (a < b) != max => a,
+        _ => b,
     }
-    if a_nan {
-        return Some(b);
-    }
-    if b_nan {
-        return Some(a);
-    }
-    // -0 is below +0 for min and max
-    if a == b {
-        return Some(if (a_neg && !max) || (!a_neg && max) {
-            a
-        } else if (b_neg && !max) || (!b_neg && max) {
-            b
-        } else {
-            a
-        });
-    }
-    let a_less = a < b;
-    Some(if a_less != max { a } else { b })
 }
 
 fn f32op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
@@ -285,20 +277,7 @@ fn f32op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         ArithOp::Abs => fa.abs(),
         ArithOp::Neg => -fa,
         ArithOp::Copysign => return (fb.abs().to_bits() | (fa.to_bits() & 0x8000_0000)) as u64,
-        ArithOp::Min | ArithOp::Max => {
-            match fmin(
-                fa,
-                fb,
-                fa.is_nan(),
-                fb.is_nan(),
-                fa.is_sign_negative(),
-                fb.is_sign_negative(),
-                op == ArithOp::Max,
-            ) {
-                Some(v) => v,
-                None => f32::NAN,
-            }
-        }
+        ArithOp::Min | ArithOp::Max => min_max(fa as f64, fb as f64, op == ArithOp::Max) as f32,
         ArithOp::Sqrt => sqrt32(fa, if m.approx { None } else { m.rnd }),
         ArithOp::Rsqrt => (1.0 / (fa as f64).sqrt()) as f32,
         ArithOp::Rcp => {
@@ -343,20 +322,7 @@ fn f64op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             return if fa.is_nan() { a ^ (1 << 63) } else { out64(-fa, m) };
         }
         ArithOp::Copysign => return (fb.abs().to_bits()) | (fa.to_bits() & (1 << 63)),
-        ArithOp::Min | ArithOp::Max => {
-            match fmin(
-                fa,
-                fb,
-                fa.is_nan(),
-                fb.is_nan(),
-                fa.is_sign_negative(),
-                fb.is_sign_negative(),
-                op == ArithOp::Max,
-            ) {
-                Some(v) => v,
-                None => f64::NAN,
-            }
-        }
+        ArithOp::Min | ArithOp::Max => min_max(fa, fb, op == ArithOp::Max),
         ArithOp::Sqrt => sqrt64(fa, m.rnd),
         ArithOp::Rsqrt => 1.0 / fa.sqrt(),
         ArithOp::Rcp => div64(1.0, fa, m.rnd),
@@ -426,10 +392,8 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         ArithOp::Div => {
             if signed {
                 if sb == 0 { u64::MAX } else { sa.wrapping_div(sb) as u64 }
-            } else if ub == 0 {
-                u64::MAX
             } else {
-                ua / ub
+                ua.checked_div(ub).unwrap_or(u64::MAX)
             }
         }
         ArithOp::Rem => {

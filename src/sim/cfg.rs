@@ -62,10 +62,9 @@ impl Cfg {
                 start = pc;
             }
         }
-        let nb = blocks.len();
         let block_at = |pc: u32| -> Option<usize> { ((pc as usize) < n).then(|| block_of[pc as usize] as usize) };
-        for b in 0..nb {
-            let last = blocks[b].end - 1;
+        for blk in &mut blocks {
+            let last = blk.end - 1;
             let inst = &f.insts[last as usize];
             let fall = block_at(last + 1);
             let guarded = inst.guard.is_some();
@@ -86,7 +85,7 @@ impl Cfg {
                 _ => succs.push(fall),
             }
             succs.dedup();
-            blocks[b].succs = succs;
+            blk.succs = succs;
         }
         let ipdom = post_dominators(&blocks);
         let reconv = (0..n)

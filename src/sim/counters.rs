@@ -225,3 +225,42 @@ impl LaunchStats {
         })
     }
 }
+
+/// Nsight Compute metric names accepted as aliases of warplight's counters.
+/// warplight counts PTX instructions; Nsight Compute counts SASS, so the
+/// instruction metrics are comparable in kind, not in value.
+pub const NCU_ALIASES: &[(&str, &str)] = &[
+    ("smsp__inst_executed.sum", "warp_instructions"),
+    ("smsp__thread_inst_executed.sum", "thread_instructions"),
+    ("smsp__thread_inst_executed_pred_on.sum", "thread_instructions_pred_on"),
+    ("smsp__sass_branch_targets.sum", "branches"),
+    ("smsp__sass_branch_targets_threads_divergent.sum", "divergent_branches"),
+    ("launch__grid_size", "ctas"),
+];
+
+impl Counters {
+    /// All counters as (dotted name, value), in a stable order.
+    pub fn flatten(&self) -> Vec<(String, u64)> {
+        fn walk(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, u64)>) {
+            match v {
+                serde_json::Value::Object(m) => {
+                    for (k, x) in m {
+                        let name = if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") };
+                        walk(&name, x, out);
+                    }
+                }
+                serde_json::Value::Number(n) => out.push((prefix.to_string(), n.as_u64().unwrap_or(0))),
+                _ => {}
+            }
+        }
+        let mut out = Vec::new();
+        walk("", &serde_json::to_value(self).expect("counters serialize"), &mut out);
+        out
+    }
+
+    /// A counter by warplight name or Nsight Compute alias.
+    pub fn get(&self, name: &str) -> Option<u64> {
+        let name = NCU_ALIASES.iter().find(|(a, _)| *a == name).map(|(_, n)| *n).unwrap_or(name);
+        self.flatten().into_iter().find(|(n, _)| n == name).map(|(_, v)| v)
+    }
+}

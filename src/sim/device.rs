@@ -428,7 +428,7 @@ impl Device {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
         let ctx = self.ctx(m, kp, &cfg);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
-        run.run(self.pool.as_ref()).map_err(|f| SimError::Fault(Box::new(f)))
+        run.run(self.pool.as_ref()).map_err(SimError::Fault)
     }
 
     /// Starts a launch for stepping one warp instruction at a time.

@@ -278,7 +278,7 @@ fn access(
 ) -> Result<u64, ExecFault> {
     let a = r.addr();
     let oob = || fault(FaultKind::OutOfBounds { space: r.space(), addr: a, size }, Some(lane));
-    if a % align as u64 != 0 {
+    if !a.is_multiple_of(align as u64) {
         return Err(fault(FaultKind::Misaligned { space: r.space(), addr: a, size: align }, Some(lane)));
     }
     match r {
@@ -333,7 +333,7 @@ fn access(
 
 /// Vector accesses must be aligned to their whole size.
 fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), ExecFault> {
-    if r.addr() % total as u64 != 0 {
+    if !r.addr().is_multiple_of(total as u64) {
         return Err(fault(FaultKind::Misaligned { space: r.space(), addr: r.addr(), size: total }, Some(lane)));
     }
     Ok(())

@@ -91,12 +91,12 @@ impl<'a> GridRun<'a> {
     }
 
     /// Turns a CTA fault into a located [`Fault`].
-    pub fn locate(&self, cta: &Cta, f: &CtaFault) -> Fault {
-        make_fault(self.ctx.prog, &self.kernel_name, cta.id, f)
+    pub fn locate(&self, cta: &Cta, f: &CtaFault) -> Box<Fault> {
+        Box::new(make_fault(self.ctx.prog, &self.kernel_name, cta.id, f))
     }
 
     /// Runs one round on `pool` (or the current thread).
-    pub fn round(&mut self, pool: Option<&rayon::ThreadPool>) -> Result<(), Fault> {
+    pub fn round(&mut self, pool: Option<&rayon::ThreadPool>) -> Result<(), Box<Fault>> {
         let ctx = &self.ctx;
         let q = self.sched.round_quantum.max(1);
         let run = |c: &mut Cta| {
@@ -110,7 +110,7 @@ impl<'a> GridRun<'a> {
     }
 
     /// The between-rounds phase: faults, atomics, retirement, admission, budget.
-    fn commit(&mut self) -> Result<(), Fault> {
+    fn commit(&mut self) -> Result<(), Box<Fault>> {
         self.totals.rounds += 1;
         if let Some(c) = self.resident.iter().find(|c| c.fault.is_some()) {
             let f = c.fault.clone().expect("fault");
@@ -153,7 +153,7 @@ impl<'a> GridRun<'a> {
     }
 
     /// Runs the whole grid.
-    pub fn run(mut self, pool: Option<&rayon::ThreadPool>) -> Result<LaunchStats, Fault> {
+    pub fn run(mut self, pool: Option<&rayon::ThreadPool>) -> Result<LaunchStats, Box<Fault>> {
         while !self.done() {
             self.round(pool)?;
         }
@@ -172,7 +172,7 @@ impl<'a> GridRun<'a> {
     /// Issues exactly one warp instruction, following the same round structure
     /// as [`GridRun::round`] with CTAs taken one after another. Returns the CTA
     /// position and what was issued, or `None` when the grid finished.
-    pub fn step_one(&mut self) -> Result<Option<(usize, Issued)>, Fault> {
+    pub fn step_one(&mut self) -> Result<Option<(usize, Issued)>, Box<Fault>> {
         loop {
             if self.done() {
                 return Ok(None);

@@ -114,7 +114,7 @@ impl Allocation {
         let mut k = 0;
         while k < data.len() {
             let o = off + k as u64;
-            if o % 4 == 0 && k + 4 <= data.len() {
+            if o.is_multiple_of(4) && k + 4 <= data.len() {
                 let v = u32::from_le_bytes(data[k..k + 4].try_into().expect("4 bytes"));
                 self.store(o, 4, v as u64);
                 k += 4;

@@ -68,7 +68,7 @@ impl<'a> Stepper<'a> {
     }
 
     /// Issues one warp instruction; `None` when the grid has finished.
-    pub fn step(&mut self) -> Result<Option<StepEvent>, Fault> {
+    pub fn step(&mut self) -> Result<Option<StepEvent>, Box<Fault>> {
         if self.finished {
             return Ok(None);
         }
@@ -98,7 +98,7 @@ impl<'a> Stepper<'a> {
 
     /// Steps until some warp's next instruction is on PTX line `line` (it has not
     /// executed yet), or the grid finishes. Returns the last event.
-    pub fn run_to_ptx_line(&mut self, line: u32, max_steps: u64) -> Result<Option<StepEvent>, Fault> {
+    pub fn run_to_ptx_line(&mut self, line: u32, max_steps: u64) -> Result<Option<StepEvent>, Box<Fault>> {
         self.run_until(max_steps, |s, ev| s.warp(ev.cta_slot, ev.warp).and_then(|w| w.next_ptx_line) == Some(line))
     }
 
@@ -107,7 +107,7 @@ impl<'a> Stepper<'a> {
         &mut self,
         max_steps: u64,
         mut stop: impl FnMut(&Self, &StepEvent) -> bool,
-    ) -> Result<Option<StepEvent>, Fault> {
+    ) -> Result<Option<StepEvent>, Box<Fault>> {
         let mut last = None;
         for _ in 0..max_steps {
             match self.step()? {

@@ -1,0 +1,38 @@
+//! `warplight kernels` and `warplight check`.
+
+use std::path::Path;
+
+/// Lists kernels with parameters and resources.
+pub fn kernels(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let prog = crate::ptx::load_file(path)?;
+    println!("{} (PTX {}, target {})", prog.source_name, prog.version, prog.target.join(","));
+    for f in prog.functions.iter().filter(|f| f.is_entry) {
+        let params: Vec<String> = f.params.iter().map(|p| format!(".{} {}", p.ty, p.name)).collect();
+        println!("  {}({})", f.name, params.join(", "));
+        println!(
+            "    {} instructions, {} registers (32-bit words declared), {} B local per thread, {} B static shared (module)",
+            f.insts.len(),
+            f.declared_reg_words,
+            f.local_size,
+            prog.static_shared_size
+        );
+    }
+    let funcs: Vec<&str> = prog.functions.iter().filter(|f| !f.is_entry).map(|f| f.name.as_str()).collect();
+    if !funcs.is_empty() {
+        println!("  device functions: {}", funcs.join(", "));
+    }
+    Ok(())
+}
+
+/// Validates a PTX file.
+pub fn check(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let prog = crate::ptx::load_file(path)?;
+    let n: usize = prog.functions.iter().map(|f| f.insts.len()).sum();
+    println!(
+        "{}: ok ({} kernels, {} functions, {n} instructions)",
+        prog.source_name,
+        prog.kernel_names().len(),
+        prog.functions.len()
+    );
+    Ok(())
+}

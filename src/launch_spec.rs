@@ -1,0 +1,568 @@
+//! Launch specifications: a TOML file that names a PTX file, a kernel, its grid,
+//! its buffers with their initial contents, and its arguments — everything
+//! `warplight launch` needs to run any kernel without writing Rust.
+//!
+//! ```toml
+//! ptx = "micro.ptx"            # relative to the spec file
+//! kernel = "copy_stride"
+//! grid = [64, 1, 1]
+//! block = [256, 1, 1]
+//! args = ["in", "out", 1, 0]   # buffer names or scalar literals, in parameter order
+//! [[buffer]]
+//! name = "in"
+//! type = "f32"                 # u8..u64, i8..i64, f32, f64
+//! len = 655360
+//! init = "iota"                # "zeros" | "iota" | { hash = 2654435761, modulo = 16384 } | { file = "x.bin" } | [1, 2, 3]
+//! ```
+//!
+//! Several `[[launch]]` tables (each with `kernel`, `grid`, `block`, `args` and
+//! optionally `shared`) may replace the top-level launch keys; they run in order
+//! on the same buffers.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::ptx::types::Ty;
+use crate::sim::{Arg, Device, DevicePtr, LaunchConfig, LaunchStats, Module, SimError};
+
+/// A problem with a spec file, naming the file and the key.
+#[derive(Debug, thiserror::Error)]
+pub enum SpecError {
+    /// The file could not be read.
+    #[error("{file}: {msg}")]
+    Io {
+        /// The file.
+        file: String,
+        /// What failed.
+        msg: String,
+    },
+    /// The TOML is malformed.
+    #[error("{file}: {msg}")]
+    Toml {
+        /// The file.
+        file: String,
+        /// The parser's message (with line and column).
+        msg: String,
+    },
+    /// A key is missing or has the wrong shape.
+    #[error("{file}: `{key}`: {msg}")]
+    Key {
+        /// The file.
+        file: String,
+        /// The key, dotted (`buffer[1].init`).
+        key: String,
+        /// What was expected.
+        msg: String,
+    },
+    /// Loading or running failed.
+    #[error("{0}")]
+    Sim(#[from] SimError),
+}
+
+/// Element types of buffers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum ElemType {
+    U8,
+    U16,
+    U32,
+    U64,
+    I8,
+    I16,
+    I32,
+    I64,
+    F32,
+    F64,
+}
+
+impl ElemType {
+    fn parse(s: &str) -> Option<ElemType> {
+        Some(match s {
+            "u8" => ElemType::U8,
+            "u16" => ElemType::U16,
+            "u32" => ElemType::U32,
+            "u64" => ElemType::U64,
+            "i8" | "s8" => ElemType::I8,
+            "i16" | "s16" => ElemType::I16,
+            "i32" | "s32" => ElemType::I32,
+            "i64" | "s64" => ElemType::I64,
+            "f32" => ElemType::F32,
+            "f64" => ElemType::F64,
+            _ => return None,
+        })
+    }
+
+    /// Size in bytes.
+    pub fn size(self) -> usize {
+        match self {
+            ElemType::U8 | ElemType::I8 => 1,
+            ElemType::U16 | ElemType::I16 => 2,
+            ElemType::U32 | ElemType::I32 | ElemType::F32 => 4,
+            ElemType::U64 | ElemType::I64 | ElemType::F64 => 8,
+        }
+    }
+
+    fn is_float(self) -> bool {
+        matches!(self, ElemType::F32 | ElemType::F64)
+    }
+
+    /// Encodes element `v` (an integer value or a float value) as little-endian bytes.
+    fn encode(self, int: i128, float: f64, use_float: bool, out: &mut Vec<u8>) {
+        let n = self.size();
+        match self {
+            ElemType::F32 => out.extend_from_slice(&(if use_float { float } else { int as f64 } as f32).to_le_bytes()),
+            ElemType::F64 => out.extend_from_slice(&(if use_float { float } else { int as f64 }).to_le_bytes()),
+            _ => {
+                let v = if use_float { float as i128 } else { int };
+                out.extend_from_slice(&(v as u64).to_le_bytes()[..n]);
+            }
+        }
+    }
+
+    /// Decodes one element to a display string.
+    pub fn show(self, b: &[u8]) -> String {
+        let mut w = [0u8; 8];
+        w[..b.len()].copy_from_slice(b);
+        let u = u64::from_le_bytes(w);
+        match self {
+            ElemType::F32 => format!("{}", f32::from_bits(u as u32)),
+            ElemType::F64 => format!("{}", f64::from_bits(u)),
+            ElemType::I8 => format!("{}", u as u8 as i8),
+            ElemType::I16 => format!("{}", u as u16 as i16),
+            ElemType::I32 => format!("{}", u as u32 as i32),
+            ElemType::I64 => format!("{}", u as i64),
+            _ => format!("{u}"),
+        }
+    }
+}
+
+/// How a buffer starts.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Init {
+    /// All zero.
+    Zeros,
+    /// Element i = i.
+    Iota,
+    /// Element i = (i × mul) mod modulo, in 64-bit unsigned arithmetic.
+    Hash {
+        /// Multiplier.
+        mul: u64,
+        /// Modulus.
+        modulo: u64,
+    },
+    /// Raw bytes from a file (relative to the spec).
+    File(PathBuf),
+    /// Explicit values (the rest is zero).
+    Values(Vec<toml::Value>),
+}
+
+/// One buffer.
+#[derive(Debug, Clone)]
+pub struct BufferSpec {
+    /// Its name.
+    pub name: String,
+    /// Element type.
+    pub ty: ElemType,
+    /// Element count.
+    pub len: usize,
+    /// Initial contents.
+    pub init: Init,
+}
+
+/// A kernel argument as written.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ArgSpec {
+    /// A buffer's address.
+    Buffer(String),
+    /// An integer scalar.
+    Int(i64),
+    /// A float scalar.
+    Float(f64),
+}
+
+/// One launch.
+#[derive(Debug, Clone)]
+pub struct LaunchSpec {
+    /// Kernel name.
+    pub kernel: String,
+    /// Grid.
+    pub grid: [u32; 3],
+    /// Block.
+    pub block: [u32; 3],
+    /// Dynamic shared memory bytes.
+    pub shared: u32,
+    /// Arguments.
+    pub args: Vec<ArgSpec>,
+}
+
+/// A parsed spec file.
+#[derive(Debug, Clone)]
+pub struct Spec {
+    /// The spec file.
+    pub file: PathBuf,
+    /// The PTX file (resolved against the spec's directory).
+    pub ptx: PathBuf,
+    /// Device profile name, when given.
+    pub device: Option<String>,
+    /// Buffers in declaration order.
+    pub buffers: Vec<BufferSpec>,
+    /// Launches in order.
+    pub launches: Vec<LaunchSpec>,
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+}
+
+impl Ctx<'_> {
+    fn err<T>(&self, key: &str, msg: impl Into<String>) -> Result<T, SpecError> {
+        Err(SpecError::Key { file: self.file.to_string(), key: key.to_string(), msg: msg.into() })
+    }
+
+    fn dims(&self, t: &toml::Table, key: &str, prefix: &str) -> Result<[u32; 3], SpecError> {
+        let k = format!("{prefix}{key}");
+        let v = match t.get(key) {
+            Some(v) => v,
+            None => return self.err(&k, "missing; expected [x, y, z] or a number"),
+        };
+        let nums: Vec<&toml::Value> = match v {
+            toml::Value::Array(a) => a.iter().collect(),
+            x @ toml::Value::Integer(_) => vec![x],
+            _ => return self.err(&k, "expected [x, y, z] or a number"),
+        };
+        if nums.is_empty() || nums.len() > 3 {
+            return self.err(&k, "expected 1 to 3 dimensions");
+        }
+        let mut d = [1u32; 3];
+        for (i, n) in nums.iter().enumerate() {
+            match n.as_integer() {
+                Some(x) if x >= 1 && x <= u32::MAX as i64 => d[i] = x as u32,
+                _ => return self.err(&k, "dimensions are positive integers"),
+            }
+        }
+        Ok(d)
+    }
+
+    fn launch(&self, t: &toml::Table, prefix: &str) -> Result<LaunchSpec, SpecError> {
+        let kernel = match t.get("kernel").and_then(|v| v.as_str()) {
+            Some(k) => k.to_string(),
+            None => return self.err(&format!("{prefix}kernel"), "missing; expected the kernel's name"),
+        };
+        let args = match t.get("args") {
+            None => Vec::new(),
+            Some(toml::Value::Array(a)) => a
+                .iter()
+                .enumerate()
+                .map(|(i, v)| match v {
+                    toml::Value::String(s) => Ok(ArgSpec::Buffer(s.clone())),
+                    toml::Value::Integer(x) => Ok(ArgSpec::Int(*x)),
+                    toml::Value::Float(x) => Ok(ArgSpec::Float(*x)),
+                    toml::Value::Boolean(b) => Ok(ArgSpec::Int(*b as i64)),
+                    _ => self.err(&format!("{prefix}args[{i}]"), "expected a buffer name or a number"),
+                })
+                .collect::<Result<_, _>>()?,
+            Some(_) => return self.err(&format!("{prefix}args"), "expected an array"),
+        };
+        let shared = match t.get("shared") {
+            None => 0,
+            Some(v) => match v.as_integer() {
+                Some(x) if x >= 0 => x as u32,
+                _ => return self.err(&format!("{prefix}shared"), "expected bytes of dynamic shared memory"),
+            },
+        };
+        Ok(LaunchSpec {
+            kernel,
+            grid: self.dims(t, "grid", prefix)?,
+            block: self.dims(t, "block", prefix)?,
+            shared,
+            args,
+        })
+    }
+}
+
+impl Spec {
+    /// Reads and validates a spec file.
+    pub fn load(path: &Path) -> Result<Spec, SpecError> {
+        let file = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| SpecError::Io { file: file.clone(), msg: e.to_string() })?;
+        Spec::parse(&text, path)
+    }
+
+    /// Parses spec text; `path` resolves relative file names and names errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Spec, SpecError> {
+        let file = path.display().to_string();
+        let cx = Ctx { file: &file };
+        let t: toml::Table =
+            toml::from_str(text).map_err(|e| SpecError::Toml { file: file.clone(), msg: e.to_string() })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let ptx = match t.get("ptx").and_then(|v| v.as_str()) {
+            Some(p) => dir.join(p),
+            None => return cx.err("ptx", "missing; expected the PTX file's path"),
+        };
+        let device = t.get("device").and_then(|v| v.as_str()).map(|s| s.to_string());
+        let mut buffers = Vec::new();
+        if let Some(b) = t.get("buffer") {
+            let Some(arr) = b.as_array() else { return cx.err("buffer", "expected [[buffer]] tables") };
+            for (i, v) in arr.iter().enumerate() {
+                let k = |f: &str| format!("buffer[{i}].{f}");
+                let Some(bt) = v.as_table() else { return cx.err(&format!("buffer[{i}]"), "expected a table") };
+                let name = match bt.get("name").and_then(|v| v.as_str()) {
+                    Some(n) => n.to_string(),
+                    None => return cx.err(&k("name"), "missing"),
+                };
+                let ty = match bt.get("type").and_then(|v| v.as_str()).and_then(ElemType::parse) {
+                    Some(t) => t,
+                    None => return cx.err(&k("type"), "expected one of u8 u16 u32 u64 i8 i16 i32 i64 f32 f64"),
+                };
+                let len = match bt.get("len").and_then(|v| v.as_integer()) {
+                    Some(n) if n >= 0 => n as usize,
+                    _ => return cx.err(&k("len"), "expected a non-negative element count"),
+                };
+                let init = match bt.get("init") {
+                    None => Init::Zeros,
+                    Some(toml::Value::String(s)) if s == "zeros" => Init::Zeros,
+                    Some(toml::Value::String(s)) if s == "iota" => Init::Iota,
+                    Some(toml::Value::Array(a)) => {
+                        if a.len() > len {
+                            return cx.err(&k("init"), format!("{} values for {len} elements", a.len()));
+                        }
+                        if let Some(bad) = a.iter().position(|v| v.as_integer().is_none() && v.as_float().is_none()) {
+                            return cx.err(&format!("buffer[{i}].init[{bad}]"), "expected a number");
+                        }
+                        Init::Values(a.clone())
+                    }
+                    Some(toml::Value::Table(it)) => {
+                        if let Some(f) = it.get("file").and_then(|v| v.as_str()) {
+                            Init::File(dir.join(f))
+                        } else {
+                            match (
+                                it.get("hash").and_then(|v| v.as_integer()),
+                                it.get("modulo").and_then(|v| v.as_integer()),
+                            ) {
+                                (Some(m), Some(n)) if n > 0 && m >= 0 => Init::Hash { mul: m as u64, modulo: n as u64 },
+                                _ => {
+                                    return cx.err(
+                                        &k("init"),
+                                        "expected { hash = M, modulo = N } with N > 0, or { file = \"x.bin\" }",
+                                    );
+                                }
+                            }
+                        }
+                    }
+                    Some(_) => return cx.err(&k("init"), "expected \"zeros\", \"iota\", a table or an array"),
+                };
+                if buffers.iter().any(|b: &BufferSpec| b.name == name) {
+                    return cx.err(&k("name"), format!("buffer `{name}` declared twice"));
+                }
+                buffers.push(BufferSpec { name, ty, len, init });
+            }
+        }
+        let launches = match t.get("launch") {
+            Some(toml::Value::Array(a)) => a
+                .iter()
+                .enumerate()
+                .map(|(i, v)| match v.as_table() {
+                    Some(lt) => cx.launch(lt, &format!("launch[{i}].")),
+                    None => cx.err(&format!("launch[{i}]"), "expected a table"),
+                })
+                .collect::<Result<Vec<_>, _>>()?,
+            Some(_) => return cx.err("launch", "expected [[launch]] tables"),
+            None => vec![cx.launch(&t, "")?],
+        };
+        for (li, l) in launches.iter().enumerate() {
+            for (ai, a) in l.args.iter().enumerate() {
+                if let ArgSpec::Buffer(n) = a
+                    && !buffers.iter().any(|b| &b.name == n)
+                {
+                    let key = if t.contains_key("launch") {
+                        format!("launch[{li}].args[{ai}]")
+                    } else {
+                        format!("args[{ai}]")
+                    };
+                    return cx.err(&key, format!("no buffer named `{n}`"));
+                }
+            }
+        }
+        Ok(Spec { file: path.to_path_buf(), ptx, device, buffers, launches })
+    }
+
+    /// The initial bytes of buffer `b`.
+    pub fn initial_bytes(&self, b: &BufferSpec) -> Result<Vec<u8>, SpecError> {
+        let size = b.ty.size();
+        let mut out = Vec::with_capacity(b.len * size);
+        match &b.init {
+            Init::Zeros => out.resize(b.len * size, 0),
+            Init::Iota => (0..b.len).for_each(|i| b.ty.encode(i as i128, i as f64, false, &mut out)),
+            Init::Hash { mul, modulo } => (0..b.len).for_each(|i| {
+                let v = (i as u64).wrapping_mul(*mul) % modulo;
+                b.ty.encode(v as i128, v as f64, false, &mut out)
+            }),
+            Init::File(p) => {
+                let data = std::fs::read(p)
+                    .map_err(|e| SpecError::Io { file: p.display().to_string(), msg: e.to_string() })?;
+                if data.len() > b.len * size {
+                    return Err(SpecError::Key {
+                        file: self.file.display().to_string(),
+                        key: format!("buffer `{}`.init.file", b.name),
+                        msg: format!("{} has {} bytes; the buffer holds {}", p.display(), data.len(), b.len * size),
+                    });
+                }
+                out = data;
+                out.resize(b.len * size, 0);
+            }
+            Init::Values(vals) => {
+                for v in vals {
+                    let (i, f, fl) = match v {
+                        toml::Value::Integer(x) => (*x as i128, 0.0, false),
+                        toml::Value::Float(x) => (0, *x, true),
+                        _ => (0, 0.0, false),
+                    };
+                    b.ty.encode(i, f, fl || (b.ty.is_float() && !matches!(v, toml::Value::Integer(_))), &mut out);
+                }
+                out.resize(b.len * size, 0);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Buffers of a spec allocated on a device.
+pub struct Prepared {
+    /// The loaded module.
+    pub module: Module,
+    /// Buffer name → (device pointer, spec).
+    pub buffers: BTreeMap<String, (DevicePtr, BufferSpec)>,
+}
+
+/// Loads the spec's PTX and allocates and fills its buffers.
+pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
+    let src = std::fs::read_to_string(&spec.ptx)
+        .map_err(|e| SpecError::Io { file: spec.ptx.display().to_string(), msg: e.to_string() })?;
+    let module = dev.load_ptx(&src, &spec.ptx.display().to_string())?;
+    let mut buffers = BTreeMap::new();
+    for b in &spec.buffers {
+        let bytes = spec.initial_bytes(b)?;
+        let p = dev.alloc_bytes(bytes.len() as u64, &b.name);
+        dev.write(p, &bytes)?;
+        buffers.insert(b.name.clone(), (p, b.clone()));
+    }
+    Ok(Prepared { module, buffers })
+}
+
+/// The kernel arguments of launch `l`, typed by the kernel's parameters.
+pub fn arguments(spec: &Spec, p: &Prepared, l: &LaunchSpec) -> Result<Vec<Arg>, SpecError> {
+    let file = spec.file.display().to_string();
+    let f = match p.module.prog.kernel(&l.kernel) {
+        Some(k) => &p.module.prog.functions[k as usize],
+        None => {
+            return Err(SpecError::Sim(SimError::UnknownKernel {
+                name: l.kernel.clone(),
+                file: p.module.prog.source_name.clone(),
+                available: p.module.prog.kernel_names().join(", "),
+            }));
+        }
+    };
+    if f.params.len() != l.args.len() {
+        return Err(SpecError::Key {
+            file,
+            key: "args".into(),
+            msg: format!("kernel `{}` takes {} argument(s), the spec gives {}", l.kernel, f.params.len(), l.args.len()),
+        });
+    }
+    let mut out = Vec::new();
+    for (i, (a, prm)) in l.args.iter().zip(&f.params).enumerate() {
+        let bad = |msg: String| SpecError::Key { file: file.clone(), key: format!("args[{i}]"), msg };
+        out.push(match a {
+            ArgSpec::Buffer(n) => {
+                if prm.size != 8 {
+                    return Err(bad(format!(
+                        "buffer `{n}` passed to `{}`, a {}-byte .{} parameter",
+                        prm.name, prm.size, prm.ty
+                    )));
+                }
+                Arg::Ptr(p.buffers[n].0)
+            }
+            ArgSpec::Int(x) => match (prm.ty, prm.size) {
+                (Ty::F32, _) => Arg::F32(*x as f32),
+                (Ty::F64, _) => Arg::F64(*x as f64),
+                (_, 4) => Arg::Bytes((*x as u32).to_le_bytes().to_vec()),
+                (_, 8) => Arg::Bytes((*x as u64).to_le_bytes().to_vec()),
+                (_, 2) => Arg::Bytes((*x as u16).to_le_bytes().to_vec()),
+                (_, 1) => Arg::Bytes(vec![*x as u8]),
+                (t, s) => return Err(bad(format!("cannot pass an integer to `{}` (.{t}, {s} bytes)", prm.name))),
+            },
+            ArgSpec::Float(x) => match prm.ty {
+                Ty::F32 => Arg::F32(*x as f32),
+                Ty::F64 => Arg::F64(*x),
+                t => return Err(bad(format!("float literal for `{}`, a .{t} parameter", prm.name))),
+            },
+        });
+    }
+    Ok(out)
+}
+
+/// Runs every launch of the spec in order; returns each launch's statistics.
+pub fn run(spec: &Spec, dev: &mut Device, p: &Prepared) -> Result<Vec<LaunchStats>, SpecError> {
+    let mut stats = Vec::new();
+    for l in &spec.launches {
+        let args = arguments(spec, p, l)?;
+        let cfg = LaunchConfig { grid: l.grid, block: l.block, dynamic_shared: l.shared };
+        stats.push(dev.launch(&p.module, &l.kernel, cfg, &args)?);
+    }
+    Ok(stats)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(s: &str) -> Result<Spec, SpecError> {
+        Spec::parse(s, Path::new("dir/spec.toml"))
+    }
+
+    #[test]
+    fn parses_the_documented_example() {
+        let s = parse(
+            r#"ptx = "micro.ptx"
+kernel = "copy_stride"
+grid = [64, 1, 1]
+block = [256, 1, 1]
+args = ["in", "out", 1, 0.5]
+[[buffer]]
+name = "in"
+type = "f32"
+len = 8
+init = { hash = 2654435761, modulo = 16 }
+[[buffer]]
+name = "out"
+type = "u8"
+len = 4
+init = [1, 2, 3]
+"#,
+        )
+        .unwrap();
+        assert_eq!(s.ptx, Path::new("dir/micro.ptx"));
+        assert_eq!(s.launches[0].grid, [64, 1, 1]);
+        assert_eq!(s.launches[0].args[3], ArgSpec::Float(0.5));
+        let inb = s.initial_bytes(&s.buffers[0]).unwrap();
+        let first: Vec<f32> = inb.chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        let exp: Vec<f32> = (0..8u64).map(|i| (i.wrapping_mul(2654435761) % 16) as f32).collect();
+        assert_eq!(first, exp);
+        assert_eq!(s.initial_bytes(&s.buffers[1]).unwrap(), vec![1, 2, 3, 0]);
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let e = parse("ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = [0]\nblock = 32\n").unwrap_err();
+        assert_eq!(e.to_string(), "dir/spec.toml: `grid`: dimensions are positive integers");
+        let e = parse("ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\nargs = [\"nope\"]\n").unwrap_err();
+        assert!(e.to_string().contains("`args[0]`: no buffer named `nope`"), "{e}");
+        let e = parse("ptx = \"a.ptx\"\n[[buffer]]\nname = \"b\"\ntype = \"f16\"\nlen = 1\n").unwrap_err();
+        assert!(e.to_string().contains("`buffer[0].type`"), "{e}");
+        let e = parse("ptx = 3").unwrap_err();
+        assert!(e.to_string().contains("`ptx`: missing"), "{e}");
+        let e = parse("ptx = \"a.ptx\"\nkernel = [").unwrap_err();
+        assert!(matches!(e, SpecError::Toml { .. }));
+    }
+}
