@@ -18,26 +18,26 @@ fn cases() -> Vec<Case> {
     vec![
         Case {
             name: "alu_loop",
-            grid: 16,
+            grid: 64,
             block: 256,
-            setup: |d| vec![Arg::Ptr(d.alloc_zeroed::<f32>(4096)), Arg::I32(200)],
+            setup: |d| vec![Arg::Ptr(d.alloc_zeroed::<f32>(16384)), Arg::I32(200)],
         },
         Case {
             name: "memory_stride",
-            grid: 16,
+            grid: 64,
             block: 256,
             setup: |d| {
                 let n = 1 << 16;
                 let input: Vec<f32> = (0..n).map(|i| i as f32).collect();
                 let inb = d.alloc_from(&input);
-                vec![Arg::Ptr(d.alloc_zeroed::<f32>(4096)), Arg::Ptr(inb), Arg::I32(n), Arg::I32(33), Arg::I32(64)]
+                vec![Arg::Ptr(d.alloc_zeroed::<f32>(16384)), Arg::Ptr(inb), Arg::I32(n), Arg::I32(33), Arg::I32(64)]
             },
         },
         Case {
             name: "divergent",
-            grid: 16,
+            grid: 64,
             block: 256,
-            setup: |d| vec![Arg::Ptr(d.alloc_zeroed::<i32>(4096)), Arg::I32(100)],
+            setup: |d| vec![Arg::Ptr(d.alloc_zeroed::<i32>(16384)), Arg::I32(100)],
         },
     ]
 }
