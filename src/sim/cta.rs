@@ -53,7 +53,6 @@ pub enum Stall {
 }
 
 /// A resident CTA.
-#[derive(Debug)]
 pub struct Cta {
     /// Index (x, y, z).
     pub id: [u32; 3],
@@ -71,6 +70,8 @@ pub struct Cta {
     pub pending: Vec<PendingAtomic>,
     /// A fault that stopped the CTA.
     pub fault: Option<CtaFault>,
+    /// Its memory observer (counter model), when one listens.
+    pub observer: Option<Box<dyn super::observer::MemObserver>>,
     cur: usize,
     slice_left: u32,
     slice: u32,
@@ -113,6 +114,7 @@ impl Cta {
             profile: InstProfile::new(ctx.prog),
             pending: Vec::new(),
             fault: None,
+            observer: ctx.observers.map(|f| f.create(linear)),
             cur: 0,
             slice_left: slice,
             slice: slice.max(1),
@@ -225,6 +227,7 @@ impl Cta {
             counters: &mut self.counters,
             profile: &mut self.profile,
             pending: &mut self.pending,
+            observer: self.observer.as_mut(),
         };
         let (func, pc, r) = exec::step(ctx, warp, &mut cm);
         self.slice_left = self.slice_left.saturating_sub(1);

@@ -36,6 +36,7 @@ use super::exec::Ctx;
 use super::fault::Fault;
 use super::grid::{GridRun, Schedule};
 use super::memory::DeviceMemory;
+use super::observer::ObserverFactory;
 use crate::ptx::{self, Program, PtxError};
 
 /// Errors of loading and launching.
@@ -402,7 +403,13 @@ impl Device {
         Ok((k, kp, shared))
     }
 
-    fn ctx<'a>(&'a self, m: &'a Module, kp: Vec<u8>, cfg: &LaunchConfig) -> Ctx<'a> {
+    fn ctx<'a>(
+        &'a self,
+        m: &'a Module,
+        kp: Vec<u8>,
+        cfg: &LaunchConfig,
+        observers: Option<&'a dyn ObserverFactory>,
+    ) -> Ctx<'a> {
         Ctx {
             prog: &m.prog,
             cfgs: &m.cfgs,
@@ -413,6 +420,7 @@ impl Device {
             block: cfg.block,
             num_sms: self.config.num_sms.max(1),
             local_limit: self.config.local_limit,
+            observers,
         }
     }
 
@@ -425,8 +433,20 @@ impl Device {
         cfg: LaunchConfig,
         args: &[Arg],
     ) -> Result<LaunchStats, SimError> {
+        self.launch_observed(m, kernel, cfg, args, None)
+    }
+
+    /// As [`Device::launch`], with a counter model observing every memory access.
+    pub fn launch_observed(
+        &mut self,
+        m: &Module,
+        kernel: &str,
+        cfg: LaunchConfig,
+        args: &[Arg],
+        observers: Option<&dyn ObserverFactory>,
+    ) -> Result<LaunchStats, SimError> {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
-        let ctx = self.ctx(m, kp, &cfg);
+        let ctx = self.ctx(m, kp, &cfg, observers);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
         run.run(self.pool.as_ref()).map_err(SimError::Fault)
     }
@@ -451,6 +471,6 @@ impl Device {
         shared: usize,
         cfg: &LaunchConfig,
     ) -> GridRun<'a> {
-        GridRun::new(self.ctx(m, kp, cfg), k, shared, self.config.schedule.clone())
+        GridRun::new(self.ctx(m, kp, cfg, None), k, shared, self.config.schedule.clone())
     }
 }

@@ -9,6 +9,7 @@ use super::fault::FaultKind;
 use super::memory::{
     CONST_WINDOW, DeviceMemory, GenericTarget, LOCAL_WINDOW, PARAM_WINDOW, SHARED_WINDOW, decode_generic,
 };
+use super::observer::{MemEvent, MemObserver, MemOp, ObserverFactory};
 use super::simt_stack::{BranchOutcome, SimtEntry};
 use super::warp::{Frame, Warp, WarpState};
 use crate::ptx::ir::*;
@@ -34,6 +35,8 @@ pub struct Ctx<'a> {
     pub num_sms: u32,
     /// Per-thread local memory limit in bytes.
     pub local_limit: u32,
+    /// Makes the per-CTA memory observers (counter models), if any.
+    pub observers: Option<&'a dyn ObserverFactory>,
 }
 
 /// The CTA-owned state an instruction may change besides its warp.
@@ -50,6 +53,8 @@ pub struct CtaMut<'a> {
     pub profile: &'a mut InstProfile,
     /// Global atomics waiting for the round's end.
     pub pending: &'a mut Vec<PendingAtomic>,
+    /// The CTA's memory observer.
+    pub observer: Option<&'a mut Box<dyn MemObserver>>,
 }
 
 /// A warp's global atomic operations, applied in order when the round ends.
@@ -331,6 +336,51 @@ fn access(
     }
 }
 
+/// Per-lane resolved accesses of one instruction, for observers.
+struct Touched {
+    space: [Option<MemSpace>; 32],
+    addr: [u64; 32],
+}
+
+impl Touched {
+    fn new() -> Self {
+        Touched { space: [None; 32], addr: [0; 32] }
+    }
+    fn set(&mut self, lane: usize, r: Resolved) {
+        self.space[lane] = Some(r.space());
+        self.addr[lane] = r.addr();
+    }
+}
+
+/// Sends one event per space the lanes touched.
+#[allow(clippy::too_many_arguments)]
+fn emit(cta: &mut CtaMut, w: &Warp, func: u32, pc: u32, op: MemOp, nc: bool, elem: u32, n: u32, t: &Touched) {
+    let (cta_linear, warp) = (cta.cta_linear, w.id);
+    let Some(obs) = cta.observer.as_deref_mut() else { return };
+    let mut done = 0u32;
+    for l in 0..32 {
+        let Some(space) = t.space[l] else { continue };
+        if done >> l & 1 != 0 {
+            continue;
+        }
+        let mask = (0..32).filter(|&k| t.space[k] == Some(space)).fold(0u32, |m, k| m | 1 << k);
+        done |= mask;
+        obs.access(&MemEvent {
+            func,
+            pc,
+            op,
+            space,
+            nc,
+            bytes: elem * n,
+            elem_bytes: elem,
+            mask,
+            addrs: &t.addr,
+            cta: cta_linear,
+            warp,
+        });
+    }
+}
+
 /// Vector accesses must be aligned to their whole size.
 fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), ExecFault> {
     if !r.addr().is_multiple_of(total as u64) {
@@ -591,18 +641,20 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             let r = if *to_generic { map1(&va, |x| x.wrapping_add(win)) } else { map1(&va, |x| x.wrapping_sub(win)) };
             write(w.frames.last_mut().expect("frame"), *d, &r, exec);
         }
-        Kind::Ld { space, ty, ds, addr, .. } => {
+        Kind::Ld { space, ty, ds, addr, nc, .. } => {
             let addrs = addresses(ctx, w, cta, addr);
             let size = ty.bytes();
             let n = ds.len() as u32;
             let mut vals = [[0u64; 32]; 4];
             let mut first = None;
+            let mut touched = Touched::new();
             for l in 0..32 {
                 if exec >> l & 1 == 0 {
                     continue;
                 }
                 let r = resolve(*space, addrs[l]);
                 first.get_or_insert(r);
+                touched.set(l, r);
                 check_vector_align(r, l, size * n)?;
                 for k in 0..n {
                     let rk = resolve(*space, addrs[l].wrapping_add((k * size) as u64));
@@ -612,6 +664,7 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             if let Some(r) = first {
                 count_space(&mut cta.counters.loads, r);
             }
+            emit(cta, w, func, pc, MemOp::Load, *nc, size, n, &touched);
             let fr = w.frames.last_mut().expect("frame");
             for (k, d) in ds.iter().enumerate() {
                 write(fr, *d, &vals[k], exec);
@@ -621,14 +674,19 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             let addrs = addresses(ctx, w, cta, addr);
             let size = ty.bytes();
             let n = vals.len() as u32;
-            let vs: Vec<Lanes> = vals.iter().map(|v| read(ctx, w, cta, *v)).collect();
+            let mut vs = [[0u64; 32]; 4];
+            for (k, v) in vals.iter().enumerate() {
+                vs[k] = read(ctx, w, cta, *v);
+            }
             let mut first = None;
+            let mut touched = Touched::new();
             for l in 0..32 {
                 if exec >> l & 1 == 0 {
                     continue;
                 }
                 let r = resolve(*space, addrs[l]);
                 first.get_or_insert(r);
+                touched.set(l, r);
                 check_vector_align(r, l, size * n)?;
                 for k in 0..n {
                     let rk = resolve(*space, addrs[l].wrapping_add((k * size) as u64));
@@ -638,9 +696,10 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             if let Some(r) = first {
                 count_space(&mut cta.counters.stores, r);
             }
+            emit(cta, w, func, pc, MemOp::Store, false, size, n, &touched);
         }
         Kind::Atom { space, op, ty, d, addr, b, c } => {
-            return atomic(ctx, w, cta, *space, *op, *ty, *d, addr, *b, *c, exec);
+            return atomic(ctx, w, cta, (func, pc), *space, *op, *ty, *d, addr, *b, *c, exec);
         }
         Kind::Bar { id, count } => {
             if exec != w.live {
@@ -797,6 +856,7 @@ fn atomic(
     ctx: &Ctx,
     w: &mut Warp,
     cta: &mut CtaMut,
+    (func, pc): (u32, u32),
     space: MemSpace,
     op: AtomOp,
     ty: Ty,
@@ -812,12 +872,14 @@ fn atomic(
     let mut old = [0u64; 32];
     let mut global = Vec::new();
     let mut first = None;
+    let mut touched = Touched::new();
     for l in 0..32 {
         if exec >> l & 1 == 0 {
             continue;
         }
         let r = resolve(space, addrs[l]);
         first.get_or_insert(r);
+        touched.set(l, r);
         cta.counters.atomic_lane_ops += 1;
         match r {
             Resolved::Shared(_) => {
@@ -844,6 +906,8 @@ fn atomic(
     if let Some(r) = first {
         count_space(&mut cta.counters.atomics, r);
     }
+    let mop = if d.is_some() { MemOp::Atomic } else { MemOp::Reduction };
+    emit(cta, w, func, pc, mop, false, size, 1, &touched);
     if let Some(d) = d {
         let shared_lanes = exec & !global.iter().fold(0u32, |m, g| m | 1 << g.0);
         write(w.frames.last_mut().expect("frame"), d, &old, shared_lanes);

@@ -85,6 +85,14 @@ impl<'a> GridRun<'a> {
         }
     }
 
+    fn retire(&mut self, mut c: Cta) {
+        self.totals.merge(&c.counters);
+        self.profile.merge(&c.profile);
+        if let (Some(f), Some(o)) = (self.ctx.observers, c.observer.take()) {
+            f.retire(o);
+        }
+    }
+
     /// True when every CTA finished.
     pub fn done(&self) -> bool {
         self.resident.is_empty() && self.next_cta >= self.total_ctas
@@ -124,8 +132,7 @@ impl<'a> GridRun<'a> {
             if self.resident[i].finished() && self.resident[i].pending.is_empty() {
                 let c = self.resident.remove(i);
                 self.retired_instructions += c.counters.warp_instructions;
-                self.totals.merge(&c.counters);
-                self.profile.merge(&c.profile);
+                self.retire(c);
             } else {
                 i += 1;
             }
@@ -163,8 +170,7 @@ impl<'a> GridRun<'a> {
     /// Final statistics (CTAs still resident are included).
     pub fn finish(mut self) -> LaunchStats {
         for c in std::mem::take(&mut self.resident) {
-            self.totals.merge(&c.counters);
-            self.profile.merge(&c.profile);
+            self.retire(c);
         }
         LaunchStats { kernel: self.kernel_name, totals: self.totals, profile: self.profile }
     }

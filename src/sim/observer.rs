@@ -1,0 +1,65 @@
+//! Memory-access events: what each warp-level memory instruction touched,
+//! lane by lane. Counter models (`crate::model`) observe these; the simulator
+//! does not know which model, if any, is listening.
+
+use std::any::Any;
+
+use crate::ptx::ir::MemSpace;
+
+/// The kind of memory operation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MemOp {
+    /// A load.
+    Load,
+    /// A store.
+    Store,
+    /// An atomic that returns the old value (`atom`).
+    Atomic,
+    /// An atomic without a result (`red`).
+    Reduction,
+}
+
+/// One warp-level memory instruction's accesses to one state space.
+/// (A generic access whose lanes resolve to several spaces gives one event per space.)
+#[derive(Debug, Clone, Copy)]
+pub struct MemEvent<'a> {
+    /// Function index.
+    pub func: u32,
+    /// Instruction index.
+    pub pc: u32,
+    /// What kind of access.
+    pub op: MemOp,
+    /// The space the lanes' addresses resolved to.
+    pub space: MemSpace,
+    /// Through the read-only (texture / non-coherent) path: `ld.global.nc`.
+    pub nc: bool,
+    /// Bytes each lane accesses (element size × vector width).
+    pub bytes: u32,
+    /// Size of one vector element.
+    pub elem_bytes: u32,
+    /// Lanes taking part.
+    pub mask: u32,
+    /// Per-lane addresses in `space` (for local memory: the thread's own offset).
+    pub addrs: &'a [u64; 32],
+    /// Linear CTA index.
+    pub cta: u32,
+    /// Warp within the CTA.
+    pub warp: u32,
+}
+
+/// Receives the memory events of one CTA.
+pub trait MemObserver: Send {
+    /// One warp-level access.
+    fn access(&mut self, ev: &MemEvent);
+    /// The observer as `Any`, for its factory to take its results back.
+    fn into_any(self: Box<Self>) -> Box<dyn Any>;
+}
+
+/// Makes one observer per CTA and collects them when the CTA retires.
+/// Collection must not depend on the order CTAs retire in (sums do not).
+pub trait ObserverFactory: Sync {
+    /// An observer for CTA `cta` (linear index).
+    fn create(&self, cta: u32) -> Box<dyn MemObserver>;
+    /// Takes back a retired CTA's observer.
+    fn retire(&self, obs: Box<dyn MemObserver>);
+}
