@@ -22,5 +22,6 @@
 
 pub mod cli;
 pub mod launch_spec;
+pub mod model;
 pub mod ptx;
 pub mod sim;

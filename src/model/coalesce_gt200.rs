@@ -1,0 +1,162 @@
+//! Global-memory coalescing of compute capability 1.2/1.3 (GT200, the GTX 280
+//! of theses 000 and 002), per half-warp, as the CUDA Programming Guide
+//! (App. G.3.2) states it:
+//!
+//! 1. Find the segment containing the address of the lowest-numbered active
+//!    thread: 32 B for 1-byte words, 64 B for 2-byte words, 128 B for 4-, 8-
+//!    and 16-byte words.
+//! 2. Find all other active threads whose address lies in that segment.
+//! 3. If the transaction is 128 B and only its lower or upper half is used,
+//!    shrink it to 64 B; if 64 B and only one half is used, to 32 B.
+//! 4. Issue it and mark those threads serviced; repeat until all are.
+
+/// Transactions by size.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Transactions {
+    /// 32-byte transactions.
+    pub t32: u64,
+    /// 64-byte transactions.
+    pub t64: u64,
+    /// 128-byte transactions.
+    pub t128: u64,
+}
+
+impl Transactions {
+    /// All transactions.
+    pub fn count(&self) -> u64 {
+        self.t32 + self.t64 + self.t128
+    }
+
+    /// Bytes moved.
+    pub fn bytes(&self) -> u64 {
+        32 * self.t32 + 64 * self.t64 + 128 * self.t128
+    }
+
+    fn add(&mut self, size: u64) {
+        match size {
+            32 => self.t32 += 1,
+            64 => self.t64 += 1,
+            _ => self.t128 += 1,
+        }
+    }
+
+    /// Adds `o`.
+    pub fn merge(&mut self, o: &Transactions) {
+        self.t32 += o.t32;
+        self.t64 += o.t64;
+        self.t128 += o.t128;
+    }
+}
+
+/// Transactions of one half-warp: `lanes` are (address, bytes) of its active threads.
+pub fn half_warp(lanes: &[(u64, u32)]) -> Transactions {
+    let mut t = Transactions::default();
+    let mut pending: Vec<(u64, u32)> = lanes.to_vec();
+    while let Some(&(a0, w)) = pending.first() {
+        let seg = match w {
+            1 => 32u64,
+            2 => 64,
+            _ => 128,
+        };
+        let base = a0 / seg * seg;
+        let (inside, rest): (Vec<_>, Vec<_>) = pending.iter().partition(|(a, _)| *a >= base && *a < base + seg);
+        pending = rest;
+        let lo = inside.iter().map(|(a, _)| *a).min().expect("one thread at least");
+        let hi = inside.iter().map(|(a, b)| a + *b as u64).max().expect("one thread at least");
+        let (mut b, mut size) = (base, seg);
+        while size > 32 {
+            let half = size / 2;
+            if hi <= b + half {
+                size = half;
+            } else if lo >= b + half {
+                b += half;
+                size = half;
+            } else {
+                break;
+            }
+        }
+        t.add(size);
+    }
+    t
+}
+
+/// Transactions of a warp-level access: each half-warp separately. A 16-byte
+/// word access by a full half-warp spans two segments and so is split.
+pub fn warp(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Transactions {
+    let mut t = Transactions::default();
+    for h in 0..2 {
+        let lanes: Vec<(u64, u32)> =
+            (h * 16..h * 16 + 16).filter(|l| mask >> l & 1 != 0).map(|l| (addr(l), bytes)).collect();
+        if !lanes.is_empty() {
+            t.merge(&half_warp(&lanes));
+        }
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hw(addrs: impl Iterator<Item = u64>, w: u32) -> Transactions {
+        half_warp(&addrs.map(|a| (a, w)).collect::<Vec<_>>())
+    }
+
+    // CUDA C Programming Guide, CC 1.2/1.3 examples (Figure G-2 and text).
+    #[test]
+    fn aligned_consecutive_words_are_one_64_byte_transaction() {
+        // 16 threads x 4 bytes, aligned: 64 bytes in a 128-byte segment's lower half.
+        let t = hw((0..16).map(|k| 1024 + 4 * k), 4);
+        assert_eq!(t, Transactions { t32: 0, t64: 1, t128: 0 });
+    }
+
+    #[test]
+    fn permuted_words_still_coalesce() {
+        let t = hw((0..16).map(|k| 1024 + 4 * ((k * 7) % 16)), 4);
+        assert_eq!(t.count(), 1);
+        assert_eq!(t.t64, 1);
+    }
+
+    #[test]
+    fn misaligned_run_crossing_a_segment_gives_two_transactions() {
+        // starting at 1024 + 68: spans bytes 1092..1156, crossing 1152
+        let t = hw((0..16).map(|k| 1024 + 68 + 4 * k), 4);
+        assert_eq!(t.count(), 2);
+        assert_eq!((t.t64, t.t32), (1, 1), "one 64-byte and one 32-byte transaction: {t:?}");
+    }
+
+    #[test]
+    fn eight_byte_words_use_a_128_byte_segment() {
+        let t = hw((0..16).map(|k| 2048 + 8 * k), 8);
+        assert_eq!(t, Transactions { t32: 0, t64: 0, t128: 1 });
+    }
+
+    #[test]
+    fn sixteen_byte_words_need_two_segments() {
+        let t = hw((0..16).map(|k| 4096 + 16 * k), 16);
+        assert_eq!(t, Transactions { t32: 0, t64: 0, t128: 2 });
+    }
+
+    #[test]
+    fn scattered_words_are_one_transaction_each() {
+        let t = hw((0..16).map(|k| k * 4096), 4);
+        assert_eq!(t.t32, 16);
+    }
+
+    #[test]
+    fn same_address_is_one_32_byte_transaction() {
+        assert_eq!(hw((0..16).map(|_| 512), 4), Transactions { t32: 1, t64: 0, t128: 0 });
+    }
+
+    #[test]
+    fn bytes_use_32_byte_segments() {
+        let t = hw((0..16).map(|k| 96 + k), 1);
+        assert_eq!(t, Transactions { t32: 1, t64: 0, t128: 0 });
+    }
+
+    #[test]
+    fn warp_counts_half_warps_separately() {
+        let t = warp(u32::MAX, 4, |l| 1024 + 4 * l as u64);
+        assert_eq!(t, Transactions { t32: 0, t64: 2, t128: 0 });
+    }
+}
