@@ -21,6 +21,14 @@
 
 #define WL_DEV static __device__ __forceinline__
 
+// ---- vector types (as the SDK lays them out) ----
+struct alignas(8) float2 { float x, y; };
+struct alignas(16) float4 { float x, y, z, w; };
+struct alignas(8) int2 { int x, y; };
+struct alignas(16) int4 { int x, y, z, w; };
+WL_DEV float2 make_float2(float x, float y) { return {x, y}; }
+WL_DEV float4 make_float4(float x, float y, float z, float w) { return {x, y, z, w}; }
+
 // ---- warp votes and shuffles (vote.sync.*, shfl.sync.*) ----
 WL_DEV unsigned __ballot_sync(unsigned mask, int p) { return __nvvm_vote_ballot_sync(mask, p); }
 WL_DEV int __all_sync(unsigned mask, int p) { return __nvvm_vote_all_sync(mask, p); }

@@ -37,6 +37,19 @@ pub enum Command {
         /// The PTX file.
         ptx: std::path::PathBuf,
     },
+    /// Compare the hopper profile with the H100 measurements of the memory
+    /// microbenchmarks (tests/fixtures/h100_micro.json).
+    Validate {
+        /// The fixture.
+        #[arg(long, default_value = "tests/fixtures/h100_micro.json")]
+        fixture: std::path::PathBuf,
+        /// The microbenchmarks' PTX.
+        #[arg(long, default_value = "kernels/micro/micro.ptx")]
+        ptx: std::path::PathBuf,
+        /// Print docs/validation.md (header and table).
+        #[arg(long)]
+        markdown: bool,
+    },
 }
 
 /// Runs the CLI; returns the process exit code.
@@ -46,6 +59,7 @@ pub fn main() -> i32 {
         Command::Launch(a) => launch::run(a),
         Command::Kernels { ptx } => ptx_info::kernels(&ptx),
         Command::Check { ptx } => ptx_info::check(&ptx),
+        Command::Validate { fixture, ptx, markdown } => validate(&fixture, &ptx, markdown),
     };
     match r {
         Ok(()) => 0,
@@ -54,4 +68,34 @@ pub fn main() -> i32 {
             1
         }
     }
+}
+
+fn validate(fixture: &std::path::Path, ptx: &std::path::Path, md: bool) -> Result<(), Box<dyn std::error::Error>> {
+    use crate::model::validation::{Expect, compare, markdown};
+    let rows = compare(fixture, ptx)?;
+    if md {
+        print!("{}", include_str!("validation_header.md"));
+        print!("{}", markdown(&rows));
+        return Ok(());
+    }
+    let exact = rows.iter().filter(|r| r.expect == Expect::Exact).count();
+    let equal = rows.iter().filter(|r| r.expect == Expect::Exact && r.measured == r.emulated).count();
+    for r in rows.iter().filter(|r| r.measured != r.emulated) {
+        println!(
+            "{:>3} {:<13} ({:>4}, {}) {:<62} H100 {:>8}  warplight {:>8}{}",
+            r.launch,
+            r.kernel,
+            r.args.0,
+            r.args.1,
+            r.metric,
+            r.measured,
+            r.emulated,
+            if r.expect == Expect::Exact { "  DIFFERS" } else { "" }
+        );
+    }
+    println!("{equal} of {exact} exactly compared metrics equal; {} shown side by side", rows.len() - exact);
+    if equal != exact {
+        return Err("the hopper profile differs from the H100".into());
+    }
+    Ok(())
 }

@@ -22,6 +22,7 @@ pub mod coalesce_gt200;
 pub mod occupancy;
 pub mod profile;
 pub mod sectors;
+pub mod validation;
 
 use std::any::Any;
 use std::sync::Mutex;
