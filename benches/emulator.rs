@@ -5,6 +5,7 @@
 use std::time::Instant;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use warplight::model::{Model, Profile};
 use warplight::sim::{Arg, Device, LaunchConfig, Module, SimConfig};
 
 struct Case {
@@ -82,8 +83,38 @@ fn report() {
     }
 }
 
+/// Counters on (a device profile's memory model) against off.
+fn report_model_cost() {
+    eprintln!("\nmemory-model cost (1 host thread): time with the profile / time without");
+    for c in cases() {
+        let (mut dev, m) = device(1);
+        let args = (c.setup)(&mut dev);
+        let cfg = LaunchConfig::linear(c.grid, c.block);
+        let time = |dev: &mut Device, profile: Option<Profile>| {
+            let t0 = Instant::now();
+            for _ in 0..3 {
+                match profile {
+                    None => {
+                        dev.launch(&m, c.name, cfg, &args).unwrap();
+                    }
+                    Some(p) => {
+                        let model = Model::new(p, &m.prog);
+                        dev.launch_observed(&m, c.name, cfg, &args, Some(&model)).unwrap();
+                    }
+                }
+            }
+            t0.elapsed().as_secs_f64()
+        };
+        let off = time(&mut dev, None);
+        let line: Vec<String> =
+            Profile::ALL.iter().map(|p| format!("{} {:.2}x", p, time(&mut dev, Some(*p)) / off)).collect();
+        eprintln!("{:<14} {}", c.name, line.join("   "));
+    }
+}
+
 fn bench(cr: &mut Criterion) {
     report();
+    report_model_cost();
     let mut g = cr.benchmark_group("emulator");
     g.sample_size(10);
     for c in cases() {

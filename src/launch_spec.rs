@@ -22,6 +22,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use crate::model::{Model, ModelStats, Occupancy, Profile, occupancy};
 use crate::ptx::types::Ty;
 use crate::sim::{Arg, Device, DevicePtr, LaunchConfig, LaunchStats, Module, SimError};
 
@@ -502,15 +503,53 @@ pub fn arguments(spec: &Spec, p: &Prepared, l: &LaunchSpec) -> Result<Vec<Arg>, 
     Ok(out)
 }
 
-/// Runs every launch of the spec in order; returns each launch's statistics.
-pub fn run(spec: &Spec, dev: &mut Device, p: &Prepared) -> Result<Vec<LaunchStats>, SpecError> {
-    let mut stats = Vec::new();
+/// What one launch produced.
+#[derive(Debug, Clone)]
+pub struct LaunchResult {
+    /// The core's counters.
+    pub stats: LaunchStats,
+    /// The device profile's memory counters.
+    pub memory: ModelStats,
+    /// Occupancy under the profile.
+    pub occupancy: Occupancy,
+}
+
+impl LaunchResult {
+    /// Every counter: the core's, the memory model's (`mem.*`), the profiler's names
+    /// for the profile, and occupancy (`occupancy.*`).
+    pub fn metrics(&self) -> Vec<(String, u64)> {
+        let mut v = self.stats.totals.flatten();
+        v.extend(self.memory.metrics(&self.stats.totals));
+        let o = &self.occupancy;
+        for (k, x) in [
+            ("occupancy.registers_per_thread", o.registers_per_thread),
+            ("occupancy.shared_per_cta", o.shared_per_cta),
+            ("occupancy.ctas_per_sm", o.ctas_per_sm),
+            ("occupancy.pct", o.occupancy_pct),
+        ] {
+            v.push((k.to_string(), x as u64));
+        }
+        v
+    }
+}
+
+/// Runs every launch of the spec in order under `profile`; returns each launch's results.
+pub fn run(spec: &Spec, dev: &mut Device, p: &Prepared, profile: Profile) -> Result<Vec<LaunchResult>, SpecError> {
+    let mut out = Vec::new();
     for l in &spec.launches {
         let args = arguments(spec, p, l)?;
         let cfg = LaunchConfig { grid: l.grid, block: l.block, dynamic_shared: l.shared };
-        stats.push(dev.launch(&p.module, &l.kernel, cfg, &args)?);
+        let model = Model::new(profile, &p.module.prog);
+        let stats = dev.launch_observed(&p.module, &l.kernel, cfg, &args, Some(&model))?;
+        let k = p.module.prog.kernel(&l.kernel).expect("checked by arguments()");
+        let threads = l.block.iter().product();
+        out.push(LaunchResult {
+            stats,
+            memory: model.finish(),
+            occupancy: occupancy(profile, &p.module.prog, k, threads, l.shared),
+        });
     }
-    Ok(stats)
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -15,7 +15,12 @@ fn hopper_profile_matches_the_h100() {
     let bad: Vec<String> = exact
         .iter()
         .filter(|r| r.measured != r.emulated)
-        .map(|r| format!("{} {} ({}, {}) {}: H100 {} warplight {}", r.launch, r.kernel, r.args.0, r.args.1, r.metric, r.measured, r.emulated))
+        .map(|r| {
+            format!(
+                "{} {} ({}, {}) {}: H100 {} warplight {}",
+                r.launch, r.kernel, r.args.0, r.args.1, r.metric, r.measured, r.emulated
+            )
+        })
         .collect();
     assert!(bad.is_empty(), "{} differences:\n{}", bad.len(), bad.join("\n"));
     // docs/validation.md is generated from the same rows

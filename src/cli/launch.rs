@@ -3,8 +3,10 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::launch_spec::{self, Spec};
-use crate::sim::counters::{LaunchStats, LineCounts};
+use crate::launch_spec::{self, LaunchResult, Spec};
+use crate::model::{InstMem, Profile};
+use crate::ptx::Program;
+use crate::sim::counters::LineCounts;
 use crate::sim::{Device, SimConfig};
 
 /// Options of `warplight launch`.
@@ -31,6 +33,10 @@ pub struct LaunchArgs {
     /// Host threads (0 = all cores). Results do not depend on it.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Device profile for the memory counters: gt200, maxwell or hopper
+    /// (default: the spec's `device`, else hopper). See docs/devices.md.
+    #[arg(long)]
+    pub device: Option<String>,
 }
 
 type Res = Result<(), Box<dyn std::error::Error>>;
@@ -38,6 +44,9 @@ type Res = Result<(), Box<dyn std::error::Error>>;
 /// Runs the command.
 pub fn run(a: LaunchArgs) -> Res {
     let spec = Spec::load(&a.spec)?;
+    let dev_name = a.device.clone().or(spec.device.clone()).unwrap_or_else(|| "hopper".into());
+    let profile = Profile::parse(&dev_name)
+        .ok_or_else(|| format!("unknown device profile `{dev_name}`; known: gt200, maxwell, hopper"))?;
     let dumps: Vec<(String, PathBuf)> = a
         .dump
         .iter()
@@ -58,7 +67,7 @@ pub fn run(a: LaunchArgs) -> Res {
         pb.enable_steady_tick(std::time::Duration::from_millis(100));
         pb
     });
-    let result = launch_spec::run(&spec, &mut dev, &prepared);
+    let result = launch_spec::run(&spec, &mut dev, &prepared, profile);
     if let Some(pb) = spinner {
         pb.finish_and_clear();
     }
@@ -80,16 +89,20 @@ pub fn run(a: LaunchArgs) -> Res {
                 let counters: serde_json::Map<String, serde_json::Value> =
                     selected(s, &a.metrics)?.into_iter().map(|(k, v)| (k, v.into())).collect();
                 let mut o = serde_json::json!({
-                    "kernel": l.kernel, "grid": l.grid, "block": l.block, "counters": counters,
+                    "kernel": l.kernel, "grid": l.grid, "block": l.block, "device": profile.to_string(),
+                    "counters": counters, "occupancy": s.occupancy,
                 });
                 if a.per_line {
-                    o["per_source_line"] = serde_json::to_value(s.per_source_line(prog))?;
-                    o["per_ptx_line"] = serde_json::to_value(s.per_ptx_line(prog))?;
+                    o["per_source_line"] = serde_json::to_value(s.stats.per_source_line(prog))?;
+                    o["per_ptx_line"] = serde_json::to_value(s.stats.per_ptx_line(prog))?;
+                    o["memory_per_ptx_line"] = serde_json::to_value(memory_per_ptx_line(prog, &s.memory.per_inst))?;
                 }
                 Ok(o)
             })
             .collect::<Result<_, Box<dyn std::error::Error>>>()?;
-        let out = serde_json::json!({ "spec": spec.file, "ptx": spec.ptx, "launches": launches });
+        let out = serde_json::json!({
+            "spec": spec.file, "ptx": spec.ptx, "device": profile.params(), "launches": launches,
+        });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
@@ -107,32 +120,91 @@ pub fn run(a: LaunchArgs) -> Res {
         for (k, v) in selected(s, &a.metrics)? {
             println!("  {k:<40} {v:>16}");
         }
+        if a.metrics.is_empty() {
+            let o = &s.occupancy;
+            println!(
+                "  occupancy: {} CTAs/SM ({}% of warps), limited by {}; {} registers/thread (PTX), {} B shared/CTA",
+                o.ctas_per_sm, o.occupancy_pct, o.limiter, o.registers_per_thread, o.shared_per_cta
+            );
+        }
         if a.per_line {
-            let src = s.per_source_line(prog);
-            let lines = if src.is_empty() { s.per_ptx_line(prog) } else { src };
-            print_lines(&lines, &spec);
+            let src = s.stats.per_source_line(prog);
+            let lines = if src.is_empty() { s.stats.per_ptx_line(prog) } else { src };
+            let src_empty = |st: &crate::sim::LaunchStats, p: &Program| st.per_source_line(p).is_empty();
+            print_lines(&lines, &spec, &memory_by_line(prog, &s.memory.per_inst, !src_empty(&s.stats, prog)));
         }
     }
     Ok(())
 }
 
-fn selected(s: &LaunchStats, metrics: &[String]) -> Result<Vec<(String, u64)>, String> {
+fn selected(s: &LaunchResult, metrics: &[String]) -> Result<Vec<(String, u64)>, String> {
+    let all = s.metrics();
     if metrics.is_empty() {
-        return Ok(s.totals.flatten());
+        return Ok(all);
     }
     metrics
         .iter()
         .map(|m| {
-            s.totals.get(m).map(|v| (m.clone(), v)).ok_or_else(|| {
-                let names: Vec<String> = s.totals.flatten().into_iter().map(|(n, _)| n).collect();
+            let found = all.iter().find(|(n, _)| n == m).map(|(_, v)| *v).or_else(|| s.stats.totals.get(m));
+            found.map(|v| (m.clone(), v)).ok_or_else(|| {
+                let names: Vec<String> = all.iter().map(|(n, _)| n.clone()).collect();
                 format!("unknown metric `{m}`; known: {}", names.join(", "))
             })
         })
         .collect()
 }
 
-fn print_lines(lines: &[LineCounts], spec: &Spec) {
-    println!("\n  {:<28} {:>12} {:>14} {:>9}  source", "line", "warp inst", "thread inst", "diverged");
+/// Memory counts summed per PTX line.
+fn memory_per_ptx_line(prog: &Program, per_inst: &[Vec<InstMem>]) -> Vec<(u32, InstMem)> {
+    let mut map: std::collections::BTreeMap<u32, InstMem> = Default::default();
+    for (f, v) in per_inst.iter().enumerate() {
+        for (pc, m) in v.iter().enumerate() {
+            if *m == InstMem::default() {
+                continue;
+            }
+            let e = map.entry(prog.functions[f].info[pc].ptx_line).or_default();
+            e.requests += m.requests;
+            e.sectors += m.sectors;
+            e.wavefronts += m.wavefronts;
+            e.bank_conflicts += m.bank_conflicts;
+        }
+    }
+    map.into_iter().collect()
+}
+
+/// Memory counts per (file, line): CUDA source lines when `by_source`, else PTX lines.
+fn memory_by_line(
+    prog: &Program,
+    per_inst: &[Vec<InstMem>],
+    by_source: bool,
+) -> std::collections::HashMap<(String, u32), InstMem> {
+    let mut map: std::collections::HashMap<(String, u32), InstMem> = Default::default();
+    for (f, v) in per_inst.iter().enumerate() {
+        for (pc, m) in v.iter().enumerate() {
+            let info = &prog.functions[f].info[pc];
+            let key = if by_source {
+                match info.src {
+                    Some(l) => (prog.files.get(l.file as usize).cloned().unwrap_or_default(), l.line),
+                    None => continue,
+                }
+            } else {
+                (prog.source_name.clone(), info.ptx_line)
+            };
+            let e = map.entry(key).or_default();
+            e.requests += m.requests;
+            e.sectors += m.sectors;
+            e.wavefronts += m.wavefronts;
+            e.bank_conflicts += m.bank_conflicts;
+        }
+    }
+    map
+}
+
+fn print_lines(lines: &[LineCounts], spec: &Spec, mem: &std::collections::HashMap<(String, u32), InstMem>) {
+    println!(
+        "\n  {:<26} {:>10} {:>12} {:>8} {:>8} {:>8} {:>8} {:>8}  source",
+        "line", "warp inst", "thread inst", "diverged", "requests", "sectors", "wavefr.", "conflict"
+    );
     let mut cache: std::collections::HashMap<String, Vec<String>> = Default::default();
     for l in lines {
         let text = cache
@@ -151,12 +223,17 @@ fn print_lines(lines: &[LineCounts], spec: &Spec) {
             .unwrap_or_default();
         let text = if l.line == 0 { "(compiler-generated: no source line)".to_string() } else { text };
         let short = l.file.rsplit('/').next().unwrap_or(&l.file);
+        let m = mem.get(&(l.file.clone(), l.line)).copied().unwrap_or_default();
         println!(
-            "  {:<28} {:>12} {:>14} {:>9}  {}",
+            "  {:<26} {:>10} {:>12} {:>8} {:>8} {:>8} {:>8} {:>8}  {}",
             format!("{short}:{}", l.line),
             l.counts.warp_instructions,
             l.counts.thread_instructions,
             l.counts.divergent_branches,
+            m.requests,
+            m.sectors,
+            m.wavefronts,
+            m.bank_conflicts,
             text
         );
     }

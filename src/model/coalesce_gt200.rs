@@ -48,21 +48,40 @@ impl Transactions {
     }
 }
 
-/// Transactions of one half-warp: `lanes` are (address, bytes) of its active threads.
+/// Transactions of one half-warp: `lanes` are (address, bytes) of its active threads
+/// (at most 16; every thread accesses the same number of bytes).
 pub fn half_warp(lanes: &[(u64, u32)]) -> Transactions {
+    let mut addr = [0u64; 16];
+    for (k, (a, _)) in lanes.iter().take(16).enumerate() {
+        addr[k] = *a;
+    }
+    let bytes = lanes.first().map(|l| l.1).unwrap_or(4);
+    let mask = if lanes.len() >= 16 { u16::MAX } else { (1u16 << lanes.len()) - 1 };
+    half_warp_masked(&addr, bytes, mask)
+}
+
+/// The segment algorithm over the threads in `mask` (no allocation).
+fn half_warp_masked(addr: &[u64; 16], bytes: u32, mut mask: u16) -> Transactions {
     let mut t = Transactions::default();
-    let mut pending: Vec<(u64, u32)> = lanes.to_vec();
-    while let Some(&(a0, w)) = pending.first() {
-        let seg = match w {
-            1 => 32u64,
-            2 => 64,
-            _ => 128,
-        };
-        let base = a0 / seg * seg;
-        let (inside, rest): (Vec<_>, Vec<_>) = pending.iter().partition(|(a, _)| *a >= base && *a < base + seg);
-        pending = rest;
-        let lo = inside.iter().map(|(a, _)| *a).min().expect("one thread at least");
-        let hi = inside.iter().map(|(a, b)| a + *b as u64).max().expect("one thread at least");
+    let seg = match bytes {
+        1 => 32u64,
+        2 => 64,
+        _ => 128,
+    };
+    while mask != 0 {
+        let base = addr[mask.trailing_zeros() as usize] / seg * seg;
+        let (mut lo, mut hi) = (u64::MAX, 0u64);
+        let mut rest = mask;
+        while rest != 0 {
+            let k = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let a = addr[k];
+            if a >= base && a < base + seg {
+                lo = lo.min(a);
+                hi = hi.max(a + bytes as u64);
+                mask &= !(1 << k);
+            }
+        }
         let (mut b, mut size) = (base, seg);
         while size > 32 {
             let half = size / 2;
@@ -85,11 +104,17 @@ pub fn half_warp(lanes: &[(u64, u32)]) -> Transactions {
 pub fn warp(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Transactions {
     let mut t = Transactions::default();
     for h in 0..2 {
-        let lanes: Vec<(u64, u32)> =
-            (h * 16..h * 16 + 16).filter(|l| mask >> l & 1 != 0).map(|l| (addr(l), bytes)).collect();
-        if !lanes.is_empty() {
-            t.merge(&half_warp(&lanes));
+        let m = (mask >> (16 * h)) as u16;
+        if m == 0 {
+            continue;
         }
+        let mut a = [0u64; 16];
+        for (k, slot) in a.iter_mut().enumerate() {
+            if m >> k & 1 != 0 {
+                *slot = addr(16 * h + k);
+            }
+        }
+        t.merge(&half_warp_masked(&a, bytes, m));
     }
     t
 }
