@@ -38,7 +38,7 @@ pub fn occupancy(p: Profile, prog: &Program, kernel: u32, threads: u32, dynamic_
     let regs_per_warp = (regs * 32).div_ceil(pr.reg_alloc_unit) * pr.reg_alloc_unit;
     let by_threads = pr.max_threads_per_sm / (warps * 32).max(1);
     let by_registers = pr.regs_per_sm / (regs_per_warp * warps).max(1);
-    let by_shared = if shared == 0 { u32::MAX } else { pr.shared_per_sm / shared };
+    let by_shared = pr.shared_per_sm.checked_div(shared).unwrap_or(u32::MAX);
     let by_cta_slots = pr.max_ctas_per_sm;
     let limits = [
         (by_threads, "threads"),

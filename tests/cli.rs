@@ -1,0 +1,105 @@
+//! The `warplight` binary: launch specs end to end, output formats, and errors
+//! that leave no partial output.
+
+use std::process::Command;
+
+fn warplight(args: &[&str]) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
+
+#[test]
+fn launch_prints_counters_and_dumps_buffers() {
+    let dir = tempdir();
+    let dump = dir.join("sums.bin");
+    let (ok, out, err) =
+        warplight(&["launch", "examples/reduce.toml", "--json", "--dump", &format!("sums={}", dump.display())]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let c = &v["launches"][0]["counters"];
+    assert_eq!(c["ctas"], 8);
+    assert_eq!(c["barriers"], 72);
+    assert!(c["l1tex__data_pipe_lsu_wavefronts_mem_shared_op_ld.sum"].as_u64().unwrap() > 0);
+    let sums: Vec<i32> =
+        std::fs::read(&dump).unwrap().chunks(4).map(|b| i32::from_le_bytes(b.try_into().unwrap())).collect();
+    let exp: Vec<i32> = (0..8)
+        .map(|b| (b * 256..(b + 1) * 256).map(|i: u64| (i.wrapping_mul(2654435761) % 100) as i32).sum())
+        .collect();
+    assert_eq!(sums, exp);
+}
+
+#[test]
+fn metrics_selection_accepts_profiler_names() {
+    let (ok, out, err) = warplight(&[
+        "launch",
+        "examples/reduce.toml",
+        "--csv",
+        "--device",
+        "gt200",
+        "--metrics",
+        "smsp__inst_executed.sum,gld_64b,warp_serialize",
+    ]);
+    assert!(ok, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "launch,kernel,metric,value");
+    assert_eq!(lines.len(), 4);
+    assert!(lines[2].starts_with("0,reduce_sum,gld_64b,"));
+    let (ok, _, err) = warplight(&["launch", "examples/reduce.toml", "--metrics", "nonsense"]);
+    assert!(!ok && err.contains("unknown metric `nonsense`"), "{err}");
+}
+
+#[test]
+fn a_faulting_launch_writes_no_files() {
+    let dir = tempdir();
+    let spec = dir.join("bad.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "ptx = \"{}/kernels/tests/memory.ptx\"\nkernel = \"out_of_bounds\"\ngrid = 2\nblock = 32\nargs = [\"out\"]\n[[buffer]]\nname = \"out\"\ntype = \"i32\"\nlen = 40\n",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+    )
+    .unwrap();
+    let dump = dir.join("out.bin");
+    let (ok, _, err) = warplight(&["launch", spec.to_str().unwrap(), "--dump", &format!("out={}", dump.display())]);
+    assert!(!ok);
+    assert!(err.contains("out-of-bounds") && err.contains("memory.cu"), "{err}");
+    assert!(!dump.exists(), "no partial output");
+}
+
+#[test]
+fn spec_errors_name_the_key() {
+    let dir = tempdir();
+    let spec = dir.join("s.toml");
+    std::fs::write(&spec, "ptx = \"x.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\nargs = [\"missing\"]\n").unwrap();
+    let (ok, _, err) = warplight(&["launch", spec.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("`args[0]`: no buffer named `missing`"), "{err}");
+    let (ok, _, err) = warplight(&["launch", "examples/reduce.toml", "--device", "fermi"]);
+    assert!(!ok && err.contains("unknown device profile `fermi`"), "{err}");
+}
+
+#[test]
+fn check_and_kernels_commands() {
+    let (ok, out, _) = warplight(&["check", "kernels/tests/shared.nvcc.ptx"]);
+    assert!(ok && out.contains("ok (5 kernels"), "{out}");
+    let (ok, out, _) = warplight(&["kernels", "kernels/tests/calls.ptx"]);
+    assert!(ok && out.contains("recursive_fib(") && out.contains("device functions"), "{out}");
+    let dir = tempdir();
+    let bad = dir.join("bad.ptx");
+    std::fs::write(&bad, ".version 7.8\n.target sm_90\n.entry k()\n{\n  frobnicate.u32 %r1;\n}\n").unwrap();
+    let (ok, _, err) = warplight(&["check", bad.to_str().unwrap()]);
+    assert!(!ok && err.contains(":5:3: unsupported instruction `frobnicate.u32`"), "{err}");
+}
+
+fn tempdir() -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("warplight-cli-{}-{}", std::process::id(), rand_suffix()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn rand_suffix() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static N: AtomicU64 = AtomicU64::new(0);
+    N.fetch_add(1, Ordering::Relaxed)
+}
