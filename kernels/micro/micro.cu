@@ -84,3 +84,19 @@ K local_array(float *out, const float *in, int a, int b) {
   for (int k = 0; k < 32; k++) buf[k] = in[k] * (float)t;
   out[t] = buf[(t * a) & 31];
 }
+// A local array too large for registers: every thread stores 256 words at
+// the same offsets (coalesced), then loads one at a thread-dependent offset
+// (a = 0: the same offset in every thread; a = 1: all different).
+K local_big(float *out, const float *in, int a, int b) {
+  float buf[256];
+  int t = WL_TID;
+  for (int k = 0; k < 256; k++) buf[k] = in[k & 7] + (float)(t ^ k);
+  out[t] = buf[(t * a) & 255];
+}
+// Votes: a ballot and a vote per warp, then one store.
+K votes(float *out, const float *in, int a, int b) {
+  int t = WL_TID;
+  unsigned bal = __ballot_sync(0xffffffffu, (t % a) == 0);
+  int any = __any_sync(0xffffffffu, t == a);
+  out[t] = (float)(__popc(bal) + any);
+}

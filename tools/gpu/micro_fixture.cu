@@ -36,6 +36,9 @@ int main(int argc, char **argv) {
     {"atom_ret", (const void *)atom_ret, 64, 0},
     {"local_array", (const void *)local_array, 1, 0}, {"local_array", (const void *)local_array, 0, 0},
     {"local_array", (const void *)local_array, 7, 0},
+    {"local_big", (const void *)local_big, 0, 0}, {"local_big", (const void *)local_big, 1, 0},
+    {"local_big", (const void *)local_big, 8, 0},
+    {"votes", (const void *)votes, 3, 0}, {"votes", (const void *)votes, 100, 0},
   };
   const int N = 1 << 20;
   float *in, *out;
