@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod cli;
+pub mod host;
 pub mod launch_spec;
 pub mod model;
 pub mod ptx;

@@ -2,6 +2,7 @@
 
 pub mod launch;
 pub mod ptx_info;
+pub mod scene_info;
 
 use clap::{Parser, Subcommand};
 
@@ -37,6 +38,13 @@ pub enum Command {
         /// The PTX file.
         ptx: std::path::PathBuf,
     },
+    /// Scenes: `warplight scene info NAME` prints triangles (and the thesis'
+    /// count), extent, materials, lights, camera and flight.
+    Scene {
+        /// What to do.
+        #[command(subcommand)]
+        what: SceneCommand,
+    },
     /// Compare the hopper profile with the H100 measurements of the memory
     /// microbenchmarks (tests/fixtures/h100_micro.json).
     Validate {
@@ -52,6 +60,16 @@ pub enum Command {
     },
 }
 
+/// `warplight scene ...`
+#[derive(Debug, Subcommand)]
+pub enum SceneCommand {
+    /// Summarise a scene: NAME is a file in scenes/ (`sponza`) or a path to a .toml.
+    Info {
+        /// Scene name or path.
+        name: String,
+    },
+}
+
 /// Runs the CLI; returns the process exit code.
 pub fn main() -> i32 {
     let cli = Cli::parse();
@@ -60,6 +78,7 @@ pub fn main() -> i32 {
         Command::Kernels { ptx } => ptx_info::kernels(&ptx),
         Command::Check { ptx } => ptx_info::check(&ptx),
         Command::Validate { fixture, ptx, markdown } => validate(&fixture, &ptx, markdown),
+        Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
     };
     match r {
         Ok(()) => 0,

@@ -1,0 +1,8 @@
+//! The host side of the theses: scenes (`scenes/*.toml`, OBJ via tobj,
+//! procedural reconstructions), cameras and flights, the CPU-built
+//! acceleration structures, images, and the native reference ray caster.
+
+pub mod camera;
+pub mod procedural;
+pub mod scene;
+pub mod scene_file;

@@ -1,0 +1,340 @@
+//! Reads `scenes/*.toml` scene descriptions (format: `docs/scenes.md`).
+//! Every field is validated; errors name the file, the key and what was expected.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use super::camera::{Camera, Flight};
+use super::procedural;
+use super::scene::{Light, Material, MaterialKind, Scene, ThesisScene, Triangle};
+
+/// A scene file that could not be loaded.
+#[derive(Debug, thiserror::Error)]
+#[error("{file}: {key}: {msg}")]
+pub struct SceneError {
+    /// The file.
+    pub file: String,
+    /// The key (or `-` for the file as a whole).
+    pub key: String,
+    /// What was expected or what failed.
+    pub msg: String,
+}
+
+struct Cx<'a> {
+    file: &'a str,
+}
+
+impl Cx<'_> {
+    fn err<T>(&self, key: &str, msg: impl Into<String>) -> Result<T, SceneError> {
+        Err(SceneError { file: self.file.into(), key: key.into(), msg: msg.into() })
+    }
+
+    fn num(&self, v: &toml::Value, key: &str) -> Result<f32, SceneError> {
+        match v {
+            toml::Value::Float(f) => Ok(*f as f32),
+            toml::Value::Integer(i) => Ok(*i as f32),
+            _ => self.err(key, "expected a number"),
+        }
+    }
+
+    fn vec3(
+        &self,
+        t: &toml::Table,
+        key: &str,
+        prefix: &str,
+        default: Option<[f32; 3]>,
+    ) -> Result<[f32; 3], SceneError> {
+        let k = format!("{prefix}{key}");
+        match t.get(key) {
+            None => default.map_or_else(|| self.err(&k, "missing; expected [x, y, z]"), Ok),
+            Some(toml::Value::Array(a)) if a.len() == 3 => {
+                Ok([self.num(&a[0], &k)?, self.num(&a[1], &k)?, self.num(&a[2], &k)?])
+            }
+            Some(_) => self.err(&k, "expected [x, y, z]"),
+        }
+    }
+
+    fn float(&self, t: &toml::Table, key: &str, prefix: &str, default: f32) -> Result<f32, SceneError> {
+        t.get(key).map_or(Ok(default), |v| self.num(v, &format!("{prefix}{key}")))
+    }
+
+    fn table<'t>(&self, t: &'t toml::Table, key: &str) -> Result<Option<&'t toml::Table>, SceneError> {
+        match t.get(key) {
+            None => Ok(None),
+            Some(toml::Value::Table(x)) => Ok(Some(x)),
+            Some(_) => self.err(key, "expected a table"),
+        }
+    }
+
+    fn tables<'t>(&self, t: &'t toml::Table, key: &str) -> Result<Vec<&'t toml::Table>, SceneError> {
+        match t.get(key) {
+            None => Ok(Vec::new()),
+            Some(toml::Value::Array(a)) => a
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v.as_table().map_or_else(|| self.err(&format!("{key}[{i}]"), "expected a table"), Ok))
+                .collect(),
+            Some(_) => self.err(key, format!("expected [[{key}]] tables")),
+        }
+    }
+}
+
+fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<Material, SceneError> {
+    let p = format!("material[{i}].");
+    let name = match t.get("name").and_then(|v| v.as_str()) {
+        Some(n) => n.to_string(),
+        None => return cx.err(&format!("{p}name"), "missing"),
+    };
+    let kind = match t.get("kind").and_then(|v| v.as_str()).unwrap_or("diffuse") {
+        "diffuse" => MaterialKind::Diffuse,
+        "mirror" => MaterialKind::Mirror,
+        "glass" => MaterialKind::Glass { ior: cx.float(t, "ior", &p, 1.5)? },
+        "emitter" => MaterialKind::Emitter,
+        other => return cx.err(&format!("{p}kind"), format!("`{other}`; expected diffuse, mirror, glass or emitter")),
+    };
+    Ok(Material {
+        name,
+        kind,
+        color: cx.vec3(t, "color", &p, Some([0.8; 3]))?,
+        emission: cx.vec3(t, "emission", &p, Some([0.0; 3]))?,
+    })
+}
+
+/// Loads a scene description.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let file = path.display().to_string();
+    let cx = Cx { file: &file };
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        file: file.clone(),
+        key: "-".into(),
+        msg: e.to_string(),
+    })?;
+    let t: toml::Table =
+        toml::from_str(&text).map_err(|e| SceneError { file: file.clone(), key: "-".into(), msg: e.to_string() })?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let name = t
+        .get("name")
+        .and_then(|v| v.as_str())
+        .map(String::from)
+        .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
+    let mut materials: Vec<Material> = Vec::new();
+    for (i, m) in cx.tables(&t, "material")?.into_iter().enumerate() {
+        materials.push(material(&cx, m, i)?);
+    }
+    let by_name = |ms: &[Material], n: &str| ms.iter().position(|m| m.name == n).map(|i| i as u32);
+    let scale = cx.float(&t, "scale", "", 1.0)?;
+    let translate = Vec3::from(cx.vec3(&t, "translate", "", Some([0.0; 3]))?);
+    let tris = match (t.get("obj"), t.get("procedural")) {
+        (Some(_), Some(_)) => return cx.err("obj", "give either `obj` or `procedural`, not both"),
+        (None, None) => return cx.err("obj", "missing; expected `obj = \"file.obj\"` or `procedural = \"scene6\"`"),
+        (None, Some(p)) => {
+            let g = match p.as_str() {
+                Some("scene6") => procedural::scene6(),
+                Some("passage") => procedural::passage(),
+                Some("ring") => procedural::ring(false),
+                Some("ring-volumetric") => procedural::ring(true),
+                _ => return cx.err("procedural", "expected scene6, passage, ring or ring-volumetric"),
+            };
+            // generated materials, unless the file defines one of the same name
+            let names: Vec<String> = g.materials.iter().map(|m| m.name.clone()).collect();
+            for m in g.materials {
+                if by_name(&materials, &m.name).is_none() {
+                    materials.push(m);
+                }
+            }
+            g.triangles
+                .into_iter()
+                .map(|tr| {
+                    let n = &names[tr.material as usize];
+                    Triangle { v: tr.v, material: by_name(&materials, n).expect("generated material") }
+                })
+                .collect()
+        }
+        (Some(o), None) => {
+            let Some(rel) = o.as_str() else { return cx.err("obj", "expected a file name") };
+            load_obj(&cx, &dir.join(rel), &t, &mut materials)?
+        }
+    };
+    let tris: Vec<Triangle> =
+        tris.into_iter().map(|tr| Triangle { v: tr.v.map(|p| p * scale + translate), material: tr.material }).collect();
+    let mut scene = Scene::assemble(&name, path, tris, materials);
+    scene.variant = t.get("variant").and_then(|v| v.as_str()).unwrap_or("").to_string();
+    if let Some(th) = cx.table(&t, "thesis")? {
+        let triangles = match th.get("triangles").and_then(|v| v.as_integer()) {
+            Some(n) if n > 0 => n as u64,
+            _ => return cx.err("thesis.triangles", "expected a positive integer"),
+        };
+        scene.thesis = Some(ThesisScene { triangles, extent: cx.vec3(th, "extent", "thesis.", None)? });
+    }
+    for (i, l) in cx.tables(&t, "light")?.into_iter().enumerate() {
+        let p = format!("light[{i}].");
+        scene.lights.push(match l.get("kind").and_then(|v| v.as_str()).unwrap_or("point") {
+            "point" => Light::Point {
+                position: cx.vec3(l, "position", &p, None)?,
+                intensity: cx.vec3(l, "intensity", &p, Some([1.0; 3]))?,
+            },
+            "directional" => Light::Directional {
+                direction: cx.vec3(l, "direction", &p, None)?,
+                radiance: cx.vec3(l, "radiance", &p, Some([1.0; 3]))?,
+            },
+            "area" => Light::Area { triangles: Vec::new() },
+            other => return cx.err(&format!("{p}kind"), format!("`{other}`; expected point, directional or area")),
+        });
+    }
+    // Area lights are the emissive triangles.
+    let emissive: Vec<u32> = scene
+        .triangles
+        .iter()
+        .enumerate()
+        .filter(|(_, tr)| scene.materials[tr.material as usize].kind == MaterialKind::Emitter)
+        .map(|(i, _)| i as u32)
+        .collect();
+    for l in &mut scene.lights {
+        if let Light::Area { triangles } = l {
+            *triangles = emissive.clone();
+        }
+    }
+    if let Some(c) = cx.table(&t, "camera")? {
+        let p = "camera.";
+        let res = match c.get("resolution") {
+            None => [512, 512],
+            Some(toml::Value::Array(a)) if a.len() == 2 => {
+                let w = a[0].as_integer().filter(|&x| x > 0);
+                let h = a[1].as_integer().filter(|&x| x > 0);
+                match (w, h) {
+                    (Some(w), Some(h)) => [w as u32, h as u32],
+                    _ => return cx.err("camera.resolution", "expected [width, height] of positive integers"),
+                }
+            }
+            Some(_) => return cx.err("camera.resolution", "expected [width, height]"),
+        };
+        let fov = cx.float(c, "fov", p, 60.0)?;
+        if !(1.0..179.0).contains(&fov) {
+            return cx.err("camera.fov", "expected a vertical field of view between 1 and 179 degrees");
+        }
+        let direction = cx.vec3(c, "direction", p, None)?;
+        if Vec3::from(direction).length() == 0.0 {
+            return cx.err("camera.direction", "must not be zero");
+        }
+        scene.camera = Camera {
+            position: cx.vec3(c, "position", p, None)?,
+            direction,
+            up: cx.vec3(c, "up", p, Some([0.0, 1.0, 0.0]))?,
+            fov_y: fov,
+            resolution: res,
+        };
+    }
+    if let Some(f) = cx.table(&t, "flight")? {
+        let p = "flight.";
+        let frames = match f.get("frames") {
+            None => 50,
+            Some(v) => match v.as_integer() {
+                Some(n) if n > 0 => n as u32,
+                _ => return cx.err("flight.frames", "expected a positive integer"),
+            },
+        };
+        scene.flight = Flight {
+            frames,
+            forward: cx.float(f, "forward", p, 0.1)?,
+            yaw_deg: cx.float(f, "yaw", p, 0.25)?,
+            move_light: f.get("move_light").and_then(|v| v.as_bool()).unwrap_or(false),
+            light_step: cx.vec3(f, "light_step", p, Some([0.03; 3]))?,
+        };
+    }
+    Ok(scene)
+}
+
+/// Loads an OBJ (polygons split as fans) with its MTL materials where present.
+fn load_obj(
+    cx: &Cx,
+    path: &PathBuf,
+    t: &toml::Table,
+    materials: &mut Vec<Material>,
+) -> Result<Vec<Triangle>, SceneError> {
+    let opts = tobj::LoadOptions { triangulate: true, single_index: false, ..Default::default() };
+    if !path.exists() {
+        return cx.err(
+            "obj",
+            format!(
+                "{} does not exist (a scene not distributed with warplight? see the comments in the scene file)",
+                path.display()
+            ),
+        );
+    }
+    let (models, mtl) = tobj::load_obj(path, &opts).map_err(|e| SceneError {
+        file: cx.file.into(),
+        key: "obj".into(),
+        msg: format!("{}: {e}", path.display()),
+    })?;
+    let mtl = mtl.unwrap_or_default();
+    // material overrides by OBJ group or MTL material name
+    let mut overrides: HashMap<String, String> = HashMap::new();
+    for (i, o) in cx.tables(t, "override")?.into_iter().enumerate() {
+        let from = o.get("group").and_then(|v| v.as_str());
+        let to = o.get("material").and_then(|v| v.as_str());
+        match (from, to) {
+            (Some(f), Some(m)) => {
+                if !materials.iter().any(|x| x.name == m) {
+                    return cx.err(&format!("override[{i}].material"), format!("no material named `{m}`"));
+                }
+                overrides.insert(f.to_string(), m.to_string());
+            }
+            _ => return cx.err(&format!("override[{i}]"), "expected group = \"name\" and material = \"name\""),
+        }
+    }
+    let default = match t.get("default_material").and_then(|v| v.as_str()) {
+        Some(d) => d.to_string(),
+        None => {
+            if !materials.iter().any(|m| m.name == "default") {
+                materials.push(Material::diffuse("default", [0.75, 0.75, 0.75]));
+            }
+            "default".into()
+        }
+    };
+    if !materials.iter().any(|m| m.name == default) {
+        return cx.err("default_material", format!("no material named `{default}`"));
+    }
+    let mut index = |name: &str, mtl_mat: Option<&tobj::Material>| -> u32 {
+        if let Some(i) = materials.iter().position(|m| m.name == name) {
+            return i as u32;
+        }
+        let m = mtl_mat.expect("only MTL materials are added on demand");
+        let kd = m.diffuse.unwrap_or([0.75; 3]);
+        let ke = m
+            .unknown_param
+            .get("Ke")
+            .map(|s| {
+                let v: Vec<f32> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+                [*v.first().unwrap_or(&0.0), *v.get(1).unwrap_or(&0.0), *v.get(2).unwrap_or(&0.0)]
+            })
+            .unwrap_or([0.0; 3]);
+        let kind = if ke.iter().any(|&x| x > 0.0) { MaterialKind::Emitter } else { MaterialKind::Diffuse };
+        materials.push(Material { name: name.to_string(), kind, color: kd, emission: ke });
+        (materials.len() - 1) as u32
+    };
+    let mut out = Vec::new();
+    for model in &models {
+        let mesh = &model.mesh;
+        let mtl_mat = mesh.material_id.and_then(|i| mtl.get(i));
+        let mat_name = overrides
+            .get(&model.name)
+            .or_else(|| mtl_mat.and_then(|m| overrides.get(&m.name)))
+            .cloned()
+            .or_else(|| mtl_mat.map(|m| m.name.clone()))
+            .unwrap_or_else(|| default.clone());
+        let mi = index(&mat_name, mtl_mat);
+        let p = |i: u32| {
+            Vec3::new(
+                mesh.positions[3 * i as usize],
+                mesh.positions[3 * i as usize + 1],
+                mesh.positions[3 * i as usize + 2],
+            )
+        };
+        for f in mesh.indices.chunks_exact(3) {
+            out.push(Triangle { v: [p(f[0]), p(f[1]), p(f[2])], material: mi });
+        }
+    }
+    Ok(out)
+}
