@@ -25,4 +25,5 @@ pub mod host;
 pub mod launch_spec;
 pub mod model;
 pub mod ptx;
+pub mod repro;
 pub mod sim;

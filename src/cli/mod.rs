@@ -3,6 +3,7 @@
 pub mod launch;
 pub mod ptx_info;
 pub mod scene_info;
+pub mod tables;
 
 use clap::{Parser, Subcommand};
 
@@ -38,6 +39,8 @@ pub enum Command {
         /// The PTX file.
         ptx: std::path::PathBuf,
     },
+    /// Reproduce thesis tables beside the published values (`warplight tables 4.4`).
+    Tables(tables::TablesArgs),
     /// Scenes: `warplight scene info NAME` prints triangles (and the thesis'
     /// count), extent, materials, lights, camera and flight.
     Scene {
@@ -79,6 +82,7 @@ pub fn main() -> i32 {
         Command::Check { ptx } => ptx_info::check(&ptx),
         Command::Validate { fixture, ptx, markdown } => validate(&fixture, &ptx, markdown),
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
+        Command::Tables(a) => tables::run(a),
     };
     match r {
         Ok(()) => 0,

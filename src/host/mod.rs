@@ -3,6 +3,7 @@
 //! acceleration structures, images, and the native reference ray caster.
 
 pub mod camera;
+pub mod kdtree;
 pub mod procedural;
 pub mod scene;
 pub mod scene_file;

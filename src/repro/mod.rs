@@ -1,0 +1,5 @@
+//! Reproductions of the theses' tables: each module holds the published
+//! numbers (with their seed line numbers), the runs that measure ours, and the
+//! side-by-side output.
+
+pub mod table_4_4;
