@@ -2,6 +2,7 @@
 
 pub mod launch;
 pub mod ptx_info;
+pub mod render;
 pub mod scene_info;
 pub mod tables;
 
@@ -11,6 +12,8 @@ use clap::{Parser, Subcommand};
 #[derive(Debug, Parser)]
 #[command(name = "warplight", version, about, long_about = None, after_help = "\
 Examples:
+  warplight render --scene cornell-box -o cornell.png   render a scene's first flight frame
+  warplight tables 4.4                             kd-tree statistics beside thesis 000's Table 4.4
   warplight launch examples/reduce.toml            run a kernel described by a spec, print counters
   warplight launch examples/reduce.toml --per-line counters per CUDA source line
   warplight kernels kernels/tests/shared.ptx       list a PTX file's kernels
@@ -39,6 +42,8 @@ pub enum Command {
         /// The PTX file.
         ptx: std::path::PathBuf,
     },
+    /// Render a frame of a scene's camera flight to PNG or EXR and print its counters.
+    Render(render::RenderArgs),
     /// Reproduce thesis tables beside the published values (`warplight tables 4.4`).
     Tables(tables::TablesArgs),
     /// Scenes: `warplight scene info NAME` prints triangles (and the thesis'
@@ -83,6 +88,7 @@ pub fn main() -> i32 {
         Command::Validate { fixture, ptx, markdown } => validate(&fixture, &ptx, markdown),
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
         Command::Tables(a) => tables::run(a),
+        Command::Render(a) => render::run(a),
     };
     match r {
         Ok(()) => 0,

@@ -3,7 +3,9 @@
 //! acceleration structures, images, and the native reference ray caster.
 
 pub mod camera;
+pub mod image;
 pub mod kdtree;
 pub mod procedural;
+pub mod raycast;
 pub mod scene;
 pub mod scene_file;
