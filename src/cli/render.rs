@@ -27,8 +27,8 @@ pub struct RenderArgs {
     /// kd-tree heuristic: sah or siroh.
     #[arg(long, default_value = "sah")]
     pub heuristic: String,
-    /// Exposure for the PNG, in stops.
-    #[arg(long, default_value_t = 0.0)]
+    /// Exposure for the PNG, in stops (negative darkens).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
     /// Output image (.png, or .exr for linear float).
     #[arg(short, long, default_value = "render.png")]

@@ -302,16 +302,17 @@ fn load_obj(
         }
         let m = mtl_mat.expect("only MTL materials are added on demand");
         let kd = m.diffuse.unwrap_or([0.75; 3]);
-        let ke = m
-            .unknown_param
-            .get("Ke")
-            .map(|s| {
-                let v: Vec<f32> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
-                [*v.first().unwrap_or(&0.0), *v.get(1).unwrap_or(&0.0), *v.get(2).unwrap_or(&0.0)]
-            })
-            .unwrap_or([0.0; 3]);
-        let kind = if ke.iter().any(|&x| x > 0.0) { MaterialKind::Emitter } else { MaterialKind::Diffuse };
-        materials.push(Material { name: name.to_string(), kind, color: kd, emission: ke });
+        let ks = m.specular.unwrap_or([0.0; 3]);
+        let ke = m.emissive.unwrap_or([0.0; 3]);
+        // MTL: emissive (Ke) makes an emitter; purely specular (Kd = 0, Ks > 0) a mirror tinted by Ks
+        let (kind, color) = if ke.iter().any(|&x| x > 0.0) {
+            (MaterialKind::Emitter, kd)
+        } else if kd.iter().all(|&x| x < 0.01) && ks.iter().any(|&x| x > 0.0) {
+            (MaterialKind::Mirror, ks)
+        } else {
+            (MaterialKind::Diffuse, kd)
+        };
+        materials.push(Material { name: name.to_string(), kind, color, emission: ke });
         (materials.len() - 1) as u32
     };
     let mut out = Vec::new();
