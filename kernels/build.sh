@@ -15,7 +15,7 @@ out_dir=.
 status=0
 clang_ptx() { # src out
   "$CLANG" -x cuda --cuda-device-only -nocudainc -nocudalib --cuda-gpu-arch=sm_90 \
-    -Xclang -target-feature -Xclang +ptx78 -O3 -gline-tables-only -fdebug-compilation-dir=. \
+    -Xclang -target-feature -Xclang +ptx78 -O3 -ffp-contract=on -gline-tables-only -fdebug-compilation-dir=. \
     -Ikernels -S -o "$2" "$1"
 }
 nvcc_ptx() { # src out

@@ -26,6 +26,8 @@ struct alignas(8) float2 { float x, y; };
 struct alignas(16) float4 { float x, y, z, w; };
 struct alignas(8) int2 { int x, y; };
 struct alignas(16) int4 { int x, y, z, w; };
+struct alignas(8) uint2 { unsigned x, y; };
+struct alignas(16) uint4 { unsigned x, y, z, w; };
 WL_DEV float2 make_float2(float x, float y) { return {x, y}; }
 WL_DEV float4 make_float4(float x, float y, float z, float w) { return {x, y, z, w}; }
 
@@ -116,6 +118,8 @@ WL_DEV float __uint2float_ru(unsigned x) { return __nvvm_ui2f_rp(x); }
 WL_DEV float __double2float_rd(double x) { return __nvvm_d2f_rm(x); }
 WL_DEV float __int_as_float(int x) { return __builtin_bit_cast(float, x); }
 WL_DEV int __float_as_int(float x) { return __builtin_bit_cast(int, x); }
+WL_DEV unsigned __float_as_uint(float x) { return __builtin_bit_cast(unsigned, x); }
+WL_DEV float __uint_as_float(unsigned x) { return __builtin_bit_cast(float, x); }
 WL_DEV double __fma_rn(double a, double b, double c) { return __nvvm_fma_rn_d(a, b, c); }
 WL_DEV double sqrt(double x) { return __nvvm_sqrt_rn_d(x); }
 

@@ -217,11 +217,17 @@ impl<'a> Caster<'a> {
         c
     }
 
-    /// The geometric normal of triangle `t`, facing against `dir`.
+    /// The geometric normal of triangle `t`, facing against `dir`, from the
+    /// Wald form (n_k = 1, n_i = n'_i, n_j = n'_j) as the kernels compute it.
     pub fn normal(&self, t: u32, dir: Vec3) -> Vec3 {
-        let v = &self.scene.triangles[t as usize].v;
-        let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-        if n.dot(dir) > 0.0 { -n } else { n }
+        let w = &self.tris[t as usize];
+        let k = w.k as usize;
+        let mut n = Vec3::ZERO;
+        n[k] = 1.0;
+        n[(k + 1) % 3] = w.n[0];
+        n[(k + 2) % 3] = w.n[1];
+        let n = n * (1.0 / (n.x * n.x + n.y * n.y + n.z * n.z).sqrt());
+        if n.x * dir.x + n.y * dir.y + n.z * dir.z > 0.0 { -n } else { n }
     }
 
     /// Emission plus diffuse direct light from the point lights (one shadow ray each).

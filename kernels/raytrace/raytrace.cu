@@ -1,0 +1,355 @@
+// Thesis 000 chapter 4: the GTX 280 kd-tree ray tracer, one kernel family.
+//
+// Persistent threads: each warp takes blocks of 32 consecutive pixels from a
+// global job queue (atomicAdd) until the image is done. Per pixel up to four
+// rays: primary, shadow, mirror reflection and its shadow ray (Whitted).
+// kd-tree nodes (8 bytes), triangle references and triangles are read through
+// the read-only (texture) path (__ldg). Traversal variants (one template,
+// one entry point each):
+//   trace_stack                stack-based traversal, stack in local memory (seed extract §4.4)
+//   trace_stackless            restart with the flags register (Alg. 4.1, errata fixed)
+//   trace_pushdown             Alg. 4.2, push-down lines only
+//   trace_shortstack           Alg. 4.2, short-stack lines only (4 entries, shared memory, round robin)
+//   trace_pushdown_shortstack  Alg. 4.2, both
+// The native caster (src/host/raycast.rs) performs the same float operations
+// in the same order, so hits agree bit for bit; keep the two in step.
+#include "../prelude.h"
+
+#if defined(__clang__) && !defined(__NVCC__)
+#pragma clang fp contract(off)
+#endif
+
+#define STACK 0
+#define STACKLESS 1
+#define PUSHDOWN 2
+#define SHORTSTACK 3
+#define PUSHDOWN_SHORTSTACK 4
+#define SHORT_CAPACITY 4
+#define CTA_THREADS 256
+#define SS_WORDS (3 * SHORT_CAPACITY * CTA_THREADS)
+
+// Short stacks of the short-stack variants: entry e of thread t, word w at
+// [(3e + w) * 256 + t] (4 entries x 12 bytes per thread, 12 KB per CTA).
+__shared__ float short_stacks[SS_WORDS];
+
+// Scene and camera, laid out by src/host/rt_kernels.rs.
+struct Params {
+  float cam_pos[3], cam_fwd[3], cam_right[3], cam_up[3];
+  float light_pos[3], light_int[3];
+  float lo[3], hi[3];
+  float eps, tan_half, aspect;
+  int width, height, num_pixels, has_light;
+};
+
+struct V3 { float x, y, z; };
+static __device__ __forceinline__ V3 v3(float x, float y, float z) { V3 r = {x, y, z}; return r; }
+static __device__ __forceinline__ float comp(V3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+static __device__ __forceinline__ float dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static __device__ __forceinline__ V3 normalize3(V3 v) {
+  float inv = 1.0f / sqrtf(v.x * v.x + v.y * v.y + v.z * v.z);
+  return v3(v.x * inv, v.y * inv, v.z * inv);
+}
+
+struct Scene {
+  const Params *p;
+  const uint2 *nodes;      // 8-byte nodes: split bits, pair << 2 | axis (3 = leaf: first << 2 | 3, count)
+  const unsigned *refs;    // triangle references
+  const float4 *tris;      // 3 float4 per triangle: [n'i n'j n'd k], [e'1], [e'2]
+  const unsigned *tri_mat; // material per triangle
+  const float4 *mats;      // [r g b kind], kind: 0 diffuse, 1 mirror, 2 emitter; then [emission, 0]
+};
+
+struct Stats { unsigned inner, leaves, planes, barys, rays; };
+
+static __device__ __forceinline__ uint2 node_at(const Scene &s, unsigned i) {
+  // an 8-byte node fetch through the texture path
+  const unsigned *w = (const unsigned *)(s.nodes + i);
+  uint2 n;
+  n.x = __ldg(w);
+  n.y = __ldg(w + 1);
+  return n;
+}
+
+// Alg. 3.3: Wald's test; updates (t_hit, tri_hit) and returns true on a hit.
+static __device__ __forceinline__ bool wald(const Scene &s, unsigned t, V3 o, V3 d, float t_min, float *t_hit,
+                                            Stats &st) {
+  const float *w = (const float *)(s.tris + 3 * t);
+  float n0 = __ldg(w), n1 = __ldg(w + 1), n2 = __ldg(w + 2);
+  int k = __float_as_int(__ldg(w + 3));
+  int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;   // (k + 1) mod 3, (k + 2) mod 3
+  st.planes++;
+  // line 3: the plane intersection
+  float tt = (n2 - comp(o, k) - n0 * comp(o, a) - n1 * comp(o, b)) / (comp(d, k) + n0 * comp(d, a) + n1 * comp(d, b));
+  // lines 4-6: early out before e'1, e'2 are loaded
+  if (!(tt >= t_min && tt <= *t_hit)) return false;
+  st.barys++;
+  // lines 7-8: barycentric coordinates
+  float hx = comp(o, a) + tt * comp(d, a), hy = comp(o, b) + tt * comp(d, b);
+  float u = __ldg(w + 8) * hx + __ldg(w + 9) * hy + __ldg(w + 10);
+  float v = __ldg(w + 4) * hx + __ldg(w + 5) * hy + __ldg(w + 6);
+  if (u < 0.0f || v < 0.0f || u + v > 1.0f) return false;
+  *t_hit = tt;
+  return true;
+}
+
+// Tests the leaf's triangles for t in [max(t_a - eps, t_min), min(t_hit, t_b + eps)].
+static __device__ __forceinline__ int visit_leaf(const Scene &s, uint2 n, V3 o, V3 d, float t_min, float t_a,
+                                                 float t_b, bool any, float *t_hit, Stats &st) {
+  st.leaves++;
+  float lo = fmaxf(t_a - s.p->eps, t_min);
+  float saved = *t_hit;
+  *t_hit = fminf(*t_hit, t_b + s.p->eps);
+  int found = -1;
+  unsigned first = n.y >> 2, count = n.x;
+  for (unsigned r = 0; r < count; r++) {
+    unsigned t = __ldg(s.refs + first + r);
+    if (wald(s, t, o, d, lo, t_hit, st)) {
+      found = (int)t;
+      if (any) return found;
+    }
+  }
+  if (found < 0) *t_hit = saved;
+  return found;
+}
+
+// Returns the nearest (or, with `any`, the first) hit in (t_min, t_max); -1 for none.
+template <int V>
+static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out, Stats &st,
+                            float *short_stack) {
+  st.rays++;
+  V3 inv = v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+  const Params *p = s.p;
+  // clip to the scene box
+  float t0x = (p->lo[0] - o.x) * inv.x, t1x = (p->hi[0] - o.x) * inv.x;
+  float t0y = (p->lo[1] - o.y) * inv.y, t1y = (p->hi[1] - o.y) * inv.y;
+  float t0z = (p->lo[2] - o.z) * inv.z, t1z = (p->hi[2] - o.z) * inv.z;
+  float tn = fmaxf(fmaxf(fminf(t0x, t1x), fminf(t0y, t1y)), fminf(t0z, t1z));
+  float tf = fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z));
+  float ta = fmaxf(t_min, tn), tb = fminf(t_max, tf);
+  if (!(ta <= tb)) return -1;
+  float t_hit = t_max;
+  if (V == STACK) {
+    // Stack-based traversal (seed extract §4.4); 8-byte entries in local memory.
+    struct Entry { unsigned node; float tb; } stack[33];
+    int size = 0;
+    unsigned node = 0;
+    for (;;) {
+      uint2 n = node_at(s, node);
+      while ((n.y & 3) != 3) {                        // inner node: one traversal step
+        st.inner++;
+        int k = n.y & 3;
+        float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);
+        unsigned left = 2 * (n.y >> 2) + 1, right = left + 1;
+        bool neg = __float_as_int(comp(d, k)) < 0;    // the IEEE sign bit: works for d_k = -0
+        unsigned near = neg ? right : left, far = neg ? left : right;
+        if (ts > tb || ts != ts) {
+          node = near;
+        } else if (ts < ta) {
+          node = far;
+        } else {
+          stack[size].node = far;                     // push the far child and the end of its interval
+          stack[size].tb = tb;
+          size++;
+          tb = ts;
+          node = near;
+        }
+        n = node_at(s, node);
+      }
+      int h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);
+      if (h >= 0) {
+        *t_out = t_hit;
+        return h;
+      }
+      if (size == 0) return -1;                       // an empty stack: the ray misses
+      size--;
+      ta = tb;                                        // the start is the previous end
+      tb = stack[size].tb;
+      node = stack[size].node;
+    }
+  } else {
+    // Alg. 4.2 (Alg. 4.1 when neither extension is on), errata fixed.
+    const bool PD = V == PUSHDOWN || V == PUSHDOWN_SHORTSTACK;
+    const bool SS = V == SHORTSTACK || V == PUSHDOWN_SHORTSTACK;
+    float r_tmin = ta, r_tmax = tb;                   // the restart interval
+    unsigned restart = 0, restart_flag = 1u << 31;
+    unsigned flags = 0;
+    int front = 0, size = 0;                          // round-robin short stack (lines 1-2)
+    bool push = true;
+    unsigned node, flag;
+    do {
+      if (SS && size > 0) {                           // lines 7-9: pop
+        ta = tb;
+        size--;
+        int at = (front + size) % SHORT_CAPACITY;
+        node = __float_as_uint(short_stack[3 * at * CTA_THREADS]);
+        flag = __float_as_uint(short_stack[(3 * at + 1) * CTA_THREADS]);
+        tb = short_stack[(3 * at + 2) * CTA_THREADS];
+      } else {                                        // lines 10-16: restart
+        ta = r_tmin;
+        tb = r_tmax;
+        node = restart;
+        flag = restart_flag;
+        push = true;
+      }
+      uint2 n = node_at(s, node);
+      while ((n.y & 3) != 3) {                        // line 17
+        st.inner++;
+        int k = n.y & 3;
+        float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);
+        unsigned left = 2 * (n.y >> 2) + 1, right = left + 1;
+        bool neg = __float_as_int(comp(d, k)) < 0;
+        unsigned near = neg ? right : left, far = neg ? left : right;
+        if (ts < ta) {                                // lines 18-20
+          flags |= flag;
+          node = far;
+        } else if (ts > tb || ts != ts) {             // lines 21-23 (erratum: t_s > t_b)
+          flags |= flag;
+          node = near;
+        } else if (flags & flag) {                    // lines 25-27
+          ta = ts;
+          node = far;
+        } else {
+          if (PD && push) {                           // lines 29-35: push down the restart point
+            r_tmin = ta;
+            r_tmax = tb;
+            restart = node;
+            restart_flag = flag;
+            push = false;
+          }
+          if (SS) {                                   // line 36: push (far, flag >> 1, t_b)
+            int at = (front + size) % SHORT_CAPACITY;
+            short_stack[3 * at * CTA_THREADS] = __uint_as_float(far);
+            short_stack[(3 * at + 1) * CTA_THREADS] = __uint_as_float(flag >> 1);
+            short_stack[(3 * at + 2) * CTA_THREADS] = tb;
+            if (size < SHORT_CAPACITY) size++;
+            else front = (front + 1) % SHORT_CAPACITY;
+          }
+          tb = ts;                                    // lines 37-38
+          node = near;
+        }
+        flag >>= 1;                                   // line 41
+        n = node_at(s, node);
+      }
+      flags += flag << 1;                             // line 43: ripple the carry
+      int h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);  // line 44
+      if (h >= 0) {                                   // a hit ends the traversal
+        *t_out = t_hit;
+        return h;
+      }
+    } while (flags != 0);                             // line 45
+    return -1;
+  }
+}
+
+static __device__ V3 normal_of(const Scene &s, unsigned t, V3 d) {
+  const float *w = (const float *)(s.tris + 3 * t);
+  int k = __float_as_int(__ldg(w + 3));
+  float n[3];
+  n[k] = 1.0f;
+  n[k == 2 ? 0 : k + 1] = __ldg(w);
+  n[k == 0 ? 2 : k - 1] = __ldg(w + 1);
+  V3 v = normalize3(v3(n[0], n[1], n[2]));
+  if (v.x * d.x + v.y * d.y + v.z * d.z > 0.0f) v = v3(-v.x, -v.y, -v.z);
+  return v;
+}
+
+// Emission plus diffuse direct light from the point light (one shadow ray).
+template <int V>
+static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, Stats &st, float *ss) {
+  unsigned m = __ldg(s.tri_mat + tri);
+  const float *mat = (const float *)(s.mats + 2 * m);
+  V3 col = v3(__ldg(mat), __ldg(mat + 1), __ldg(mat + 2));
+  int kind = (int)__ldg(mat + 3);
+  V3 c = v3(__ldg(mat + 4), __ldg(mat + 5), __ldg(mat + 6));
+  if (kind != 0) return c;
+  const Params *p = s.p;
+  V3 pt = v3(o.x + d.x * t, o.y + d.y * t, o.z + d.z * t);
+  V3 n = normal_of(s, tri, d);
+  if (p->has_light) {
+    V3 to = v3(p->light_pos[0] - pt.x, p->light_pos[1] - pt.y, p->light_pos[2] - pt.z);
+    float dist = sqrtf(dot3(to, to));
+    V3 dir = v3(to.x / dist, to.y / dist, to.z / dist);
+    float cos = dot3(n, dir);
+    if (cos > 0.0f) {
+      float ts;
+      if (trace<V>(s, pt, dir, p->eps, dist - p->eps, true, &ts, st, ss) < 0) {
+        float g = cos / (dist * dist) / 3.14159265358979323846f;
+        c.x += col.x * p->light_int[0] * g;
+        c.y += col.y * p->light_int[1] * g;
+        c.z += col.z * p->light_int[2] * g;
+      }
+    }
+  }
+  c.x += 0.02f * col.x;
+  c.y += 0.02f * col.y;
+  c.z += 0.02f * col.z;
+  return c;
+}
+
+template <int V>
+static __device__ void render(const Params *p, const uint2 *nodes, const unsigned *refs, const float4 *tris,
+                              const unsigned *tri_mat, const float4 *mats, unsigned *next, float4 *color,
+                              int *hit_tri, unsigned *stats) {
+  Scene s = {p, nodes, refs, tris, tri_mat, mats};
+  float *ss = short_stacks + threadIdx.x;
+  int lane = threadIdx.x & 31;
+  for (;;) {
+    // the job queue: blocks of 32 consecutive pixels
+    unsigned base = 0;
+    if (lane == 0) base = atomicAdd(next, 32u);
+    base = (unsigned)__shfl_sync(0xffffffffu, (int)base, 0);
+    if (base >= (unsigned)p->num_pixels) break;
+    int pix = (int)base + lane;
+    if (pix >= p->num_pixels) continue;
+    int x = pix % p->width, y = pix / p->width;
+    Stats st = {0, 0, 0, 0, 0};
+    float px = (((float)x + 0.5f) / (float)p->width * 2.0f - 1.0f) * p->tan_half * p->aspect;
+    float py = (1.0f - ((float)y + 0.5f) / (float)p->height * 2.0f) * p->tan_half;
+    V3 o = v3(p->cam_pos[0], p->cam_pos[1], p->cam_pos[2]);
+    V3 d = normalize3(v3(p->cam_fwd[0] + px * p->cam_right[0] + py * p->cam_up[0],
+                         p->cam_fwd[1] + px * p->cam_right[1] + py * p->cam_up[1],
+                         p->cam_fwd[2] + px * p->cam_right[2] + py * p->cam_up[2]));
+    float t;
+    int h = trace<V>(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t, st, ss);   // the primary ray
+    V3 c = v3(0.0f, 0.0f, 0.0f);
+    if (h >= 0) {
+      c = direct<V>(s, o, d, t, (unsigned)h, st, ss);
+      unsigned m = __ldg(tri_mat + h);
+      if (__ldg((const float *)(mats + 2 * m) + 3) == 1.0f) {                         // a mirror: reflect
+        V3 n = normal_of(s, (unsigned)h, d);
+        V3 pt = v3(o.x + d.x * t, o.y + d.y * t, o.z + d.z * t);
+        float s2 = 2.0f * dot3(d, n);
+        V3 r = normalize3(v3(d.x - s2 * n.x, d.y - s2 * n.y, d.z - s2 * n.z));
+        float t2;
+        int h2 = trace<V>(s, pt, r, p->eps, __int_as_float(0x7f800000), false, &t2, st, ss);
+        if (h2 >= 0) {
+          V3 c2 = direct<V>(s, pt, r, t2, (unsigned)h2, st, ss);
+          const float *mat = (const float *)(mats + 2 * m);
+          c.x += __ldg(mat) * c2.x;
+          c.y += __ldg(mat + 1) * c2.y;
+          c.z += __ldg(mat + 2) * c2.z;
+        }
+      }
+    }
+    color[pix] = make_float4(c.x, c.y, c.z, 1.0f);
+    hit_tri[pix] = h;
+    unsigned *sp = stats + 8 * pix;
+    sp[0] = st.inner;
+    sp[1] = st.leaves;
+    sp[2] = st.planes;
+    sp[3] = st.barys;
+    sp[4] = st.rays;
+  }
+}
+
+#define ENTRY(name, V)                                                                                     \
+  extern "C" __global__ void name(const Params *p, const uint2 *nodes, const unsigned *refs,               \
+                                  const float4 *tris, const unsigned *tri_mat, const float4 *mats,         \
+                                  unsigned *next, float4 *color, int *hit_tri, unsigned *stats) {          \
+    render<V>(p, nodes, refs, tris, tri_mat, mats, next, color, hit_tri, stats);                         \
+  }
+ENTRY(trace_stack, STACK)
+ENTRY(trace_stackless, STACKLESS)
+ENTRY(trace_pushdown, PUSHDOWN)
+ENTRY(trace_shortstack, SHORTSTACK)
+ENTRY(trace_pushdown_shortstack, PUSHDOWN_SHORTSTACK)
