@@ -7,5 +7,6 @@ pub mod image;
 pub mod kdtree;
 pub mod procedural;
 pub mod raycast;
+pub mod rt_kernels;
 pub mod scene;
 pub mod scene_file;

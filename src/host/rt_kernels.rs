@@ -1,0 +1,199 @@
+//! Runs thesis 000's ray-tracing kernels (`kernels/raytrace/raytrace.cu`) on
+//! the emulator: uploads the laid-out kd-tree, triangles, materials and camera,
+//! launches 30 persistent CTAs of 256 threads, and reads back the image, the
+//! primary hit of each pixel and the per-ray work the kernel counted.
+
+use glam::Vec3;
+
+use super::camera::Camera;
+use super::image::FrameBuffer;
+use super::kdtree::KdTree;
+use super::kdtree::layout::layout;
+use super::raycast::{EPS_REL, TraceStats};
+use super::scene::{Light, MaterialKind, Scene};
+use crate::model::{Model, ModelStats, Profile};
+use crate::sim::device::to_bytes;
+use crate::sim::{Arg, Device, LaunchConfig, LaunchStats, Module, SimError};
+
+/// Traversal variants of the kernel family (thesis 000 §4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum Variant {
+    /// Stack-based traversal, stack in local memory.
+    Stack,
+    /// Restart with the flags register (Alg. 4.1).
+    Stackless,
+    /// Alg. 4.2 with push-down.
+    PushDown,
+    /// Alg. 4.2 with a 4-entry short stack in shared memory.
+    ShortStack,
+    /// Alg. 4.2 with both.
+    PushDownShortStack,
+}
+
+impl Variant {
+    /// All variants.
+    pub const ALL: [Variant; 5] =
+        [Variant::Stack, Variant::Stackless, Variant::PushDown, Variant::ShortStack, Variant::PushDownShortStack];
+
+    /// The kernel's entry point.
+    pub fn kernel(self) -> &'static str {
+        match self {
+            Variant::Stack => "trace_stack",
+            Variant::Stackless => "trace_stackless",
+            Variant::PushDown => "trace_pushdown",
+            Variant::ShortStack => "trace_shortstack",
+            Variant::PushDownShortStack => "trace_pushdown_shortstack",
+        }
+    }
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Stack => "stack",
+            Variant::Stackless => "stackless",
+            Variant::PushDown => "push-down",
+            Variant::ShortStack => "short-stack",
+            Variant::PushDownShortStack => "push-down+short-stack",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn parse(s: &str) -> Option<Variant> {
+        Variant::ALL.into_iter().find(|v| v.name() == s)
+    }
+}
+
+/// The kernels' PTX, compiled in (`kernels/raytrace/raytrace.ptx`).
+pub const PTX: &str = include_str!("../../kernels/raytrace/raytrace.ptx");
+
+/// CTAs of the persistent-threads launch (one per GTX 280 SM).
+pub const CTAS: u32 = 30;
+/// Threads per CTA.
+pub const THREADS: u32 = 256;
+
+/// What a kernel render produced.
+#[derive(Debug, Clone)]
+pub struct KernelRender {
+    /// The image.
+    pub image: FrameBuffer,
+    /// Triangle hit by each pixel's primary ray (-1: none).
+    pub hit_tri: Vec<i32>,
+    /// Work counted by the kernel, summed over pixels.
+    pub trace: TraceStats,
+    /// The emulator's counters.
+    pub launch: LaunchStats,
+    /// The device profile's memory counters.
+    pub memory: ModelStats,
+}
+
+fn f32s(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+/// Renders `camera`'s view with kernel `variant` under device profile `profile`.
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    dev: &mut Device,
+    module: &Module,
+    scene: &Scene,
+    tree: &KdTree,
+    camera: &Camera,
+    light_offset: Vec3,
+    variant: Variant,
+    profile: Profile,
+) -> Result<KernelRender, SimError> {
+    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let lay = layout(tree, &tris, 0);
+    let (r, u, f) = camera.frame();
+    let [w, h] = camera.resolution;
+    let npix = (w * h) as usize;
+    let light = scene.lights.iter().find_map(|l| match l {
+        Light::Point { position, intensity } => Some((Vec3::from(*position) + light_offset, *intensity)),
+        _ => None,
+    });
+    let (lp, li) = light.unwrap_or((Vec3::ZERO, [0.0; 3]));
+    let eps = tree.bounds.size().length().max(1e-3) * EPS_REL;
+    let mut params = f32s(&[
+        camera.position[0],
+        camera.position[1],
+        camera.position[2],
+        f.x,
+        f.y,
+        f.z,
+        r.x,
+        r.y,
+        r.z,
+        u.x,
+        u.y,
+        u.z,
+        lp.x,
+        lp.y,
+        lp.z,
+        li[0],
+        li[1],
+        li[2],
+        tree.bounds.lo.x,
+        tree.bounds.lo.y,
+        tree.bounds.lo.z,
+        tree.bounds.hi.x,
+        tree.bounds.hi.y,
+        tree.bounds.hi.z,
+        eps,
+        (camera.fov_y.to_radians() * 0.5).tan(),
+        w as f32 / h as f32,
+    ]);
+    for v in [w as i32, h as i32, npix as i32, light.is_some() as i32] {
+        params.extend_from_slice(&v.to_le_bytes());
+    }
+    let mut mats = Vec::new();
+    for m in &scene.materials {
+        let kind = match m.kind {
+            MaterialKind::Diffuse => 0.0,
+            MaterialKind::Mirror | MaterialKind::Glass { .. } => 1.0,
+            MaterialKind::Emitter => 2.0,
+        };
+        mats.extend_from_slice(&[m.color[0], m.color[1], m.color[2], kind, m.emission[0], m.emission[1], m.emission[2], 0.0]);
+    }
+    let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
+    let up = |dev: &mut Device, bytes: &[u8], name: &str| -> Result<crate::sim::DevicePtr, SimError> {
+        let p = dev.alloc_bytes(bytes.len().max(4) as u64, name);
+        if !bytes.is_empty() {
+            dev.write(p, bytes)?;
+        }
+        Ok(p)
+    };
+    let pp = up(dev, &params, "params")?;
+    let nodes = up(dev, &lay.nodes, "nodes")?;
+    let refs = up(dev, &lay.tri_refs, "tri_refs")?;
+    let tb = up(dev, &lay.triangles, "triangles")?;
+    let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
+    let mb = up(dev, &f32s(&mats), "materials")?;
+    let next = dev.alloc_zeroed::<u32>(1);
+    let color = dev.alloc_zeroed::<f32>(4 * npix);
+    let hit = dev.alloc_zeroed::<i32>(npix);
+    let stats = dev.alloc_zeroed::<u32>(8 * npix);
+    let model = Model::new(profile, &module.prog);
+    let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, next, color, hit, stats].into_iter().map(Arg::Ptr).collect();
+    let launch = dev.launch_observed(module, variant.kernel(), LaunchConfig::linear(CTAS, THREADS), &args, Some(&model))?;
+    let rgba = dev.read::<f32>(color, 4 * npix);
+    let mut image = FrameBuffer::new(w, h);
+    for (i, px) in rgba.chunks_exact(4).enumerate() {
+        image.pixels[i] = [px[0], px[1], px[2]];
+    }
+    let st = dev.read::<u32>(stats, 8 * npix);
+    let mut trace = TraceStats::default();
+    for s in st.chunks_exact(8) {
+        trace.inner_nodes += s[0] as u64;
+        trace.leaves += s[1] as u64;
+        trace.plane_tests += s[2] as u64;
+        trace.barycentric_tests += s[3] as u64;
+        trace.rays += s[4] as u64;
+    }
+    trace.primary = npix as u64;
+    Ok(KernelRender { image, hit_tri: dev.read::<i32>(hit, npix), trace, launch, memory: model.finish() })
+}
+
+/// Loads the kernels' PTX on `dev`.
+pub fn load(dev: &mut Device) -> Result<Module, SimError> {
+    dev.load_ptx(PTX, "kernels/raytrace/raytrace.ptx")
+}
