@@ -37,11 +37,15 @@ fn every_variant_matches_the_native_caster() {
         let mut dev = Device::new();
         let module = rt_kernels::load(&mut dev).unwrap();
         for v in Variant::ALL {
-            let k = rt_kernels::render(&mut dev, &module, &scene, &tree, &cam, glam::Vec3::ZERO, v, Profile::Gt200).unwrap();
+            let k = rt_kernels::render(&mut dev, &module, &scene, &tree, &cam, glam::Vec3::ZERO, v, Profile::Gt200)
+                .unwrap();
             assert_eq!(k.hit_tri, native_hits, "{name} {v:?}: primary hits");
             for (i, (a, b)) in k.image.pixels.iter().zip(&native.pixels).enumerate() {
                 for c in 0..3 {
-                    assert!((a[c] - b[c]).abs() <= 1e-6 * b[c].abs().max(1.0), "{name} {v:?} pixel {i}: {a:?} vs {b:?}");
+                    assert!(
+                        (a[c] - b[c]).abs() <= 1e-6 * b[c].abs().max(1.0),
+                        "{name} {v:?} pixel {i}: {a:?} vs {b:?}"
+                    );
                 }
             }
             assert_eq!(k.trace.rays, nst.rays, "{name} {v:?}: the same rays");
@@ -55,4 +59,20 @@ fn every_variant_matches_the_native_caster() {
             assert!(k.launch.totals.atomics.global > 0, "the job queue hands out pixel blocks");
         }
     }
+}
+
+#[test]
+fn tables_4_5_and_4_7_on_a_small_flight() {
+    use warplight::repro::tables_4_5_4_7::{TABLE_4_5, markdown, measure};
+    let scene = scene_file::load(Path::new("scenes/scene6.toml")).unwrap();
+    let mut ticks = 0;
+    let r = measure(&scene, 2, 16, |_, _| ticks += 1).unwrap();
+    assert_eq!(ticks, 2 * 5);
+    let [stack, stackless, pushdown, short, both] = r.inner_per_ray;
+    // restarts add node visits; push-down saves some of them; a short stack almost all
+    assert!(stackless > pushdown && pushdown > stack, "{:?}", r.inner_per_ray);
+    assert!(short >= stack && short < stack * 1.1 && both <= short, "{:?}", r.inner_per_ray);
+    assert!(r.instr_per_ray.iter().all(|&x| x > 100.0));
+    let md = markdown("t", &TABLE_4_5, &[r], |r| r.inner_per_ray);
+    assert!(md.contains("| scene6 |") && md.contains("+35.7%") && md.contains("Std. Dev."), "{md}");
 }

@@ -5,8 +5,13 @@ use std::time::Instant;
 
 use super::scene_info::scene_path;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
+use std::io::IsTerminal;
+
 use crate::host::raycast::{Caster, render};
+use crate::host::rt_kernels::{self, Variant};
 use crate::host::scene_file;
+use crate::model::Profile;
+use crate::sim::Device;
 
 /// Options of `warplight render`.
 #[derive(Debug, clap::Args)]
@@ -20,10 +25,13 @@ pub struct RenderArgs {
     /// Image size WIDTHxHEIGHT (default: the scene's camera).
     #[arg(long)]
     pub resolution: Option<String>,
-    /// Renderer: `native` (the Rust reference ray caster). The emulated kernel
-    /// variants arrive with the ray-tracing kernels.
+    /// Renderer: `native` (the Rust reference ray caster), or a kernel variant run
+    /// on the emulator: stack, stackless, push-down, short-stack, push-down+short-stack.
     #[arg(long, default_value = "native")]
     pub variant: String,
+    /// Device profile of the emulated kernels' memory counters: gt200, maxwell, hopper.
+    #[arg(long, default_value = "gt200")]
+    pub device: String,
     /// kd-tree heuristic: sah or siroh.
     #[arg(long, default_value = "sah")]
     pub heuristic: String,
@@ -40,9 +48,14 @@ pub struct RenderArgs {
 
 /// Runs the command.
 pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if a.variant != "native" {
-        return Err(format!("variant `{}` is not available yet; available: native", a.variant).into());
-    }
+    let kernel_variant = match a.variant.as_str() {
+        "native" => None,
+        v => Some(Variant::parse(v).ok_or_else(|| {
+            let names: Vec<&str> = Variant::ALL.iter().map(|v| v.name()).collect();
+            format!("unknown variant `{v}`; expected native, {}", names.join(", "))
+        })?),
+    };
+    let profile = Profile::parse(&a.device).ok_or_else(|| format!("unknown device `{}`", a.device))?;
     let h = match a.heuristic.as_str() {
         "sah" => Heuristic::Sah,
         "siroh" => Heuristic::Siroh,
@@ -67,7 +80,42 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let build_s = t0.elapsed().as_secs_f64();
     let caster = Caster::new(&scene, &tree);
     let t1 = Instant::now();
-    let (fb, st) = render(&caster, &cam, scene.flight.light_offset(a.frame));
+    let (fb, st, emulated) = match kernel_variant {
+        None => {
+            let (fb, st) = render(&caster, &cam, scene.flight.light_offset(a.frame));
+            (fb, st, None)
+        }
+        Some(v) => {
+            let mut dev = Device::new();
+            let module = rt_kernels::load(&mut dev)?;
+            let pb = std::io::stderr().is_terminal().then(|| {
+                let pb = indicatif::ProgressBar::new_spinner();
+                pb.set_message(format!(
+                    "emulating {} ({} x {} pixels)",
+                    v.kernel(),
+                    cam.resolution[0],
+                    cam.resolution[1]
+                ));
+                pb.enable_steady_tick(std::time::Duration::from_millis(100));
+                pb
+            });
+            let k = rt_kernels::render(
+                &mut dev,
+                &module,
+                &scene,
+                &tree,
+                &cam,
+                scene.flight.light_offset(a.frame),
+                v,
+                profile,
+            );
+            if let Some(pb) = pb {
+                pb.finish_and_clear();
+            }
+            let k = k?;
+            (k.image.clone(), k.trace, Some(k))
+        }
+    };
     let render_s = t1.elapsed().as_secs_f64();
     let is_exr = a.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if is_exr {
@@ -105,11 +153,34 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         st.plane_tests as f64 / st.rays.max(1) as f64,
         st.barycentric_tests as f64 / st.rays.max(1) as f64
     );
+    if let Some(k) = &emulated {
+        let c = &k.launch.totals;
+        println!(
+            "  emulated {}: {} warp instructions, {} thread instructions ({:.0} instructions per ray by the thesis' rule: warp instructions x 32 / rays)",
+            k.launch.kernel,
+            c.warp_instructions,
+            c.thread_instructions,
+            c.warp_instructions as f64 * 32.0 / st.rays.max(1) as f64
+        );
+        println!(
+            "  branches {} (divergent {}), global atomics {}, {} profile: {} global load transactions, {} texture lookups ({} hits)",
+            c.branches,
+            c.divergent_branches,
+            c.atomics.global,
+            profile,
+            k.memory.counters.global_ld.sectors,
+            k.memory.counters.texture.sectors,
+            k.memory.counters.texture.hits
+        );
+    }
     println!("  wrote {}", a.output.display());
     if let Some(j) = &a.json {
         let v = serde_json::json!({
             "scene": scene.name, "frame": a.frame, "variant": a.variant, "heuristic": h,
             "resolution": cam.resolution, "tree": ts, "counters": st, "render_seconds": render_s,
+            "emulator": emulated.as_ref().map(|k| serde_json::json!({
+                "totals": k.launch.totals, "memory": k.memory.metrics(&k.launch.totals).into_iter().collect::<std::collections::BTreeMap<_, _>>(),
+            })),
         });
         std::fs::write(j, serde_json::to_string_pretty(&v)?)?;
     }

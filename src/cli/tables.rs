@@ -4,13 +4,19 @@ use std::io::IsTerminal;
 
 use super::scene_info::scene_path;
 use crate::host::scene_file;
-use crate::repro::table_4_4;
+use crate::repro::{table_4_4, tables_4_5_4_7};
 
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
 pub struct TablesArgs {
-    /// Tables to reproduce: 4.4 (more arrive with the ray-tracing kernels).
+    /// Tables to reproduce: 4.4, 4.5, 4.7, or all.
     pub tables: Vec<String>,
+    /// Frames of each camera flight (the thesis: 50).
+    #[arg(long, default_value_t = 50)]
+    pub frames: u32,
+    /// Image side in pixels (the thesis: 512).
+    #[arg(long, default_value_t = 512)]
+    pub resolution: u32,
     /// Scenes (names in scenes/), comma-separated; default: every scene of the table that is available.
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
@@ -27,13 +33,97 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.tables.is_empty() {
         return Err("name a table: 4.4".into());
     }
+    let mut flights: Option<Vec<tables_4_5_4_7::SceneRun>> = None;
     for t in &a.tables {
         match t.as_str() {
-            "4.4" | "all" => table_4_4(&a)?,
-            other => return Err(format!("table {other} is not reproduced yet; available: 4.4").into()),
+            "4.4" => table_4_4(&a)?,
+            "4.5" | "4.7" => {
+                if flights.is_none() {
+                    flights = Some(flight_runs(&a)?);
+                }
+                let runs = flights.as_ref().expect("measured");
+                print_4_5_4_7(t, runs, &a);
+            }
+            "all" => {
+                table_4_4(&a)?;
+                let runs = flight_runs(&a)?;
+                print_4_5_4_7("4.5", &runs, &a);
+                print_4_5_4_7("4.7", &runs, &a);
+            }
+            other => return Err(format!("table {other} is not reproduced yet; available: 4.4, 4.5, 4.7, all").into()),
         }
     }
     Ok(())
+}
+
+fn flight_runs(a: &TablesArgs) -> Result<Vec<tables_4_5_4_7::SceneRun>, Box<dyn std::error::Error>> {
+    let names: Vec<String> = if a.scenes.is_empty() {
+        tables_4_5_4_7::TABLE_4_5.iter().map(|r| r.0.to_string()).collect()
+    } else {
+        a.scenes.clone()
+    };
+    let mut scenes = Vec::new();
+    for n in &names {
+        match scene_file::load(&scene_path(n)) {
+            Ok(s) => scenes.push(s),
+            Err(e) => eprintln!("skipped {n}: {e}"),
+        }
+    }
+    let total: u64 = scenes.iter().map(|s| a.frames.min(s.flight.frames) as u64 * 5).sum();
+    let pb = std::io::stderr().is_terminal().then(|| {
+        let pb = indicatif::ProgressBar::new(total);
+        pb.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:30} {pos}/{len} frames x variants, {msg} [{elapsed}, eta {eta}]",
+            )
+            .expect("template"),
+        );
+        pb
+    });
+    let mut runs = Vec::new();
+    for s in &scenes {
+        let r = tables_4_5_4_7::measure(s, a.frames, a.resolution, |f, v| {
+            if let Some(pb) = &pb {
+                pb.set_message(format!("{} frame {f} {}", s.name, v.name()));
+                pb.inc(1);
+            }
+        })?;
+        runs.push(r);
+    }
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    Ok(runs)
+}
+
+fn print_4_5_4_7(t: &str, runs: &[tables_4_5_4_7::SceneRun], a: &TablesArgs) {
+    if a.format == "json" {
+        println!("{}", serde_json::to_string_pretty(runs).unwrap_or_default());
+        return;
+    }
+    let md = if t == "4.5" {
+        tables_4_5_4_7::markdown(
+            "Table 4.5: inner node traversals per ray, stackless variants relative to stack-based (thesis 000, seed L1878-1888)",
+            &tables_4_5_4_7::TABLE_4_5,
+            runs,
+            |r| r.inner_per_ray,
+        )
+    } else {
+        tables_4_5_4_7::markdown(
+            "Table 4.7: instructions per ray (warp instructions x 32 / rays), relative to stack-based (thesis 000, seed L1914-1924)",
+            &tables_4_5_4_7::TABLE_4_7,
+            runs,
+            |r| r.instr_per_ray,
+        )
+    };
+    println!("{md}");
+    println!(
+        "Ours: SIROH trees, {} frame(s) of each flight at {}x{}, 30 persistent CTAs x 256 threads, 32-pixel job blocks, clang-16 PTX.",
+        a.frames, a.resolution, a.resolution
+    );
+    println!(
+        "Fixtures: docs/fixtures.md. Instructions are PTX instructions, not GT200 SASS; scene variants as in `warplight scene info`.\n"
+    );
 }
 
 fn table_4_4(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {

@@ -152,7 +152,16 @@ pub fn render(
             MaterialKind::Mirror | MaterialKind::Glass { .. } => 1.0,
             MaterialKind::Emitter => 2.0,
         };
-        mats.extend_from_slice(&[m.color[0], m.color[1], m.color[2], kind, m.emission[0], m.emission[1], m.emission[2], 0.0]);
+        mats.extend_from_slice(&[
+            m.color[0],
+            m.color[1],
+            m.color[2],
+            kind,
+            m.emission[0],
+            m.emission[1],
+            m.emission[2],
+            0.0,
+        ]);
     }
     let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
     let up = |dev: &mut Device, bytes: &[u8], name: &str| -> Result<crate::sim::DevicePtr, SimError> {
@@ -174,7 +183,8 @@ pub fn render(
     let stats = dev.alloc_zeroed::<u32>(8 * npix);
     let model = Model::new(profile, &module.prog);
     let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, next, color, hit, stats].into_iter().map(Arg::Ptr).collect();
-    let launch = dev.launch_observed(module, variant.kernel(), LaunchConfig::linear(CTAS, THREADS), &args, Some(&model))?;
+    let launch =
+        dev.launch_observed(module, variant.kernel(), LaunchConfig::linear(CTAS, THREADS), &args, Some(&model))?;
     let rgba = dev.read::<f32>(color, 4 * npix);
     let mut image = FrameBuffer::new(w, h);
     for (i, px) in rgba.chunks_exact(4).enumerate() {

@@ -3,3 +3,4 @@
 //! side-by-side output.
 
 pub mod table_4_4;
+pub mod tables_4_5_4_7;
