@@ -76,3 +76,15 @@ fn tables_4_5_and_4_7_on_a_small_flight() {
     let md = markdown("t", &TABLE_4_5, &[r], |r| r.inner_per_ray);
     assert!(md.contains("| scene6 |") && md.contains("+35.7%") && md.contains("Std. Dev."), "{md}");
 }
+
+#[test]
+fn table_4_3_counts_with_three_trees() {
+    use warplight::repro::table_4_3::{markdown, measure};
+    let scene = scene_file::load(Path::new("scenes/scene6.toml")).unwrap();
+    let r = measure(&scene, 1, 24);
+    // the same rays with every tree; every count positive; the thesis' SAH value beside ours
+    assert!(r.rays[0] == r.rays[1] && r.rays[1] == r.rays[2]);
+    assert!(r.per_ray.iter().flatten().all(|&x| x > 0.0));
+    let md = markdown(&[r]);
+    assert!(md.contains("| scene6 |") && md.contains("| 9.68 |"), "{md}");
+}

@@ -4,12 +4,12 @@ use std::io::IsTerminal;
 
 use super::scene_info::scene_path;
 use crate::host::scene_file;
-use crate::repro::{table_4_4, tables_4_5_4_7};
+use crate::repro::{table_4_3, table_4_4, tables_4_5_4_7};
 
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
 pub struct TablesArgs {
-    /// Tables to reproduce: 4.4, 4.5, 4.7, or all.
+    /// Tables to reproduce: 4.3, 4.4, 4.5, 4.7, or all.
     pub tables: Vec<String>,
     /// Frames of each camera flight (the thesis: 50).
     #[arg(long, default_value_t = 50)]
@@ -36,6 +36,7 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut flights: Option<Vec<tables_4_5_4_7::SceneRun>> = None;
     for t in &a.tables {
         match t.as_str() {
+            "4.3" => table_4_3(&a)?,
             "4.4" => table_4_4(&a)?,
             "4.5" | "4.7" => {
                 if flights.is_none() {
@@ -45,14 +46,61 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
                 print_4_5_4_7(t, runs, &a);
             }
             "all" => {
+                table_4_3(&a)?;
                 table_4_4(&a)?;
                 let runs = flight_runs(&a)?;
                 print_4_5_4_7("4.5", &runs, &a);
                 print_4_5_4_7("4.7", &runs, &a);
             }
-            other => return Err(format!("table {other} is not reproduced yet; available: 4.4, 4.5, 4.7, all").into()),
+            other => {
+                return Err(format!("table {other} is not reproduced yet; available: 4.3, 4.4, 4.5, 4.7, all").into());
+            }
         }
     }
+    Ok(())
+}
+
+fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let names: Vec<String> = if a.scenes.is_empty() {
+        table_4_3::THESIS.iter().map(|r| r.0.to_string()).collect()
+    } else {
+        a.scenes.clone()
+    };
+    let pb = std::io::stderr().is_terminal().then(|| {
+        let pb = indicatif::ProgressBar::new(names.len() as u64);
+        pb.set_style(
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]").expect("template"),
+        );
+        pb
+    });
+    let mut rows = Vec::new();
+    for n in &names {
+        if let Some(pb) = &pb {
+            pb.set_message(format!("{n}: three trees (the numerical one takes a while) and the flight"));
+        }
+        match scene_file::load(&scene_path(n)) {
+            Ok(s) => rows.push(table_4_3::measure(&s, a.frames, a.resolution)),
+            Err(e) => eprintln!("skipped {n}: {e}"),
+        }
+        if let Some(pb) = &pb {
+            pb.inc(1);
+        }
+    }
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    if a.format == "json" {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+        return Ok(());
+    }
+    println!(
+        "Table 4.3: traversals, plane and triangle intersections per ray with the numerical approximation (4.1.2) and SIROH, relative to the SAH (thesis 000, seed L1699-1709)\n"
+    );
+    print!("{}", table_4_3::markdown(&rows));
+    println!(
+        "\nOurs: stack-based traversal (the native caster, step for step the stack kernel), {} frame(s) of each flight at {}x{}.\n",
+        a.frames, a.resolution, a.resolution
+    );
     Ok(())
 }
 
