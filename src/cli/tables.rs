@@ -3,6 +3,7 @@
 use std::io::IsTerminal;
 
 use super::scene_info::scene_path;
+use crate::host::scene::Scene;
 use crate::host::scene_file;
 use crate::repro::{table_4_3, table_4_4, tables_4_5_4_7};
 
@@ -60,12 +61,9 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let names: Vec<String> = if a.scenes.is_empty() {
-        table_4_3::THESIS.iter().map(|r| r.0.to_string()).collect()
-    } else {
-        a.scenes.clone()
-    };
+/// Loads each named scene and measures it, with a progress bar; returns the
+/// results and the scenes that could not be loaded (with why).
+fn per_scene<T>(names: &[String], what: &str, mut f: impl FnMut(&Scene) -> T) -> (Vec<T>, Vec<String>) {
     let pb = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new(names.len() as u64);
         pb.set_style(
@@ -73,14 +71,14 @@ fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         );
         pb
     });
-    let mut rows = Vec::new();
-    for n in &names {
+    let (mut out, mut skipped) = (Vec::new(), Vec::new());
+    for n in names {
         if let Some(pb) = &pb {
-            pb.set_message(format!("{n}: three trees (the numerical one takes a while) and the flight"));
+            pb.set_message(format!("{n}: {what}"));
         }
         match scene_file::load(&scene_path(n)) {
-            Ok(s) => rows.push(table_4_3::measure(&s, a.frames, a.resolution)),
-            Err(e) => eprintln!("skipped {n}: {e}"),
+            Ok(s) => out.push(f(&s)),
+            Err(e) => skipped.push(format!("{n}: {e}")),
         }
         if let Some(pb) = &pb {
             pb.inc(1);
@@ -88,6 +86,21 @@ fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(pb) = pb {
         pb.finish_and_clear();
+    }
+    (out, skipped)
+}
+
+fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let names: Vec<String> = if a.scenes.is_empty() {
+        table_4_3::THESIS.iter().map(|r| r.0.to_string()).collect()
+    } else {
+        a.scenes.clone()
+    };
+    let (rows, skipped) = per_scene(&names, "three trees (the numerical one takes a while) and the flight", |s| {
+        table_4_3::measure(s, a.frames, a.resolution)
+    });
+    for sk in skipped {
+        eprintln!("skipped {sk}");
     }
     if a.format == "json" {
         println!("{}", serde_json::to_string_pretty(&rows)?);
@@ -180,28 +193,7 @@ fn table_4_4(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         a.scenes.clone()
     };
-    let pb = std::io::stderr().is_terminal().then(|| {
-        let pb = indicatif::ProgressBar::new(names.len() as u64);
-        pb.set_style(indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").expect("template"));
-        pb
-    });
-    let mut rows = Vec::new();
-    let mut skipped = Vec::new();
-    for n in &names {
-        if let Some(pb) = &pb {
-            pb.set_message(format!("building {n}"));
-        }
-        match scene_file::load(&scene_path(n)) {
-            Ok(s) => rows.push(table_4_4::measure(&s, a.repeats)),
-            Err(e) => skipped.push(format!("{n}: {e}")),
-        }
-        if let Some(pb) = &pb {
-            pb.inc(1);
-        }
-    }
-    if let Some(pb) = pb {
-        pb.finish_and_clear();
-    }
+    let (rows, skipped) = per_scene(&names, "building the trees", |s| table_4_4::measure(s, a.repeats));
     if a.format == "json" {
         println!("{}", serde_json::to_string_pretty(&rows)?);
         return Ok(());

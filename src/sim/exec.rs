@@ -381,6 +381,46 @@ fn emit(cta: &mut CtaMut, w: &Warp, func: u32, pc: u32, op: MemOp, nc: bool, ele
     }
 }
 
+/// Loads (`store` = None) or stores `n` consecutive elements of `ty` for every
+/// active lane. Returns the loaded values, the first lane's resolved space (for
+/// counting) and what every lane touched (for observers).
+#[allow(clippy::too_many_arguments)]
+fn vector_access(
+    ctx: &Ctx,
+    w: &mut Warp,
+    shared: &mut [u8],
+    space: MemSpace,
+    ty: Ty,
+    n: u32,
+    addrs: &Lanes,
+    exec: u32,
+    store: Option<&[Lanes; 4]>,
+) -> Result<([Lanes; 4], Option<Resolved>, Touched), ExecFault> {
+    let size = ty.bytes();
+    let mut vals = [[0u64; 32]; 4];
+    let mut first = None;
+    let mut touched = Touched::new();
+    for l in 0..32 {
+        if exec >> l & 1 == 0 {
+            continue;
+        }
+        let r = resolve(space, addrs[l]);
+        first.get_or_insert(r);
+        touched.set(l, r);
+        check_vector_align(r, l, size * n)?;
+        for k in 0..n as usize {
+            let rk = resolve(space, addrs[l].wrapping_add((k as u32 * size) as u64));
+            match store {
+                None => vals[k][l] = ty.extend(access(ctx, w, shared, rk, l, size, size, None)?),
+                Some(v) => {
+                    access(ctx, w, shared, rk, l, size, size, Some(v[k][l] & ty.mask()))?;
+                }
+            }
+        }
+    }
+    Ok((vals, first, touched))
+}
+
 /// Vector accesses must be aligned to their whole size.
 fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), ExecFault> {
     if !r.addr().is_multiple_of(total as u64) {
@@ -643,28 +683,12 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         }
         Kind::Ld { space, ty, ds, addr, nc, .. } => {
             let addrs = addresses(ctx, w, cta, addr);
-            let size = ty.bytes();
             let n = ds.len() as u32;
-            let mut vals = [[0u64; 32]; 4];
-            let mut first = None;
-            let mut touched = Touched::new();
-            for l in 0..32 {
-                if exec >> l & 1 == 0 {
-                    continue;
-                }
-                let r = resolve(*space, addrs[l]);
-                first.get_or_insert(r);
-                touched.set(l, r);
-                check_vector_align(r, l, size * n)?;
-                for k in 0..n {
-                    let rk = resolve(*space, addrs[l].wrapping_add((k * size) as u64));
-                    vals[k as usize][l] = ty.extend(access(ctx, w, cta.shared, rk, l, size, size, None)?);
-                }
-            }
+            let (vals, first, touched) = vector_access(ctx, w, cta.shared, *space, *ty, n, &addrs, exec, None)?;
             if let Some(r) = first {
                 count_space(&mut cta.counters.loads, r);
             }
-            emit(cta, w, func, pc, MemOp::Load, *nc, size, n, &touched);
+            emit(cta, w, func, pc, MemOp::Load, *nc, ty.bytes(), n, &touched);
             let fr = w.frames.last_mut().expect("frame");
             for (k, d) in ds.iter().enumerate() {
                 write(fr, *d, &vals[k], exec);
@@ -672,31 +696,16 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         }
         Kind::St { space, ty, vals, addr, .. } => {
             let addrs = addresses(ctx, w, cta, addr);
-            let size = ty.bytes();
             let n = vals.len() as u32;
             let mut vs = [[0u64; 32]; 4];
             for (k, v) in vals.iter().enumerate() {
                 vs[k] = read(ctx, w, cta, *v);
             }
-            let mut first = None;
-            let mut touched = Touched::new();
-            for l in 0..32 {
-                if exec >> l & 1 == 0 {
-                    continue;
-                }
-                let r = resolve(*space, addrs[l]);
-                first.get_or_insert(r);
-                touched.set(l, r);
-                check_vector_align(r, l, size * n)?;
-                for k in 0..n {
-                    let rk = resolve(*space, addrs[l].wrapping_add((k * size) as u64));
-                    access(ctx, w, cta.shared, rk, l, size, size, Some(vs[k as usize][l] & ty.mask()))?;
-                }
-            }
+            let (_, first, touched) = vector_access(ctx, w, cta.shared, *space, *ty, n, &addrs, exec, Some(&vs))?;
             if let Some(r) = first {
                 count_space(&mut cta.counters.stores, r);
             }
-            emit(cta, w, func, pc, MemOp::Store, false, size, n, &touched);
+            emit(cta, w, func, pc, MemOp::Store, false, ty.bytes(), n, &touched);
         }
         Kind::Atom { space, op, ty, d, addr, b, c } => {
             return atomic(ctx, w, cta, (func, pc), *space, *op, *ty, *d, addr, *b, *c, exec);
