@@ -28,6 +28,13 @@
 #define CTA_THREADS 256
 #define SS_WORDS (3 * SHORT_CAPACITY * CTA_THREADS)
 
+// Node caches (§4.3.1): the heap-ordered top of the tree, preloaded by each CTA.
+// I: the top 10 levels as 8-byte nodes; II: the top 8 levels with their AABBs.
+#define NC1_NODES 1024
+#define NC2_NODES 256
+__shared__ uint2 node_cache[NC1_NODES];
+__shared__ float aabb_cache[6 * NC2_NODES];
+
 // Short stacks of the short-stack variants: entry e of thread t, word w at
 // [(3e + w) * 256 + t] (4 entries x 12 bytes per thread, 12 KB per CTA).
 __shared__ float short_stacks[SS_WORDS];
@@ -57,12 +64,20 @@ struct Scene {
   const float4 *tris;      // 3 float4 per triangle: [n'i n'j n'd k], [e'1], [e'2]
   const unsigned *tri_mat; // material per triangle
   const float4 *mats;      // [r g b kind], kind: 0 diffuse, 1 mirror, 2 emitter; then [emission, 0]
+  const float *aabbs;      // 6 floats per heap node (node cache II)
 };
 
-struct Stats { unsigned inner, leaves, planes, barys, rays; };
+struct Stats { unsigned inner, leaves, planes, barys, rays, tex_nodes, local_stack; };
 
-static __device__ __forceinline__ uint2 node_at(const Scene &s, unsigned i) {
-  // an 8-byte node fetch through the texture path
+// A node fetch: from the shared-memory node cache when `i` is cached (NC I:
+// index < 2^10, NC II: index < 2^8), else 8 bytes through the texture path.
+template <int NC>
+static __device__ __forceinline__ uint2 node_at(const Scene &s, unsigned i, bool *tex) {
+  if ((NC == 1 && i < NC1_NODES) || (NC == 2 && i < NC2_NODES)) {
+    *tex = false;
+    return node_cache[i];
+  }
+  *tex = true;
   const unsigned *w = (const unsigned *)(s.nodes + i);
   uint2 n;
   n.x = __ldg(w);
@@ -113,7 +128,8 @@ static __device__ __forceinline__ int visit_leaf(const Scene &s, uint2 n, V3 o, 
 }
 
 // Returns the nearest (or, with `any`, the first) hit in (t_min, t_max); -1 for none.
-template <int V>
+// V: traversal variant; NC: node cache (0, I, II); SC: stack cache (0, I, II) of the stack variant.
+template <int V, int NC = 0, int SC = 0>
 static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out, Stats &st,
                             float *short_stack) {
   st.rays++;
@@ -129,14 +145,21 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
   if (!(ta <= tb)) return -1;
   float t_hit = t_max;
   if (V == STACK) {
-    // Stack-based traversal (seed extract §4.4); 8-byte entries in local memory.
+    // Stack-based traversal (seed extract §4.4); 8-byte entries in local memory,
+    // with the stack caches of §4.3.2 (Alg. 4.3-4.6).
     struct Entry { unsigned node; float tb; } stack[33];
     int size = 0;
+    unsigned head_node = 0;                           // stack cache I: the top entry in registers
+    float head_tb = 0.0f;
+    unsigned top1 = 0, top2 = 0;                      // stack cache II: 8-bit node indices of the top 8 levels
+    const float t_end = tb;                           // the ray's end, for stack cache II's clipping
     unsigned node = 0;
     for (;;) {
-      uint2 n = node_at(s, node);
+      bool tex;
+      uint2 n = node_at<NC>(s, node, &tex);
       while ((n.y & 3) != 3) {                        // inner node: one traversal step
         st.inner++;
+        if (tex) st.tex_nodes++;
         int k = n.y & 3;
         float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);
         unsigned left = 2 * (n.y >> 2) + 1, right = left + 1;
@@ -147,24 +170,62 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
         } else if (ts < ta) {
           node = far;
         } else {
-          stack[size].node = far;                     // push the far child and the end of its interval
-          stack[size].tb = tb;
-          size++;
+          if (SC == 1) {                              // Alg. 4.3
+            if (head_node > 0) {
+              stack[size].node = head_node;
+              stack[size].tb = head_tb;
+              size++;
+              st.local_stack++;
+            }
+            head_node = far;
+            head_tb = tb;
+          } else if (SC == 2 && far < NC2_NODES) {    // Alg. 4.5 lines 1-6
+            if (top1 < (1u << 24)) top1 = (top1 << 8) | far;
+            else top2 = (top2 << 8) | far;
+          } else {                                    // push the far child and the end of its interval
+            stack[size].node = far;
+            stack[size].tb = tb;
+            size++;
+            st.local_stack++;
+          }
           tb = ts;
           node = near;
         }
-        n = node_at(s, node);
+        n = node_at<NC>(s, node, &tex);
       }
       int h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);
       if (h >= 0) {
         *t_out = t_hit;
         return h;
       }
-      if (size == 0) return -1;                       // an empty stack: the ray misses
-      size--;
-      ta = tb;                                        // the start is the previous end
-      tb = stack[size].tb;
-      node = stack[size].node;
+      if (SC == 1 && head_node > 0) {                 // Alg. 4.4
+        ta = tb;
+        node = head_node;
+        tb = head_tb;
+        head_node = 0;
+      } else if (size > 0) {
+        size--;
+        st.local_stack++;
+        ta = tb;                                      // the start is the previous end
+        tb = stack[size].tb;
+        node = stack[size].node;
+      } else if (SC == 2 && (top1 > 0 || top2 > 0)) { // Alg. 4.6 lines 4-12
+        if (top2 > 0) {
+          node = top2 & 255;
+          top2 >>= 8;
+        } else {
+          node = top1 & 255;
+          top1 >>= 8;
+        }
+        ta = tb;                                      // [t_a, t_b] <- [t_b, t_max] clipped by AABB(node)
+        const float *bx = aabb_cache + 6 * node;
+        float fx = fmaxf((bx[0] - o.x) * inv.x, (bx[3] - o.x) * inv.x);
+        float fy = fmaxf((bx[1] - o.y) * inv.y, (bx[4] - o.y) * inv.y);
+        float fz = fmaxf((bx[2] - o.z) * inv.z, (bx[5] - o.z) * inv.z);
+        tb = fminf(t_end, fminf(fminf(fx, fy), fz));
+      } else {
+        return -1;                                    // empty stacks: the ray misses
+      }
     }
   } else {
     // Alg. 4.2 (Alg. 4.1 when neither extension is on), errata fixed.
@@ -191,9 +252,11 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
         flag = restart_flag;
         push = true;
       }
-      uint2 n = node_at(s, node);
+      bool tex;
+      uint2 n = node_at<NC>(s, node, &tex);
       while ((n.y & 3) != 3) {                        // line 17
         st.inner++;
+        if (tex) st.tex_nodes++;
         int k = n.y & 3;
         float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);
         unsigned left = 2 * (n.y >> 2) + 1, right = left + 1;
@@ -228,7 +291,7 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
           node = near;
         }
         flag >>= 1;                                   // line 41
-        n = node_at(s, node);
+        n = node_at<NC>(s, node, &tex);
       }
       flags += flag << 1;                             // line 43: ripple the carry
       int h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);  // line 44
@@ -254,7 +317,7 @@ static __device__ V3 normal_of(const Scene &s, unsigned t, V3 d) {
 }
 
 // Emission plus diffuse direct light from the point light (one shadow ray).
-template <int V>
+template <int V, int NC, int SC>
 static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, Stats &st, float *ss) {
   unsigned m = __ldg(s.tri_mat + tri);
   const float *mat = (const float *)(s.mats + 2 * m);
@@ -272,7 +335,7 @@ static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, S
     float cos = dot3(n, dir);
     if (cos > 0.0f) {
       float ts;
-      if (trace<V>(s, pt, dir, p->eps, dist - p->eps, true, &ts, st, ss) < 0) {
+      if (trace<V, NC, SC>(s, pt, dir, p->eps, dist - p->eps, true, &ts, st, ss) < 0) {
         float g = cos / (dist * dist) / 3.14159265358979323846f;
         c.x += col.x * p->light_int[0] * g;
         c.y += col.y * p->light_int[1] * g;
@@ -286,11 +349,29 @@ static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, S
   return c;
 }
 
-template <int V>
+template <int V, int NC, int SC>
 static __device__ void render(const Params *p, const uint2 *nodes, const unsigned *refs, const float4 *tris,
-                              const unsigned *tri_mat, const float4 *mats, unsigned *next, float4 *color,
-                              int *hit_tri, unsigned *stats) {
-  Scene s = {p, nodes, refs, tris, tri_mat, mats};
+                              const unsigned *tri_mat, const float4 *mats, const float *aabbs, unsigned *next,
+                              float4 *color, int *hit_tri, unsigned *stats) {
+  Scene s = {p, nodes, refs, tris, tri_mat, mats, aabbs};
+  if (NC == 1) {
+    // every thread preloads 4 nodes of the top 10 levels, then the CTA synchronises
+    for (int i = threadIdx.x; i < NC1_NODES; i += CTA_THREADS) {
+      const unsigned *w = (const unsigned *)(nodes + i);
+      node_cache[i].x = __ldg(w);
+      node_cache[i].y = __ldg(w + 1);
+    }
+    __syncthreads();
+  } else if (NC == 2) {
+    // every thread preloads one node of the top 8 levels and its AABB
+    for (int i = threadIdx.x; i < NC2_NODES; i += CTA_THREADS) {
+      const unsigned *w = (const unsigned *)(nodes + i);
+      node_cache[i].x = __ldg(w);
+      node_cache[i].y = __ldg(w + 1);
+      for (int j = 0; j < 6; j++) aabb_cache[6 * i + j] = __ldg(aabbs + 6 * i + j);
+    }
+    __syncthreads();
+  }
   float *ss = short_stacks + threadIdx.x;
   int lane = threadIdx.x & 31;
   for (;;) {
@@ -302,7 +383,7 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     int pix = (int)base + lane;
     if (pix >= p->num_pixels) continue;
     int x = pix % p->width, y = pix / p->width;
-    Stats st = {0, 0, 0, 0, 0};
+    Stats st = {0, 0, 0, 0, 0, 0, 0};
     float px = (((float)x + 0.5f) / (float)p->width * 2.0f - 1.0f) * p->tan_half * p->aspect;
     float py = (1.0f - ((float)y + 0.5f) / (float)p->height * 2.0f) * p->tan_half;
     V3 o = v3(p->cam_pos[0], p->cam_pos[1], p->cam_pos[2]);
@@ -310,10 +391,10 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
                          p->cam_fwd[1] + px * p->cam_right[1] + py * p->cam_up[1],
                          p->cam_fwd[2] + px * p->cam_right[2] + py * p->cam_up[2]));
     float t;
-    int h = trace<V>(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t, st, ss);   // the primary ray
+    int h = trace<V, NC, SC>(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t, st, ss);   // the primary ray
     V3 c = v3(0.0f, 0.0f, 0.0f);
     if (h >= 0) {
-      c = direct<V>(s, o, d, t, (unsigned)h, st, ss);
+      c = direct<V, NC, SC>(s, o, d, t, (unsigned)h, st, ss);
       unsigned m = __ldg(tri_mat + h);
       if (__ldg((const float *)(mats + 2 * m) + 3) == 1.0f) {                         // a mirror: reflect
         V3 n = normal_of(s, (unsigned)h, d);
@@ -321,9 +402,9 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
         float s2 = 2.0f * dot3(d, n);
         V3 r = normalize3(v3(d.x - s2 * n.x, d.y - s2 * n.y, d.z - s2 * n.z));
         float t2;
-        int h2 = trace<V>(s, pt, r, p->eps, __int_as_float(0x7f800000), false, &t2, st, ss);
+        int h2 = trace<V, NC, SC>(s, pt, r, p->eps, __int_as_float(0x7f800000), false, &t2, st, ss);
         if (h2 >= 0) {
-          V3 c2 = direct<V>(s, pt, r, t2, (unsigned)h2, st, ss);
+          V3 c2 = direct<V, NC, SC>(s, pt, r, t2, (unsigned)h2, st, ss);
           const float *mat = (const float *)(mats + 2 * m);
           c.x += __ldg(mat) * c2.x;
           c.y += __ldg(mat + 1) * c2.y;
@@ -339,17 +420,25 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     sp[2] = st.planes;
     sp[3] = st.barys;
     sp[4] = st.rays;
+    sp[5] = st.tex_nodes;
+    sp[6] = st.local_stack;
   }
 }
 
-#define ENTRY(name, V)                                                                                     \
+#define ENTRY(name, V, NC, SC)                                                                             \
   extern "C" __global__ void name(const Params *p, const uint2 *nodes, const unsigned *refs,               \
                                   const float4 *tris, const unsigned *tri_mat, const float4 *mats,         \
-                                  unsigned *next, float4 *color, int *hit_tri, unsigned *stats) {          \
-    render<V>(p, nodes, refs, tris, tri_mat, mats, next, color, hit_tri, stats);                         \
+                                  const float *aabbs, unsigned *next, float4 *color, int *hit_tri,         \
+                                  unsigned *stats) {                                                       \
+    render<V, NC, SC>(p, nodes, refs, tris, tri_mat, mats, aabbs, next, color, hit_tri, stats);          \
   }
-ENTRY(trace_stack, STACK)
-ENTRY(trace_stackless, STACKLESS)
-ENTRY(trace_pushdown, PUSHDOWN)
-ENTRY(trace_shortstack, SHORTSTACK)
-ENTRY(trace_pushdown_shortstack, PUSHDOWN_SHORTSTACK)
+ENTRY(trace_stack, STACK, 0, 0)
+ENTRY(trace_stackless, STACKLESS, 0, 0)
+ENTRY(trace_pushdown, PUSHDOWN, 0, 0)
+ENTRY(trace_shortstack, SHORTSTACK, 0, 0)
+ENTRY(trace_pushdown_shortstack, PUSHDOWN_SHORTSTACK, 0, 0)
+// Table 4.8's cache columns (stack cache III is not implemented yet)
+ENTRY(trace_nc1, STACK, 1, 0)
+ENTRY(trace_sc1, STACK, 0, 1)
+ENTRY(trace_nc1_sc1, STACK, 1, 1)
+ENTRY(trace_nc2_sc2, STACK, 2, 2)

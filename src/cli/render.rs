@@ -26,7 +26,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub resolution: Option<String>,
     /// Renderer: `native` (the Rust reference ray caster), or a kernel variant run
-    /// on the emulator: stack, stackless, push-down, short-stack, push-down+short-stack.
+    /// on the emulator: stack, stackless, push-down, short-stack, push-down+short-stack,
+    /// node-cache-1, stack-cache-1, node-cache-1+stack-cache-1, node-cache-2+stack-cache-2.
     #[arg(long, default_value = "native")]
     pub variant: String,
     /// Device profile of the emulated kernels' memory counters: gt200, maxwell, hopper.
@@ -51,7 +52,7 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let kernel_variant = match a.variant.as_str() {
         "native" => None,
         v => Some(Variant::parse(v).ok_or_else(|| {
-            let names: Vec<&str> = Variant::ALL.iter().map(|v| v.name()).collect();
+            let names: Vec<&str> = Variant::EVERY.iter().map(|v| v.name()).collect();
             format!("unknown variant `{v}`; expected native, {}", names.join(", "))
         })?),
     };

@@ -63,6 +63,10 @@ pub struct TraceStats {
     pub barycentric_tests: u64,
     /// Stack pushes.
     pub pushes: u64,
+    /// Inner-node fetches through the texture path (kernels; node-cache hits excluded).
+    pub tex_node_fetches: u64,
+    /// Pushes and pops that touched the local-memory stack (kernels; register-cached entries excluded).
+    pub local_stack_accesses: u64,
 }
 
 impl TraceStats {
@@ -77,6 +81,8 @@ impl TraceStats {
         self.plane_tests += o.plane_tests;
         self.barycentric_tests += o.barycentric_tests;
         self.pushes += o.pushes;
+        self.tex_node_fetches += o.tex_node_fetches;
+        self.local_stack_accesses += o.local_stack_accesses;
     }
 }
 

@@ -28,12 +28,51 @@ pub enum Variant {
     ShortStack,
     /// Alg. 4.2 with both.
     PushDownShortStack,
+    /// Stack-based with node cache I (top 10 levels in shared memory).
+    NodeCache1,
+    /// Stack-based with stack cache I (the top entry in registers).
+    StackCache1,
+    /// Node cache I and stack cache I.
+    NodeCache1StackCache1,
+    /// Node cache II (top 8 levels with AABBs) and stack cache II (their indices in two registers).
+    NodeCache2StackCache2,
 }
 
 impl Variant {
-    /// All variants.
+    /// The traversal variants of §4.2 (Tables 4.5-4.7).
     pub const ALL: [Variant; 5] =
         [Variant::Stack, Variant::Stackless, Variant::PushDown, Variant::ShortStack, Variant::PushDownShortStack];
+
+    /// The cache variants of §4.3 implemented so far (Table 4.8 columns 1, 2, 3, 5, 6).
+    pub const CACHES: [Variant; 5] = [
+        Variant::Stack,
+        Variant::NodeCache1,
+        Variant::StackCache1,
+        Variant::NodeCache1StackCache1,
+        Variant::NodeCache2StackCache2,
+    ];
+
+    /// Every variant.
+    pub const EVERY: [Variant; 9] = [
+        Variant::Stack,
+        Variant::Stackless,
+        Variant::PushDown,
+        Variant::ShortStack,
+        Variant::PushDownShortStack,
+        Variant::NodeCache1,
+        Variant::StackCache1,
+        Variant::NodeCache1StackCache1,
+        Variant::NodeCache2StackCache2,
+    ];
+
+    /// Levels of the tree top laid out in heap order for this variant's node cache.
+    pub fn heap_levels(self) -> u32 {
+        match self {
+            Variant::NodeCache1 | Variant::NodeCache1StackCache1 => 10,
+            Variant::NodeCache2StackCache2 => 8,
+            _ => 0,
+        }
+    }
 
     /// The kernel's entry point.
     pub fn kernel(self) -> &'static str {
@@ -43,6 +82,10 @@ impl Variant {
             Variant::PushDown => "trace_pushdown",
             Variant::ShortStack => "trace_shortstack",
             Variant::PushDownShortStack => "trace_pushdown_shortstack",
+            Variant::NodeCache1 => "trace_nc1",
+            Variant::StackCache1 => "trace_sc1",
+            Variant::NodeCache1StackCache1 => "trace_nc1_sc1",
+            Variant::NodeCache2StackCache2 => "trace_nc2_sc2",
         }
     }
 
@@ -54,12 +97,16 @@ impl Variant {
             Variant::PushDown => "push-down",
             Variant::ShortStack => "short-stack",
             Variant::PushDownShortStack => "push-down+short-stack",
+            Variant::NodeCache1 => "node-cache-1",
+            Variant::StackCache1 => "stack-cache-1",
+            Variant::NodeCache1StackCache1 => "node-cache-1+stack-cache-1",
+            Variant::NodeCache2StackCache2 => "node-cache-2+stack-cache-2",
         }
     }
 
     /// Parses a command-line name.
     pub fn parse(s: &str) -> Option<Variant> {
-        Variant::ALL.into_iter().find(|v| v.name() == s)
+        Variant::EVERY.into_iter().find(|v| v.name() == s)
     }
 }
 
@@ -103,7 +150,7 @@ pub fn render(
     profile: Profile,
 ) -> Result<KernelRender, SimError> {
     let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let lay = layout(tree, &tris, 0);
+    let lay = layout(tree, &tris, variant.heap_levels());
     let (r, u, f) = camera.frame();
     let [w, h] = camera.resolution;
     let npix = (w * h) as usize;
@@ -177,12 +224,13 @@ pub fn render(
     let tb = up(dev, &lay.triangles, "triangles")?;
     let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
     let mb = up(dev, &f32s(&mats), "materials")?;
+    let ab = up(dev, &lay.aabbs, "aabbs")?;
     let next = dev.alloc_zeroed::<u32>(1);
     let color = dev.alloc_zeroed::<f32>(4 * npix);
     let hit = dev.alloc_zeroed::<i32>(npix);
     let stats = dev.alloc_zeroed::<u32>(8 * npix);
     let model = Model::new(profile, &module.prog);
-    let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, next, color, hit, stats].into_iter().map(Arg::Ptr).collect();
+    let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, ab, next, color, hit, stats].into_iter().map(Arg::Ptr).collect();
     let launch =
         dev.launch_observed(module, variant.kernel(), LaunchConfig::linear(CTAS, THREADS), &args, Some(&model))?;
     let rgba = dev.read::<f32>(color, 4 * npix);
@@ -198,6 +246,8 @@ pub fn render(
         trace.plane_tests += s[2] as u64;
         trace.barycentric_tests += s[3] as u64;
         trace.rays += s[4] as u64;
+        trace.tex_node_fetches += s[5] as u64;
+        trace.local_stack_accesses += s[6] as u64;
     }
     trace.primary = npix as u64;
     Ok(KernelRender { image, hit_tri: dev.read::<i32>(hit, npix), trace, launch, memory: model.finish() })

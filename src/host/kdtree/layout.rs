@@ -95,7 +95,8 @@ pub fn layout(tree: &KdTree, tris: &[[Vec3; 3]], heap_levels: u32) -> DeviceTree
         }
     }
     let len = pos.iter().copied().max().unwrap_or(0) as usize + 1;
-    let mut nodes = vec![0u8; len.max(heap_nodes as usize) * NODE_BYTES];
+    // the padded top spans 2^levels slots, so a cache preload of 2^levels nodes stays in bounds
+    let mut nodes = vec![0u8; len.max(heap_nodes as usize + (heap_levels > 0) as usize) * NODE_BYTES];
     for (i, n) in tree.nodes.iter().enumerate() {
         let (w0, w1) = match *n {
             Node::Inner { axis, split, .. } => (split.to_bits(), pairs[i] << 2 | axis as u32),
@@ -106,7 +107,7 @@ pub fn layout(tree: &KdTree, tris: &[[Vec3; 3]], heap_levels: u32) -> DeviceTree
         nodes[at + 4..at + 8].copy_from_slice(&w1.to_le_bytes());
     }
     // AABBs of heap nodes
-    let mut aabbs = vec![0u8; heap_nodes as usize * 24];
+    let mut aabbs = vec![0u8; (heap_nodes as usize + (heap_levels > 0) as usize) * 24];
     let mut stack = vec![(0u32, tree.bounds)];
     while let Some((n, b)) = stack.pop() {
         let p = pos[n as usize] as usize;
