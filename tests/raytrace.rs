@@ -64,17 +64,18 @@ fn every_variant_matches_the_native_caster() {
 
 #[test]
 fn tables_4_5_and_4_7_on_a_small_flight() {
-    use warplight::repro::tables_4_5_4_7::{TABLE_4_5, markdown, measure};
+    use warplight::repro::flight_tables::{TABLE_4_5, markdown, measure};
     let scene = scene_file::load(Path::new("scenes/scene6.toml")).unwrap();
     let mut ticks = 0;
-    let r = measure(&scene, 2, 16, |_, _| ticks += 1).unwrap();
+    let r = measure(&scene, 2, 16, &Variant::ALL, |_, _| ticks += 1).unwrap();
     assert_eq!(ticks, 2 * 5);
-    let [stack, stackless, pushdown, short, both] = r.inner_per_ray;
+    let inner = r.inner_per_ray();
+    let (stack, stackless, pushdown, short, both) = (inner[0], inner[1], inner[2], inner[3], inner[4]);
     // restarts add node visits; push-down saves some of them; a short stack almost all
-    assert!(stackless > pushdown && pushdown > stack, "{:?}", r.inner_per_ray);
-    assert!(short >= stack && short < stack * 1.1 && both <= short, "{:?}", r.inner_per_ray);
-    assert!(r.instr_per_ray.iter().all(|&x| x > 100.0));
-    let md = markdown("t", &TABLE_4_5, &[r], |r| r.inner_per_ray);
+    assert!(stackless > pushdown && pushdown > stack, "{inner:?}");
+    assert!(short >= stack && short < stack * 1.1 && both <= short, "{inner:?}");
+    assert!(r.instr_per_ray().iter().all(|&x| x > 100.0));
+    let md = markdown("t", &TABLE_4_5, &[r], |r| r.inner_per_ray());
     assert!(md.contains("| scene6 |") && md.contains("+35.7%") && md.contains("Std. Dev."), "{md}");
 }
 
@@ -166,4 +167,25 @@ fn stackless_variants_survive_degenerate_geometry() {
             }
         }
     }
+}
+
+#[test]
+fn caches_cut_texture_fetches_and_local_stack_accesses() {
+    use warplight::repro::flight_tables::measure;
+    let scene = scene_file::load(Path::new("scenes/sponza.toml")).unwrap();
+    let r = measure(&scene, 1, 16, &Variant::CACHES, |_, _| {}).unwrap();
+    let tex = r.per_ray(|t| t.tex_node_fetches);
+    let local = r.per_ray(|t| t.local_stack_accesses);
+    let inner = r.inner_per_ray();
+    // baseline: every inner node is one texture fetch (Table 4.8 (a) column 1 = Table 4.5's n_T)
+    assert!((tex[0] - inner[0]).abs() < 1e-9);
+    // node cache I serves the top 10 levels; stack caches leave texture fetches alone
+    assert!(tex[1] < 0.8 * tex[0] && (tex[2] - tex[0]).abs() < 1e-9 && (tex[3] - tex[1]).abs() < 1e-9, "{tex:?}");
+    // stack cache I keeps the top entry in registers; node caches leave the stack alone
+    assert!(
+        local[2] < 0.8 * local[0] && (local[1] - local[0]).abs() < 1e-9 && (local[3] - local[2]).abs() < 1e-9,
+        "{local:?}"
+    );
+    // node cache II + stack cache II: fewer of both than the baseline
+    assert!(tex[4] < tex[0] && local[4] < local[0], "{tex:?} {local:?}");
 }

@@ -3,14 +3,15 @@
 use std::io::IsTerminal;
 
 use super::scene_info::scene_path;
+use crate::host::rt_kernels::Variant;
 use crate::host::scene::Scene;
 use crate::host::scene_file;
-use crate::repro::{table_4_3, table_4_4, tables_4_5_4_7};
+use crate::repro::{flight_tables, table_4_3, table_4_4};
 
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
 pub struct TablesArgs {
-    /// Tables to reproduce: 4.3, 4.4, 4.5, 4.7, or all.
+    /// Tables to reproduce: 4.3, 4.4, 4.5, 4.7, 4.8, 4.9, or all.
     pub tables: Vec<String>,
     /// Frames of each camera flight (the thesis: 50).
     #[arg(long, default_value_t = 50)]
@@ -34,27 +35,33 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.tables.is_empty() {
         return Err("name a table: 4.4".into());
     }
-    let mut flights: Option<Vec<tables_4_5_4_7::SceneRun>> = None;
-    for t in &a.tables {
-        match t.as_str() {
+    let (mut traversal, mut caches) = (None, None);
+    let tables: Vec<&str> = if a.tables.iter().any(|t| t == "all") {
+        vec!["4.3", "4.4", "4.5", "4.7", "4.8", "4.9"]
+    } else {
+        a.tables.iter().map(|t| t.as_str()).collect()
+    };
+    for t in tables {
+        match t {
             "4.3" => table_4_3(&a)?,
             "4.4" => table_4_4(&a)?,
             "4.5" | "4.7" => {
-                if flights.is_none() {
-                    flights = Some(flight_runs(&a)?);
+                if traversal.is_none() {
+                    traversal = Some(flight_runs(&a, &Variant::ALL)?);
                 }
-                let runs = flights.as_ref().expect("measured");
-                print_4_5_4_7(t, runs, &a);
+                print_flight_table(t, traversal.as_ref().expect("measured"), &a);
             }
-            "all" => {
-                table_4_3(&a)?;
-                table_4_4(&a)?;
-                let runs = flight_runs(&a)?;
-                print_4_5_4_7("4.5", &runs, &a);
-                print_4_5_4_7("4.7", &runs, &a);
+            "4.8" | "4.9" => {
+                if caches.is_none() {
+                    caches = Some(flight_runs(&a, &Variant::CACHES)?);
+                }
+                print_flight_table(t, caches.as_ref().expect("measured"), &a);
             }
             other => {
-                return Err(format!("table {other} is not reproduced yet; available: 4.3, 4.4, 4.5, 4.7, all").into());
+                return Err(format!(
+                    "table {other} is not reproduced yet; available: 4.3, 4.4, 4.5, 4.7, 4.8, 4.9, all"
+                )
+                .into());
             }
         }
     }
@@ -117,9 +124,12 @@ fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-fn flight_runs(a: &TablesArgs) -> Result<Vec<tables_4_5_4_7::SceneRun>, Box<dyn std::error::Error>> {
+fn flight_runs(
+    a: &TablesArgs,
+    variants: &[Variant],
+) -> Result<Vec<flight_tables::SceneRun>, Box<dyn std::error::Error>> {
     let names: Vec<String> = if a.scenes.is_empty() {
-        tables_4_5_4_7::TABLE_4_5.iter().map(|r| r.0.to_string()).collect()
+        flight_tables::TABLE_4_5.iter().map(|r| r.0.to_string()).collect()
     } else {
         a.scenes.clone()
     };
@@ -130,7 +140,7 @@ fn flight_runs(a: &TablesArgs) -> Result<Vec<tables_4_5_4_7::SceneRun>, Box<dyn 
             Err(e) => eprintln!("skipped {n}: {e}"),
         }
     }
-    let total: u64 = scenes.iter().map(|s| a.frames.min(s.flight.frames) as u64 * 5).sum();
+    let total: u64 = scenes.iter().map(|s| (a.frames.min(s.flight.frames) as usize * variants.len()) as u64).sum();
     let pb = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new(total);
         pb.set_style(
@@ -143,7 +153,7 @@ fn flight_runs(a: &TablesArgs) -> Result<Vec<tables_4_5_4_7::SceneRun>, Box<dyn 
     });
     let mut runs = Vec::new();
     for s in &scenes {
-        let r = tables_4_5_4_7::measure(s, a.frames, a.resolution, |f, v| {
+        let r = flight_tables::measure(s, a.frames, a.resolution, variants, |f, v| {
             if let Some(pb) = &pb {
                 pb.set_message(format!("{} frame {f} {}", s.name, v.name()));
                 pb.inc(1);
@@ -157,25 +167,59 @@ fn flight_runs(a: &TablesArgs) -> Result<Vec<tables_4_5_4_7::SceneRun>, Box<dyn 
     Ok(runs)
 }
 
-fn print_4_5_4_7(t: &str, runs: &[tables_4_5_4_7::SceneRun], a: &TablesArgs) {
+fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs) {
+    use flight_tables as ft;
     if a.format == "json" {
         println!("{}", serde_json::to_string_pretty(runs).unwrap_or_default());
         return;
     }
-    let md = if t == "4.5" {
-        tables_4_5_4_7::markdown(
+    let md = match t {
+        "4.5" => ft::markdown(
             "Table 4.5: inner node traversals per ray, stackless variants relative to stack-based (thesis 000, seed L1878-1888)",
-            &tables_4_5_4_7::TABLE_4_5,
+            &ft::TABLE_4_5,
             runs,
-            |r| r.inner_per_ray,
-        )
-    } else {
-        tables_4_5_4_7::markdown(
+            |r| r.inner_per_ray(),
+        ),
+        "4.7" => ft::markdown(
             "Table 4.7: instructions per ray (warp instructions x 32 / rays), relative to stack-based (thesis 000, seed L1914-1924)",
-            &tables_4_5_4_7::TABLE_4_7,
+            &ft::TABLE_4_7,
             runs,
-            |r| r.instr_per_ray,
-        )
+            |r| r.instr_per_ray(),
+        ),
+        "4.9" => ft::markdown(
+            "Table 4.9: instructions per ray with explicitly managed caches, relative to the baseline (thesis 000, seed L2123-2134; columns 1, 2, 3, 5, 6)",
+            &ft::TABLE_4_9,
+            runs,
+            |r| r.instr_per_ray(),
+        ),
+        _ => {
+            let a_ = ft::markdown(
+                "Table 4.8 (a): inner nodes loaded through the texturing unit per ray (thesis 000, seed L2066-2119; columns 1, 2, 3, 5, 6)",
+                &ft::TABLE_4_8A,
+                runs,
+                |r| r.per_ray(|t| t.tex_node_fetches),
+            );
+            let b_ = ft::markdown(
+                "Table 4.8 (b): stack entries accessed in local memory per ray",
+                &ft::TABLE_4_8B,
+                runs,
+                |r| r.per_ray(|t| t.local_stack_accesses),
+            );
+            let c_ = ft::markdown_with(
+                "Table 4.8 (c): texture cache hit ratios, % (gt200 profile: an 8 KB cache per CTA; differences in percentage points)",
+                &ft::TABLE_4_8C,
+                runs,
+                |r| r.totals.iter().map(|t| t.tex_hits as f64 * 100.0 / t.tex_lookups.max(1) as f64).collect(),
+                true,
+            );
+            let d_ = ft::markdown(
+                "Table 4.8 (d): global memory bytes per ray, 8 x ((a) + (b))",
+                &ft::TABLE_4_8D,
+                runs,
+                |r| r.per_ray(|t| 8 * (t.tex_node_fetches + t.local_stack_accesses)),
+            );
+            format!("{a_}\n{b_}\n{c_}\n{d_}")
+        }
     };
     println!("{md}");
     println!(

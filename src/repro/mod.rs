@@ -2,6 +2,6 @@
 //! numbers (with their seed line numbers), the runs that measure ours, and the
 //! side-by-side output.
 
+pub mod flight_tables;
 pub mod table_4_3;
 pub mod table_4_4;
-pub mod tables_4_5_4_7;
