@@ -33,8 +33,47 @@ fn report() {
     }
 }
 
+/// Emulated rays per second of the kernel variants beside the native caster (same scene, same view).
+fn report_emulated() {
+    use warplight::host::rt_kernels::{self, Variant};
+    eprintln!("\n{:<10} {:<28} {:>14}", "scene", "renderer (64x64)", "rays/s");
+    for name in ["scene6", "sponza"] {
+        let s = scene_file::load(Path::new(&format!("scenes/{name}.toml"))).expect("scene");
+        let tris: Vec<[glam::Vec3; 3]> = s.triangles.iter().map(|t| t.v).collect();
+        let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+        let mut cam = s.camera;
+        cam.resolution = [64, 64];
+        let caster = Caster::new(&s, &tree);
+        let t0 = Instant::now();
+        let (_, st) = render(&caster, &cam, glam::Vec3::ZERO);
+        eprintln!("{name:<10} {:<28} {:>14.0}", "native", st.rays as f64 / t0.elapsed().as_secs_f64());
+        for v in [Variant::Stack, Variant::Stackless, Variant::ShortStack, Variant::NodeCache1StackCache1] {
+            let mut dev = warplight::sim::Device::new();
+            let module = rt_kernels::load(&mut dev).expect("kernels");
+            let t0 = Instant::now();
+            let k = rt_kernels::render(
+                &mut dev,
+                &module,
+                &s,
+                &tree,
+                &cam,
+                glam::Vec3::ZERO,
+                v,
+                warplight::model::Profile::Gt200,
+            )
+            .expect("render");
+            eprintln!(
+                "{name:<10} {:<28} {:>14.0}",
+                format!("emulated {}", v.name()),
+                k.trace.rays as f64 / t0.elapsed().as_secs_f64()
+            );
+        }
+    }
+}
+
 fn bench(c: &mut Criterion) {
     report();
+    report_emulated();
     let mut g = c.benchmark_group("host");
     g.sample_size(10);
     for name in ["scene6", "sponza"] {

@@ -189,3 +189,33 @@ fn caches_cut_texture_fetches_and_local_stack_accesses() {
     // node cache II + stack cache II: fewer of both than the baseline
     assert!(tex[4] < tex[0] && local[4] < local[0], "{tex:?} {local:?}");
 }
+
+#[test]
+fn emulated_renders_match_the_reference_images() {
+    use warplight::host::image::FrameBuffer;
+    for name in ["scene6", "cornell-box"] {
+        let scene = scene_file::load(Path::new(&format!("scenes/{name}.toml"))).unwrap();
+        let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+        // the reference images were rendered with SAH trees by the native caster
+        let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+        let mut cam = scene.flight.camera(&scene.camera, 0);
+        cam.resolution = [96, 96];
+        let mut dev = Device::new();
+        let module = rt_kernels::load(&mut dev).unwrap();
+        let k = rt_kernels::render(
+            &mut dev,
+            &module,
+            &scene,
+            &tree,
+            &cam,
+            glam::Vec3::ZERO,
+            Variant::Stackless,
+            Profile::Gt200,
+        )
+        .unwrap();
+        let want = FrameBuffer::read_png(Path::new(&format!("reference_images/{name}.png"))).unwrap().to_srgb8(0.0);
+        let got = k.image.to_srgb8(0.0);
+        let worst = got.iter().zip(&want).map(|(a, b)| (*a as i32 - *b as i32).abs()).max().unwrap();
+        assert!(worst <= 1, "{name}: the emulated render differs by {worst} steps");
+    }
+}
