@@ -98,6 +98,7 @@ impl Cta {
                     state: WarpState::Ready,
                     local: Vec::new(),
                     local_top: f.local_size,
+                    frame_pool: Vec::new(),
                 };
                 warp.ensure_local(f.local_size);
                 warp

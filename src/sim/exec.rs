@@ -543,8 +543,11 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             if need > ctx.local_limit as u64 {
                 return Err(fault(FaultKind::LocalStackOverflow { needed: need, limit: ctx.local_limit as u64 }, None));
             }
-            let mut nf = Frame::new(*callee, cf, lb, w.stack.entries.len(), pc);
-            let ps_c = caller.param_size as usize;
+            let (caller_func, caller_ps) = (caller.func, caller.param_size);
+            let mut nf = w.take_frame(*callee, cf, lb, w.stack.entries.len(), pc);
+            let caller = w.frames.last().expect("caller");
+            debug_assert_eq!(caller.func, caller_func);
+            let ps_c = caller_ps as usize;
             let ps_n = nf.param_size as usize;
             for l in 0..32 {
                 if exec >> l & 1 == 0 {
@@ -935,7 +938,8 @@ fn atomic(
 /// Pops callee frames whose paths are all gone (their lanes exited).
 fn pop_empty_frames(ctx: &Ctx, w: &mut Warp) {
     while w.frames.len() > 1 && w.stack.entries.len() <= w.frame().stack_base {
-        w.frames.pop();
+        let done = w.frames.pop().expect("callee frame");
+        w.recycle(done);
         let f = w.frame();
         w.local_top = f.local_base + ctx.prog.functions[f.func as usize].local_size;
     }
@@ -961,6 +965,7 @@ fn return_from_call(ctx: &Ctx, w: &mut Warp) {
     }
     let cf = &ctx.prog.functions[caller.func as usize];
     w.local_top = caller.local_base + cf.local_size;
+    w.recycle(callee);
 }
 
 /// Applies a CTA's pending global atomics in order and wakes the waiting warps.

@@ -84,9 +84,34 @@ pub struct Warp {
     pub local: Vec<u32>,
     /// Bytes of local memory in use per thread (top of the frame stack).
     pub local_top: u32,
+    /// Frames of returned calls, kept for reuse so that calls do not allocate.
+    pub frame_pool: Vec<Frame>,
 }
 
 impl Warp {
+    /// A frame for a call of `func`, reused from an earlier call when possible.
+    /// Registers keep stale values: PTX leaves them undefined at entry.
+    pub fn take_frame(&mut self, func: u32, f: &Function, local_base: u32, stack_base: usize, call_pc: u32) -> Frame {
+        match self.frame_pool.iter().rposition(|fr| fr.func == func) {
+            Some(i) => {
+                let mut fr = self.frame_pool.swap_remove(i);
+                fr.local_base = local_base;
+                fr.stack_base = stack_base;
+                fr.call_pc = call_pc;
+                fr.returned = 0;
+                fr
+            }
+            None => Frame::new(func, f, local_base, stack_base, call_pc),
+        }
+    }
+
+    /// Returns a finished frame to the pool.
+    pub fn recycle(&mut self, fr: Frame) {
+        if self.frame_pool.len() < 64 {
+            self.frame_pool.push(fr);
+        }
+    }
+
     /// The current frame.
     #[inline]
     pub fn frame(&self) -> &Frame {
