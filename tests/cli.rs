@@ -103,3 +103,19 @@ fn rand_suffix() -> u64 {
     static N: AtomicU64 = AtomicU64::new(0);
     N.fetch_add(1, Ordering::Relaxed)
 }
+
+#[test]
+fn step_logs_divergence_and_breakpoints() {
+    let (ok, out, err) = warplight(&["step", "examples/if_else.toml", "--trace"]);
+    assert!(ok, "{err}");
+    // the hand-derived counts of tests/control_flow.rs, seen instruction by instruction
+    assert!(out.contains("finished after 28 warp instructions"), "{out}");
+    assert!(out.contains("688 thread instructions, 1 divergent branches, 2 reconvergences"), "{out}");
+    assert!(out.contains("bra.uni                      mask aaaaaaaa (16 lanes)"), "{out}");
+    let (ok, out, _) = warplight(&["step", "examples/if_else.toml", "--break", "45", "--watch", "%r10"]);
+    assert!(ok);
+    assert!(out.contains("stack[1]: pc 13 rpc 25 mask 55555555"), "{out}");
+    assert!(out.contains("%r10 = 1:1 3:3 5:5"), "{out}");
+    let (ok, _, err) = warplight(&["step", "examples/if_else.toml", "--warp", "nonsense"]);
+    assert!(!ok && err.contains("expected SLOT:WARP"), "{err}");
+}

@@ -4,6 +4,7 @@ pub mod launch;
 pub mod ptx_info;
 pub mod render;
 pub mod scene_info;
+pub mod step;
 pub mod tables;
 
 use clap::{Parser, Subcommand};
@@ -32,6 +33,9 @@ pub enum Command {
     /// The spec names the PTX file, the kernel, grid and block, the buffers with
     /// their initial contents and the arguments; see `docs/launch-spec.md`.
     Launch(launch::LaunchArgs),
+    /// Step through a launch warp instruction by warp instruction: a log with the
+    /// SIMT stack and watched registers at breakpoints (`--break LINE --watch %r1`).
+    Step(step::StepArgs),
     /// List the kernels of a PTX file with their parameters and resources.
     Kernels {
         /// The PTX file.
@@ -89,6 +93,7 @@ pub fn main() -> i32 {
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
         Command::Tables(a) => tables::run(a),
         Command::Render(a) => render::run(a),
+        Command::Step(a) => step::run(a),
     };
     match r {
         Ok(()) => 0,
