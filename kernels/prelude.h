@@ -29,6 +29,7 @@ struct alignas(16) int4 { int x, y, z, w; };
 struct alignas(8) uint2 { unsigned x, y; };
 struct alignas(16) uint4 { unsigned x, y, z, w; };
 WL_DEV float2 make_float2(float x, float y) { return {x, y}; }
+WL_DEV uint2 make_uint2(unsigned x, unsigned y) { return {x, y}; }
 WL_DEV float4 make_float4(float x, float y, float z, float w) { return {x, y, z, w}; }
 
 // ---- warp votes and shuffles (vote.sync.*, shfl.sync.*) ----

@@ -128,7 +128,7 @@ static __device__ __forceinline__ int visit_leaf(const Scene &s, uint2 n, V3 o, 
 }
 
 // Returns the nearest (or, with `any`, the first) hit in (t_min, t_max); -1 for none.
-// V: traversal variant; NC: node cache (0, I, II); SC: stack cache (0, I, II) of the stack variant.
+// V: traversal variant; NC: node cache (0, I, II); SC: stack cache (0, I, II, III) of the stack variant.
 template <int V, int NC = 0, int SC = 0>
 static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out, Stats &st,
                             float *short_stack) {
@@ -153,6 +153,9 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
     float head_tb = 0.0f;
     unsigned top1 = 0, top2 = 0;                      // stack cache II: 8-bit node indices of the top 8 levels
     const float t_end = tb;                           // the ray's end, for stack cache II's clipping
+    bool postponed = false;                           // stack cache III: a leaf waiting for the next one
+    uint2 leaf = make_uint2(0, 0);
+    float leaf_ta = 0.0f;
     unsigned node = 0;
     for (;;) {
       bool tex;
@@ -193,7 +196,26 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
         }
         n = node_at<NC>(s, node, &tex);
       }
-      int h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);
+      int h;
+      if (SC == 3 && !postponed) {
+        // stack cache III: postpone this leaf and traverse on to the next one (§4.3.2.3)
+        postponed = true;
+        leaf = n;
+        leaf_ta = ta;
+        if (size == 0) {                              // no next leaf: visit the postponed one alone
+          h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);
+          if (h >= 0) *t_out = t_hit;
+          return h;
+        }
+        h = -1;
+      } else if (SC == 3) {
+        // visit the postponed leaf over [leaf.t_a, t_a], then this one over [t_a, t_b]
+        postponed = false;
+        h = visit_leaf(s, leaf, o, d, t_min, leaf_ta, ta, any, &t_hit, st);
+        if (h < 0) h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);
+      } else {
+        h = visit_leaf(s, n, o, d, t_min, ta, tb, any, &t_hit, st);
+      }
       if (h >= 0) {
         *t_out = t_hit;
         return h;
@@ -224,6 +246,11 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
         float fz = fmaxf((bx[2] - o.z) * inv.z, (bx[5] - o.z) * inv.z);
         tb = fminf(t_end, fminf(fminf(fx, fy), fz));
       } else {
+        if (SC == 3 && postponed) {                   // the stack ran out with a leaf postponed
+          h = visit_leaf(s, leaf, o, d, t_min, leaf_ta, tb, any, &t_hit, st);
+          if (h >= 0) *t_out = t_hit;
+          return h;
+        }
         return -1;                                    // empty stacks: the ray misses
       }
     }
@@ -437,8 +464,10 @@ ENTRY(trace_stackless, STACKLESS, 0, 0)
 ENTRY(trace_pushdown, PUSHDOWN, 0, 0)
 ENTRY(trace_shortstack, SHORTSTACK, 0, 0)
 ENTRY(trace_pushdown_shortstack, PUSHDOWN_SHORTSTACK, 0, 0)
-// Table 4.8's cache columns (stack cache III is not implemented yet)
+// Table 4.8's cache columns 2-7
 ENTRY(trace_nc1, STACK, 1, 0)
 ENTRY(trace_sc1, STACK, 0, 1)
+ENTRY(trace_sc3, STACK, 0, 3)
 ENTRY(trace_nc1_sc1, STACK, 1, 1)
 ENTRY(trace_nc2_sc2, STACK, 2, 2)
+ENTRY(trace_nc1_sc3, STACK, 1, 3)

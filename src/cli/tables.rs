@@ -187,14 +187,14 @@ fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs)
             |r| r.instr_per_ray(),
         ),
         "4.9" => ft::markdown(
-            "Table 4.9: instructions per ray with explicitly managed caches, relative to the baseline (thesis 000, seed L2123-2134; columns 1, 2, 3, 5, 6)",
+            "Table 4.9: instructions per ray with explicitly managed caches, relative to the baseline (thesis 000, seed L2123-2134)",
             &ft::TABLE_4_9,
             runs,
             |r| r.instr_per_ray(),
         ),
         _ => {
             let a_ = ft::markdown(
-                "Table 4.8 (a): inner nodes loaded through the texturing unit per ray (thesis 000, seed L2066-2119; columns 1, 2, 3, 5, 6)",
+                "Table 4.8 (a): inner nodes loaded through the texturing unit per ray (thesis 000, seed L2066-2119)",
                 &ft::TABLE_4_8A,
                 runs,
                 |r| r.per_ray(|t| t.tex_node_fetches),

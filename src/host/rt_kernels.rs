@@ -36,6 +36,10 @@ pub enum Variant {
     NodeCache1StackCache1,
     /// Node cache II (top 8 levels with AABBs) and stack cache II (their indices in two registers).
     NodeCache2StackCache2,
+    /// Stack cache III: speculative traversal, a leaf postponed until the next is found.
+    StackCache3,
+    /// Node cache I and stack cache III.
+    NodeCache1StackCache3,
 }
 
 impl Variant {
@@ -43,17 +47,19 @@ impl Variant {
     pub const ALL: [Variant; 5] =
         [Variant::Stack, Variant::Stackless, Variant::PushDown, Variant::ShortStack, Variant::PushDownShortStack];
 
-    /// The cache variants of §4.3 implemented so far (Table 4.8 columns 1, 2, 3, 5, 6).
-    pub const CACHES: [Variant; 5] = [
+    /// The cache variants of §4.3 in the order of Tables 4.8-4.10's columns 1-7.
+    pub const CACHES: [Variant; 7] = [
         Variant::Stack,
         Variant::NodeCache1,
         Variant::StackCache1,
+        Variant::StackCache3,
         Variant::NodeCache1StackCache1,
         Variant::NodeCache2StackCache2,
+        Variant::NodeCache1StackCache3,
     ];
 
     /// Every variant.
-    pub const EVERY: [Variant; 9] = [
+    pub const EVERY: [Variant; 11] = [
         Variant::Stack,
         Variant::Stackless,
         Variant::PushDown,
@@ -63,12 +69,14 @@ impl Variant {
         Variant::StackCache1,
         Variant::NodeCache1StackCache1,
         Variant::NodeCache2StackCache2,
+        Variant::StackCache3,
+        Variant::NodeCache1StackCache3,
     ];
 
     /// Levels of the tree top laid out in heap order for this variant's node cache.
     pub fn heap_levels(self) -> u32 {
         match self {
-            Variant::NodeCache1 | Variant::NodeCache1StackCache1 => 10,
+            Variant::NodeCache1 | Variant::NodeCache1StackCache1 | Variant::NodeCache1StackCache3 => 10,
             Variant::NodeCache2StackCache2 => 8,
             _ => 0,
         }
@@ -86,6 +94,8 @@ impl Variant {
             Variant::StackCache1 => "trace_sc1",
             Variant::NodeCache1StackCache1 => "trace_nc1_sc1",
             Variant::NodeCache2StackCache2 => "trace_nc2_sc2",
+            Variant::StackCache3 => "trace_sc3",
+            Variant::NodeCache1StackCache3 => "trace_nc1_sc3",
         }
     }
 
@@ -101,6 +111,8 @@ impl Variant {
             Variant::StackCache1 => "stack-cache-1",
             Variant::NodeCache1StackCache1 => "node-cache-1+stack-cache-1",
             Variant::NodeCache2StackCache2 => "node-cache-2+stack-cache-2",
+            Variant::StackCache3 => "stack-cache-3",
+            Variant::NodeCache1StackCache3 => "node-cache-1+stack-cache-3",
         }
     }
 
