@@ -119,3 +119,25 @@ fn step_logs_divergence_and_breakpoints() {
     let (ok, _, err) = warplight(&["step", "examples/if_else.toml", "--warp", "nonsense"]);
     assert!(!ok && err.contains("expected SLOT:WARP"), "{err}");
 }
+
+#[test]
+fn the_lessons_example_specs_run() {
+    for spec in ["examples/coalescing.toml", "examples/banks.toml", "examples/votes.toml", "examples/reduce.toml"] {
+        for device in ["gt200", "hopper"] {
+            let (ok, out, err) = warplight(&["launch", spec, "--device", device, "--csv"]);
+            assert!(ok, "{spec} on {device}: {err}");
+            assert!(out.lines().count() > 10, "{spec}: {out}");
+        }
+    }
+    // lesson 3's numbers
+    let (ok, out, _) = warplight(&[
+        "launch",
+        "examples/banks.toml",
+        "--csv",
+        "--metrics",
+        "l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_ld.sum",
+    ]);
+    assert!(ok);
+    let v: Vec<&str> = out.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
+    assert_eq!(v, vec!["0", "248", "0"]);
+}
