@@ -11,7 +11,7 @@ use crate::repro::{flight_tables, table_4_3, table_4_4};
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
 pub struct TablesArgs {
-    /// Tables to reproduce: 4.3, 4.4, 4.5, 4.7, 4.8, 4.9, or all.
+    /// Tables to reproduce: 4.3, 4.4, 4.5, 4.6, 4.7, 4.8, 4.9, 4.10, or all.
     pub tables: Vec<String>,
     /// Frames of each camera flight (the thesis: 50).
     #[arg(long, default_value_t = 50)]
@@ -37,7 +37,7 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let (mut traversal, mut caches) = (None, None);
     let tables: Vec<&str> = if a.tables.iter().any(|t| t == "all") {
-        vec!["4.3", "4.4", "4.5", "4.7", "4.8", "4.9"]
+        vec!["4.3", "4.4", "4.5", "4.6", "4.7", "4.8", "4.9", "4.10"]
     } else {
         a.tables.iter().map(|t| t.as_str()).collect()
     };
@@ -45,13 +45,13 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         match t {
             "4.3" => table_4_3(&a)?,
             "4.4" => table_4_4(&a)?,
-            "4.5" | "4.7" => {
+            "4.5" | "4.6" | "4.7" => {
                 if traversal.is_none() {
                     traversal = Some(flight_runs(&a, &Variant::ALL)?);
                 }
                 print_flight_table(t, traversal.as_ref().expect("measured"), &a);
             }
-            "4.8" | "4.9" => {
+            "4.8" | "4.9" | "4.10" => {
                 if caches.is_none() {
                     caches = Some(flight_runs(&a, &Variant::CACHES)?);
                 }
@@ -59,7 +59,7 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
             }
             other => {
                 return Err(format!(
-                    "table {other} is not reproduced yet; available: 4.3, 4.4, 4.5, 4.7, 4.8, 4.9, all"
+                    "table {other} is not reproduced yet; available: 4.3, 4.4, 4.5, 4.6, 4.7, 4.8, 4.9, 4.10, all"
                 )
                 .into());
             }
@@ -185,6 +185,16 @@ fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs)
             &ft::TABLE_4_7,
             runs,
             |r| r.instr_per_ray(),
+        ),
+        "4.6" => crate::repro::timing::markdown(
+            "Table 4.6: frame rates (GT200 timing model) with stackless traversal, relative to stack-based (thesis 000, seed L1902-1912)",
+            &crate::repro::timing::TABLE_4_6,
+            runs,
+        ),
+        "4.10" => crate::repro::timing::markdown(
+            "Table 4.10: frame rates (GT200 timing model) with explicitly managed caches, relative to the baseline (thesis 000, seed L2146-2157)",
+            &crate::repro::timing::TABLE_4_10,
+            runs,
         ),
         "4.9" => ft::markdown(
             "Table 4.9: instructions per ray with explicitly managed caches, relative to the baseline (thesis 000, seed L2123-2134)",

@@ -47,6 +47,9 @@ pub struct Totals {
     pub tex_lookups: u64,
     /// Texture-cache hits.
     pub tex_hits: u64,
+    /// Memory transactions of the gt200 profile: global and local segment
+    /// transactions plus texture-cache misses (for the timing model).
+    pub mem_transactions: u64,
 }
 
 /// One scene's flight, per variant.
@@ -121,6 +124,13 @@ pub fn measure(
             t.warp_instructions += k.launch.totals.warp_instructions;
             t.tex_lookups += k.memory.counters.texture.sectors;
             t.tex_hits += k.memory.counters.texture.hits;
+            let m = &k.memory.counters;
+            t.mem_transactions += m.global_ld.sectors
+                + m.global_st.sectors
+                + m.local_ld.sectors
+                + m.local_st.sectors
+                + m.global_atom.sectors
+                + m.texture.misses;
         }
     }
     Ok(SceneRun {

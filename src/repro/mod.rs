@@ -5,3 +5,4 @@
 pub mod flight_tables;
 pub mod table_4_3;
 pub mod table_4_4;
+pub mod timing;
