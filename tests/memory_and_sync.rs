@@ -358,3 +358,24 @@ fn read_only_path_gather() {
         }
     }
 }
+
+#[test]
+fn each_kernel_counts_only_the_shared_memory_it_names() {
+    use warplight::model::{Profile, occupancy::occupancy};
+    for d in BOTH {
+        let mut dev = device(1);
+        let m = load(&mut dev, "shared", d);
+        let p = &m.prog;
+        let size = |k: &str| p.kernel_shared_size(p.kernel(k).unwrap());
+        // The module lays out all five kernels' arrays (1024 + 2*1024 + 64 + 256 bytes) ...
+        assert!(p.static_shared_size >= 1024 + 2048 + 64 + 256, "{d:?}");
+        // ... but each kernel needs only its own.
+        assert_eq!(size("reduce_sum"), 256 * 4, "{d:?}");
+        assert_eq!(size("matmul_tiled"), 2 * 16 * 16 * 4, "{d:?}");
+        assert_eq!(size("histogram"), 16 * 4, "{d:?}");
+        assert_eq!(size("reverse_dynamic"), 0, "{d:?}");
+        assert_eq!(size("divergent_barrier"), 64 * 4, "{d:?}");
+        let o = occupancy(Profile::Gt200, p, p.kernel("histogram").unwrap(), 256, 0);
+        assert_eq!(o.shared_per_cta, 64, "{d:?}");
+    }
+}

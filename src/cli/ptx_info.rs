@@ -6,14 +6,15 @@ use std::path::Path;
 pub fn kernels(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let prog = crate::ptx::load_file(path)?;
     println!("{} (PTX {}, target {})", prog.source_name, prog.version, prog.target.join(","));
-    for f in prog.functions.iter().filter(|f| f.is_entry) {
+    for (k, f) in prog.functions.iter().enumerate().filter(|(_, f)| f.is_entry) {
         let params: Vec<String> = f.params.iter().map(|p| format!(".{} {}", p.ty, p.name)).collect();
         println!("  {}({})", f.name, params.join(", "));
         println!(
-            "    {} instructions, {} registers (32-bit words declared), {} B local per thread, {} B static shared (module)",
+            "    {} instructions, {} registers (32-bit words declared), {} B local per thread, {} B static shared ({} B in the module layout)",
             f.insts.len(),
             f.declared_reg_words,
             f.local_size,
+            prog.kernel_shared_size(k as u32),
             prog.static_shared_size
         );
     }

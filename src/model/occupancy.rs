@@ -33,7 +33,7 @@ pub fn occupancy(p: Profile, prog: &Program, kernel: u32, threads: u32, dynamic_
     let pr = p.params();
     let f = &prog.functions[kernel as usize];
     let regs = f.declared_reg_words.max(1);
-    let shared = prog.static_shared_size.div_ceil(16) * 16 + dynamic_shared;
+    let shared = prog.kernel_shared_size(kernel).div_ceil(16) * 16 + dynamic_shared;
     let warps = threads.div_ceil(32);
     let regs_per_warp = (regs * 32).div_ceil(pr.reg_alloc_unit) * pr.reg_alloc_unit;
     let by_threads = pr.max_threads_per_sm / (warps * 32).max(1);

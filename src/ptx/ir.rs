@@ -406,6 +406,8 @@ pub struct Function {
     pub labels: Vec<(String, u32)>,
     /// 32-bit registers the PTX declares (a `.b64` counts two), for occupancy.
     pub declared_reg_words: u32,
+    /// Offsets of the shared variables the function names itself (callees not included).
+    pub shared_refs: Vec<u32>,
 }
 
 /// A module-scope `.global` variable.
@@ -461,6 +463,34 @@ impl Program {
     /// Finds a kernel (an `.entry`) by name.
     pub fn kernel(&self, name: &str) -> Option<u32> {
         self.functions.iter().position(|f| f.is_entry && f.name == name).map(|i| i as u32)
+    }
+
+    /// Static shared memory `kernel` itself needs in bytes: the shared variables
+    /// it or a function it calls (transitively) names, aligned as in the module layout (at most 16 bytes),
+    /// as ptxas lays out only what a kernel uses. The emulator still gives every
+    /// CTA the whole module layout ([`Program::static_shared_size`]); this is the
+    /// figure for occupancy.
+    pub fn kernel_shared_size(&self, kernel: u32) -> u32 {
+        let mut seen = vec![false; self.functions.len()];
+        let mut todo = vec![kernel as usize];
+        let mut offsets = std::collections::BTreeSet::new();
+        while let Some(f) = todo.pop() {
+            if std::mem::replace(&mut seen[f], true) {
+                continue;
+            }
+            offsets.extend(self.functions[f].shared_refs.iter().copied());
+            for i in &self.functions[f].insts {
+                if let Kind::Call { func, .. } = i.kind {
+                    todo.push(func as usize);
+                }
+            }
+        }
+        let mut size = 0u32;
+        for v in self.shared_vars.iter().filter(|v| v.size > 0 && offsets.contains(&v.offset)) {
+            let align = if v.offset == 0 { 1 } else { 1 << v.offset.trailing_zeros().min(4) };
+            size = size.div_ceil(align) * align + v.size;
+        }
+        size
     }
 
     /// Names of all kernels.

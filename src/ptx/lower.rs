@@ -271,6 +271,8 @@ struct FnLower<'a> {
     loc: Option<SrcLoc>,
     frame_param: u64,
     local: u64,
+    /// Offsets of the shared variables this function names (for per-kernel occupancy).
+    shared_refs: std::cell::RefCell<std::collections::BTreeSet<u32>>,
 }
 
 /// Modifier words of one instruction, sorted into kinds.
@@ -436,6 +438,7 @@ impl<'a> FnLower<'a> {
             info: Vec::new(),
             labels: Vec::new(),
             declared_reg_words: 0,
+            shared_refs: Vec::new(),
         };
         FnLower {
             f,
@@ -450,6 +453,7 @@ impl<'a> FnLower<'a> {
             loc: None,
             frame_param,
             local: 0,
+            shared_refs: Default::default(),
         }
     }
 
@@ -478,16 +482,16 @@ impl<'a> FnLower<'a> {
         self.out.labels = labels;
         self.out.frame_param_size = align_up(self.frame_param, 8) as u32;
         self.out.local_size = align_up(self.local, 16) as u32;
+        self.out.shared_refs = self.shared_refs.take().into_iter().collect();
         Ok(self.out)
     }
 
     fn lookup(&self, name: &str) -> Option<Sym> {
-        for s in self.scopes.iter().rev() {
-            if let Some(v) = s.get(name) {
-                return Some(*v);
-            }
+        let sym = self.scopes.iter().rev().find_map(|s| s.get(name)).or_else(|| self.module.get(name)).copied();
+        if let Some(Sym::Shared(o)) = sym {
+            self.shared_refs.borrow_mut().insert(o);
         }
-        self.module.get(name).copied()
+        sym
     }
 
     fn declare(&mut self, name: String, sym: Sym) {
