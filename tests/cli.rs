@@ -121,6 +121,29 @@ fn step_logs_divergence_and_breakpoints() {
 }
 
 #[test]
+fn step_breaks_once_where_a_warp_enters_a_source_line() {
+    // line 11 (`odd[i] = t * 3;`) spans several PTX instructions; the odd lanes enter it once
+    let (ok, out, err) =
+        warplight(&["step", "examples/if_else.toml", "--break-src", "divergence.cu:11", "--watch", "%r10"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("break at source line 11, PTX line 64"), "{out}");
+    assert!(out.contains("active aaaaaaaa"), "{out}");
+    assert!(out.contains("1 breakpoint stops"), "{out}");
+    // the else side (line 14) is entered by the even lanes
+    let (ok, out, _) = warplight(&["step", "examples/if_else.toml", "--break-src", "14", "--watch", "%r10"]);
+    assert!(ok);
+    assert!(out.contains("active 55555555") && out.contains("%r10 = 0:0 2:2"), "{out}");
+    for (arg, msg) in [
+        ("divergence.cu:99", "no instruction comes from that line"),
+        ("nope.cu:11", "no source file `nope.cu`"),
+        ("x:y", "expected [FILE:]LINE"),
+    ] {
+        let (ok, _, err) = warplight(&["step", "examples/if_else.toml", "--break-src", arg]);
+        assert!(!ok && err.contains(msg), "{arg}: {err}");
+    }
+}
+
+#[test]
 fn the_lessons_example_specs_run() {
     for spec in ["examples/coalescing.toml", "examples/banks.toml", "examples/votes.toml", "examples/reduce.toml"] {
         for device in ["gt200", "hopper"] {
@@ -140,4 +163,20 @@ fn the_lessons_example_specs_run() {
     assert!(ok);
     let v: Vec<&str> = out.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
     assert_eq!(v, vec!["0", "248", "0"]);
+}
+
+#[test]
+fn a_closed_stdout_ends_quietly() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["step", "examples/reduce.toml", "--trace"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader goes away, like `| head` after its lines
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(o.status.code(), Some(141), "{err}");
 }

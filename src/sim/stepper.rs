@@ -45,6 +45,8 @@ pub struct WarpView {
     pub next_pc: Option<u32>,
     /// PTX line of the next instruction.
     pub next_ptx_line: Option<u32>,
+    /// CUDA source position (from `.loc`) of the next instruction, if the PTX has line info.
+    pub next_source: Option<crate::ptx::ir::SrcLoc>,
     /// Lanes of the running path.
     pub active: u32,
     /// Lanes not exited.
@@ -153,6 +155,7 @@ impl<'a> Stepper<'a> {
             function: f.name.clone(),
             next_pc,
             next_ptx_line: next_pc.map(|pc| f.info[pc as usize].ptx_line),
+            next_source: next_pc.and_then(|pc| f.info[pc as usize].src),
             active: top.map(|t| t.mask).unwrap_or(0),
             live: w.live,
             stack: w.stack.entries.clone(),
