@@ -432,6 +432,8 @@ pub struct SharedVar {
     pub offset: u32,
     /// Size in bytes (0 for the dynamic `extern` array).
     pub size: u32,
+    /// Alignment in bytes (`.align`, else the element size).
+    pub align: u32,
 }
 
 /// A complete validated module.
@@ -466,7 +468,7 @@ impl Program {
     }
 
     /// Static shared memory `kernel` itself needs in bytes: the shared variables
-    /// it or a function it calls (transitively) names, aligned as in the module layout (at most 16 bytes),
+    /// it or a function it calls (transitively) names, each at its own alignment,
     /// as ptxas lays out only what a kernel uses. The emulator still gives every
     /// CTA the whole module layout ([`Program::static_shared_size`]); this is the
     /// figure for occupancy.
@@ -487,8 +489,7 @@ impl Program {
         }
         let mut size = 0u32;
         for v in self.shared_vars.iter().filter(|v| v.size > 0 && offsets.contains(&v.offset)) {
-            let align = if v.offset == 0 { 1 } else { 1 << v.offset.trailing_zeros().min(4) };
-            size = size.div_ceil(align) * align + v.size;
+            size = size.div_ceil(v.align) * v.align + v.size;
         }
         size
     }

@@ -71,7 +71,12 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
         if shared_off > u32::MAX as u64 {
             return invalid(v.pos, "shared memory too large");
         }
-        prog.shared_vars.push(SharedVar { name: v.name.clone(), offset: off as u32, size: v.size_bytes() as u32 });
+        prog.shared_vars.push(SharedVar {
+            name: v.name.clone(),
+            offset: off as u32,
+            size: v.size_bytes() as u32,
+            align: align as u32,
+        });
         Ok(off as u32)
     };
     for v in &m.vars {
@@ -122,7 +127,7 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
     prog.static_shared_size = shared_off as u32;
     let dyn_base = align_up(shared_off, 16) as u32;
     for name in &extern_shared {
-        prog.shared_vars.push(SharedVar { name: name.clone(), offset: dyn_base, size: 0 });
+        prog.shared_vars.push(SharedVar { name: name.clone(), offset: dyn_base, size: 0, align: 16 });
     }
     let fix_extern = |off: u32| if off == u32::MAX { dyn_base } else { off };
     for s in module_syms.values_mut() {
