@@ -27,3 +27,4 @@ pub mod model;
 pub mod ptx;
 pub mod repro;
 pub mod sim;
+pub mod teach;

@@ -76,9 +76,7 @@ pub fn run(a: LaunchArgs) -> Res {
     for (name, file) in &dumps {
         let (p, b) = &prepared.buffers[name];
         let bytes = dev.read::<u8>(*p, b.len * b.ty.size());
-        let tmp = file.with_extension("warplight-tmp");
-        std::fs::write(&tmp, &bytes).map_err(|e| format!("{}: {e}", tmp.display()))?;
-        std::fs::rename(&tmp, file).map_err(|e| format!("{}: {e}", file.display()))?;
+        crate::cli::write_atomically(file, &bytes)?;
     }
     let prog = &prepared.module.prog;
     if a.json {

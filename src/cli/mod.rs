@@ -6,6 +6,7 @@ pub mod render;
 pub mod scene_info;
 pub mod step;
 pub mod tables;
+pub mod trace;
 
 use clap::{Parser, Subcommand};
 
@@ -17,6 +18,8 @@ Examples:
   warplight tables 4.4                             kd-tree statistics beside thesis 000's Table 4.4
   warplight launch examples/reduce.toml            run a kernel described by a spec, print counters
   warplight launch examples/reduce.toml --per-line counters per CUDA source line
+  warplight step examples/if_else.toml             step a warp through an if/else (interactive)
+  warplight trace examples/if_else.toml -o t.html  the same as an HTML timeline
   warplight kernels kernels/tests/shared.ptx       list a PTX file's kernels
   warplight check my_kernels.ptx                   parse and validate a PTX file")]
 pub struct Cli {
@@ -33,9 +36,13 @@ pub enum Command {
     /// The spec names the PTX file, the kernel, grid and block, the buffers with
     /// their initial contents and the arguments; see `docs/launch-spec.md`.
     Launch(launch::LaunchArgs),
-    /// Step through a launch warp instruction by warp instruction: a log with the
-    /// SIMT stack and watched registers at breakpoints (`--break LINE --watch %r1`).
+    /// Step through a launch warp by warp: an interactive terminal view (source,
+    /// PTX, active lanes, SIMT stack, registers, memory transactions), or with
+    /// `--log`/`--trace` a text log with breakpoints (`--break LINE --watch %r1`).
     Step(step::StepArgs),
+    /// Record a launch into a self-contained HTML page: a timeline per warp to scrub,
+    /// active masks, divergence and reconvergence, memory transactions per instruction.
+    Trace(trace::TraceArgs),
     /// List the kernels of a PTX file with their parameters and resources.
     Kernels {
         /// The PTX file.
@@ -94,14 +101,25 @@ pub fn main() -> i32 {
         Command::Tables(a) => tables::run(a),
         Command::Render(a) => render::run(a),
         Command::Step(a) => step::run(a),
+        Command::Trace(a) => trace::run(a),
     };
     match r {
         Ok(()) => 0,
+        // the reader of stdout went away (`warplight step ... | head`): end as C tools do
+        Err(e) if e.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) => 141,
         Err(e) => {
             eprintln!("error: {e}");
             1
         }
     }
+}
+
+/// Writes `bytes` to `file` through a temporary file beside it, so that a
+/// failure never leaves a partial file under the final name.
+pub fn write_atomically(file: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
+    let tmp = file.with_extension("warplight-tmp");
+    std::fs::write(&tmp, bytes).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    std::fs::rename(&tmp, file).map_err(|e| format!("{}: {e}", file.display()))
 }
 
 fn validate(fixture: &std::path::Path, ptx: &std::path::Path, md: bool) -> Result<(), Box<dyn std::error::Error>> {

@@ -61,8 +61,15 @@ pub fn half_warp(lanes: &[(u64, u32)]) -> Transactions {
 }
 
 /// The segment algorithm over the threads in `mask` (no allocation).
-fn half_warp_masked(addr: &[u64; 16], bytes: u32, mut mask: u16) -> Transactions {
+fn half_warp_masked(addr: &[u64; 16], bytes: u32, mask: u16) -> Transactions {
     let mut t = Transactions::default();
+    half_warp_segments(addr, bytes, mask, |_, size, _| t.add(size));
+    t
+}
+
+/// Runs the segment algorithm over the threads in `mask`, calling
+/// `issue(base, size, threads)` for each transaction (threads as a mask of `addr` indices).
+fn half_warp_segments(addr: &[u64; 16], bytes: u32, mut mask: u16, mut issue: impl FnMut(u64, u64, u16)) {
     let seg = match bytes {
         1 => 32u64,
         2 => 64,
@@ -72,6 +79,7 @@ fn half_warp_masked(addr: &[u64; 16], bytes: u32, mut mask: u16) -> Transactions
         let base = addr[mask.trailing_zeros() as usize] / seg * seg;
         let (mut lo, mut hi) = (u64::MAX, 0u64);
         let mut rest = mask;
+        let mut served = 0u16;
         while rest != 0 {
             let k = rest.trailing_zeros() as usize;
             rest &= rest - 1;
@@ -79,9 +87,10 @@ fn half_warp_masked(addr: &[u64; 16], bytes: u32, mut mask: u16) -> Transactions
             if a >= base && a < base + seg {
                 lo = lo.min(a);
                 hi = hi.max(a + bytes as u64);
-                mask &= !(1 << k);
+                served |= 1 << k;
             }
         }
+        mask &= !served;
         let (mut b, mut size) = (base, seg);
         while size > 32 {
             let half = size / 2;
@@ -94,9 +103,42 @@ fn half_warp_masked(addr: &[u64; 16], bytes: u32, mut mask: u16) -> Transactions
                 break;
             }
         }
-        t.add(size);
+        issue(b, size, served);
     }
-    t
+}
+
+/// One transaction of a warp-level access, for display.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Segment {
+    /// Half-warp (0 or 1).
+    pub half: u32,
+    /// Address of the first byte moved.
+    pub base: u64,
+    /// 32, 64 or 128 bytes.
+    pub size: u64,
+    /// Lanes it serves (warp lane mask).
+    pub lanes: u32,
+}
+
+/// The transactions of [`warp`], listed in issue order (for teaching views).
+pub fn warp_segments(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<Segment> {
+    let mut v = Vec::new();
+    for h in 0..2u32 {
+        let m = (mask >> (16 * h)) as u16;
+        if m == 0 {
+            continue;
+        }
+        let mut a = [0u64; 16];
+        for (k, slot) in a.iter_mut().enumerate() {
+            if m >> k & 1 != 0 {
+                *slot = addr(16 * h as usize + k);
+            }
+        }
+        half_warp_segments(&a, bytes, m, |base, size, lanes| {
+            v.push(Segment { half: h, base, size, lanes: (lanes as u32) << (16 * h) })
+        });
+    }
+    v
 }
 
 /// Transactions of a warp-level access: each half-warp separately. A 16-byte
@@ -125,6 +167,31 @@ mod tests {
 
     fn hw(addrs: impl Iterator<Item = u64>, w: u32) -> Transactions {
         half_warp(&addrs.map(|a| (a, w)).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn segments_agree_with_counts() {
+        for (stride, bytes) in [(1u64, 4u32), (2, 4), (1, 8), (1, 16), (3, 4), (1, 1), (1, 2), (64, 4)] {
+            let addr = |l: usize| 0x1000 + l as u64 * stride * bytes as u64;
+            let t = warp(u32::MAX, bytes, addr);
+            let segs = warp_segments(u32::MAX, bytes, addr);
+            assert_eq!(segs.len() as u64, t.count(), "stride {stride} bytes {bytes}");
+            assert_eq!(segs.iter().map(|s| s.size).sum::<u64>(), t.bytes());
+            let served = segs.iter().fold(0u32, |m, s| {
+                assert_eq!(m & s.lanes, 0, "a lane served twice");
+                m | s.lanes
+            });
+            assert_eq!(served, u32::MAX);
+        }
+        // a coalesced float load: one 64-byte transaction per half-warp
+        let s = warp_segments(u32::MAX, 4, |l| 0x1000 + 4 * l as u64);
+        assert_eq!(
+            s,
+            vec![
+                Segment { half: 0, base: 0x1000, size: 64, lanes: 0xFFFF },
+                Segment { half: 1, base: 0x1040, size: 64, lanes: 0xFFFF_0000 }
+            ]
+        );
     }
 
     // CUDA C Programming Guide, CC 1.2/1.3 examples (Figure G-2 and text).

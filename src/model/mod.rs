@@ -19,6 +19,7 @@
 pub mod banks;
 pub mod cache;
 pub mod coalesce_gt200;
+pub mod explain;
 pub mod occupancy;
 pub mod profile;
 pub mod sectors;

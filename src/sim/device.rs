@@ -460,7 +460,21 @@ impl Device {
         args: &[Arg],
     ) -> Result<super::stepper::Stepper<'a>, SimError> {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
-        Ok(super::stepper::Stepper::new(self, m, k, kp, shared, cfg))
+        Ok(super::stepper::Stepper::new(self, m, k, kp, shared, cfg, None))
+    }
+
+    /// Like [`Device::stepper`], and every step's memory accesses are recorded
+    /// in `log` and handed out with its [`StepEvent`](super::stepper::StepEvent).
+    pub fn stepper_logged<'a>(
+        &'a self,
+        m: &'a Module,
+        kernel: &str,
+        cfg: LaunchConfig,
+        args: &[Arg],
+        log: &'a super::access_log::AccessLog,
+    ) -> Result<super::stepper::Stepper<'a>, SimError> {
+        let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
+        Ok(super::stepper::Stepper::new(self, m, k, kp, shared, cfg, Some(log)))
     }
 
     pub(crate) fn make_run<'a>(
@@ -470,7 +484,8 @@ impl Device {
         kp: Vec<u8>,
         shared: usize,
         cfg: &LaunchConfig,
+        observers: Option<&'a dyn ObserverFactory>,
     ) -> GridRun<'a> {
-        GridRun::new(self.ctx(m, kp, cfg, None), k, shared, self.config.schedule.clone())
+        GridRun::new(self.ctx(m, kp, cfg, observers), k, shared, self.config.schedule.clone())
     }
 }

@@ -4,6 +4,7 @@
 //! ([`memory`]), faults ([`fault`]), counters ([`counters`]), stepping
 //! ([`stepper`]) and the public [`Device`] API ([`device`]).
 
+pub mod access_log;
 pub mod alu;
 pub mod cfg;
 pub mod counters;

@@ -2,6 +2,7 @@
 //! scheduling (and so the same results) as a normal launch. For debuggers and
 //! the teaching views.
 
+use super::access_log::{Access, AccessLog};
 use super::counters::Counters;
 use super::device::{Device, LaunchConfig, Module};
 use super::fault::Fault;
@@ -30,6 +31,9 @@ pub struct StepEvent {
     pub opcode: String,
     /// Active lanes.
     pub mask: u32,
+    /// Its memory accesses (one per state space touched), when the stepper
+    /// was made with [`Device::stepper_logged`]; empty otherwise.
+    pub accesses: Vec<Access>,
 }
 
 /// A snapshot of a warp.
@@ -62,11 +66,26 @@ pub struct Stepper<'a> {
     run: GridRun<'a>,
     module: &'a Module,
     finished: bool,
+    log: Option<&'a AccessLog>,
 }
 
 impl<'a> Stepper<'a> {
-    pub(crate) fn new(dev: &'a Device, m: &'a Module, k: u32, kp: Vec<u8>, shared: usize, cfg: LaunchConfig) -> Self {
-        Stepper { run: dev.make_run(m, k, kp, shared, &cfg), module: m, finished: false }
+    pub(crate) fn new(
+        dev: &'a Device,
+        m: &'a Module,
+        k: u32,
+        kp: Vec<u8>,
+        shared: usize,
+        cfg: LaunchConfig,
+        log: Option<&'a AccessLog>,
+    ) -> Self {
+        let obs = log.map(|l| l as &dyn super::observer::ObserverFactory);
+        Stepper { run: dev.make_run(m, k, kp, shared, &cfg, obs), module: m, finished: false, log }
+    }
+
+    /// The module being run.
+    pub fn module(&self) -> &'a Module {
+        self.module
     }
 
     /// Issues one warp instruction; `None` when the grid has finished.
@@ -93,6 +112,7 @@ impl<'a> Stepper<'a> {
                     source_line: info.src.map(|s| s.line),
                     opcode: info.opcode.clone(),
                     mask: i.mask,
+                    accesses: self.log.map(|l| l.take()).unwrap_or_default(),
                 }))
             }
         }

@@ -1,0 +1,68 @@
+//! `warplight trace SPEC.toml -o trace.html`: record a launch into one
+//! self-contained HTML timeline (see `crate::teach::trace`).
+
+use std::path::PathBuf;
+
+use crate::model::Profile;
+use crate::teach::session::Session;
+use crate::teach::trace::{self, TraceOptions};
+
+/// Options of `warplight trace`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "The page needs no network: open it in any browser. Keys there: Left/Right step,\n\
+Home/End, Space plays; choose a warp to step along it alone; click the timeline to jump.\n\n\
+Examples:\n  warplight trace examples/if_else.toml -o if_else.html\n  \
+warplight trace examples/reduce.toml --cta 0 --warp 0 --warp 1 -o reduce.html\n  \
+warplight trace examples/coalescing.toml --device gt200 --to 400 -o coalescing.html")]
+pub struct TraceArgs {
+    /// The launch spec (TOML); its first launch is recorded.
+    pub spec: PathBuf,
+    /// The HTML file to write (written only when the recording succeeded).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Keep only this CTA (linear index; repeatable). Default: all.
+    #[arg(long = "cta", value_name = "N")]
+    pub ctas: Vec<u32>,
+    /// Keep only this warp of each kept CTA (repeatable). Default: all.
+    #[arg(long = "warp", value_name = "N")]
+    pub warps: Vec<u32>,
+    /// First step kept (warp instructions of the whole launch, counted from 1).
+    #[arg(long, default_value_t = 1)]
+    pub from: u64,
+    /// Stop recording after this step.
+    #[arg(long, default_value_t = u64::MAX)]
+    pub to: u64,
+    /// Most instructions kept; the page says when the recording was cut.
+    #[arg(long, default_value_t = 20_000)]
+    pub max_events: usize,
+    /// Device profile for the memory transactions, sectors and banks: gt200, maxwell or hopper.
+    #[arg(long, default_value = "hopper")]
+    pub device: String,
+}
+
+/// Runs the command.
+pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let profile =
+        Profile::parse(&a.device).ok_or_else(|| format!("--device {}: expected gt200, maxwell or hopper", a.device))?;
+    if a.from > a.to {
+        return Err(format!("--from {} is after --to {}", a.from, a.to).into());
+    }
+    let session = Session::load(&a.spec)?;
+    let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
+    let t = trace::record(&session, &o)?;
+    if t.events.is_empty() {
+        return Err("nothing recorded: no instruction matched --cta/--warp/--from/--to".into());
+    }
+    let page = trace::html(&t)?;
+    crate::cli::write_atomically(&a.output, page.as_bytes())?;
+    println!(
+        "wrote {} ({} KiB): {} of {} warp instructions, {} warps{}",
+        a.output.display(),
+        page.len() / 1024,
+        t.events.len(),
+        t.total_steps,
+        t.warps.len(),
+        if t.truncated { format!(" (cut at --max-events {})", a.max_events) } else { String::new() }
+    );
+    Ok(())
+}
