@@ -145,7 +145,13 @@ fn step_breaks_once_where_a_warp_enters_a_source_line() {
 
 #[test]
 fn the_lessons_example_specs_run() {
-    for spec in ["examples/coalescing.toml", "examples/banks.toml", "examples/votes.toml", "examples/reduce.toml"] {
+    for spec in [
+        "examples/coalescing.toml",
+        "examples/banks.toml",
+        "examples/votes.toml",
+        "examples/reduce.toml",
+        "examples/stackless.toml",
+    ] {
         for device in ["gt200", "hopper"] {
             let (ok, out, err) = warplight(&["launch", spec, "--device", device, "--csv"]);
             assert!(ok, "{spec} on {device}: {err}");
@@ -179,4 +185,43 @@ fn a_closed_stdout_ends_quietly() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(o.status.code(), Some(141), "{err}");
+}
+
+#[test]
+fn trace_writes_a_page_or_nothing() {
+    let dir = tempdir();
+    let page = dir.join("t.html");
+    let p = page.to_str().unwrap();
+    let (ok, out, err) = warplight(&["trace", "examples/reduce.toml", "--cta", "1", "--warp", "0", "-o", p]);
+    assert!(ok, "{err}");
+    assert!(out.contains("warp instructions, 1 warps"), "{out}");
+    assert!(std::fs::read_to_string(&page).unwrap().contains("reduce_sum"));
+    std::fs::remove_file(&page).unwrap();
+    for (args, msg) in [
+        (vec!["--cta", "99"], "nothing recorded"),
+        (vec!["--from", "10", "--to", "5"], "--from 10 is after --to 5"),
+        (vec!["--launch", "2"], "--launch 2: the spec has 1 launch (1 to 1)"),
+        (vec!["--device", "fermi"], "expected gt200, maxwell or hopper"),
+    ] {
+        let mut a = vec!["trace", "examples/reduce.toml", "-o", p];
+        a.extend(args);
+        let (ok, _, err) = warplight(&a);
+        assert!(!ok && err.contains(msg), "{a:?}: {err}");
+        assert!(!page.exists(), "{a:?} left a file");
+    }
+}
+
+#[test]
+fn step_log_steps_a_later_launch_and_checks_breakpoints() {
+    // launch 2 of the bank lesson runs after launch 1, on the same buffers
+    let (ok, out, err) = warplight(&["step", "examples/banks.toml", "--launch", "2", "--log"]);
+    assert!(ok, "{err}");
+    assert!(out.starts_with("stepping sh_stride") && out.contains("finished after 200 warp instructions"), "{out}");
+    // a breakpoint on a line without an instruction is refused with the line's text
+    let (ok, _, err) = warplight(&["step", "examples/if_else.toml", "--break", "1"]);
+    assert!(!ok && err.contains("--break 1: no instruction on PTX line 1"), "{err}");
+    // not a terminal: the text log even without --log
+    let (ok, out, _) = warplight(&["step", "examples/stackless.toml", "--break", "97", "--watch", "%r36"]);
+    assert!(ok && out.matches("break at PTX line 97").count() == 3, "{out}");
+    assert!(out.contains("4 divergent branches, 8 reconvergences"), "{out}");
 }

@@ -21,8 +21,11 @@ use crate::teach::{log, tui};
     warplight step examples/if_else.toml --log --break 45 --watch %r10\n  \
     warplight step examples/banks.toml --device gt200")]
 pub struct StepArgs {
-    /// The launch spec (TOML); its first launch is stepped.
+    /// The launch spec (TOML).
     pub spec: PathBuf,
+    /// Which of the spec's launches is stepped, from 1; those before it run first.
+    #[arg(long, default_value_t = 1)]
+    pub launch: usize,
     /// Stop at this PTX line (repeatable): print the warp's state before it executes.
     #[arg(long = "break", value_name = "PTX_LINE")]
     pub breaks: Vec<u32>,
@@ -65,7 +68,7 @@ pub fn parse_warp(w: &str) -> Result<(usize, u32), String> {
 
 /// Runs the command.
 pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let session = Session::load(&a.spec)?;
+    let session = Session::load_launch(&a.spec, a.launch)?;
     let only = a.warp.as_deref().map(parse_warp).transpose()?;
     let profile =
         Profile::parse(&a.device).ok_or_else(|| format!("--device {}: expected gt200, maxwell or hopper", a.device))?;

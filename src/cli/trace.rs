@@ -15,8 +15,11 @@ Examples:\n  warplight trace examples/if_else.toml -o if_else.html\n  \
 warplight trace examples/reduce.toml --cta 0 --warp 0 --warp 1 -o reduce.html\n  \
 warplight trace examples/coalescing.toml --device gt200 --to 400 -o coalescing.html")]
 pub struct TraceArgs {
-    /// The launch spec (TOML); its first launch is recorded.
+    /// The launch spec (TOML).
     pub spec: PathBuf,
+    /// Which of the spec's launches is recorded, from 1; those before it run first.
+    #[arg(long, default_value_t = 1)]
+    pub launch: usize,
     /// The HTML file to write (written only when the recording succeeded).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -47,7 +50,7 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.from > a.to {
         return Err(format!("--from {} is after --to {}", a.from, a.to).into());
     }
-    let session = Session::load(&a.spec)?;
+    let session = Session::load_launch(&a.spec, a.launch)?;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
     let t = trace::record(&session, &o)?;
     if t.events.is_empty() {

@@ -24,7 +24,8 @@ pub struct Unit {
 pub struct Explanation {
     /// One line: what, how many lanes, what it costs.
     pub summary: String,
-    /// Transactions, sectors or banks, in order.
+    /// Transactions or sectors in order; for shared memory every bank, lanes or not
+    /// (so a lane's unit index is its bank).
     pub units: Vec<Unit>,
     /// For each lane, the index of the first unit serving it (None: inactive).
     pub lane_unit: Vec<Option<usize>>,
@@ -146,6 +147,7 @@ fn shared(profile: Profile, a: &Access, head: String) -> (String, Vec<Unit>) {
     } else {
         (32u64, banks::cost32(a.mask, a.bytes, |l| a.addrs[l]))
     };
+    // one unit per bank, empty ones included, so that a lane's unit is its bank
     let mut units = Vec::new();
     for b in 0..nbanks {
         let mut lanes = 0u32;
@@ -158,10 +160,8 @@ fn shared(profile: Profile, a: &Access, head: String) -> (String, Vec<Unit>) {
         }
         words.sort_unstable();
         words.dedup();
-        if lanes != 0 {
-            let w = words.len();
-            units.push(Unit { label: format!("bank {b}: {w} word{}", if w == 1 { "" } else { "s" }), lanes });
-        }
+        let w = words.len();
+        units.push(Unit { label: format!("bank {b}: {w} word{}", if w == 1 { "" } else { "s" }), lanes });
     }
     let summary = format!(
         "{head}: {} {nbanks} banks, {} wavefront{}, {} conflict{}",
@@ -213,14 +213,17 @@ mod tests {
         // stride 32 words: every lane in bank 0 -> 32-way on Hopper, 16-way per half-warp on GT200
         let a = access(MemSpace::Shared, 4, |l| 128 * l as u64);
         let h = explain(Profile::Hopper, &a);
-        assert_eq!(h.units.len(), 1);
+        assert_eq!(h.units.len(), 32);
         assert_eq!(h.units[0].label, "bank 0: 32 words");
+        assert_eq!(h.units[1].lanes, 0);
         assert!(h.summary.contains("32 wavefronts, 31 conflicts"), "{}", h.summary);
         let g = explain(Profile::Gt200, &a);
         assert!(g.summary.contains("32 wavefronts, 30 conflicts"), "{}", g.summary);
         // stride 33: conflict-free
         let p = explain(Profile::Hopper, &access(MemSpace::Shared, 4, |l| 132 * l as u64));
-        assert_eq!(p.units.len(), 32);
+        assert!(p.units.iter().all(|u| u.lanes.count_ones() == 1));
+        assert_eq!(p.lane_unit[1], Some(1));
+        assert_eq!(p.lane_unit[31], Some(31));
         assert!(p.summary.contains("1 wavefront, 0 conflicts"), "{}", p.summary);
     }
 

@@ -32,7 +32,7 @@ pub fn run(session: &Session, o: &LogOptions, out: &mut dyn Write) -> Result<(),
 
 fn log(session: &Session, st: &mut Stepper, o: &LogOptions, out: &mut dyn Write) -> Result<(), Error> {
     let prog = &st.module().prog;
-    let l = &session.spec.launches[0];
+    let l = session.launch_spec();
     writeln!(
         out,
         "stepping {} (grid {:?}, block {:?}) from {}",

@@ -14,7 +14,9 @@ use crate::sim::{Device, LaunchConfig};
 pub struct Session {
     /// The spec.
     pub spec: Spec,
-    /// Its first launch's kernel name.
+    /// The launch stepped (index into `spec.launches`).
+    pub launch: usize,
+    /// Its kernel name.
     pub kernel: String,
 }
 
@@ -24,9 +26,31 @@ pub type Error = Box<dyn std::error::Error>;
 impl Session {
     /// Loads a spec; its first launch is the one stepped.
     pub fn load(path: &Path) -> Result<Session, Error> {
+        Self::load_launch(path, 1)
+    }
+
+    /// Loads a spec to step its `n`-th launch (from 1). The launches before it
+    /// run first, unobserved, on the same buffers, as `warplight launch` runs them.
+    pub fn load_launch(path: &Path, n: usize) -> Result<Session, Error> {
         let spec = Spec::load(path)?;
-        let kernel = spec.launches.first().ok_or("the spec has no launch")?.kernel.clone();
-        Ok(Session { spec, kernel })
+        let count = spec.launches.len();
+        if count == 0 {
+            return Err("the spec has no launch".into());
+        }
+        if n == 0 || n > count {
+            return Err(format!(
+                "--launch {n}: the spec has {count} launch{} (1 to {count})",
+                if count == 1 { "" } else { "es" }
+            )
+            .into());
+        }
+        let kernel = spec.launches[n - 1].kernel.clone();
+        Ok(Session { spec, launch: n - 1, kernel })
+    }
+
+    /// The stepped launch's spec.
+    pub fn launch_spec(&self) -> &launch_spec::LaunchSpec {
+        &self.spec.launches[self.launch]
     }
 
     /// The PTX file.
@@ -39,9 +63,15 @@ impl Session {
     pub fn with_stepper<R>(&self, f: impl FnOnce(&mut Stepper) -> Result<R, Error>) -> Result<R, Error> {
         let mut dev = Device::new();
         let prepared = launch_spec::prepare(&self.spec, &mut dev)?;
-        let l = &self.spec.launches[0];
+        let config =
+            |l: &launch_spec::LaunchSpec| LaunchConfig { grid: l.grid, block: l.block, dynamic_shared: l.shared };
+        for l in &self.spec.launches[..self.launch] {
+            let args = launch_spec::arguments(&self.spec, &prepared, l)?;
+            dev.launch(&prepared.module, &l.kernel, config(l), &args)?;
+        }
+        let l = self.launch_spec();
         let args = launch_spec::arguments(&self.spec, &prepared, l)?;
-        let cfg = LaunchConfig { grid: l.grid, block: l.block, dynamic_shared: l.shared };
+        let cfg = config(l);
         let log = AccessLog::new();
         let mut st = dev.stepper_logged(&prepared.module, &l.kernel, cfg, &args, &log)?;
         f(&mut st)

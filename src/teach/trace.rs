@@ -53,7 +53,7 @@ pub struct TraceMem {
     pub offsets: Vec<Option<u64>>,
     /// Per-lane unit index.
     pub lane_unit: Vec<Option<usize>>,
-    /// Unit labels.
+    /// Unit labels (empty for a bank no lane uses).
     pub units: Vec<String>,
 }
 
@@ -122,7 +122,7 @@ pub struct Trace {
 pub fn record(session: &Session, o: &TraceOptions) -> Result<Trace, Error> {
     session.with_stepper(|st| {
         let prog = &st.module().prog;
-        let l = &session.spec.launches[0];
+        let l = session.launch_spec();
         let grid = l.grid;
         let found = sources::read_all(prog, &session.ptx_path());
         let sources = prog
@@ -192,7 +192,11 @@ pub fn record(session: &Session, o: &TraceOptions) -> Result<Trace, Error> {
                         base,
                         offsets: (0..32).map(|l| (a.mask >> l & 1 != 0).then(|| a.addrs[l] - base)).collect(),
                         lane_unit: e.lane_unit,
-                        units: e.units.into_iter().map(|u| u.label).collect(),
+                        units: e
+                            .units
+                            .into_iter()
+                            .map(|u| if u.lanes == 0 { String::new() } else { u.label })
+                            .collect(),
                     }
                 })
                 .collect();

@@ -633,20 +633,26 @@ impl App {
                     let e = explain::explain(self.o.profile, a);
                     lines.push(Line::styled(e.summary.clone(), Style::new().fg(Color::Green)));
                     let base = (0..32).filter(|l| a.mask >> l & 1 != 0).map(|l| a.addrs[l]).min().unwrap_or(0);
-                    lines.push(Line::raw(format!("lane: +offset from {base:#x} / unit")));
+                    let unit = if a.space == crate::ptx::ir::MemSpace::Shared { "bank" } else { "unit" };
+                    lines.push(Line::raw(format!("lanes: +offset from {base:#x} / {unit} of each lane")));
                     for row in 0..4 {
-                        let mut s = String::new();
+                        let mut s = format!("{:>2}-{:<2} ", row * 8, row * 8 + 7);
                         for l in row * 8..row * 8 + 8 {
                             let cell = match e.lane_unit[l] {
                                 Some(u) => format!("+{:x}/{u}", a.addrs[l] - base),
                                 None => "-".into(),
                             };
-                            s.push_str(&format!("{l:>2}:{cell:<7}"));
+                            s.push_str(&format!("{cell:>8} "));
                         }
                         lines.push(Line::raw(s));
                     }
-                    let units: Vec<String> =
-                        e.units.iter().enumerate().map(|(i, u)| format!("{i}={}", u.label)).collect();
+                    let units: Vec<String> = e
+                        .units
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, u)| u.lanes != 0)
+                        .map(|(i, u)| format!("{i}={}", u.label))
+                        .collect();
                     lines.push(Line::raw(units.join("  ")));
                 }
             }

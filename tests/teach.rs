@@ -1,0 +1,289 @@
+//! The teaching views: the interactive step view driven with scripted keys on
+//! a test backend (80×24), and the trace recorder behind `warplight trace`.
+
+use std::path::Path;
+
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use warplight::model::Profile;
+use warplight::teach::breakpoints::Breakpoints;
+use warplight::teach::session::Session;
+use warplight::teach::trace::{self, TraceOptions};
+use warplight::teach::tui::{self, TuiOptions};
+
+fn session(spec: &str) -> Session {
+    Session::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(spec)).expect("spec loads")
+}
+
+fn options(profile: Profile) -> TuiOptions {
+    TuiOptions { breaks: Breakpoints::default(), watches: vec![], start: (0, 0), profile, max_steps: 100_000 }
+}
+
+/// Keys from a script: characters, with `\n` for Enter.
+fn keys(script: &str) -> Vec<KeyEvent> {
+    script
+        .chars()
+        .map(|c| {
+            let code = match c {
+                '\n' => KeyCode::Enter,
+                c => KeyCode::Char(c),
+            };
+            KeyEvent::new(code, KeyModifiers::NONE)
+        })
+        .collect()
+}
+
+/// Runs the view over `script` and returns the final screen, one string per row.
+fn screen(spec: &str, o: TuiOptions, script: &str) -> (Vec<String>, tui::App) {
+    let s = session(spec);
+    let mut term = Terminal::new(TestBackend::new(80, 24)).unwrap();
+    let mut k = keys(script).into_iter();
+    let app = tui::drive(&mut term, &s, o, || Ok(k.next())).expect("view runs");
+    let buf = term.backend().buffer();
+    let rows = (0..24).map(|y| (0..80).map(|x| buf[(x, y)].symbol().to_string()).collect::<String>()).collect();
+    (rows, app)
+}
+
+fn text(rows: &[String]) -> String {
+    rows.join("\n")
+}
+
+#[test]
+fn the_view_starts_at_the_first_instruction_with_all_lanes() {
+    let (rows, app) = screen("examples/if_else.toml", options(Profile::Hopper), "");
+    let t = text(&rows);
+    assert!(rows[0].contains("if_else") && rows[0].contains("step 0"), "{t}");
+    assert!(t.contains("PTX if_else"), "{t}");
+    assert!(t.contains("lanes 0-31 ################################ active ffffffff (32)"), "{t}");
+    assert!(t.contains("stack[0] pc 0"), "{t}");
+    assert_eq!(app.steps, 0);
+}
+
+#[test]
+fn stepping_to_the_branch_shows_the_divergence() {
+    // 12 instructions up to and including the conditional branch (PTX line 44)
+    let (rows, app) = screen("examples/if_else.toml", options(Profile::Hopper), &"s".repeat(12));
+    let t = text(&rows);
+    assert_eq!(app.steps, 12);
+    assert!(app.message.contains("ran PTX 44") && app.message.ends_with("diverged"), "{}", app.message);
+    // odd lanes run first, even lanes wait
+    assert!(t.contains("lanes 0-31 .#.#.#.#.#.#.#.#.#.#.#.#.#.#.#.# active aaaaaaaa (16)"), "{t}");
+    assert!(t.contains("mask aaaaaaaa (16) <- running"), "{t}");
+    assert!(t.contains("mask 55555555 (16)"), "{t}");
+    assert!(t.contains("if (t % 2) {"), "the source pane shows the branch's line:\n{t}");
+}
+
+#[test]
+fn stepping_back_restores_the_same_screen() {
+    let o = || options(Profile::Hopper);
+    let (ahead, _) = screen("examples/if_else.toml", o(), &"s".repeat(14));
+    let (back, app) = screen("examples/if_else.toml", o(), &format!("{}uu", "s".repeat(16)));
+    assert_eq!(app.steps, 14);
+    assert!(app.message.contains("stepped back to step 14"), "{}", app.message);
+    // everything but the message line is identical
+    for y in (0..24).filter(|&y| y != 22) {
+        assert_eq!(ahead[y], back[y], "row {y}\n{}\n---\n{}", text(&ahead), text(&back));
+    }
+    let (_, app) = screen("examples/if_else.toml", o(), "u");
+    assert_eq!(app.message, "nothing to step back to");
+}
+
+#[test]
+fn source_line_steps_and_goto_and_breakpoints() {
+    // `n` runs until the warp leaves its CUDA line: from the first instruction of
+    // line 10 (`if (t % 2)`, step 5) through the compiler's line-0 instructions to the branch
+    let (rows, a) = screen("examples/if_else.toml", options(Profile::Hopper), "sssssn");
+    assert!(a.steps >= 12, "line 10 is several instructions: {}", a.steps);
+    let t = text(&rows);
+    assert!(!t.contains(">  10") && t.contains(">  11"), "the source pane moved on to line 11:\n{t}");
+    // g 71 Enter: the warp runs to the reconvergence point
+    let (rows, a) = screen("examples/if_else.toml", options(Profile::Hopper), "g71\n");
+    assert!(text(&rows).contains(">  71"), "{}", text(&rows));
+    assert!(rows[11].contains("################################"), "reconverged: {}", rows[11]);
+    assert!(a.steps > 20);
+    // b 48 Enter sets a breakpoint (marked *), c continues to it: the even path's first line
+    let (rows, a) = screen("examples/if_else.toml", options(Profile::Hopper), "b48\nc");
+    assert!(a.message.contains("breakpoint: warp 0:0 before PTX line 48"), "{}", a.message);
+    assert!(text(&rows).contains("active 55555555 (16)"), "{}", text(&rows));
+    // a line without an instruction is refused
+    let (_, a) = screen("examples/if_else.toml", options(Profile::Hopper), "b1\n");
+    assert_eq!(a.message, "PTX line 1 holds no instruction");
+}
+
+#[test]
+fn memory_panel_explains_coalescing_per_profile() {
+    // `n` four times reaches past the load of in[t * a + b] (stride 1 in the spec's first launch)
+    let script = "nnnnnn3";
+    let (rows, _) = screen("examples/coalescing.toml", options(Profile::Gt200), script);
+    let t = text(&rows);
+    assert!(t.contains("last memory instruction"), "{t}");
+    assert!(t.contains("gt200 2 transactions, 128 B moved for 128 B used"), "{t}");
+    assert!(t.contains("0=half-warp 0: 64 B at"), "{t}");
+    let (rows, _) = screen("examples/coalescing.toml", options(Profile::Hopper), script);
+    assert!(text(&rows).contains("hopper 1 request, 4 sectors"), "{}", text(&rows));
+}
+
+#[test]
+fn register_panel_and_warp_selection() {
+    let mut o = options(Profile::Hopper);
+    o.watches = vec!["%r10".into()];
+    // after 2 instructions %r10 = tid.x; radix cycles dec -> hex
+    let (rows, _) = screen("examples/if_else.toml", o.clone(), "ss2");
+    let t = text(&rows);
+    assert!(t.contains("%r10"), "{t}");
+    assert!(
+        rows.iter().any(|r| r.contains(" 24       24       25       26       27       28       29       30       31")),
+        "{t}"
+    );
+    let (rows, _) = screen("examples/if_else.toml", o, "ss2x");
+    assert!(
+        rows.iter().any(|r| r.contains("24       18       19       1a       1b       1c       1d       1e       1f")),
+        "{}",
+        text(&rows)
+    );
+    // a CTA of 256 threads has 8 warps: w moves to warp 1, W back, W wraps to 7
+    let (_, a) = screen("examples/reduce.toml", options(Profile::Hopper), "w");
+    assert_eq!(a.sel, (0, 1));
+    let (_, a) = screen("examples/reduce.toml", options(Profile::Hopper), "wWW");
+    assert_eq!(a.sel, (0, 7));
+}
+
+#[test]
+fn barrier_key_and_help() {
+    let (rows, a) = screen("examples/reduce.toml", options(Profile::Hopper), "a");
+    assert!(a.message.contains("bar"), "{}", a.message);
+    assert!(text(&rows).contains("Barrier"), "the warp waits at the barrier:\n{}", text(&rows));
+    let (rows, _) = screen("examples/reduce.toml", options(Profile::Hopper), "?");
+    assert!(text(&rows).contains("keys (any key closes)"), "{}", text(&rows));
+    let (rows, _) = screen("examples/reduce.toml", options(Profile::Hopper), "?s");
+    assert!(!text(&rows).contains("keys (any key closes)"));
+}
+
+fn trace_options() -> TraceOptions {
+    TraceOptions { ctas: vec![], warps: vec![], from: 1, to: u64::MAX, max_events: 20_000, profile: Profile::Hopper }
+}
+
+#[test]
+fn trace_records_every_instruction_with_divergence_marks() {
+    let t = trace::record(&session("examples/if_else.toml"), &trace_options()).unwrap();
+    assert_eq!(t.events.len(), 28, "the log's 28 warp instructions");
+    assert!(t.finished && !t.truncated);
+    let fx: Vec<(u32, &str)> = t.events.iter().filter(|e| !e.fx.is_empty()).map(|e| (e.line, e.fx.as_str())).collect();
+    assert_eq!(fx[0], (44, "diverged"), "{fx:?}");
+    assert_eq!(fx.iter().filter(|f| f.1 == "reconverged").count(), 2, "{fx:?}");
+    assert_eq!(fx.last().unwrap().1, "exited");
+    let thread_insts: u64 = t.events.iter().map(|e| e.mask.count_ones() as u64).sum();
+    assert_eq!(thread_insts, 688, "as the counters say");
+    // the stores: each side stores every other word of its array (16 lanes, 4
+    // sectors); the compiler merged the two `[i + 1024]` stores after the
+    // reconvergence point into one store of all 32 lanes to two arrays (8 sectors)
+    let stores: Vec<&str> = t
+        .events
+        .iter()
+        .flat_map(|e| &e.mem)
+        .map(|m| m.summary.as_str())
+        .filter(|s| s.starts_with("global store"))
+        .collect();
+    assert_eq!(
+        stores,
+        [
+            "global store 4B x16: hopper 1 request, 4 sectors",
+            "global store 4B x16: hopper 1 request, 4 sectors",
+            "global store 4B x32: hopper 1 request, 8 sectors"
+        ]
+    );
+}
+
+#[test]
+fn trace_selection_bounds_its_size() {
+    let s = session("examples/reduce.toml");
+    let all = trace::record(&s, &trace_options()).unwrap();
+    let mut o = trace_options();
+    o.ctas = vec![0];
+    o.warps = vec![1];
+    let one = trace::record(&s, &o).unwrap();
+    assert_eq!(one.warps.len(), 1);
+    assert!(one.events.iter().all(|e| e.w == 0));
+    assert!(one.events.len() < all.events.len());
+    o.max_events = 5;
+    let cut = trace::record(&s, &o).unwrap();
+    assert_eq!(cut.events.len(), 5);
+    assert!(cut.truncated);
+    let mut o = trace_options();
+    o.from = 10;
+    o.to = 19;
+    let range = trace::record(&s, &o).unwrap();
+    assert_eq!(range.events.iter().map(|e| e.step).collect::<Vec<_>>(), (10..=19).collect::<Vec<_>>());
+    assert!(!range.finished);
+}
+
+#[test]
+fn trace_page_is_self_contained() {
+    let t = trace::record(&session("examples/if_else.toml"), &trace_options()).unwrap();
+    let page = trace::html(&t).unwrap();
+    assert!(!page.contains("/*TRACE_DATA*/"));
+    // outside its data (which holds source text, comments and all), nothing refers elsewhere
+    let code = page.split("id=\"data\">").next().unwrap().to_string() + page.rsplit("</script>").nth(1).unwrap();
+    for external in ["http:", "https:", "src=\"", "<link", "@import", "url("] {
+        assert!(!code.contains(external), "the page must not load anything ({external})");
+    }
+    // the data cannot end its script element early
+    let data = page.split("id=\"data\">").nth(1).unwrap().split("</script>").next().unwrap();
+    assert!(!data.contains('<'));
+    let back: serde_json::Value = serde_json::from_str(data).unwrap();
+    assert_eq!(back["events"].as_array().unwrap().len(), 28);
+}
+
+/// Lesson 6's kernel against a Rust reference: the nearest segment of each ray
+/// by brute force, and the restarts counted as the cell boundaries (x = 4,
+/// y = 4) the ray crosses before its hit (or before t = 20).
+#[test]
+fn stackless_lesson_matches_brute_force() {
+    use warplight::launch_spec::{self, Spec};
+    use warplight::sim::Device;
+    let spec = Spec::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/stackless.toml")).unwrap();
+    let mut dev = Device::new();
+    let prepared = launch_spec::prepare(&spec, &mut dev).unwrap();
+    let stats = launch_spec::run(&spec, &mut dev, &prepared, Profile::Hopper).unwrap();
+    let floats = |name: &str| -> Vec<f32> {
+        let b = spec.buffers.iter().find(|b| b.name == name).unwrap();
+        spec.initial_bytes(b).unwrap().chunks(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
+    };
+    let read_i32 = |name: &str| dev.read::<i32>(prepared.buffers[name].0, 32);
+    let (segs, rays) = (floats("segs"), floats("rays"));
+    let (hit, thit, restarts) =
+        (read_i32("hit"), dev.read::<f32>(prepared.buffers["thit"].0, 32), read_i32("restarts"));
+    let tmax = 20.0f64;
+    let mut total_restarts = 0;
+    for i in 0..32 {
+        let [ox, oy, dx, dy] = [0, 1, 2, 3].map(|k| rays[4 * i + k] as f64);
+        let mut best: Option<(f64, i32)> = None;
+        for s in 0..segs.len() / 4 {
+            let [x0, y0, x1, y1] = [0, 1, 2, 3].map(|k| segs[4 * s + k] as f64);
+            let (ex, ey) = (x1 - x0, y1 - y0);
+            let den = dx * ey - dy * ex;
+            if den == 0.0 {
+                continue;
+            }
+            let (qx, qy) = (x0 - ox, y0 - oy);
+            let (t, u) = ((qx * ey - qy * ex) / den, (qx * dy - qy * dx) / den);
+            if (0.0..=1.0).contains(&u) && t >= 0.0 && t <= tmax && best.is_none_or(|b| t < b.0) {
+                best = Some((t, s as i32));
+            }
+        }
+        assert_eq!(hit[i], best.map_or(-1, |b| b.1), "ray {i}");
+        if let Some((t, _)) = best {
+            assert!((thit[i] as f64 - t).abs() < 1e-4, "ray {i}: t {} vs {t}", thit[i]);
+        }
+        let end = best.map_or(tmax, |b| b.0);
+        let crossings = [(4.0 - ox) / dx, (4.0 - oy) / dy].iter().filter(|&&c| c > 0.0 && c < end).count() as i32;
+        assert_eq!(restarts[i], crossings, "ray {i}");
+        total_restarts += crossings;
+    }
+    // the fan has rays with 0, 1 and 2 restarts, so the warp diverges in the restart loop
+    assert!(restarts.contains(&0) && restarts.contains(&1) && restarts.contains(&2));
+    assert!(total_restarts > 0);
+    let c = &stats[0].stats.totals;
+    assert!(c.divergent_branches > 0 && c.reconvergences > 0);
+}

@@ -1,0 +1,93 @@
+//! The page of `warplight trace` in headless Chromium: it loads without
+//! console messages or errors, its self-test steps through events with the
+//! arrow keys, and a screenshot is taken. Needs Debian's `chromium` (`.ci/run`
+//! installs it); set WARPLIGHT_SKIP_EXTERNAL=1 to skip where it cannot be installed.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn chromium() -> Option<PathBuf> {
+    if std::env::var_os("WARPLIGHT_SKIP_EXTERNAL").is_some() {
+        return None;
+    }
+    let p = PathBuf::from(std::env::var_os("WARPLIGHT_CHROMIUM").unwrap_or("/usr/bin/chromium".into()));
+    assert!(p.exists(), "{} is needed for this test (apt-get install chromium)", p.display());
+    Some(p)
+}
+
+/// Runs headless Chromium on `url` with `extra` arguments; returns (stdout, stderr).
+fn headless(chromium: &Path, dir: &Path, url: &str, extra: &[&str]) -> (String, String) {
+    let profile = dir.join(format!("profile-{}", extra.len()));
+    let o = Command::new("timeout")
+        .arg("120")
+        .arg(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=5000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(extra)
+        .arg(url)
+        .output()
+        .expect("chromium runs");
+    (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+fn console_lines(stderr: &str) -> Vec<&str> {
+    stderr.lines().filter(|l| l.contains(":CONSOLE")).collect()
+}
+
+#[test]
+fn trace_page_steps_in_headless_chromium() {
+    let Some(chromium) = chromium() else { return };
+    let dir = std::env::temp_dir().join(format!("warplight-trace-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let page = dir.join("if_else.html");
+    let o = Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["trace", "examples/if_else.toml", "-o"])
+        .arg(&page)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let url = format!("file://{}#selftest=11", page.display());
+
+    // The detector works: a page with a console message and an uncaught error is caught.
+    let bad = dir.join("bad.html");
+    std::fs::write(&bad, "<html><body><script>console.error('boom'); missing();</script></body></html>").unwrap();
+    let (_, err) = headless(&chromium, &dir, &format!("file://{}", bad.display()), &["--dump-dom"]);
+    assert_eq!(console_lines(&err).len(), 2, "{err}");
+
+    // Load, step 11 events with the arrow key, read back what the page shows.
+    let (dom, err) = headless(&chromium, &dir, &url, &["--dump-dom"]);
+    assert!(console_lines(&err).is_empty(), "console output: {:?}", console_lines(&err));
+    assert!(dom.contains("<div id=\"errors\"></div>"), "errors on the page: {dom}");
+    assert!(
+        dom.contains("selftest ok: event 12 shown, 32 mask cells, 0 errors, op bra, fx diverged"),
+        "{}",
+        dom.lines().filter(|l| l.contains("selftest")).collect::<Vec<_>>().join("\n")
+    );
+
+    // A screenshot of the page after those steps.
+    let shot = dir.join("trace.png");
+    let (_, err) = headless(
+        &chromium,
+        &dir,
+        &url,
+        &["--hide-scrollbars", "--window-size=1280,900", &format!("--screenshot={}", shot.display())],
+    );
+    let img = image::open(&shot).unwrap_or_else(|e| panic!("no screenshot ({e}): {err}")).to_rgb8();
+    assert_eq!(img.dimensions(), (1280, 900));
+    let colours: std::collections::HashSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    assert!(colours.len() > 50, "the screenshot is nearly blank ({} colours)", colours.len());
+    let _ = std::fs::remove_dir_all(&dir);
+}
