@@ -145,30 +145,37 @@ fn step_breaks_once_where_a_warp_enters_a_source_line() {
 
 #[test]
 fn the_lessons_example_specs_run() {
-    for spec in [
-        "examples/coalescing.toml",
-        "examples/banks.toml",
-        "examples/votes.toml",
-        "examples/reduce.toml",
-        "examples/stackless.toml",
-    ] {
+    let mut specs: Vec<_> = std::fs::read_dir("examples/lessons").unwrap().map(|e| e.unwrap().path()).collect();
+    specs.sort();
+    assert_eq!(specs.len(), 6, "one spec per lesson: {specs:?}");
+    for spec in &specs {
+        let spec = spec.to_str().unwrap();
         for device in ["gt200", "hopper"] {
             let (ok, out, err) = warplight(&["launch", spec, "--device", device, "--csv"]);
             assert!(ok, "{spec} on {device}: {err}");
             assert!(out.lines().count() > 10, "{spec}: {out}");
         }
+        let (ok, out, err) = warplight(&["step", spec, "--log"]);
+        assert!(ok && out.contains("finished after"), "{spec}: {out}{err}");
+    }
+    // every lesson's commands name a spec that exists
+    for doc in std::fs::read_dir("docs/lessons").unwrap().map(|e| e.unwrap().path()) {
+        let text = std::fs::read_to_string(&doc).unwrap();
+        for word in text.split_whitespace().filter(|w| w.starts_with("examples/") && w.ends_with(".toml")) {
+            assert!(std::path::Path::new(word).exists(), "{}: {word} does not exist", doc.display());
+        }
     }
     // lesson 3's numbers
     let (ok, out, _) = warplight(&[
         "launch",
-        "examples/banks.toml",
+        "examples/lessons/banks.toml",
         "--csv",
         "--metrics",
         "l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_ld.sum",
     ]);
     assert!(ok);
     let v: Vec<&str> = out.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
-    assert_eq!(v, vec!["0", "248", "0"]);
+    assert_eq!(v, vec!["992", "0"]);
 }
 
 #[test]
@@ -214,14 +221,14 @@ fn trace_writes_a_page_or_nothing() {
 #[test]
 fn step_log_steps_a_later_launch_and_checks_breakpoints() {
     // launch 2 of the bank lesson runs after launch 1, on the same buffers
-    let (ok, out, err) = warplight(&["step", "examples/banks.toml", "--launch", "2", "--log"]);
+    let (ok, out, err) = warplight(&["step", "examples/lessons/banks.toml", "--launch", "2", "--log"]);
     assert!(ok, "{err}");
-    assert!(out.starts_with("stepping sh_stride") && out.contains("finished after 200 warp instructions"), "{out}");
+    assert!(out.starts_with("stepping transpose") && out.contains("finished after 832 warp instructions"), "{out}");
     // a breakpoint on a line without an instruction is refused with the line's text
     let (ok, _, err) = warplight(&["step", "examples/if_else.toml", "--break", "1"]);
     assert!(!ok && err.contains("--break 1: no instruction on PTX line 1"), "{err}");
     // not a terminal: the text log even without --log
-    let (ok, out, _) = warplight(&["step", "examples/stackless.toml", "--break", "97", "--watch", "%r36"]);
+    let (ok, out, _) = warplight(&["step", "examples/lessons/stackless.toml", "--break", "97", "--watch", "%r36"]);
     assert!(ok && out.matches("break at PTX line 97").count() == 3, "{out}");
     assert!(out.contains("4 divergent branches, 8 reconvergences"), "{out}");
 }

@@ -19,7 +19,7 @@ use crate::teach::{log, tui};
     w/W next/previous warp  ]/[ next/previous CTA  1/2/3 stack, registers, memory   q quit\n\n\
     Examples:\n  warplight step examples/if_else.toml\n  \
     warplight step examples/if_else.toml --log --break 45 --watch %r10\n  \
-    warplight step examples/banks.toml --device gt200")]
+    warplight step examples/lessons/banks.toml --device gt200")]
 pub struct StepArgs {
     /// The launch spec (TOML).
     pub spec: PathBuf,

@@ -13,7 +13,7 @@ use crate::teach::trace::{self, TraceOptions};
 Home/End, Space plays; choose a warp to step along it alone; click the timeline to jump.\n\n\
 Examples:\n  warplight trace examples/if_else.toml -o if_else.html\n  \
 warplight trace examples/reduce.toml --cta 0 --warp 0 --warp 1 -o reduce.html\n  \
-warplight trace examples/coalescing.toml --device gt200 --to 400 -o coalescing.html")]
+warplight trace examples/lessons/coalescing.toml --launch 3 --device gt200 --cta 0 -o stride32.html")]
 pub struct TraceArgs {
     /// The launch spec (TOML).
     pub spec: PathBuf,

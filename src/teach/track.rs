@@ -13,8 +13,12 @@ pub struct Effect {
     /// The warp split: fewer lanes run next than ran this instruction, and the
     /// SIMT stack grew.
     pub diverged: bool,
-    /// Lanes rejoined: more lanes run next than ran this instruction.
+    /// Lanes rejoined: the lanes that run next include all that ran this
+    /// instruction, and more.
     pub reconverged: bool,
+    /// This path reached its reconvergence point and a waiting path runs next
+    /// (none of this instruction's lanes).
+    pub switched: bool,
     /// The warp now waits at a barrier.
     pub at_barrier: bool,
     /// The warp finished.
@@ -29,7 +33,8 @@ pub fn effect(ev: &StepEvent, stack_before: usize, after: &WarpView) -> Effect {
             && after.stack.len() > stack_before
             && after.active & !ev.mask == 0
             && after.active != ev.mask,
-        reconverged: !exited && after.active & !ev.mask != 0,
+        reconverged: !exited && after.active & ev.mask == ev.mask && after.active != ev.mask,
+        switched: !exited && after.active & ev.mask == 0 && after.active != 0,
         at_barrier: matches!(after.state, WarpState::Barrier { .. }),
         exited,
     }
@@ -42,6 +47,8 @@ impl Effect {
             "diverged"
         } else if self.reconverged {
             "reconverged"
+        } else if self.switched {
+            "other path"
         } else if self.at_barrier {
             "waits at barrier"
         } else if self.exited {

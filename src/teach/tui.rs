@@ -345,13 +345,13 @@ impl App {
             self.message = format!("warp {}:{} has finished; w selects another", sel.0, sel.1);
             return Ok(());
         }
-        let start_line = w0.next_source.map(|s| s.line);
+        let start_line = w0.next_source.map(|s| (s.file, s.line));
         let is_sel = move |ev: &StepEvent| (ev.cta_slot, ev.warp) == sel;
         let stopped = match a {
             Action::Instruction => self.run_until(st, |_, ev, _| is_sel(ev))?,
             Action::SourceLine => self.run_until(st, |_, ev, w| {
-                let line = w.next_source.map(|s| s.line);
-                is_sel(ev) && (w.next_pc.is_none() || (line != start_line && line != Some(0)))
+                let line = w.next_source.map(|s| (s.file, s.line));
+                is_sel(ev) && (w.next_pc.is_none() || (line != start_line && line.is_none_or(|l| l.1 != 0)))
             })?,
             Action::Goto(l) => self.run_until(st, |_, ev, w| is_sel(ev) && w.next_ptx_line == Some(l))?,
             Action::Barrier => self.run_until(st, |_, ev, _| is_sel(ev) && ev.opcode.starts_with("bar"))?,
