@@ -72,7 +72,7 @@ fn trace_page_steps_in_headless_chromium() {
     assert!(console_lines(&err).is_empty(), "console output: {:?}", console_lines(&err));
     assert!(dom.contains("<div id=\"errors\"></div>"), "errors on the page: {dom}");
     assert!(
-        dom.contains("selftest ok: event 12 shown, 32 mask cells, 0 errors, op bra, fx diverged"),
+        dom.contains("selftest ok: event 12 shown, 32 mask cells, 1 memory diagram, 0 errors, op bra, fx diverged"),
         "{}",
         dom.lines().filter(|l| l.contains("selftest")).collect::<Vec<_>>().join("\n")
     );
