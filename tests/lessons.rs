@@ -34,6 +34,11 @@ impl Run {
         self.spec.initial_bytes(b).unwrap().chunks(4).map(|c| decode(c.try_into().unwrap())).collect()
     }
 
+    /// `name` for every launch, in order.
+    fn metrics(&self, name: &str) -> Vec<u64> {
+        (0..self.results.len()).map(|l| self.metric(l, name)).collect()
+    }
+
     fn metric(&self, launch: usize, name: &str) -> u64 {
         let r = &self.results[launch];
         let found = r.metrics().into_iter().find(|(k, _)| k == name).map(|(_, v)| v);
@@ -73,9 +78,9 @@ fn lesson2_coalescing_counts_as_the_measured_micro_kernel() {
     let by_size: Vec<[u64; 3]> = (0..3).map(|l| ["gld_32b", "gld_64b", "gld_128b"].map(|m| g.metric(l, m))).collect();
     assert_eq!(by_size, [[0, 64, 0], [0, 0, 64], [1024, 0, 0]]);
     let h = run("examples/lessons/coalescing.toml", Profile::Hopper);
-    let sectors: Vec<u64> = (0..3).map(|l| h.metric(l, "l1tex__t_sectors_pipe_lsu_mem_global_op_ld.sum")).collect();
+    let sectors: Vec<u64> = h.metrics("l1tex__t_sectors_pipe_lsu_mem_global_op_ld.sum");
     assert_eq!(sectors, [128, 256, 1024]);
-    let requests: Vec<u64> = (0..3).map(|l| h.metric(l, "l1tex__t_requests_pipe_lsu_mem_global_op_ld.sum")).collect();
+    let requests: Vec<u64> = h.metrics("l1tex__t_requests_pipe_lsu_mem_global_op_ld.sum");
     assert_eq!(requests, [32, 32, 32]);
     // results: out[t] = in[t * stride] with in = iota, for the last launch (stride 32)
     let out = h.read::<f32>("out");
@@ -97,8 +102,7 @@ fn lesson2_coalescing_counts_as_the_measured_micro_kernel() {
     let file = dir.join("micro.toml");
     std::fs::write(&file, spec).unwrap();
     let m = run(file.to_str().unwrap(), Profile::Hopper);
-    let micro_sectors: Vec<u64> =
-        (0..3).map(|l| m.metric(l, "l1tex__t_sectors_pipe_lsu_mem_global_op_ld.sum")).collect();
+    let micro_sectors: Vec<u64> = m.metrics("l1tex__t_sectors_pipe_lsu_mem_global_op_ld.sum");
     assert_eq!(micro_sectors, sectors);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -114,15 +118,13 @@ fn lesson3_bank_conflicts() {
         }
     }
     // column reads: 32 lanes in one bank -> 32 wavefronts, 31 conflicts per warp, 32 warps
-    let conflicts: Vec<u64> =
-        (0..2).map(|l| h.metric(l, "l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_ld.sum")).collect();
+    let conflicts: Vec<u64> = h.metrics("l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_ld.sum");
     assert_eq!(conflicts, [32 * 31, 0]);
-    let wavefronts: Vec<u64> =
-        (0..2).map(|l| h.metric(l, "l1tex__data_pipe_lsu_wavefronts_mem_shared_op_ld.sum")).collect();
+    let wavefronts: Vec<u64> = h.metrics("l1tex__data_pipe_lsu_wavefronts_mem_shared_op_ld.sum");
     assert_eq!(wavefronts, [32 * 32, 32]);
     // GT200: 16 banks per half-warp -> 16 passes per half-warp without padding
     let g = run("examples/lessons/banks.toml", Profile::Gt200);
-    let passes: Vec<u64> = (0..2).map(|l| g.metric(l, "mem.shared_ld.wavefronts")).collect();
+    let passes: Vec<u64> = g.metrics("mem.shared_ld.wavefronts");
     assert_eq!(passes, [32 * 2 * 16, 32 * 2]);
     assert_eq!([g.metric(0, "warp_serialize"), g.metric(1, "warp_serialize")], [32, 0]);
 }
@@ -157,8 +159,7 @@ fn lesson5_reduction_orders() {
     // 9 barriers per CTA; divergence counted by hand in docs/lessons/05-reduction.md
     assert_eq!((c[0].barriers, c[1].barriers), (72, 72));
     assert_eq!((c[0].divergent_branches, c[1].divergent_branches), (8 * 48, 8 * 6));
-    let conflicts: Vec<u64> =
-        (0..2).map(|l| r.metric(l, "l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_ld.sum")).collect();
+    let conflicts: Vec<u64> = r.metrics("l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_ld.sum");
     assert_eq!(conflicts[0], 0);
     assert!(conflicts[1] > 0, "the sequential order's lanes are 2d words apart");
 }

@@ -120,9 +120,9 @@ pub struct Segment {
     pub lanes: u32,
 }
 
-/// The transactions of [`warp`], listed in issue order (for teaching views).
-pub fn warp_segments(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<Segment> {
-    let mut v = Vec::new();
+/// Calls `f(half, addresses, lanes)` for each half-warp with active lanes
+/// (addresses of inactive lanes are 0; `lanes` is the half-warp's 16-bit mask).
+fn half_warps(mask: u32, addr: impl Fn(usize) -> u64, mut f: impl FnMut(u32, &[u64; 16], u16)) {
     for h in 0..2u32 {
         let m = (mask >> (16 * h)) as u16;
         if m == 0 {
@@ -134,10 +134,18 @@ pub fn warp_segments(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<
                 *slot = addr(16 * h as usize + k);
             }
         }
-        half_warp_segments(&a, bytes, m, |base, size, lanes| {
-            v.push(Segment { half: h, base, size, lanes: (lanes as u32) << (16 * h) })
-        });
+        f(h, &a, m);
     }
+}
+
+/// The transactions of [`warp`], listed in issue order (for teaching views).
+pub fn warp_segments(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<Segment> {
+    let mut v = Vec::new();
+    half_warps(mask, addr, |h, a, m| {
+        half_warp_segments(a, bytes, m, |base, size, lanes| {
+            v.push(Segment { half: h, base, size, lanes: (lanes as u32) << (16 * h) })
+        })
+    });
     v
 }
 
@@ -145,19 +153,7 @@ pub fn warp_segments(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<
 /// word access by a full half-warp spans two segments and so is split.
 pub fn warp(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Transactions {
     let mut t = Transactions::default();
-    for h in 0..2 {
-        let m = (mask >> (16 * h)) as u16;
-        if m == 0 {
-            continue;
-        }
-        let mut a = [0u64; 16];
-        for (k, slot) in a.iter_mut().enumerate() {
-            if m >> k & 1 != 0 {
-                *slot = addr(16 * h + k);
-            }
-        }
-        t.merge(&half_warp_masked(&a, bytes, m));
-    }
+    half_warps(mask, addr, |_, a, m| t.merge(&half_warp_masked(a, bytes, m)));
     t
 }
 

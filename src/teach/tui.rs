@@ -457,57 +457,22 @@ impl App {
             }
             None => ("source (no line info)".to_string(), &[][..], 0),
         };
-        let inner = area.height.saturating_sub(2) as usize;
-        let first = cur.saturating_sub(inner / 2 + 1);
-        let body: Vec<Line> = lines
-            .iter()
-            .enumerate()
-            .skip(first)
-            .take(inner)
-            .map(|(i, l)| {
-                let n = i + 1;
-                let text = format!("{}{n:>4} {}", if n == cur { '>' } else { ' ' }, l.replace('\t', "    "));
-                if n == cur {
-                    Line::styled(text, Style::new().add_modifier(Modifier::REVERSED))
-                } else {
-                    Line::raw(text)
-                }
-            })
-            .collect();
+        let body = window(lines, cur, area, false, |n| if n == cur { ('>', reversed()) } else { (' ', Style::new()) });
         f.render_widget(Paragraph::new(body).block(Block::default().borders(Borders::ALL).title(title)), area);
     }
 
     fn draw_ptx(&self, f: &mut Frame, area: Rect, st: &Stepper, w: Option<&WarpView>) {
         let prog = &st.module().prog;
         let cur = w.and_then(|w| w.next_ptx_line).unwrap_or(0) as usize;
-        let inner = area.height.saturating_sub(2) as usize;
-        let first = cur.saturating_sub(inner / 2 + 1);
-        let body: Vec<Line> = prog
-            .ptx_lines
-            .iter()
-            .enumerate()
-            .skip(first)
-            .take(inner)
-            .map(|(i, l)| {
-                let n = i + 1;
-                let mark = if n == cur {
-                    '>'
-                } else if self.o.breaks.ptx.contains(&(n as u32)) {
-                    '*'
-                } else {
-                    ' '
-                };
-                let text = format!("{mark}{n:>4} {}", l.trim().replace('\t', " "));
-                let style = if n == cur {
-                    Style::new().add_modifier(Modifier::REVERSED)
-                } else if mark == '*' {
-                    Style::new().fg(Color::Red)
-                } else {
-                    Style::new()
-                };
-                Line::styled(text, style)
-            })
-            .collect();
+        let body = window(&prog.ptx_lines, cur, area, true, |n| {
+            if n == cur {
+                ('>', reversed())
+            } else if self.o.breaks.ptx.contains(&(n as u32)) {
+                ('*', Style::new().fg(Color::Red))
+            } else {
+                (' ', Style::new())
+            }
+        });
         let title = format!("PTX {}", w.map(|w| w.function.as_str()).unwrap_or("(finished)"));
         f.render_widget(Paragraph::new(body).block(Block::default().borders(Borders::ALL).title(title)), area);
     }
@@ -690,6 +655,36 @@ fn mask_line(w: Option<&WarpView>) -> Line<'static> {
     }
     spans.push(Span::raw(format!(" active {:08x} ({})", w.active, w.active.count_ones())));
     Line::from(spans)
+}
+
+fn reversed() -> Style {
+    Style::new().add_modifier(Modifier::REVERSED)
+}
+
+/// The lines of a listing that fit `area` (inside its border), centred on line
+/// `cur` (1-based), each numbered, with the mark and style `mark(n)` gives.
+/// `trim` drops leading whitespace (PTX indents with tabs).
+fn window(
+    lines: &[String],
+    cur: usize,
+    area: Rect,
+    trim: bool,
+    mark: impl Fn(usize) -> (char, Style),
+) -> Vec<Line<'static>> {
+    let inner = area.height.saturating_sub(2) as usize;
+    let first = cur.saturating_sub(inner / 2 + 1);
+    lines
+        .iter()
+        .enumerate()
+        .skip(first)
+        .take(inner)
+        .map(|(i, l)| {
+            let n = i + 1;
+            let (m, style) = mark(n);
+            let text = if trim { l.trim().replace('\t', " ") } else { l.trim_end().replace('\t', "    ") };
+            Line::styled(format!("{m}{n:>4} {text}"), style)
+        })
+        .collect()
 }
 
 fn centered(r: Rect, w: u16, h: u16) -> Rect {
