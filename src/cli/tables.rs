@@ -6,12 +6,13 @@ use super::scene_info::scene_path;
 use crate::host::rt_kernels::Variant;
 use crate::host::scene::Scene;
 use crate::host::scene_file;
-use crate::repro::{flight_tables, table_4_3, table_4_4};
+use crate::repro::{flight_tables, table_4_1, table_4_2, table_4_3, table_4_4};
 
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
 pub struct TablesArgs {
-    /// Tables to reproduce: 4.3, 4.4, 4.5, 4.6, 4.7, 4.8, 4.9, 4.10, or all.
+    /// Tables to reproduce: 4.1, 4.2 (its part (b), qualitatively), 4.3, 4.4, 4.5, 4.6, 4.7,
+    /// 4.8, 4.9, 4.10, or all.
     pub tables: Vec<String>,
     /// Frames of each camera flight (the thesis: 50).
     #[arg(long, default_value_t = 50)]
@@ -37,12 +38,14 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let (mut traversal, mut caches) = (None, None);
     let tables: Vec<&str> = if a.tables.iter().any(|t| t == "all") {
-        vec!["4.3", "4.4", "4.5", "4.6", "4.7", "4.8", "4.9", "4.10"]
+        vec!["4.1", "4.2", "4.3", "4.4", "4.5", "4.6", "4.7", "4.8", "4.9", "4.10"]
     } else {
         a.tables.iter().map(|t| t.as_str()).collect()
     };
     for t in tables {
         match t {
+            "4.1" => table_4_1(&a)?,
+            "4.2" => table_4_2(&a)?,
             "4.3" => table_4_3(&a)?,
             "4.4" => table_4_4(&a)?,
             "4.5" | "4.6" | "4.7" => {
@@ -59,7 +62,7 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
             }
             other => {
                 return Err(format!(
-                    "table {other} is not reproduced yet; available: 4.3, 4.4, 4.5, 4.6, 4.7, 4.8, 4.9, 4.10, all"
+                    "table {other} is not reproduced; available: 4.1, 4.2, 4.3, 4.4, 4.5, 4.6, 4.7, 4.8, 4.9, 4.10, all"
                 )
                 .into());
             }
@@ -120,6 +123,100 @@ fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "\nOurs: stack-based traversal (the native caster, step for step the stack kernel), {} frame(s) of each flight at {}x{}.\n",
         a.frames, a.resolution, a.resolution
+    );
+    Ok(())
+}
+
+/// Loads the named scenes (default: `all`), reporting those that cannot be loaded.
+fn load_scenes(a: &TablesArgs, all: &[&str]) -> Vec<Scene> {
+    let names: Vec<String> =
+        if a.scenes.is_empty() { all.iter().map(|s| s.to_string()).collect() } else { a.scenes.clone() };
+    let mut scenes = Vec::new();
+    for n in &names {
+        match scene_file::load(&scene_path(n)) {
+            Ok(s) => scenes.push(s),
+            Err(e) => eprintln!("skipped {n}: {e}"),
+        }
+    }
+    scenes
+}
+
+/// A progress bar over `total` frames (None when stderr is not a terminal).
+fn frame_bar(total: u64, unit: &str) -> Option<indicatif::ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let pb = indicatif::ProgressBar::new(total);
+        pb.set_style(
+            indicatif::ProgressStyle::with_template(&format!(
+                "{{bar:30}} {{pos}}/{{len}} {unit}, {{msg}} [{{elapsed}}, eta {{eta}}]"
+            ))
+            .expect("template"),
+        );
+        pb
+    })
+}
+
+fn table_4_1(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let all: Vec<&str> = table_4_1::THESIS.iter().map(|r| r.0).collect();
+    let scenes = load_scenes(a, &all);
+    let total: u64 = scenes.iter().map(|s| 3 * a.frames.min(s.flight.frames) as u64).sum();
+    let pb = frame_bar(total, "frames x trees");
+    let mut rows = Vec::new();
+    for s in &scenes {
+        rows.push(table_4_1::measure(s, a.frames, a.resolution, |f, h| {
+            if let Some(pb) = &pb {
+                pb.set_message(format!("{} frame {f} {:?} tree", s.name, table_4_1::HEURISTICS[h]));
+                pb.inc(1);
+            }
+        })?);
+    }
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    if a.format == "json" {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+        return Ok(());
+    }
+    println!(
+        "Table 4.1: frame rates with the numerical approximation (4.1.2) and SIROH relative to the SAH, two code bases (thesis 000, seed L1664-1674)
+"
+    );
+    print!("{}", table_4_1::markdown(&rows));
+    println!(
+        "Ours: the stack-based kernel on each heuristic's tree, {} frame(s) of each flight at {}x{}, frame rates from the GT200 timing model. \
+         Code base I is not described beyond its SAH frame rates; compare the signs and sizes of the relative columns. \
+         Fixtures: docs/fixtures.md.\n",
+        a.frames, a.resolution, a.resolution
+    );
+    Ok(())
+}
+
+fn table_4_2(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let names: Vec<String> = if a.scenes.is_empty() {
+        table_4_1::THESIS.iter().map(|r| r.0.to_string()).collect()
+    } else {
+        a.scenes.clone()
+    };
+    let (rows, skipped) =
+        per_scene(&names, "SAH and SIROH trees, shadow rays", |s| table_4_2::measure(s, a.resolution));
+    for sk in skipped {
+        eprintln!("skipped {sk}");
+    }
+    if a.format == "json" {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+        return Ok(());
+    }
+    println!(
+        "Table 4.2 (b), qualitatively: SIROH vs SAH for shadow rays from a light inside and outside the scene (thesis 000, seed L1682-1697)\n"
+    );
+    print!("{}", table_4_2::markdown(&rows));
+    println!(
+        "\nOurs: shadow rays traced from the light to every primary hit of frame 0 at {}x{}, inner-node traversals per ray (native caster). \
+         Lights at the scene centre + extent x {:?} (inside) and x {:?} (outside). Table 4.2 (a) and the frame rates of (b) \
+         measured third-party ray tracers and are not reproduced. Fixtures: docs/fixtures.md.\n",
+        a.resolution,
+        a.resolution,
+        table_4_2::LIGHT_INSIDE,
+        table_4_2::LIGHT_OUTSIDE
     );
     Ok(())
 }

@@ -3,7 +3,7 @@
 //! stack-based traversal (seed 000, L1878–1888, L1914–1924, L2066–2134),
 //! measured by running the kernels on the emulator over camera flights.
 
-use crate::host::kdtree::{BuildParams, Heuristic, build};
+use crate::host::kdtree::{BuildParams, Heuristic, KdTree, build};
 use crate::host::rt_kernels::{self, Variant};
 use crate::host::scene::Scene;
 use crate::model::Profile;
@@ -93,10 +93,22 @@ pub fn measure(
     frames: u32,
     res: u32,
     variants: &[Variant],
-    mut tick: impl FnMut(u32, Variant),
+    tick: impl FnMut(u32, Variant),
 ) -> Result<SceneRun, SimError> {
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+    measure_tree(scene, &tree, frames, res, variants, tick)
+}
+
+/// As [`measure`], over a given tree.
+pub fn measure_tree(
+    scene: &Scene,
+    tree: &KdTree,
+    frames: u32,
+    res: u32,
+    variants: &[Variant],
+    mut tick: impl FnMut(u32, Variant),
+) -> Result<SceneRun, SimError> {
     let mut totals = vec![Totals::default(); variants.len()];
     for f in 0..frames.min(scene.flight.frames) {
         let mut cam = scene.flight.camera(&scene.camera, f);
@@ -110,7 +122,7 @@ pub fn measure(
                 &mut dev,
                 &module,
                 scene,
-                &tree,
+                tree,
                 &cam,
                 scene.flight.light_offset(f),
                 *v,

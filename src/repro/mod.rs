@@ -3,6 +3,8 @@
 //! side-by-side output.
 
 pub mod flight_tables;
+pub mod table_4_1;
+pub mod table_4_2;
 pub mod table_4_3;
 pub mod table_4_4;
 pub mod timing;
