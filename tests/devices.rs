@@ -78,3 +78,24 @@ fn maxwell_sectors_and_texture_cache() {
     let names: Vec<&str> = s.profiler_names(&c).into_iter().map(|(n, _)| n).collect();
     assert!(names.contains(&"gld_transactions") && names.contains(&"tex_cache_hits"));
 }
+
+#[test]
+fn gt200_texture_cache_is_shared_per_tpc() {
+    // Every thread reads in[0] through the texture path: one 32-byte line per
+    // half-warp lookup. CTAs 0-2 run on SMs 0-2, which share the texture cache of
+    // cluster (TPC) 0; CTAs 3-5 share that of TPC 1. Each cluster misses once
+    // and hits on the other 47 of its 48 half-warp lookups, for any number of host threads.
+    for threads in [1, 2] {
+        let mut dev = Device::with_config(warplight::sim::SimConfig { threads, ..Default::default() });
+        let src = std::fs::read_to_string("kernels/micro/micro.ptx").unwrap();
+        let m = dev.load_ptx(&src, "micro.ptx").unwrap();
+        let out = dev.alloc_zeroed::<f32>(1 << 12);
+        let inb = dev.alloc_zeroed::<f32>(1 << 16);
+        let model = Model::new(Profile::Gt200, &m.prog);
+        let args = [Arg::Ptr(out), Arg::Ptr(inb), Arg::I32(0), Arg::I32(0)];
+        dev.launch_observed(&m, "ldg_gather", LaunchConfig::linear(6, 256), &args, Some(&model)).unwrap();
+        let s = model.finish();
+        assert_eq!(s.counters.texture.sectors, 6 * 16, "{threads} threads");
+        assert_eq!((s.counters.texture.misses, s.counters.texture.hits), (2, 94), "{threads} threads");
+    }
+}

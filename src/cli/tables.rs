@@ -313,7 +313,7 @@ fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs)
                 |r| r.per_ray(|t| t.local_stack_accesses),
             );
             let c_ = ft::markdown_with(
-                "Table 4.8 (c): texture cache hit ratios, % (gt200 profile: an 8 KB cache per CTA; differences in percentage points)",
+                "Table 4.8 (c): texture cache hit ratios, % (gt200 profile: a 5 KB cache per TPC of 3 SMs, all TPCs; differences in percentage points)",
                 &ft::TABLE_4_8C,
                 runs,
                 |r| r.totals.iter().map(|t| t.tex_hits as f64 * 100.0 / t.tex_lookups.max(1) as f64).collect(),

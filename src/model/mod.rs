@@ -168,7 +168,12 @@ pub struct CtaModel {
     counters: MemCounters,
     per_inst: Vec<Vec<InstMem>>,
     l1: Option<cache::SectorCache>,
+    /// A texture cache of this CTA's own (when not shared between SMs).
     tex: Option<cache::SectorCache>,
+    /// Texture lines looked up this round, for a cache shared between SMs:
+    /// the lines of each half-warp lookup end at the next `tex_ends` entry.
+    tex_pending: Vec<u64>,
+    tex_ends: Vec<usize>,
 }
 
 impl CtaModel {
@@ -179,8 +184,10 @@ impl CtaModel {
             counters: MemCounters::default(),
             per_inst: shape.iter().map(|&n| vec![InstMem::default(); n]).collect(),
             l1: (p.l1_bytes > 0).then(|| cache::SectorCache::new(p.l1_bytes, 128, 4)),
-            tex: (p.tex_bytes > 0)
-                .then(|| cache::SectorCache::new(p.tex_bytes, 32 * (1 + (profile != Profile::Gt200) as u64 * 3), 4)),
+            tex: (p.tex_bytes > 0 && p.tex_shared_sms == 1)
+                .then(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways)),
+            tex_pending: Vec::new(),
+            tex_ends: Vec::new(),
         }
     }
 
@@ -210,12 +217,22 @@ impl CtaModel {
                     c.requests += (!lines.is_empty()) as u64;
                     c.sectors += lines.len() as u64;
                     im.sectors += lines.len() as u64;
-                    for s in lines {
-                        if self.tex.as_mut().expect("gt200 texture cache").access(s) {
-                            c.hits += 1;
-                        } else {
-                            c.misses += 1;
+                    match self.tex.as_mut() {
+                        Some(cache) => {
+                            for s in lines {
+                                if cache.access(s) {
+                                    c.hits += 1;
+                                } else {
+                                    c.misses += 1;
+                                }
+                            }
                         }
+                        // a cache shared by the TPC: looked up at the round's end
+                        None if !lines.is_empty() => {
+                            self.tex_pending.extend_from_slice(&lines);
+                            self.tex_ends.push(self.tex_pending.len());
+                        }
+                        None => {}
                     }
                 }
                 im.requests = 1;
@@ -367,6 +384,10 @@ impl MemObserver for CtaModel {
     fn into_any(self: Box<Self>) -> Box<dyn Any> {
         self
     }
+
+    fn as_any_mut(&mut self) -> Option<&mut dyn Any> {
+        Some(self)
+    }
 }
 
 /// A counter model for one launch: hand it to [`crate::sim::Device::launch_observed`],
@@ -375,6 +396,9 @@ pub struct Model {
     profile: Profile,
     shape: Vec<usize>,
     acc: Mutex<ModelStats>,
+    /// Texture caches shared by the SMs of a texture processor cluster (GT200),
+    /// by cluster; created on first use.
+    shared_tex: Mutex<Vec<Option<cache::SectorCache>>>,
 }
 
 /// What a model counted.
@@ -394,7 +418,12 @@ impl Model {
     pub fn new(profile: Profile, prog: &Program) -> Self {
         let shape: Vec<usize> = prog.functions.iter().map(|f| f.insts.len()).collect();
         let per_inst = shape.iter().map(|&n| vec![InstMem::default(); n]).collect();
-        Model { profile, shape, acc: Mutex::new(ModelStats { profile, counters: MemCounters::default(), per_inst }) }
+        Model {
+            profile,
+            shape,
+            acc: Mutex::new(ModelStats { profile, counters: MemCounters::default(), per_inst }),
+            shared_tex: Mutex::new(Vec::new()),
+        }
     }
 
     /// The results (summed over every CTA that retired).
@@ -406,6 +435,62 @@ impl Model {
 impl ObserverFactory for Model {
     fn create(&self, _cta: u32) -> Box<dyn MemObserver> {
         Box::new(CtaModel::new(self.profile, &self.shape))
+    }
+
+    /// Replays the round's texture lookups of the CTAs that share a texture
+    /// cache. CTA `i` runs on SM `i mod SMs` (persistent CTAs: one per SM),
+    /// SMs `3k..3k+2` form cluster `k`; the clusters' CTAs take turns one
+    /// half-warp lookup at a time, in CTA order — a fixed stand-in for the
+    /// hardware's interleaving.
+    fn end_round(&self, observers: &mut [(u32, &mut dyn MemObserver)]) {
+        let p = self.profile.params();
+        if p.tex_bytes == 0 || p.tex_shared_sms <= 1 {
+            return;
+        }
+        let mut ctas: Vec<(u32, &mut CtaModel)> = observers
+            .iter_mut()
+            .filter_map(|(linear, o)| {
+                let cluster = (*linear % p.sms) / p.tex_shared_sms;
+                o.as_any_mut()?.downcast_mut::<CtaModel>().map(|m| (cluster, m))
+            })
+            .filter(|(_, m)| !m.tex_ends.is_empty())
+            .collect();
+        if ctas.is_empty() {
+            return;
+        }
+        ctas.sort_by_key(|c| c.0); // stable: CTA order within a cluster
+        let mut caches = self.shared_tex.lock().expect("model lock");
+        for group in ctas.chunk_by_mut(|a, b| a.0 == b.0) {
+            let k = group[0].0 as usize;
+            if caches.len() <= k {
+                caches.resize(k + 1, None);
+            }
+            let cache = caches[k].get_or_insert_with(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways));
+            let mut next = vec![0usize; group.len()];
+            loop {
+                let mut any = false;
+                for (j, (_, m)) in group.iter_mut().enumerate() {
+                    let Some(&end) = m.tex_ends.get(next[j]) else { continue };
+                    let start = if next[j] == 0 { 0 } else { m.tex_ends[next[j] - 1] };
+                    for i in start..end {
+                        if cache.access(m.tex_pending[i]) {
+                            m.counters.texture.hits += 1;
+                        } else {
+                            m.counters.texture.misses += 1;
+                        }
+                    }
+                    next[j] += 1;
+                    any = true;
+                }
+                if !any {
+                    break;
+                }
+            }
+            for (_, m) in group.iter_mut() {
+                m.tex_pending.clear();
+                m.tex_ends.clear();
+            }
+        }
     }
 
     fn retire(&self, obs: Box<dyn MemObserver>) {

@@ -39,8 +39,14 @@ pub struct Params {
     pub banks: u32,
     /// L1 data cache per SM for global loads (0 = global loads not cached in L1).
     pub l1_bytes: u64,
-    /// Texture / read-only cache per SM (or per TPC) in bytes (0 = none; read-only loads use L1).
+    /// Texture / read-only cache in bytes, one per `tex_shared_sms` SMs (0 = none; read-only loads use L1).
     pub tex_bytes: u64,
+    /// Its line size in bytes (a multiple of the 32-byte sector).
+    pub tex_line: u64,
+    /// Its associativity.
+    pub tex_ways: usize,
+    /// SMs sharing one texture cache: 3 on GT200 (one per texture processor cluster), else 1.
+    pub tex_shared_sms: u32,
 }
 
 impl Profile {
@@ -72,7 +78,10 @@ impl Profile {
                 shared_per_sm: 16 * 1024,
                 banks: 16,
                 l1_bytes: 0,
-                tex_bytes: 8 * 1024,
+                tex_bytes: 5 * 1024,
+                tex_line: 32,
+                tex_ways: 20,
+                tex_shared_sms: 3,
             },
             Profile::Maxwell => Params {
                 name: "maxwell",
@@ -87,6 +96,9 @@ impl Profile {
                 banks: 32,
                 l1_bytes: 0,
                 tex_bytes: 24 * 1024,
+                tex_line: 128,
+                tex_ways: 4,
+                tex_shared_sms: 1,
             },
             Profile::Hopper => Params {
                 name: "hopper",
@@ -101,6 +113,9 @@ impl Profile {
                 banks: 32,
                 l1_bytes: 256 * 1024,
                 tex_bytes: 0,
+                tex_line: 128,
+                tex_ways: 4,
+                tex_shared_sms: 1,
             },
         }
     }

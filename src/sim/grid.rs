@@ -127,6 +127,17 @@ impl<'a> GridRun<'a> {
         for c in &mut self.resident {
             c.commit_atomics(&self.ctx);
         }
+        if let Some(f) = self.ctx.observers {
+            let mut obs: Vec<(u32, &mut dyn super::observer::MemObserver)> = self
+                .resident
+                .iter_mut()
+                .filter_map(|c| {
+                    let linear = c.linear;
+                    c.observer.as_deref_mut().map(|o| (linear, o as &mut dyn super::observer::MemObserver))
+                })
+                .collect();
+            f.end_round(&mut obs);
+        }
         let mut i = 0;
         while i < self.resident.len() {
             if self.resident[i].finished() && self.resident[i].pending.is_empty() {

@@ -53,6 +53,12 @@ pub trait MemObserver: Send {
     fn access(&mut self, ev: &MemEvent);
     /// The observer as `Any`, for its factory to take its results back.
     fn into_any(self: Box<Self>) -> Box<dyn Any>;
+    /// The observer as `Any` while its CTA runs, for factories that settle
+    /// state shared between CTAs at the end of each round (see
+    /// [`ObserverFactory::end_round`]); `None` by default.
+    fn as_any_mut(&mut self) -> Option<&mut dyn Any> {
+        None
+    }
 }
 
 /// Makes one observer per CTA and collects them when the CTA retires.
@@ -62,4 +68,10 @@ pub trait ObserverFactory: Sync {
     fn create(&self, cta: u32) -> Box<dyn MemObserver>;
     /// Takes back a retired CTA's observer.
     fn retire(&self, obs: Box<dyn MemObserver>);
+    /// Called once at the end of every scheduling round, before any CTA
+    /// retires, with the resident CTAs' observers (linear CTA index, observer)
+    /// in CTA order. A model of hardware shared between CTAs (a cache per
+    /// texture processor cluster) replays the round's accesses here in a fixed
+    /// order, so that its results do not depend on host threads. Default: nothing.
+    fn end_round(&self, _observers: &mut [(u32, &mut dyn MemObserver)]) {}
 }
