@@ -234,3 +234,32 @@ fn trace_page_is_self_contained() {
     let back: serde_json::Value = serde_json::from_str(data).unwrap();
     assert_eq!(back["events"].as_array().unwrap().len(), 28);
 }
+
+#[test]
+fn a_fault_keeps_the_view_on_the_faulting_warp() {
+    // thread 37 of `out_of_bounds` stores past the end of its buffer
+    let dir = std::env::temp_dir().join(format!("warplight-fault-view-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ptx = Path::new(env!("CARGO_MANIFEST_DIR")).join("kernels/tests/memory.ptx");
+    let spec = dir.join("fault.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "ptx = {:?}\nkernel = \"out_of_bounds\"\ngrid = 2\nblock = 32\nargs = [\"out\"]\n[[buffer]]\nname = \"out\"\ntype = \"i32\"\nlen = 40\n",
+            ptx.display().to_string()
+        ),
+    )
+    .unwrap();
+    let spec = spec.to_str().unwrap().to_string();
+    let (rows, app) = screen(&spec, options(Profile::Hopper), "c");
+    let t = text(&rows);
+    assert!(app.fault.as_deref().is_some_and(|f| f.contains("out-of-bounds")), "{:?}", app.fault);
+    assert!(t.contains("fault (u steps back)") && t.contains("CTA (1, 0, 0), warp 0, lane 5"), "{t}");
+    assert_eq!(app.sel, (1, 0), "the faulting CTA's warp is selected");
+    // stepping on is refused; stepping back clears the fault
+    let (_, app) = screen(&spec, options(Profile::Hopper), "cs");
+    assert_eq!(app.message, "the launch faulted: u steps back, q quits");
+    let (_, app) = screen(&spec, options(Profile::Hopper), "cu");
+    assert!(app.fault.is_none() && app.steps == 0, "{:?} at {}", app.fault, app.steps);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -146,6 +146,8 @@ pub struct App {
     pub message: String,
     help: bool,
     prompt: Option<Prompt>,
+    /// The fault that stopped the launch, if one did.
+    pub fault: Option<String>,
 }
 
 impl App {
@@ -167,12 +169,14 @@ impl App {
             message: "press s to step the selected warp, ? for help".into(),
             help: false,
             prompt: None,
+            fault: None,
         })
     }
 
     /// Brings a fresh stepper to `target` steps, rebuilding the per-warp notes.
     fn replay(&mut self, st: &mut Stepper, target: u64) -> Result<(), Error> {
         self.steps = 0;
+        self.fault = None;
         self.last.clear();
         self.last_mem.clear();
         self.tracker = Tracker::default();
@@ -331,6 +335,10 @@ impl App {
     }
 
     fn act(&mut self, st: &mut Stepper, a: Action) -> Result<(), Error> {
+        if self.fault.is_some() {
+            self.message = "the launch faulted: u steps back, q quits".into();
+            return Ok(());
+        }
         if st.finished() {
             self.message = "the grid has finished: u steps back, q quits".into();
             return Ok(());
@@ -347,19 +355,39 @@ impl App {
         }
         let start_line = w0.next_source.map(|s| (s.file, s.line));
         let is_sel = move |ev: &StepEvent| (ev.cta_slot, ev.warp) == sel;
-        let stopped = match a {
-            Action::Instruction => self.run_until(st, |_, ev, _| is_sel(ev))?,
+        let result = match a {
+            Action::Instruction => self.run_until(st, |_, ev, _| is_sel(ev)),
             Action::SourceLine => self.run_until(st, |_, ev, w| {
                 let line = w.next_source.map(|s| (s.file, s.line));
                 is_sel(ev) && (w.next_pc.is_none() || (line != start_line && line.is_none_or(|l| l.1 != 0)))
-            })?,
-            Action::Goto(l) => self.run_until(st, |_, ev, w| is_sel(ev) && w.next_ptx_line == Some(l))?,
-            Action::Barrier => self.run_until(st, |_, ev, _| is_sel(ev) && ev.opcode.starts_with("bar"))?,
-            Action::Continue => self.run_until(st, |app, ev, w| app.o.breaks.hit(ev, w).is_some())?,
+            }),
+            Action::Goto(l) => self.run_until(st, |_, ev, w| is_sel(ev) && w.next_ptx_line == Some(l)),
+            Action::Barrier => self.run_until(st, |_, ev, _| is_sel(ev) && ev.opcode.starts_with("bar")),
+            Action::Continue => self.run_until(st, |app, ev, w| app.o.breaks.hit(ev, w).is_some()),
         };
         if self.steps > start {
             self.history.push(start);
         }
+        let stopped = match result {
+            Ok(s) => s,
+            Err(e) => {
+                // the launch faulted: keep the view on the faulting warp, show the fault,
+                // allow stepping back
+                let fault = e
+                    .downcast_ref::<Box<crate::sim::fault::Fault>>()
+                    .map(|b| &**b)
+                    .or_else(|| e.downcast_ref::<crate::sim::fault::Fault>());
+                if let Some(f) = fault
+                    && let Some(slot) = st.resident_ctas().iter().position(|c| *c == f.cta)
+                {
+                    self.sel = (slot, f.warp);
+                }
+                let text = e.to_string().replace('\t', " ");
+                self.message = format!("fault: {} (u steps back)", text.lines().next().unwrap_or(""));
+                self.fault = Some(text);
+                return Ok(());
+            }
+        };
         if let Some(ev) = stopped {
             if a == Action::Continue {
                 self.sel = (ev.cta_slot, ev.warp);
@@ -417,6 +445,16 @@ impl App {
             Panel::Stack => self.draw_stack(f, lower, st, w.as_ref()),
             Panel::Registers => self.draw_registers(f, lower, st, w.as_ref()),
             Panel::Memory => self.draw_memory(f, lower, st),
+        }
+        if let Some(fault) = &self.fault {
+            f.render_widget(Clear, lower);
+            f.render_widget(
+                Paragraph::new(fault.as_str())
+                    .style(Style::new().fg(Color::Red))
+                    .wrap(ratatui::widgets::Wrap { trim: false })
+                    .block(Block::default().borders(Borders::ALL).title(" fault (u steps back) ")),
+                lower,
+            );
         }
         let m = match &self.prompt {
             Some(Prompt::Goto(t)) => format!("run the warp to PTX line: {t}_   (Enter: go, Esc: cancel)"),
