@@ -570,6 +570,63 @@ pub fn compare(cmp: Cmp, ty: Ty, ftz: bool, a: u64, b: u64) -> bool {
     }
 }
 
+/// Evaluates a comparison in all 32 lanes: bit `l` of the result is lane `l`'s
+/// outcome, exactly as [`compare`] gives it. The type and the comparison are
+/// dispatched once per warp instead of once per lane (`setp` is the most
+/// frequent instruction of the ray-tracing kernels).
+pub fn compare_lanes(cmp: Cmp, ty: Ty, ftz: bool, a: &[u64; 32], b: &[u64; 32]) -> u32 {
+    #[inline(always)]
+    fn each(a: &[u64; 32], b: &[u64; 32], f: impl Fn(u64, u64) -> bool) -> u32 {
+        let mut t = 0u32;
+        for l in 0..32 {
+            t |= (f(a[l], b[l]) as u32) << l;
+        }
+        t
+    }
+    let generic = |a: &[u64; 32], b: &[u64; 32]| each(a, b, |x, y| compare(cmp, ty, ftz, x, y));
+    macro_rules! ordered {
+        ($conv:expr) => {{
+            let c = $conv;
+            match cmp {
+                Cmp::Eq => each(a, b, |x, y| c(x) == c(y)),
+                Cmp::Ne => each(a, b, |x, y| {
+                    let (x, y) = (c(x), c(y));
+                    !(x.is_nan() || y.is_nan()) && x != y
+                }),
+                Cmp::Lt | Cmp::Lo => each(a, b, |x, y| c(x) < c(y)),
+                Cmp::Le | Cmp::Ls => each(a, b, |x, y| c(x) <= c(y)),
+                Cmp::Gt | Cmp::Hi => each(a, b, |x, y| c(x) > c(y)),
+                Cmp::Ge | Cmp::Hs => each(a, b, |x, y| c(x) >= c(y)),
+                _ => generic(a, b),
+            }
+        }};
+    }
+    match ty {
+        Ty::F32 if ftz => ordered!(|x: u64| ftz32(f32of(x))),
+        Ty::F32 => ordered!(f32of),
+        Ty::F64 => ordered!(f64::from_bits),
+        t if t.is_float() => generic(a, b),
+        t => {
+            let m = t.mask();
+            let sh = 64 - t.bits().min(64);
+            let sx = |x: u64| ((x << sh) as i64) >> sh;
+            match (cmp, t.is_signed()) {
+                (Cmp::Eq | Cmp::Equ, _) => each(a, b, |x, y| x & m == y & m),
+                (Cmp::Ne | Cmp::Neu, _) => each(a, b, |x, y| x & m != y & m),
+                (Cmp::Lt | Cmp::Ltu, true) => each(a, b, |x, y| sx(x) < sx(y)),
+                (Cmp::Le | Cmp::Leu, true) => each(a, b, |x, y| sx(x) <= sx(y)),
+                (Cmp::Gt | Cmp::Gtu, true) => each(a, b, |x, y| sx(x) > sx(y)),
+                (Cmp::Ge | Cmp::Geu, true) => each(a, b, |x, y| sx(x) >= sx(y)),
+                (Cmp::Lt | Cmp::Ltu | Cmp::Lo, _) => each(a, b, |x, y| x & m < y & m),
+                (Cmp::Le | Cmp::Leu | Cmp::Ls, _) => each(a, b, |x, y| x & m <= y & m),
+                (Cmp::Gt | Cmp::Gtu | Cmp::Hi, _) => each(a, b, |x, y| x & m > y & m),
+                (Cmp::Ge | Cmp::Geu | Cmp::Hs, _) => each(a, b, |x, y| x & m >= y & m),
+                _ => generic(a, b),
+            }
+        }
+    }
+}
+
 fn round_int_f64(x: f64, rnd: Option<Rounding>) -> f64 {
     match rnd {
         Some(Rounding::Rni) | Some(Rounding::Rn) => x.round_ties_even(),
@@ -720,6 +777,82 @@ pub fn atom(op: AtomOp, ty: Ty, old: u64, b: u64, c: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn compare_lanes_agrees_with_compare_lane_by_lane() {
+        let edges: Vec<u64> = vec![
+            0,
+            1,
+            u64::MAX,
+            0x7f,
+            0x80,
+            0xffff,
+            0x8000,
+            0x7fff_ffff,
+            0x8000_0000,
+            0xffff_ffff,
+            i64::MIN as u64,
+            i64::MAX as u64,
+            1.5f32.to_bits() as u64,
+            (-2.0f32).to_bits() as u64,
+            f32::NAN.to_bits() as u64,
+            f32::INFINITY.to_bits() as u64,
+            (-0.0f32).to_bits() as u64,
+            1u64, // the smallest f32 subnormal
+            0x8000_0001,
+            f64::NAN.to_bits(),
+            (-0.0f64).to_bits(),
+            2.5f64.to_bits(),
+        ];
+        let cmps = [
+            Cmp::Eq,
+            Cmp::Ne,
+            Cmp::Lt,
+            Cmp::Le,
+            Cmp::Gt,
+            Cmp::Ge,
+            Cmp::Lo,
+            Cmp::Ls,
+            Cmp::Hi,
+            Cmp::Hs,
+            Cmp::Equ,
+            Cmp::Neu,
+            Cmp::Ltu,
+            Cmp::Leu,
+            Cmp::Gtu,
+            Cmp::Geu,
+            Cmp::Num,
+            Cmp::Nan,
+        ];
+        let tys = [
+            Ty::S8,
+            Ty::U8,
+            Ty::S16,
+            Ty::U16,
+            Ty::B16,
+            Ty::S32,
+            Ty::U32,
+            Ty::B32,
+            Ty::S64,
+            Ty::U64,
+            Ty::B64,
+            Ty::F32,
+            Ty::F64,
+        ];
+        let n = edges.len();
+        for round in 0..n {
+            let a: [u64; 32] = std::array::from_fn(|l| edges[(l + round) % n]);
+            let b: [u64; 32] = std::array::from_fn(|l| edges[(l * 7 + round * 3) % n]);
+            for ty in tys {
+                for cmp in cmps {
+                    for ftz in [false, true] {
+                        let want = (0..32).fold(0u32, |t, l| t | (compare(cmp, ty, ftz, a[l], b[l]) as u32) << l);
+                        assert_eq!(compare_lanes(cmp, ty, ftz, &a, &b), want, "{cmp:?} {ty:?} ftz {ftz}");
+                    }
+                }
+            }
+        }
+    }
 
     const M: FloatMode = FloatMode { rnd: None, ftz: false, sat: false, approx: false };
 

@@ -613,12 +613,7 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         }
         Kind::Setp { cmp, ty, p, q, a, b, comb, ftz } => {
             let (va, vb) = (read(ctx, w, cta, *a), read(ctx, w, cta, *b));
-            let mut t = 0u32;
-            for l in 0..32 {
-                if alu::compare(*cmp, *ty, *ftz, va[l], vb[l]) {
-                    t |= 1 << l;
-                }
-            }
+            let t = alu::compare_lanes(*cmp, *ty, *ftz, &va, &vb);
             let fr = w.frames.last_mut().expect("frame");
             let (pv, qv) = match comb {
                 Some((op, c)) => {
