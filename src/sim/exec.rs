@@ -171,6 +171,9 @@ fn read(ctx: &Ctx, w: &Warp, cta: &CtaMut, s: Src) -> Lanes {
 
 /// An operand's lanes: a register borrowed from the frame, or a value built
 /// for any other source. Saves copying 256 bytes per register operand.
+// Boxing the value would allocate per operand; the enum lives on the stack
+// for one instruction.
+#[allow(clippy::large_enum_variant)]
 enum Operand<'a> {
     Reg(&'a Lanes),
     Value(Lanes),
