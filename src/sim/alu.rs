@@ -570,6 +570,23 @@ pub fn compare(cmp: Cmp, ty: Ty, ftz: bool, a: u64, b: u64) -> bool {
     }
 }
 
+/// The float types [`compare_lanes`] specialises on.
+trait Float: Copy + PartialOrd {
+    fn is_nan(self) -> bool;
+}
+
+impl Float for f32 {
+    fn is_nan(self) -> bool {
+        f32::is_nan(self)
+    }
+}
+
+impl Float for f64 {
+    fn is_nan(self) -> bool {
+        f64::is_nan(self)
+    }
+}
+
 /// Evaluates a comparison in all 32 lanes: bit `l` of the result is lane `l`'s
 /// outcome, exactly as [`compare`] gives it. The type and the comparison are
 /// dispatched once per warp instead of once per lane (`setp` is the most
@@ -584,6 +601,10 @@ pub fn compare_lanes(cmp: Cmp, ty: Ty, ftz: bool, a: &[u64; 32], b: &[u64; 32]) 
         t
     }
     let generic = |a: &[u64; 32], b: &[u64; 32]| each(a, b, |x, y| compare(cmp, ty, ftz, x, y));
+    #[inline(always)]
+    fn unordered<F: Float>(x: F, y: F, f: impl Fn(F, F) -> bool) -> bool {
+        x.is_nan() || y.is_nan() || f(x, y)
+    }
     macro_rules! ordered {
         ($conv:expr) => {{
             let c = $conv;
@@ -597,7 +618,15 @@ pub fn compare_lanes(cmp: Cmp, ty: Ty, ftz: bool, a: &[u64; 32], b: &[u64; 32]) 
                 Cmp::Le | Cmp::Ls => each(a, b, |x, y| c(x) <= c(y)),
                 Cmp::Gt | Cmp::Hi => each(a, b, |x, y| c(x) > c(y)),
                 Cmp::Ge | Cmp::Hs => each(a, b, |x, y| c(x) >= c(y)),
-                _ => generic(a, b),
+                // unordered: true where either is NaN
+                Cmp::Equ => each(a, b, |x, y| unordered(c(x), c(y), |x, y| x == y)),
+                Cmp::Neu => each(a, b, |x, y| c(x) != c(y)),
+                Cmp::Ltu => each(a, b, |x, y| unordered(c(x), c(y), |x, y| x < y)),
+                Cmp::Leu => each(a, b, |x, y| unordered(c(x), c(y), |x, y| x <= y)),
+                Cmp::Gtu => each(a, b, |x, y| unordered(c(x), c(y), |x, y| x > y)),
+                Cmp::Geu => each(a, b, |x, y| unordered(c(x), c(y), |x, y| x >= y)),
+                Cmp::Num => each(a, b, |x, y| !(c(x).is_nan() || c(y).is_nan())),
+                Cmp::Nan => each(a, b, |x, y| c(x).is_nan() || c(y).is_nan()),
             }
         }};
     }
