@@ -1,6 +1,7 @@
 //! `warplight trace SPEC.toml -o trace.html`: record a launch into one
 //! self-contained HTML timeline (see `crate::teach::trace`).
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use crate::model::Profile;
@@ -52,7 +53,21 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let session = Session::load_launch(&a.spec, a.launch)?;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
-    let t = trace::record(&session, &o)?;
+    let spinner = std::io::stderr().is_terminal().then(|| {
+        let pb = indicatif::ProgressBar::new_spinner();
+        pb.set_style(indicatif::ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("template"));
+        pb
+    });
+    let t = trace::record_with(&session, &o, |steps| {
+        if let Some(pb) = &spinner {
+            pb.set_message(format!("recording {}: {steps} warp instructions", session.kernel));
+            pb.tick();
+        }
+    });
+    if let Some(pb) = spinner {
+        pb.finish_and_clear();
+    }
+    let t = t?;
     if t.events.is_empty() {
         return Err("nothing recorded: no instruction matched --cta/--warp/--from/--to".into());
     }

@@ -120,6 +120,11 @@ pub struct Trace {
 
 /// Records the session's launch.
 pub fn record(session: &Session, o: &TraceOptions) -> Result<Trace, Error> {
+    record_with(session, o, |_| {})
+}
+
+/// As [`record`], calling `tick(steps)` every 4096 warp instructions (for a progress display).
+pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64)) -> Result<Trace, Error> {
     session.with_stepper(|st| {
         let prog = &st.module().prog;
         let l = session.launch_spec();
@@ -151,6 +156,9 @@ pub fn record(session: &Session, o: &TraceOptions) -> Result<Trace, Error> {
                 break;
             };
             step += 1;
+            if step % 4096 == 0 {
+                tick(step);
+            }
             let w = st.warp(ev.cta_slot, ev.warp).ok_or("stepped warp vanished")?;
             let fx = tracker.observe(&ev, &w);
             let linear = ev.cta[0] + grid[0] * (ev.cta[1] + grid[1] * ev.cta[2]);
