@@ -156,7 +156,7 @@ pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64
                 break;
             };
             step += 1;
-            if step % 4096 == 0 {
+            if step.is_multiple_of(4096) {
                 tick(step);
             }
             let w = st.warp(ev.cta_slot, ev.warp).ok_or("stepped warp vanished")?;
