@@ -256,6 +256,7 @@ fn a_fault_keeps_the_view_on_the_faulting_warp() {
     assert!(app.fault.as_deref().is_some_and(|f| f.contains("out-of-bounds")), "{:?}", app.fault);
     assert!(t.contains("fault (u steps back)") && t.contains("CTA (1, 0, 0), warp 0, lane 5"), "{t}");
     assert_eq!(app.sel, (1, 0), "the faulting CTA's warp is selected");
+    assert!(t.contains("> 234 st.global.u32"), "the PTX pane shows the faulting store:\n{t}");
     // stepping on is refused; stepping back clears the fault
     let (_, app) = screen(&spec, options(Profile::Hopper), "cs");
     assert_eq!(app.message, "the launch faulted: u steps back, q quits");

@@ -148,6 +148,8 @@ pub struct App {
     prompt: Option<Prompt>,
     /// The fault that stopped the launch, if one did.
     pub fault: Option<String>,
+    /// Its PTX line (the PTX pane shows it rather than the warp's next line).
+    fault_line: Option<u32>,
 }
 
 impl App {
@@ -170,6 +172,7 @@ impl App {
             help: false,
             prompt: None,
             fault: None,
+            fault_line: None,
         })
     }
 
@@ -177,6 +180,7 @@ impl App {
     fn replay(&mut self, st: &mut Stepper, target: u64) -> Result<(), Error> {
         self.steps = 0;
         self.fault = None;
+        self.fault_line = None;
         self.last.clear();
         self.last_mem.clear();
         self.tracker = Tracker::default();
@@ -381,6 +385,7 @@ impl App {
                     && let Some(slot) = st.resident_ctas().iter().position(|c| *c == f.cta)
                 {
                     self.sel = (slot, f.warp);
+                    self.fault_line = Some(f.ptx_line);
                 }
                 let text = e.to_string().replace('\t', " ");
                 self.message = format!("fault: {} (u steps back)", text.lines().next().unwrap_or(""));
@@ -501,7 +506,7 @@ impl App {
 
     fn draw_ptx(&self, f: &mut Frame, area: Rect, st: &Stepper, w: Option<&WarpView>) {
         let prog = &st.module().prog;
-        let cur = w.and_then(|w| w.next_ptx_line).unwrap_or(0) as usize;
+        let cur = self.fault_line.or_else(|| w.and_then(|w| w.next_ptx_line)).unwrap_or(0) as usize;
         let body = window(&prog.ptx_lines, cur, area, true, |n| {
             if n == cur {
                 ('>', reversed())
