@@ -101,38 +101,50 @@ fn per_scene<T>(names: &[String], what: &str, mut f: impl FnMut(&Scene) -> T) ->
 }
 
 fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let names: Vec<String> = if a.scenes.is_empty() {
-        table_4_3::THESIS.iter().map(|r| r.0.to_string()).collect()
-    } else {
-        a.scenes.clone()
-    };
-    let (rows, skipped) = per_scene(&names, "three trees (the numerical one takes a while) and the flight", |s| {
-        table_4_3::measure(s, a.frames, a.resolution)
-    });
+    let all: Vec<&str> = table_4_3::THESIS.iter().map(|r| r.0).collect();
+    let (rows, skipped) =
+        per_scene(&scene_names(a, &all), "three trees (the numerical one takes a while) and the flight", |s| {
+            table_4_3::measure(s, a.frames, a.resolution)
+        });
     for sk in skipped {
         eprintln!("skipped {sk}");
     }
-    if a.format == "json" {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
-        return Ok(());
+    let title = "Table 4.3: traversals, plane and triangle intersections per ray with the numerical approximation (4.1.2) and SIROH, relative to the SAH (thesis 000, seed L1699-1709)";
+    if emit(a, &rows, title, table_4_3::markdown)? {
+        println!(
+            "\nOurs: stack-based traversal (the native caster, step for step the stack kernel), {} frame(s) of each flight at {}x{}.\n",
+            a.frames, a.resolution, a.resolution
+        );
     }
-    println!(
-        "Table 4.3: traversals, plane and triangle intersections per ray with the numerical approximation (4.1.2) and SIROH, relative to the SAH (thesis 000, seed L1699-1709)\n"
-    );
-    print!("{}", table_4_3::markdown(&rows));
-    println!(
-        "\nOurs: stack-based traversal (the native caster, step for step the stack kernel), {} frame(s) of each flight at {}x{}.\n",
-        a.frames, a.resolution, a.resolution
-    );
     Ok(())
+}
+
+/// The scenes asked for with `--scenes`, or `all`.
+fn scene_names(a: &TablesArgs, all: &[&str]) -> Vec<String> {
+    if a.scenes.is_empty() { all.iter().map(|s| s.to_string()).collect() } else { a.scenes.clone() }
+}
+
+/// Prints `rows` as JSON with `--format json`; otherwise prints `title` and the
+/// table `markdown` makes of them, and returns true so that the caller adds its notes.
+fn emit<T: serde::Serialize>(
+    a: &TablesArgs,
+    rows: &[T],
+    title: &str,
+    markdown: impl FnOnce(&[T]) -> String,
+) -> Result<bool, Box<dyn std::error::Error>> {
+    if a.format == "json" {
+        println!("{}", serde_json::to_string_pretty(rows)?);
+        return Ok(false);
+    }
+    println!("{title}\n");
+    print!("{}", markdown(rows));
+    Ok(true)
 }
 
 /// Loads the named scenes (default: `all`), reporting those that cannot be loaded.
 fn load_scenes(a: &TablesArgs, all: &[&str]) -> Vec<Scene> {
-    let names: Vec<String> =
-        if a.scenes.is_empty() { all.iter().map(|s| s.to_string()).collect() } else { a.scenes.clone() };
     let mut scenes = Vec::new();
-    for n in &names {
+    for n in &scene_names(a, all) {
         match scene_file::load(&scene_path(n)) {
             Ok(s) => scenes.push(s),
             Err(e) => eprintln!("skipped {n}: {e}"),
@@ -172,52 +184,37 @@ fn table_4_1(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(pb) = pb {
         pb.finish_and_clear();
     }
-    if a.format == "json" {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
-        return Ok(());
+    let title = "Table 4.1: frame rates with the numerical approximation (4.1.2) and SIROH relative to the SAH, two code bases (thesis 000, seed L1664-1674)";
+    if emit(a, &rows, title, table_4_1::markdown)? {
+        println!(
+            "Ours: the stack-based kernel on each heuristic's tree, {} frame(s) of each flight at {}x{}, frame rates from the GT200 timing model. \
+             Code base I is not described beyond its SAH frame rates; compare the signs and sizes of the relative columns. \
+             Fixtures: docs/fixtures.md.\n",
+            a.frames, a.resolution, a.resolution
+        );
     }
-    println!(
-        "Table 4.1: frame rates with the numerical approximation (4.1.2) and SIROH relative to the SAH, two code bases (thesis 000, seed L1664-1674)
-"
-    );
-    print!("{}", table_4_1::markdown(&rows));
-    println!(
-        "Ours: the stack-based kernel on each heuristic's tree, {} frame(s) of each flight at {}x{}, frame rates from the GT200 timing model. \
-         Code base I is not described beyond its SAH frame rates; compare the signs and sizes of the relative columns. \
-         Fixtures: docs/fixtures.md.\n",
-        a.frames, a.resolution, a.resolution
-    );
     Ok(())
 }
 
 fn table_4_2(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let names: Vec<String> = if a.scenes.is_empty() {
-        table_4_1::THESIS.iter().map(|r| r.0.to_string()).collect()
-    } else {
-        a.scenes.clone()
-    };
+    let all: Vec<&str> = table_4_1::THESIS.iter().map(|r| r.0).collect();
     let (rows, skipped) =
-        per_scene(&names, "SAH and SIROH trees, shadow rays", |s| table_4_2::measure(s, a.resolution));
+        per_scene(&scene_names(a, &all), "SAH and SIROH trees, shadow rays", |s| table_4_2::measure(s, a.resolution));
     for sk in skipped {
         eprintln!("skipped {sk}");
     }
-    if a.format == "json" {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
-        return Ok(());
+    let title = "Table 4.2 (b), qualitatively: SIROH vs SAH for shadow rays from a light inside and outside the scene (thesis 000, seed L1682-1697)";
+    if emit(a, &rows, title, table_4_2::markdown)? {
+        println!(
+            "\nOurs: shadow rays traced from the light to every primary hit of frame 0 at {}x{}, inner-node traversals per ray (native caster). \
+             Lights at the scene centre + extent x {:?} (inside) and x {:?} (outside). Table 4.2 (a) and the frame rates of (b) \
+             measured third-party ray tracers and are not reproduced. Fixtures: docs/fixtures.md.\n",
+            a.resolution,
+            a.resolution,
+            table_4_2::LIGHT_INSIDE,
+            table_4_2::LIGHT_OUTSIDE
+        );
     }
-    println!(
-        "Table 4.2 (b), qualitatively: SIROH vs SAH for shadow rays from a light inside and outside the scene (thesis 000, seed L1682-1697)\n"
-    );
-    print!("{}", table_4_2::markdown(&rows));
-    println!(
-        "\nOurs: shadow rays traced from the light to every primary hit of frame 0 at {}x{}, inner-node traversals per ray (native caster). \
-         Lights at the scene centre + extent x {:?} (inside) and x {:?} (outside). Table 4.2 (a) and the frame rates of (b) \
-         measured third-party ray tracers and are not reproduced. Fixtures: docs/fixtures.md.\n",
-        a.resolution,
-        a.resolution,
-        table_4_2::LIGHT_INSIDE,
-        table_4_2::LIGHT_OUTSIDE
-    );
     Ok(())
 }
 
@@ -225,29 +222,10 @@ fn flight_runs(
     a: &TablesArgs,
     variants: &[Variant],
 ) -> Result<Vec<flight_tables::SceneRun>, Box<dyn std::error::Error>> {
-    let names: Vec<String> = if a.scenes.is_empty() {
-        flight_tables::TABLE_4_5.iter().map(|r| r.0.to_string()).collect()
-    } else {
-        a.scenes.clone()
-    };
-    let mut scenes = Vec::new();
-    for n in &names {
-        match scene_file::load(&scene_path(n)) {
-            Ok(s) => scenes.push(s),
-            Err(e) => eprintln!("skipped {n}: {e}"),
-        }
-    }
+    let all: Vec<&str> = flight_tables::TABLE_4_5.iter().map(|r| r.0).collect();
+    let scenes = load_scenes(a, &all);
     let total: u64 = scenes.iter().map(|s| (a.frames.min(s.flight.frames) as usize * variants.len()) as u64).sum();
-    let pb = std::io::stderr().is_terminal().then(|| {
-        let pb = indicatif::ProgressBar::new(total);
-        pb.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:30} {pos}/{len} frames x variants, {msg} [{elapsed}, eta {eta}]",
-            )
-            .expect("template"),
-        );
-        pb
-    });
+    let pb = frame_bar(total, "frames x variants");
     let mut runs = Vec::new();
     for s in &scenes {
         let r = flight_tables::measure(s, a.frames, a.resolution, variants, |f, v| {
