@@ -5,6 +5,7 @@ pub mod ptx_info;
 pub mod render;
 pub mod scene_info;
 pub mod step;
+pub mod table_format;
 pub mod tables;
 pub mod trace;
 

@@ -8,6 +8,21 @@ use crate::host::scene::Scene;
 use crate::host::scene_file;
 use crate::repro::{flight_tables, table_4_1, table_4_2, table_4_3, table_4_4};
 
+/// `println!` into the output buffer.
+macro_rules! outln {
+    ($out:expr, $($arg:tt)*) => {{
+        $out.push_str(&format!($($arg)*));
+        $out.push('\n');
+    }};
+}
+
+/// `print!` into the output buffer.
+macro_rules! outp {
+    ($out:expr, $($arg:tt)*) => {
+        $out.push_str(&format!($($arg)*))
+    };
+}
+
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
 pub struct TablesArgs {
@@ -26,7 +41,8 @@ pub struct TablesArgs {
     /// Builds per heuristic; the fastest time counts.
     #[arg(long, default_value_t = 1)]
     pub repeats: u32,
-    /// Output: markdown (default) or json.
+    /// Output: markdown (default), table (aligned columns for a terminal), csv (every
+    /// table's rows with the table's name in the first column) or json (the raw measurements).
     #[arg(long, default_value = "markdown")]
     pub format: String,
 }
@@ -36,6 +52,10 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.tables.is_empty() {
         return Err("name a table: 4.4".into());
     }
+    if !["markdown", "json", "csv", "table"].contains(&a.format.as_str()) {
+        return Err(format!("--format {}: expected markdown, table, csv or json", a.format).into());
+    }
+    let mut out = String::new();
     let (mut traversal, mut caches) = (None, None);
     let tables: Vec<&str> = if a.tables.iter().any(|t| t == "all") {
         vec!["4.1", "4.2", "4.3", "4.4", "4.5", "4.6", "4.7", "4.8", "4.9", "4.10"]
@@ -44,21 +64,21 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     for t in tables {
         match t {
-            "4.1" => table_4_1(&a)?,
-            "4.2" => table_4_2(&a)?,
-            "4.3" => table_4_3(&a)?,
-            "4.4" => table_4_4(&a)?,
+            "4.1" => table_4_1(&a, &mut out)?,
+            "4.2" => table_4_2(&a, &mut out)?,
+            "4.3" => table_4_3(&a, &mut out)?,
+            "4.4" => table_4_4(&a, &mut out)?,
             "4.5" | "4.6" | "4.7" => {
                 if traversal.is_none() {
                     traversal = Some(flight_runs(&a, &Variant::ALL)?);
                 }
-                print_flight_table(t, traversal.as_ref().expect("measured"), &a);
+                print_flight_table(t, traversal.as_ref().expect("measured"), &a, &mut out);
             }
             "4.8" | "4.9" | "4.10" => {
                 if caches.is_none() {
                     caches = Some(flight_runs(&a, &Variant::CACHES)?);
                 }
-                print_flight_table(t, caches.as_ref().expect("measured"), &a);
+                print_flight_table(t, caches.as_ref().expect("measured"), &a, &mut out);
             }
             other => {
                 return Err(format!(
@@ -67,6 +87,11 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
                 .into());
             }
         }
+    }
+    match a.format.as_str() {
+        "csv" => print!("{}", super::table_format::csv(&out)),
+        "table" => print!("{}", super::table_format::terminal(&out)),
+        _ => print!("{out}"),
     }
     Ok(())
 }
@@ -100,7 +125,7 @@ fn per_scene<T>(names: &[String], what: &str, mut f: impl FnMut(&Scene) -> T) ->
     (out, skipped)
 }
 
-fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+fn table_4_3(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
     let all: Vec<&str> = table_4_3::THESIS.iter().map(|r| r.0).collect();
     let (rows, skipped) =
         per_scene(&scene_names(a, &all), "three trees (the numerical one takes a while) and the flight", |s| {
@@ -110,10 +135,13 @@ fn table_4_3(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("skipped {sk}");
     }
     let title = "Table 4.3: traversals, plane and triangle intersections per ray with the numerical approximation (4.1.2) and SIROH, relative to the SAH (thesis 000, seed L1699-1709)";
-    if emit(a, &rows, title, table_4_3::markdown)? {
-        println!(
+    if emit(a, out, &rows, title, table_4_3::markdown)? {
+        outln!(
+            out,
             "\nOurs: stack-based traversal (the native caster, step for step the stack kernel), {} frame(s) of each flight at {}x{}.\n",
-            a.frames, a.resolution, a.resolution
+            a.frames,
+            a.resolution,
+            a.resolution
         );
     }
     Ok(())
@@ -128,6 +156,7 @@ fn scene_names(a: &TablesArgs, all: &[&str]) -> Vec<String> {
 /// table `markdown` makes of them, and returns true so that the caller adds its notes.
 fn emit<T: serde::Serialize>(
     a: &TablesArgs,
+    out: &mut String,
     rows: &[T],
     title: &str,
     markdown: impl FnOnce(&[T]) -> String,
@@ -136,8 +165,7 @@ fn emit<T: serde::Serialize>(
         println!("{}", serde_json::to_string_pretty(rows)?);
         return Ok(false);
     }
-    println!("{title}\n");
-    print!("{}", markdown(rows));
+    out.push_str(&format!("{title}\n\n{}", markdown(rows)));
     Ok(true)
 }
 
@@ -167,7 +195,7 @@ fn frame_bar(total: u64, unit: &str) -> Option<indicatif::ProgressBar> {
     })
 }
 
-fn table_4_1(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+fn table_4_1(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
     let all: Vec<&str> = table_4_1::THESIS.iter().map(|r| r.0).collect();
     let scenes = load_scenes(a, &all);
     let total: u64 = scenes.iter().map(|s| 3 * a.frames.min(s.flight.frames) as u64).sum();
@@ -185,18 +213,21 @@ fn table_4_1(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         pb.finish_and_clear();
     }
     let title = "Table 4.1: frame rates with the numerical approximation (4.1.2) and SIROH relative to the SAH, two code bases (thesis 000, seed L1664-1674)";
-    if emit(a, &rows, title, table_4_1::markdown)? {
-        println!(
+    if emit(a, out, &rows, title, table_4_1::markdown)? {
+        outln!(
+            out,
             "Ours: the stack-based kernel on each heuristic's tree, {} frame(s) of each flight at {}x{}, frame rates from the GT200 timing model. \
              Code base I is not described beyond its SAH frame rates; compare the signs and sizes of the relative columns. \
              Fixtures: docs/fixtures.md.\n",
-            a.frames, a.resolution, a.resolution
+            a.frames,
+            a.resolution,
+            a.resolution
         );
     }
     Ok(())
 }
 
-fn table_4_2(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+fn table_4_2(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
     let all: Vec<&str> = table_4_1::THESIS.iter().map(|r| r.0).collect();
     let (rows, skipped) =
         per_scene(&scene_names(a, &all), "SAH and SIROH trees, shadow rays", |s| table_4_2::measure(s, a.resolution));
@@ -204,8 +235,9 @@ fn table_4_2(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         eprintln!("skipped {sk}");
     }
     let title = "Table 4.2 (b), qualitatively: SIROH vs SAH for shadow rays from a light inside and outside the scene (thesis 000, seed L1682-1697)";
-    if emit(a, &rows, title, table_4_2::markdown)? {
-        println!(
+    if emit(a, out, &rows, title, table_4_2::markdown)? {
+        outln!(
+            out,
             "\nOurs: shadow rays traced from the light to every primary hit of frame 0 at {}x{}, inner-node traversals per ray (native caster). \
              Lights at the scene centre + extent x {:?} (inside) and x {:?} (outside). Table 4.2 (a) and the frame rates of (b) \
              measured third-party ray tracers and are not reproduced. Fixtures: docs/fixtures.md.\n",
@@ -242,7 +274,7 @@ fn flight_runs(
     Ok(runs)
 }
 
-fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs) {
+fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs, out: &mut String) {
     use flight_tables as ft;
     if a.format == "json" {
         println!("{}", serde_json::to_string_pretty(runs).unwrap_or_default());
@@ -306,17 +338,22 @@ fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs)
             format!("{a_}\n{b_}\n{c_}\n{d_}")
         }
     };
-    println!("{md}");
-    println!(
+    out.push_str(&md);
+    out.push('\n');
+    outln!(
+        out,
         "Ours: SIROH trees, {} frame(s) of each flight at {}x{}, 30 persistent CTAs x 256 threads, 32-pixel job blocks, clang-16 PTX.",
-        a.frames, a.resolution, a.resolution
+        a.frames,
+        a.resolution,
+        a.resolution
     );
-    println!(
+    outln!(
+        out,
         "Fixtures: docs/fixtures.md. Instructions are PTX instructions, not GT200 SASS; scene variants as in `warplight scene info`.\n"
     );
 }
 
-fn table_4_4(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
+fn table_4_4(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
     let names: Vec<String> = if a.scenes.is_empty() {
         table_4_4::THESIS.iter().map(|r| r.scene.to_string()).collect()
     } else {
@@ -327,9 +364,10 @@ fn table_4_4(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         println!("{}", serde_json::to_string_pretty(&rows)?);
         return Ok(());
     }
-    println!("Table 4.4: kd-tree construction with SIROH relative to the SAH (thesis 000, seed L1711-1721)\n");
-    print!("{}", table_4_4::markdown(&rows));
-    println!(
+    outln!(out, "Table 4.4: kd-tree construction with SIROH relative to the SAH (thesis 000, seed L1711-1721)\n");
+    outp!(out, "{}", table_4_4::markdown(&rows));
+    outln!(
+        out,
         "\nOurs: this machine, single-threaded, best of {} build(s); thesis timings are CPU II (Core2 Quad Q9450).\n\
          Fixtures (docs/fixtures.md): C_T = 1, C_I = 3, leaves at <= 4 triangles, empty-space bias 20% above 30% volume,\n\
          depth <= 32, triangle bounds clamped to the node (no clipping), ties to the first candidate in (axis, position) order.\n\
@@ -337,7 +375,7 @@ fn table_4_4(a: &TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         a.repeats
     );
     for s in skipped {
-        println!("skipped {s}");
+        eprintln!("skipped {s}");
     }
     Ok(())
 }
