@@ -347,9 +347,11 @@ fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs,
         a.resolution,
         a.resolution
     );
+    let scenes: Vec<String> = runs.iter().map(|r| format!("{} {} triangles", r.scene, r.triangles)).collect();
     outln!(
         out,
-        "Fixtures: docs/fixtures.md. Instructions are PTX instructions, not GT200 SASS; scene variants as in `warplight scene info`.\n"
+        "Scenes: {} (variants as in `warplight scene info NAME`). Fixtures: docs/fixtures.md. Instructions are PTX instructions, not GT200 SASS.\n",
+        scenes.join(", ")
     );
 }
 
