@@ -218,10 +218,14 @@ fn table_4_1(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error:
             out,
             "Ours: the stack-based kernel on each heuristic's tree, {} frame(s) of each flight at {}x{}, frame rates from the GT200 timing model. \
              Code base I is not described beyond its SAH frame rates; compare the signs and sizes of the relative columns. \
-             Fixtures: docs/fixtures.md.\n",
+             Scenes: {}. Fixtures: docs/fixtures.md.\n",
             a.frames,
             a.resolution,
-            a.resolution
+            a.resolution,
+            rows.iter()
+                .map(|r| format!("{} {} triangles", r.run.scene, r.run.triangles))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     Ok(())
