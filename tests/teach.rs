@@ -264,3 +264,14 @@ fn a_fault_keeps_the_view_on_the_faulting_warp() {
     assert!(app.fault.is_none() && app.steps == 0, "{:?} at {}", app.fault, app.steps);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_view_survives_small_and_large_terminals() {
+    for (w, h) in [(20, 5), (40, 12), (200, 60)] {
+        let s = session("examples/lessons/coalescing.toml");
+        let mut term = Terminal::new(TestBackend::new(w, h)).unwrap();
+        let mut k = keys("sss?x3nn2jjkxw]1g46\ns").into_iter();
+        let app = tui::drive(&mut term, &s, options(Profile::Gt200), || Ok(k.next())).expect("view runs");
+        assert!(app.steps > 0, "{w}x{h}");
+    }
+}
