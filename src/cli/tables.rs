@@ -96,9 +96,9 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-/// Loads each named scene and measures it, with a progress bar; returns the
-/// results and the scenes that could not be loaded (with why).
-fn per_scene<T>(names: &[String], what: &str, mut f: impl FnMut(&Scene) -> T) -> (Vec<T>, Vec<String>) {
+/// Loads each named scene and measures it, with a progress bar; reports the
+/// scenes that could not be loaded (with why) on stderr.
+fn per_scene<T>(names: &[String], what: &str, mut f: impl FnMut(&Scene) -> T) -> Vec<T> {
     let pb = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new(names.len() as u64);
         pb.set_style(
@@ -122,18 +122,17 @@ fn per_scene<T>(names: &[String], what: &str, mut f: impl FnMut(&Scene) -> T) ->
     if let Some(pb) = pb {
         pb.finish_and_clear();
     }
-    (out, skipped)
+    for sk in skipped {
+        eprintln!("skipped {sk}");
+    }
+    out
 }
 
 fn table_4_3(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
     let all: Vec<&str> = table_4_3::THESIS.iter().map(|r| r.0).collect();
-    let (rows, skipped) =
-        per_scene(&scene_names(a, &all), "three trees (the numerical one takes a while) and the flight", |s| {
-            table_4_3::measure(s, a.frames, a.resolution)
-        });
-    for sk in skipped {
-        eprintln!("skipped {sk}");
-    }
+    let rows = per_scene(&scene_names(a, &all), "three trees (the numerical one takes a while) and the flight", |s| {
+        table_4_3::measure(s, a.frames, a.resolution)
+    });
     let title = "Table 4.3: traversals, plane and triangle intersections per ray with the numerical approximation (4.1.2) and SIROH, relative to the SAH (thesis 000, seed L1699-1709)";
     if emit(a, out, &rows, title, table_4_3::markdown)? {
         outln!(
@@ -233,11 +232,8 @@ fn table_4_1(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error:
 
 fn table_4_2(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
     let all: Vec<&str> = table_4_1::THESIS.iter().map(|r| r.0).collect();
-    let (rows, skipped) =
+    let rows =
         per_scene(&scene_names(a, &all), "SAH and SIROH trees, shadow rays", |s| table_4_2::measure(s, a.resolution));
-    for sk in skipped {
-        eprintln!("skipped {sk}");
-    }
     let title = "Table 4.2 (b), qualitatively: SIROH vs SAH for shadow rays from a light inside and outside the scene (thesis 000, seed L1682-1697)";
     if emit(a, out, &rows, title, table_4_2::markdown)? {
         outln!(
@@ -360,12 +356,8 @@ fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs,
 }
 
 fn table_4_4(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
-    let names: Vec<String> = if a.scenes.is_empty() {
-        table_4_4::THESIS.iter().map(|r| r.scene.to_string()).collect()
-    } else {
-        a.scenes.clone()
-    };
-    let (rows, skipped) = per_scene(&names, "building the trees", |s| table_4_4::measure(s, a.repeats));
+    let all: Vec<&str> = table_4_4::THESIS.iter().map(|r| r.scene).collect();
+    let rows = per_scene(&scene_names(a, &all), "building the trees", |s| table_4_4::measure(s, a.repeats));
     if a.format == "json" {
         println!("{}", serde_json::to_string_pretty(&rows)?);
         return Ok(());
@@ -380,8 +372,5 @@ fn table_4_4(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error:
          Scene variants differ from the thesis' where the triangle counts do (`warplight scene info NAME`).",
         a.repeats
     );
-    for s in skipped {
-        eprintln!("skipped {s}");
-    }
     Ok(())
 }
