@@ -1,7 +1,9 @@
 //! `warplight step` in a real pseudo-terminal: the binary runs inside a
 //! detached tmux session of 80×24; keys go in with `send-keys`, the screen
-//! comes back with `capture-pane`. Needs tmux (`.ci/run` installs it); set
-//! WARPLIGHT_SKIP_EXTERNAL=1 to skip where it cannot be installed.
+//! comes back with `capture-pane`. Needs tmux (`.ci/run` installs it); skips
+//! without it unless WARPLIGHT_REQUIRE_EXTERNAL=1 (see `common::external`).
+
+mod common;
 
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -12,15 +14,13 @@ struct Tmux {
 
 impl Tmux {
     fn start(cmd: &str) -> Option<Tmux> {
-        if std::env::var_os("WARPLIGHT_SKIP_EXTERNAL").is_some() {
-            return None;
-        }
+        common::external("tmux", "apt-get install tmux")?;
         let socket = format!("warplight-test-{}", std::process::id());
         let ok = Command::new("tmux")
             .args(["-L", &socket, "new-session", "-d", "-s", "w", "-x", "80", "-y", "24", cmd])
             .current_dir(env!("CARGO_MANIFEST_DIR"))
             .status()
-            .unwrap_or_else(|e| panic!("tmux is needed for this test (apt-get install tmux): {e}"));
+            .unwrap_or_else(|e| panic!("tmux did not run: {e}"));
         assert!(ok.success(), "tmux could not start");
         Some(Tmux { socket })
     }

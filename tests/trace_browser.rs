@@ -1,18 +1,17 @@
 //! The page of `warplight trace` in headless Chromium: it loads without
 //! console messages or errors, its self-test steps through events with the
 //! arrow keys, and a screenshot is taken. Needs Debian's `chromium` (`.ci/run`
-//! installs it); set WARPLIGHT_SKIP_EXTERNAL=1 to skip where it cannot be installed.
+//! installs it; WARPLIGHT_CHROMIUM names another binary); skips without it
+//! unless WARPLIGHT_REQUIRE_EXTERNAL=1 (see `common::external`).
+
+mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn chromium() -> Option<PathBuf> {
-    if std::env::var_os("WARPLIGHT_SKIP_EXTERNAL").is_some() {
-        return None;
-    }
-    let p = PathBuf::from(std::env::var_os("WARPLIGHT_CHROMIUM").unwrap_or("/usr/bin/chromium".into()));
-    assert!(p.exists(), "{} is needed for this test (apt-get install chromium)", p.display());
-    Some(p)
+    let program = std::env::var("WARPLIGHT_CHROMIUM").unwrap_or_else(|_| "chromium".into());
+    common::external(&program, "apt-get install chromium")
 }
 
 /// Runs headless Chromium on `url` with `extra` arguments; returns (stdout, stderr).
