@@ -22,6 +22,8 @@ nvcc_ptx() { # src out
   "$NVCC" -arch=sm_90 -O3 -ptx -lineinfo -Ikernels -o "$2" "$1"
   # keep the SDK's install location out of the file
   sed -i -E 's#"[^"]*/include/#"cuda/include/#' "$2"
+  # and the build machine's checkout: paths relative to the repository, as clang writes them
+  sed -i -E "s#\"$(pwd)/#\"./#" "$2"
 }
 while IFS= read -r cu; do
   base=${cu%.cu}

@@ -233,25 +233,3 @@ fn step_log_steps_a_later_launch_and_checks_breakpoints() {
     assert!(out.contains("4 divergent branches, 8 reconvergences"), "{out}");
 }
 
-#[test]
-fn tables_4_1_and_4_2_on_one_small_scene() {
-    let (ok, out, err) =
-        warplight(&["tables", "4.1", "4.2", "--scenes", "scene6", "--frames", "1", "--resolution", "16"]);
-    assert!(ok, "{err}");
-    assert!(out.contains("Table 4.1:") && out.contains("| scene6 |") && out.contains("| 341.8 |"), "{out}");
-    assert!(out.contains("Table 4.2 (b)") && out.contains("light outside -3.8%"), "{out}");
-    let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "json"]);
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    assert!(ok && v[0]["rays"].as_u64().unwrap() > 0, "{out}");
-    let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "csv"]);
-    assert!(
-        ok && out.starts_with("table,Scene,shadow rays,") && out.contains("\n\"Table 4.2 (b), qualitatively\",scene6,"),
-        "{out}"
-    );
-    let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "table"]);
-    assert!(ok && out.contains("\nscene6 ") && !out.contains("| scene6 |"), "{out}");
-    let (ok, _, err) = warplight(&["tables", "4.2", "--format", "xml"]);
-    assert!(!ok && err.contains("expected markdown, table, csv or json"), "{err}");
-    let (ok, _, err) = warplight(&["tables", "4.11"]);
-    assert!(!ok && err.contains("table 4.11 is not reproduced; available: 4.1, 4.2"), "{err}");
-}

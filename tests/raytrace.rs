@@ -64,7 +64,7 @@ fn every_variant_matches_the_native_caster() {
 
 #[test]
 fn tables_4_5_and_4_7_on_a_small_flight() {
-    use warplight::repro::flight_tables::{TABLE_4_5, markdown, measure};
+    use warplight::repro::fabianowski2011::flight::measure;
     let scene = scene_file::load(Path::new("scenes/scene6.toml")).unwrap();
     let mut ticks = 0;
     let r = measure(&scene, 2, 16, &Variant::ALL, |_, _| ticks += 1).unwrap();
@@ -75,20 +75,41 @@ fn tables_4_5_and_4_7_on_a_small_flight() {
     assert!(stackless > pushdown && pushdown > stack, "{inner:?}");
     assert!(short >= stack && short < stack * 1.1 && both <= short, "{inner:?}");
     assert!(r.instr_per_ray().iter().all(|&x| x > 100.0));
-    let md = markdown("t", &TABLE_4_5, &[r], |r| r.inner_per_ray());
-    assert!(md.contains("| scene6 |") && md.contains("+35.7%") && md.contains("Std. Dev."), "{md}");
 }
 
 #[test]
 fn table_4_3_counts_with_three_trees() {
-    use warplight::repro::table_4_3::{markdown, measure};
+    use warplight::repro::fabianowski2011::{HEURISTIC_COUNTS, table_4_3};
+    use warplight::repro::protocol::Protocol;
+    use warplight::repro::registry::{Workspace, resolve};
+    use warplight::repro::results::{Results, SceneInfo};
     let scene = scene_file::load(Path::new("scenes/scene6.toml")).unwrap();
-    let r = measure(&scene, 1, 24);
-    // the same rays with every tree; every count positive; the thesis' SAH value beside ours
-    assert!(r.rays[0] == r.rays[1] && r.rays[1] == r.rays[2]);
-    assert!(r.per_ray.iter().flatten().all(|&x| x > 0.0));
-    let md = markdown(&[r]);
-    assert!(md.contains("| scene6 |") && md.contains("| 9.68 |"), "{md}");
+    let mut ws = Workspace::new(&scene, 0..1, 24);
+    let samples = table_4_3::measure(&mut ws, &mut |_| {}).unwrap();
+    let mut r = Results::new(
+        "test",
+        Protocol::quick().with(Some(1), Some(24)),
+        vec!["fabianowski:4.3".into()],
+        vec![HEURISTIC_COUNTS.into()],
+    );
+    r.scenes.push(SceneInfo {
+        name: "scene6".into(),
+        triangles: scene.triangles.len(),
+        thesis_triangles: None,
+        flight_frames: 50,
+        frames: vec![],
+    });
+    r.samples = samples;
+    // the same rays with every tree; every count positive
+    let rays: Vec<f64> =
+        ["sah", "numerical", "siroh"].iter().map(|v| r.sum(HEURISTIC_COUNTS, "scene6", v, "rays").unwrap()).collect();
+    assert!(rays[0] == rays[1] && rays[1] == rays[2] && rays[0] > 0.0, "{rays:?}");
+    let p = table_4_3::per_ray(&r, "scene6").unwrap();
+    assert!(p.iter().flatten().all(|&x| x > 0.0), "{p:?}");
+    // the thesis' SAH value beside ours
+    let e = resolve(&["fabianowski:4.3".into()]).unwrap()[0];
+    let md = table_4_3::render(&e, &r)[0].markdown();
+    assert!(md.contains("| scene6 |") && md.contains("| 9.68 |") && md.contains("| −24.9% |"), "{md}");
 }
 
 /// Fig. 4.3's failure cases of restart-based traversal: zero-volume nodes
@@ -171,7 +192,7 @@ fn stackless_variants_survive_degenerate_geometry() {
 
 #[test]
 fn caches_cut_texture_fetches_and_local_stack_accesses() {
-    use warplight::repro::flight_tables::measure;
+    use warplight::repro::fabianowski2011::flight::measure;
     let scene = scene_file::load(Path::new("scenes/sponza.toml")).unwrap();
     let r = measure(&scene, 1, 16, &Variant::CACHES, |_, _| {}).unwrap();
     let tex = r.per_ray(|t| t.tex_node_fetches);

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use warplight::host::scene_file;
-use warplight::repro::table_4_4;
+use warplight::repro::fabianowski2011::table_4_4;
 
 fn load(name: &str) -> warplight::host::scene::Scene {
     scene_file::load(Path::new(&format!("scenes/{name}.toml"))).unwrap_or_else(|e| panic!("{e}"))
@@ -83,6 +83,4 @@ fn table_4_4_statistics() {
     let dr = r.siroh.tri_refs as f64 / r.sah.tri_refs as f64 - 1.0;
     assert!(di.abs() < 0.03 && dr.abs() < 0.03, "{di} {dr}");
     assert!(r.sah.depth <= 32 && r.siroh.depth <= 32);
-    let md = table_4_4::markdown(&[r]);
-    assert!(md.contains("| sponza | 66453 (76107) |") && md.contains("207425"), "{md}");
 }

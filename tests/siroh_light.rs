@@ -4,7 +4,7 @@
 //! ground to SAH trees; with the light inside they keep their advantage.
 
 use warplight::host::scene_file;
-use warplight::repro::table_4_2;
+use warplight::repro::fabianowski2011::table_4_2;
 
 #[test]
 fn siroh_loses_ground_for_shadow_rays_from_outside_the_scene() {

@@ -1,6 +1,5 @@
-//! The tables' other output formats, made from their markdown: aligned
-//! columns for a terminal, and CSV. Markdown stays the one place the tables are
-//! laid out (`crate::repro`).
+//! Markdown tables as aligned columns for a terminal (`--format table`); CSV
+//! comes from the tables themselves (`crate::repro::table::Table::csv`).
 
 /// The cells of a markdown table row, or `None` for other lines.
 fn cells(line: &str) -> Option<Vec<&str>> {
@@ -61,35 +60,6 @@ pub fn terminal(md: &str) -> String {
     out
 }
 
-fn csv_cell(c: &str) -> String {
-    if c.contains([',', '"', '\n']) { format!("\"{}\"", c.replace('"', "\"\"")) } else { c.to_string() }
-}
-
-/// Every markdown table's rows as CSV, each prefixed with its table's name (the
-/// last line before it that starts with "Table", up to its colon); a table's
-/// header row starts with `table`. Other lines are left out.
-pub fn csv(md: &str) -> String {
-    let mut out = String::new();
-    let mut name = String::new();
-    for line in md.lines() {
-        match cells(line) {
-            None => {
-                if line.starts_with("Table") {
-                    name = line.split(':').next().unwrap_or(line).to_string();
-                }
-            }
-            Some(c) if is_rule(&c) => {}
-            Some(c) => {
-                let header = c.first().is_some_and(|x| *x == "Scene" || *x == "Setting");
-                let first = if header { "table".to_string() } else { csv_cell(&name) };
-                let rest: Vec<String> = c.iter().map(|x| csv_cell(x)).collect();
-                out.push_str(&format!("{first},{}\n", rest.join(",")));
-            }
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -101,11 +71,5 @@ mod tests {
         let t = terminal(MD);
         assert!(t.contains("Scene    stack  thesis\n-------  -----  ------\nscene6   16.05    7.31\n"), "{t}");
         assert!(t.contains("Ours: a note."));
-    }
-
-    #[test]
-    fn csv_names_each_row_s_table() {
-        let c = csv(MD);
-        assert_eq!(c, "table,Scene,stack,thesis\nTable 4.5,scene6,16.05,7.31\nTable 4.5,Average,,\"+1,2%\"\n");
     }
 }

@@ -1,376 +1,295 @@
-//! `warplight tables 4.4 ...`: reproduced thesis tables beside the published values.
+//! `warplight tables`: runs reproductions and prints them beside the theses'
+//! tables; `tables merge` prints the tables of shards; `tables --list` lists
+//! every table of every thesis. What a table is and how it is measured lives
+//! in `crate::repro`; this module only renders.
 
 use std::io::IsTerminal;
+use std::path::PathBuf;
 
 use super::scene_info::scene_path;
-use crate::host::rt_kernels::Variant;
 use crate::host::scene::Scene;
 use crate::host::scene_file;
-use crate::repro::{flight_tables, table_4_1, table_4_2, table_4_3, table_4_4};
-
-/// `println!` into the output buffer.
-macro_rules! outln {
-    ($out:expr, $($arg:tt)*) => {{
-        $out.push_str(&format!($($arg)*));
-        $out.push('\n');
-    }};
-}
-
-/// `print!` into the output buffer.
-macro_rules! outp {
-    ($out:expr, $($arg:tt)*) => {
-        $out.push_str(&format!($($arg)*))
-    };
-}
+use crate::repro::baseline::Baseline;
+use crate::repro::protocol::{FrameRange, Protocol};
+use crate::repro::registry::{self, Entry};
+use crate::repro::results::Results;
+use crate::repro::run::{self, Plan, Unavailable};
+use crate::repro::table::Table;
 
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Examples:
+  warplight tables --list                          every table of every thesis, with its status
+  warplight tables 4.4                             Table 4.4 of thesis 000 (a bare number works while unambiguous)
+  warplight tables fabianowski:4.5 fabianowski:4.7 --protocol quick
+  warplight tables fabianowski:all --protocol thesis   the published protocol (hours: the estimate is printed first)
+  warplight tables 4.5 --protocol thesis --frames 0..25 --out a.json   one shard ...
+  warplight tables 4.5 --protocol thesis --frames 25..50 --out b.json  ... and the other
+  warplight tables merge a.json b.json             prints what the unsplit run prints
+  warplight chart table fabianowski:4.5 --from a.json -o t45.svg")]
 pub struct TablesArgs {
-    /// Tables to reproduce: 4.1, 4.2 (its part (b), qualitatively), 4.3, 4.4, 4.5, 4.6, 4.7,
-    /// 4.8, 4.9, 4.10, or all.
+    /// Tables: `thesis:id` (`fabianowski:4.5`), a bare id while unambiguous (`4.5`),
+    /// `thesis:all` or `all`. `merge FILE...` merges result files instead.
     pub tables: Vec<String>,
-    /// Frames of each camera flight (the thesis: 50).
-    #[arg(long, default_value_t = 50)]
-    pub frames: u32,
-    /// Image side in pixels (the thesis: 512).
-    #[arg(long, default_value_t = 512)]
-    pub resolution: u32,
-    /// Scenes (names in scenes/), comma-separated; default: every scene of the table that is available.
+    /// List every table of every thesis with its status and the command that runs it.
+    #[arg(long)]
+    pub list: bool,
+    /// quick (3 frames of each flight at 96x96, minutes) or thesis (the published protocol: 50 frames at 512x512).
+    #[arg(long, default_value = "quick")]
+    pub protocol: String,
+    /// N: the protocol with N frames of each flight; A..B: frames A to B-1 of the protocol (a shard).
+    #[arg(long)]
+    pub frames: Option<String>,
+    /// Image side in pixels (overrides the protocol's).
+    #[arg(long)]
+    pub resolution: Option<u32>,
+    /// Scenes (names in scenes/), comma-separated; default: every scene of the tables.
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
-    /// Builds per heuristic; the fastest time counts.
+    /// Builds per heuristic for build timings; the fastest counts.
     #[arg(long, default_value_t = 1)]
     pub repeats: u32,
-    /// Output: markdown (default), table (aligned columns for a terminal), csv (every
-    /// table's rows with the table's name in the first column) or json (the raw measurements).
+    /// Output: markdown (default), table (aligned columns for a terminal), csv (numeric
+    /// cells, one header per table) or json (the raw measurements, as --out writes them).
     #[arg(long, default_value = "markdown")]
     pub format: String,
+    /// Write the raw measurements (a shard) to this JSON file; `tables merge` reads them.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Render from a results file (--out or merged) instead of running.
+    #[arg(long)]
+    pub from: Option<PathBuf>,
+    /// merge: accept shards that leave frames of the protocol out.
+    #[arg(long)]
+    pub partial: bool,
+    /// Compare the verdicts with a baseline file; fail when a cell recorded within tolerance is not.
+    #[arg(long)]
+    pub baseline: Option<PathBuf>,
+    /// Write the verdicts as a baseline file.
+    #[arg(long)]
+    pub write_baseline: Option<PathBuf>,
 }
 
 /// Runs the command.
 pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if a.tables.is_empty() {
-        return Err("name a table: 4.4".into());
-    }
     if !["markdown", "json", "csv", "table"].contains(&a.format.as_str()) {
         return Err(format!("--format {}: expected markdown, table, csv or json", a.format).into());
     }
-    let mut out = String::new();
-    let (mut traversal, mut caches) = (None, None);
-    let tables: Vec<&str> = if a.tables.iter().any(|t| t == "all") {
-        vec!["4.1", "4.2", "4.3", "4.4", "4.5", "4.6", "4.7", "4.8", "4.9", "4.10"]
+    if a.list {
+        print!("{}", list());
+        return Ok(());
+    }
+    let results = if a.tables.first().is_some_and(|t| t == "merge") {
+        let files: Vec<PathBuf> = a.tables[1..].iter().map(PathBuf::from).collect();
+        merge(&files, a.partial)?
+    } else if let Some(f) = &a.from {
+        Results::read(f)?
     } else {
-        a.tables.iter().map(|t| t.as_str()).collect()
+        if a.tables.is_empty() {
+            return Err(
+                "name tables (`warplight tables 4.5`, `fabianowski:all`) or see `warplight tables --list`".into()
+            );
+        }
+        measure(&a)?
     };
-    for t in tables {
-        match t {
-            "4.1" => table_4_1(&a, &mut out)?,
-            "4.2" => table_4_2(&a, &mut out)?,
-            "4.3" => table_4_3(&a, &mut out)?,
-            "4.4" => table_4_4(&a, &mut out)?,
-            "4.5" | "4.6" | "4.7" => {
-                if traversal.is_none() {
-                    traversal = Some(flight_runs(&a, &Variant::ALL)?);
-                }
-                print_flight_table(t, traversal.as_ref().expect("measured"), &a, &mut out);
-            }
-            "4.8" | "4.9" | "4.10" => {
-                if caches.is_none() {
-                    caches = Some(flight_runs(&a, &Variant::CACHES)?);
-                }
-                print_flight_table(t, caches.as_ref().expect("measured"), &a, &mut out);
-            }
-            other => {
-                return Err(format!(
-                    "table {other} is not reproduced; available: 4.1, 4.2, 4.3, 4.4, 4.5, 4.6, 4.7, 4.8, 4.9, 4.10, all"
-                )
-                .into());
-            }
-        }
+    if let Some(out) = &a.out {
+        super::write_atomically(out, serde_json::to_string_pretty(&results)?.as_bytes())?;
+        eprintln!("wrote {}", out.display());
     }
-    match a.format.as_str() {
-        "csv" => print!("{}", super::table_format::csv(&out)),
-        "table" => print!("{}", super::table_format::terminal(&out)),
-        _ => print!("{out}"),
+    let tables = render(&results)?;
+    if let Some(f) = &a.write_baseline {
+        let b = Baseline::record(&results.protocol.describe(), &scene_names(&results), &tables);
+        super::write_atomically(f, serde_json::to_string_pretty(&b)?.as_bytes())?;
+        eprintln!("wrote {}", f.display());
+    }
+    print!("{}", format(&results, &tables, &a.format)?);
+    if let Some(f) = &a.baseline {
+        check_baseline(f, &results, &tables)?;
     }
     Ok(())
 }
 
-/// Loads each named scene and measures it, with a progress bar; reports the
-/// scenes that could not be loaded (with why) on stderr.
-fn per_scene<T>(names: &[String], what: &str, mut f: impl FnMut(&Scene) -> T) -> Vec<T> {
-    let pb = std::io::stderr().is_terminal().then(|| {
-        let pb = indicatif::ProgressBar::new(names.len() as u64);
-        pb.set_style(
-            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]").expect("template"),
-        );
-        pb
+fn scene_names(r: &Results) -> Vec<String> {
+    r.scenes.iter().map(|s| s.name.clone()).collect()
+}
+
+/// Every table of every thesis: status, address, caption and the command.
+pub fn list() -> String {
+    let mut s = String::new();
+    for t in registry::THESES {
+        s.push_str(&format!("{} (seed {}, src/repro/{}/): {}\n", t.short, t.seed, t.dir, t.citation));
+        for table in t.tables {
+            let e = Entry { thesis: t, table };
+            let cmd = if table.render.is_some() { format!("warplight tables {}", e.address()) } else { "–".into() };
+            let title: String = table.title.chars().take(70).collect();
+            let ell = if table.title.chars().count() > 70 { "…" } else { "" };
+            s.push_str(&format!("  {:<16} {:<18} {:<38} {title}{ell}\n", e.address(), table.status.name(), cmd));
+        }
+        s.push('\n');
+    }
+    let all = registry::entries();
+    let count = |st: registry::Status| all.iter().filter(|e| e.table.status == st).count();
+    s.push_str(&format!(
+        "{} tables: {} reproduced, {} modelled, {} partly, {} missing, {} not reproducible, {} not measurements.\n",
+        all.len(),
+        count(registry::Status::Reproduced),
+        count(registry::Status::Modelled),
+        count(registry::Status::Partly),
+        count(registry::Status::Missing),
+        count(registry::Status::NotReproducible),
+        count(registry::Status::NotAMeasurement),
+    ));
+    s
+}
+
+fn protocol_of(a: &TablesArgs) -> Result<(Protocol, Option<FrameRange>), String> {
+    let base = Protocol::named(&a.protocol)?;
+    let (n, range) = match a.frames.as_deref() {
+        None => (None, None),
+        Some(f) if f.contains("..") => (None, Some(FrameRange::parse(f)?)),
+        Some(f) => {
+            let n: u32 = f.parse().map_err(|_| format!("--frames {f}: expected N or A..B"))?;
+            if n == 0 {
+                return Err("--frames 0: run at least one frame".into());
+            }
+            (Some(n), None)
+        }
+    };
+    if a.resolution == Some(0) {
+        return Err("--resolution 0: the image needs at least one pixel".into());
+    }
+    let p = base.with(n, a.resolution);
+    if let Some(r) = range
+        && r.start >= p.frames
+    {
+        return Err(format!("--frames {r}: the protocol has {} frames (0..{})", p.frames, p.frames));
+    }
+    Ok((p, range))
+}
+
+fn measure(a: &TablesArgs) -> Result<Results, Box<dyn std::error::Error>> {
+    let entries = registry::resolve(&a.tables)?;
+    let (protocol, frames) = protocol_of(a)?;
+    let plan = Plan::new(entries, &a.scenes, protocol, frames, a.repeats);
+    let (scenes, unavailable) = load(&plan.scenes());
+    if scenes.is_empty() {
+        let why: Vec<String> = unavailable.iter().map(|u| u.why.clone()).collect();
+        return Err(format!("no scene of these tables could be loaded: {}", why.join("; ")).into());
+    }
+    let threads = rayon::current_num_threads();
+    eprint!("{}", plan.describe(&scenes, &unavailable, threads));
+    let bar = bar(plan.units(&scenes));
+    let t0 = std::time::Instant::now();
+    let r = run::execute(&plan, &scenes, &unavailable, crate::repro::COMMIT, &mut |p| {
+        if let Some(b) = &bar {
+            let frame = p.frame.map(|f| format!(" frame {f}")).unwrap_or_default();
+            b.set_message(format!("{} {}{frame} {}", p.scene, p.group, p.variant));
+            b.inc(1);
+        }
     });
-    let (mut out, mut skipped) = (Vec::new(), Vec::new());
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    eprintln!("  took {}", run::human(t0.elapsed().as_secs_f64()));
+    Ok(r?)
+}
+
+fn load(names: &[String]) -> (Vec<Scene>, Vec<Unavailable>) {
+    let (mut ok, mut missing) = (Vec::new(), Vec::new());
     for n in names {
-        if let Some(pb) = &pb {
-            pb.set_message(format!("{n}: {what}"));
-        }
         match scene_file::load(&scene_path(n)) {
-            Ok(s) => out.push(f(&s)),
-            Err(e) => skipped.push(format!("{n}: {e}")),
-        }
-        if let Some(pb) = &pb {
-            pb.inc(1);
+            Ok(s) => ok.push(s),
+            Err(e) => missing.push(Unavailable { name: n.clone(), why: e.to_string() }),
         }
     }
-    if let Some(pb) = pb {
-        pb.finish_and_clear();
-    }
-    for sk in skipped {
-        eprintln!("skipped {sk}");
-    }
-    out
+    (ok, missing)
 }
 
-fn table_4_3(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
-    let all: Vec<&str> = table_4_3::THESIS.iter().map(|r| r.0).collect();
-    let rows = per_scene(&scene_names(a, &all), "three trees (the numerical one takes a while) and the flight", |s| {
-        table_4_3::measure(s, a.frames, a.resolution)
-    });
-    let title = "Table 4.3: traversals, plane and triangle intersections per ray with the numerical approximation (4.1.2) and SIROH, relative to the SAH (thesis 000, seed L1699-1709)";
-    if emit(a, out, &rows, title, table_4_3::markdown)? {
-        outln!(
-            out,
-            "\nOurs: stack-based traversal (the native caster, step for step the stack kernel), {} frame(s) of each flight at {}x{}.\n",
-            a.frames,
-            a.resolution,
-            a.resolution
-        );
-    }
-    Ok(())
-}
-
-/// The scenes asked for with `--scenes`, or `all`.
-fn scene_names(a: &TablesArgs, all: &[&str]) -> Vec<String> {
-    if a.scenes.is_empty() { all.iter().map(|s| s.to_string()).collect() } else { a.scenes.clone() }
-}
-
-/// Prints `rows` as JSON with `--format json`; otherwise prints `title` and the
-/// table `markdown` makes of them, and returns true so that the caller adds its notes.
-fn emit<T: serde::Serialize>(
-    a: &TablesArgs,
-    out: &mut String,
-    rows: &[T],
-    title: &str,
-    markdown: impl FnOnce(&[T]) -> String,
-) -> Result<bool, Box<dyn std::error::Error>> {
-    if a.format == "json" {
-        println!("{}", serde_json::to_string_pretty(rows)?);
-        return Ok(false);
-    }
-    out.push_str(&format!("{title}\n\n{}", markdown(rows)));
-    Ok(true)
-}
-
-/// Loads the named scenes (default: `all`), reporting those that cannot be loaded.
-fn load_scenes(a: &TablesArgs, all: &[&str]) -> Vec<Scene> {
-    let mut scenes = Vec::new();
-    for n in &scene_names(a, all) {
-        match scene_file::load(&scene_path(n)) {
-            Ok(s) => scenes.push(s),
-            Err(e) => eprintln!("skipped {n}: {e}"),
-        }
-    }
-    scenes
-}
-
-/// A progress bar over `total` frames (None when stderr is not a terminal).
-fn frame_bar(total: u64, unit: &str) -> Option<indicatif::ProgressBar> {
+fn bar(total: u64) -> Option<indicatif::ProgressBar> {
     std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new(total);
         pb.set_style(
-            indicatif::ProgressStyle::with_template(&format!(
-                "{{bar:30}} {{pos}}/{{len}} {unit}, {{msg}} [{{elapsed}}, eta {{eta}}]"
-            ))
-            .expect("template"),
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}, eta {eta}]")
+                .expect("template"),
         );
         pb
     })
 }
 
-fn table_4_1(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
-    let all: Vec<&str> = table_4_1::THESIS.iter().map(|r| r.0).collect();
-    let scenes = load_scenes(a, &all);
-    let total: u64 = scenes.iter().map(|s| 3 * a.frames.min(s.flight.frames) as u64).sum();
-    let pb = frame_bar(total, "frames x trees");
-    let mut rows = Vec::new();
-    for s in &scenes {
-        rows.push(table_4_1::measure(s, a.frames, a.resolution, |f, h| {
-            if let Some(pb) = &pb {
-                pb.set_message(format!("{} frame {f} {:?} tree", s.name, table_4_1::HEURISTICS[h]));
-                pb.inc(1);
-            }
-        })?);
+fn merge(files: &[PathBuf], partial: bool) -> Result<Results, Box<dyn std::error::Error>> {
+    let mut shards = Vec::new();
+    for f in files {
+        shards.push((f.display().to_string(), Results::read(f)?));
     }
-    if let Some(pb) = pb {
-        pb.finish_and_clear();
-    }
-    let title = "Table 4.1: frame rates with the numerical approximation (4.1.2) and SIROH relative to the SAH, two code bases (thesis 000, seed L1664-1674)";
-    if emit(a, out, &rows, title, table_4_1::markdown)? {
-        outln!(
-            out,
-            "Ours: the stack-based kernel on each heuristic's tree, {} frame(s) of each flight at {}x{}, frame rates from the GT200 timing model. \
-             Code base I is not described beyond its SAH frame rates; compare the signs and sizes of the relative columns. \
-             Scenes: {}. Fixtures: docs/fixtures.md.\n",
-            a.frames,
-            a.resolution,
-            a.resolution,
-            rows.iter()
-                .map(|r| format!("{} {} triangles", r.run.scene, r.run.triangles))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    Ok(())
+    Ok(Results::merge(&shards, partial)?)
 }
 
-fn table_4_2(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
-    let all: Vec<&str> = table_4_1::THESIS.iter().map(|r| r.0).collect();
-    let rows =
-        per_scene(&scene_names(a, &all), "SAH and SIROH trees, shadow rays", |s| table_4_2::measure(s, a.resolution));
-    let title = "Table 4.2 (b), qualitatively: SIROH vs SAH for shadow rays from a light inside and outside the scene (thesis 000, seed L1682-1697)";
-    if emit(a, out, &rows, title, table_4_2::markdown)? {
-        outln!(
-            out,
-            "\nOurs: shadow rays traced from the light to every primary hit of frame 0 at {}x{}, inner-node traversals per ray (native caster). \
-             Lights at the scene centre + extent x {:?} (inside) and x {:?} (outside). Table 4.2 (a) and the frame rates of (b) \
-             measured third-party ray tracers and are not reproduced. Fixtures: docs/fixtures.md.\n",
-            a.resolution,
-            a.resolution,
-            table_4_2::LIGHT_INSIDE,
-            table_4_2::LIGHT_OUTSIDE
-        );
-    }
-    Ok(())
-}
-
-fn flight_runs(
-    a: &TablesArgs,
-    variants: &[Variant],
-) -> Result<Vec<flight_tables::SceneRun>, Box<dyn std::error::Error>> {
-    let all: Vec<&str> = flight_tables::TABLE_4_5.iter().map(|r| r.0).collect();
-    let scenes = load_scenes(a, &all);
-    let total: u64 = scenes.iter().map(|s| (a.frames.min(s.flight.frames) as usize * variants.len()) as u64).sum();
-    let pb = frame_bar(total, "frames x variants");
-    let mut runs = Vec::new();
-    for s in &scenes {
-        let r = flight_tables::measure(s, a.frames, a.resolution, variants, |f, v| {
-            if let Some(pb) = &pb {
-                pb.set_message(format!("{} frame {f} {}", s.name, v.name()));
-                pb.inc(1);
-            }
-        })?;
-        runs.push(r);
-    }
-    if let Some(pb) = pb {
-        pb.finish_and_clear();
-    }
-    Ok(runs)
-}
-
-fn print_flight_table(t: &str, runs: &[flight_tables::SceneRun], a: &TablesArgs, out: &mut String) {
-    use flight_tables as ft;
-    if a.format == "json" {
-        println!("{}", serde_json::to_string_pretty(runs).unwrap_or_default());
-        return;
-    }
-    let md = match t {
-        "4.5" => ft::markdown(
-            "Table 4.5: inner node traversals per ray, stackless variants relative to stack-based (thesis 000, seed L1878-1888)",
-            &ft::TABLE_4_5,
-            runs,
-            |r| r.inner_per_ray(),
-        ),
-        "4.7" => ft::markdown(
-            "Table 4.7: instructions per ray (warp instructions x 32 / rays), relative to stack-based (thesis 000, seed L1914-1924)",
-            &ft::TABLE_4_7,
-            runs,
-            |r| r.instr_per_ray(),
-        ),
-        "4.6" => crate::repro::timing::markdown(
-            "Table 4.6: frame rates (GT200 timing model) with stackless traversal, relative to stack-based (thesis 000, seed L1902-1912)",
-            &crate::repro::timing::TABLE_4_6,
-            runs,
-        ),
-        "4.10" => crate::repro::timing::markdown(
-            "Table 4.10: frame rates (GT200 timing model) with explicitly managed caches, relative to the baseline (thesis 000, seed L2146-2157)",
-            &crate::repro::timing::TABLE_4_10,
-            runs,
-        ),
-        "4.9" => ft::markdown(
-            "Table 4.9: instructions per ray with explicitly managed caches, relative to the baseline (thesis 000, seed L2123-2134)",
-            &ft::TABLE_4_9,
-            runs,
-            |r| r.instr_per_ray(),
-        ),
-        _ => {
-            let a_ = ft::markdown(
-                "Table 4.8 (a): inner nodes loaded through the texturing unit per ray (thesis 000, seed L2066-2119)",
-                &ft::TABLE_4_8A,
-                runs,
-                |r| r.per_ray(|t| t.tex_node_fetches),
-            );
-            let b_ = ft::markdown(
-                "Table 4.8 (b): stack entries accessed in local memory per ray",
-                &ft::TABLE_4_8B,
-                runs,
-                |r| r.per_ray(|t| t.local_stack_accesses),
-            );
-            let c_ = ft::markdown_with(
-                "Table 4.8 (c): texture cache hit ratios, % (gt200 profile: a 5 KB cache per TPC of 3 SMs, all TPCs; differences in percentage points)",
-                &ft::TABLE_4_8C,
-                runs,
-                |r| r.totals.iter().map(|t| t.tex_hits as f64 * 100.0 / t.tex_lookups.max(1) as f64).collect(),
-                true,
-            );
-            let d_ = ft::markdown(
-                "Table 4.8 (d): global memory bytes per ray, 8 x ((a) + (b))",
-                &ft::TABLE_4_8D,
-                runs,
-                |r| r.per_ray(|t| 8 * (t.tex_node_fetches + t.local_stack_accesses)),
-            );
-            format!("{a_}\n{b_}\n{c_}\n{d_}")
+/// The tables of a result.
+pub fn render(r: &Results) -> Result<Vec<Table>, Box<dyn std::error::Error>> {
+    let entries = registry::resolve(&r.tables)?;
+    let mut out = Vec::new();
+    for e in entries {
+        if let Some(render) = e.table.render {
+            out.extend(render(&e, r));
         }
-    };
-    out.push_str(&md);
-    out.push('\n');
-    outln!(
-        out,
-        "Ours: SIROH trees, {} frame(s) of each flight at {}x{}, 30 persistent CTAs x 256 threads, 32-pixel job blocks, clang-16 PTX.",
-        a.frames,
-        a.resolution,
-        a.resolution
-    );
-    let scenes: Vec<String> = runs.iter().map(|r| format!("{} {} triangles", r.scene, r.triangles)).collect();
-    outln!(
-        out,
-        "Scenes: {} (variants as in `warplight scene info NAME`). Fixtures: docs/fixtures.md. Instructions are PTX instructions, not GT200 SASS.\n",
-        scenes.join(", ")
-    );
+    }
+    Ok(out)
 }
 
-fn table_4_4(a: &TablesArgs, out: &mut String) -> Result<(), Box<dyn std::error::Error>> {
-    let all: Vec<&str> = table_4_4::THESIS.iter().map(|r| r.scene).collect();
-    let rows = per_scene(&scene_names(a, &all), "building the trees", |s| table_4_4::measure(s, a.repeats));
-    if a.format == "json" {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
-        return Ok(());
+fn format(r: &Results, tables: &[Table], format: &str) -> Result<String, Box<dyn std::error::Error>> {
+    let mut s = String::new();
+    match format {
+        "json" => {
+            s.push_str(&serde_json::to_string_pretty(r)?);
+            s.push('\n');
+        }
+        "csv" => {
+            for (i, t) in tables.iter().enumerate() {
+                if i > 0 {
+                    s.push('\n');
+                }
+                s.push_str(&t.csv(true));
+            }
+        }
+        _ => {
+            let mut md = String::new();
+            for t in tables {
+                md.push_str(&t.markdown());
+                md.push('\n');
+            }
+            let (w, n) = tables.iter().map(Table::score).fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            md.push_str(&format!("Overall: {w}/{n} compared cells within tolerance.\n"));
+            for u in &r.unavailable {
+                md.push_str(&format!("Unavailable: {u}\n"));
+            }
+            s.push_str(&if format == "table" { super::table_format::terminal(&md) } else { md });
+        }
     }
-    outln!(out, "Table 4.4: kd-tree construction with SIROH relative to the SAH (thesis 000, seed L1711-1721)\n");
-    outp!(out, "{}", table_4_4::markdown(&rows));
-    outln!(
-        out,
-        "\nOurs: this machine, single-threaded, best of {} build(s); thesis timings are CPU II (Core2 Quad Q9450).\n\
-         Fixtures (docs/fixtures.md): C_T = 1, C_I = 3, leaves at <= 4 triangles, empty-space bias 20% above 30% volume,\n\
-         depth <= 32, triangle bounds clamped to the node (no clipping), ties to the first candidate in (axis, position) order.\n\
-         Scene variants differ from the thesis' where the triangle counts do (`warplight scene info NAME`).",
-        a.repeats
-    );
+    Ok(s)
+}
+
+fn check_baseline(f: &std::path::Path, r: &Results, tables: &[Table]) -> Result<(), Box<dyn std::error::Error>> {
+    let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}", f.display()))?;
+    let b: Baseline = serde_json::from_str(&text).map_err(|e| format!("{}: not a baseline file ({e})", f.display()))?;
+    if b.protocol != r.protocol.describe() || b.scenes != scene_names(r) {
+        return Err(format!(
+            "{}: recorded under {} on {}, this run is {} on {}",
+            f.display(),
+            b.protocol,
+            b.scenes.join(","),
+            r.protocol.describe(),
+            scene_names(r).join(",")
+        )
+        .into());
+    }
+    let (worse, better) = b.compare(tables);
+    for x in &better {
+        eprintln!("improved: {x}");
+    }
+    if !worse.is_empty() {
+        return Err(format!("{} cell(s) dropped out of tolerance:\n  {}", worse.len(), worse.join("\n  ")).into());
+    }
+    eprintln!("baseline {}: no cell dropped out of tolerance", f.display());
     Ok(())
 }

@@ -1,4 +1,4 @@
-//! Runs thesis 000's ray-tracing kernels (`kernels/raytrace/raytrace.cu`) on
+//! Runs thesis 000's ray-tracing kernels (`kernels/fabianowski2011/raytrace.cu`) on
 //! the emulator: uploads the laid-out kd-tree, triangles, materials and camera,
 //! launches 30 persistent CTAs of 256 threads, and reads back the image, the
 //! primary hit of each pixel and the per-ray work the kernel counted.
@@ -122,8 +122,8 @@ impl Variant {
     }
 }
 
-/// The kernels' PTX, compiled in (`kernels/raytrace/raytrace.ptx`).
-pub const PTX: &str = include_str!("../../kernels/raytrace/raytrace.ptx");
+/// The kernels' PTX, compiled in (`kernels/fabianowski2011/raytrace.ptx`).
+pub const PTX: &str = include_str!("../../kernels/fabianowski2011/raytrace.ptx");
 
 /// CTAs of the persistent-threads launch (one per GTX 280 SM).
 pub const CTAS: u32 = 30;
@@ -267,5 +267,5 @@ pub fn render(
 
 /// Loads the kernels' PTX on `dev`.
 pub fn load(dev: &mut Device) -> Result<Module, SimError> {
-    dev.load_ptx(PTX, "kernels/raytrace/raytrace.ptx")
+    dev.load_ptx(PTX, "kernels/fabianowski2011/raytrace.ptx")
 }

@@ -10,28 +10,7 @@
 //! transaction. Both coefficients absorb everything else (clock, occupancy,
 //! SASS versus PTX counts).
 
-use super::flight_tables::SceneRun;
-
-/// Published frame rates: scene, stack-based fps, relative changes (%) of the other columns.
-pub type Published = (&'static str, f64, &'static [f64]);
-
-/// Table 4.6 (L1902–1912): fps with stackless traversal.
-pub const TABLE_4_6: [Published; 5] = [
-    ("scene6", 392.6, &[-5.3, -2.6, -1.3, -2.5]),
-    ("sponza", 213.7, &[-37.1, -30.6, -8.7, -12.2]),
-    ("sibenik", 194.6, &[-43.5, -35.8, -10.2, -13.8]),
-    ("fairy", 149.0, &[-41.6, -29.8, -11.6, -14.9]),
-    ("conference", 172.0, &[-18.1, -11.4, -4.6, -7.2]),
-];
-
-/// Table 4.10 (L2146–2157): fps with explicitly managed caches.
-pub const TABLE_4_10: [Published; 5] = [
-    ("scene6", 392.6, &[2.4, 3.8, -6.2, 6.1, 2.5, -3.2]),
-    ("sponza", 213.7, &[-0.3, 1.3, -29.2, 2.3, -4.3, -29.1]),
-    ("sibenik", 194.6, &[-1.0, 1.2, -27.1, 1.8, -6.0, -27.2]),
-    ("fairy", 149.0, &[-1.5, 1.5, -51.7, 1.0, -5.9, -52.5]),
-    ("conference", 172.0, &[-0.1, 0.4, -42.1, 0.8, -2.9, -42.0]),
-];
+use super::flight::SceneRun;
 
 /// The fitted model.
 #[derive(Debug, Clone, Copy, serde::Serialize)]
@@ -51,11 +30,12 @@ fn per_frame(r: &SceneRun, i: usize) -> (f64, f64) {
     (t.warp_instructions as f64 * scale, t.mem_transactions as f64 * scale)
 }
 
-/// Fits a, b ≥ 0 to the baselines (column 0 of each run with a published row).
-pub fn fit(runs: &[SceneRun], published: &[Published]) -> Fit {
+/// Fits a, b ≥ 0 to the baselines' frame rates (column 0 of each run with a
+/// baseline: `(scene, fps)`).
+pub fn fit(runs: &[SceneRun], baselines: &[(&str, f64)]) -> Fit {
     let rows: Vec<(f64, f64, f64)> = runs
         .iter()
-        .filter_map(|r| published.iter().find(|p| p.0 == r.scene).map(|p| (r, p.1)))
+        .filter_map(|r| baselines.iter().find(|p| p.0 == r.scene).map(|p| (r, p.1)))
         .map(|(r, fps)| {
             let (w, m) = per_frame(r, 0);
             (w, m, 1.0 / fps)
@@ -92,30 +72,22 @@ pub fn fps(f: &Fit, r: &SceneRun, i: usize) -> f64 {
     1.0 / (f.per_instruction * w + f.per_transaction * m)
 }
 
-/// The table: predicted baseline fps and relative changes beside the thesis, with the fit.
-pub fn markdown(title: &str, published: &[Published], runs: &[SceneRun]) -> String {
-    let f = fit(runs, published);
-    let preds: Vec<Vec<f64>> = runs.iter().map(|r| (0..r.totals.len()).map(|i| fps(&f, r, i)).collect()).collect();
-    let runs_as_tables: Vec<SceneRun> = runs.to_vec();
-    let pubs: Vec<super::flight_tables::Published> = published.iter().map(|p| (p.0, p.1, p.2)).collect();
-    let mut s = super::flight_tables::markdown(title, &pubs, &runs_as_tables, |r| {
-        let k = runs.iter().position(|x| x.scene == r.scene).expect("same runs");
-        preds[k].clone()
-    });
-    s.push_str(&format!(
-        "\nModel: frame time = {:.3e} s x warp instructions + {:.3e} s x memory transactions (512 x 512), fitted to the stack-based column only; baseline frame rates reproduced to {:.1} % RMS.\n",
+/// One line describing the fitted model.
+pub fn describe(f: &Fit) -> String {
+    format!(
+        "GT200 timing model: frame time = {:.3e} s x warp instructions + {:.3e} s x memory transactions (512 x 512), \
+         fitted to the thesis' stack-based frame rates only; those baselines reproduced to {:.1} % RMS",
         f.per_instruction,
         f.per_transaction,
         f.baseline_rms_error * 100.0
-    ));
-    s
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::host::rt_kernels::Variant;
-    use crate::repro::flight_tables::Totals;
+    use crate::repro::fabianowski2011::flight::Totals;
 
     fn run(scene: &str, w: u64, m: u64) -> SceneRun {
         SceneRun {
@@ -137,9 +109,7 @@ mod tests {
             .iter()
             .map(|r| 1.0 / (a * r.totals[0].warp_instructions as f64 + b * r.totals[0].mem_transactions as f64))
             .collect();
-        let published: Vec<Published> =
-            vec![("scene6", fps[0], &[]), ("sponza", fps[1], &[]), ("sibenik", fps[2], &[])];
-        let f = fit(&runs, &published);
+        let f = fit(&runs, &[("scene6", fps[0]), ("sponza", fps[1]), ("sibenik", fps[2])]);
         assert!((f.per_instruction / a - 1.0).abs() < 1e-6 && (f.per_transaction / b - 1.0).abs() < 1e-6, "{f:?}");
         assert!(f.baseline_rms_error < 1e-9);
         assert!((fps_of(&f, &runs[1]) / fps[1] - 1.0).abs() < 1e-9);

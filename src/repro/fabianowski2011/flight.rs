@@ -1,0 +1,266 @@
+//! Runs thesis 000's ray-tracing kernels on the emulator over a scene's camera
+//! flight and totals their counts per variant: what Tables 4.1 and 4.5–4.10
+//! are made of. One frame of one variant is one [`Sample`] of counters named
+//! as the fields of [`Totals`].
+
+use std::collections::BTreeMap;
+
+use crate::host::camera::Camera;
+use crate::host::kdtree::{BuildParams, Heuristic, KdTree, build};
+use crate::host::rt_kernels::{self, Variant};
+use crate::host::scene::Scene;
+use crate::model::Profile;
+use crate::repro::registry::{MeasureError, Tick, Workspace};
+use crate::repro::results::{Results, Sample};
+use crate::sim::{Device, SimError};
+
+/// Totals of one variant over a flight.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Totals {
+    /// Rays traced.
+    pub rays: u64,
+    /// Inner-node traversal steps.
+    pub inner_nodes: u64,
+    /// Inner-node fetches through the texture path.
+    pub tex_node_fetches: u64,
+    /// Local-memory stack pushes and pops.
+    pub local_stack_accesses: u64,
+    /// Warp instructions issued.
+    pub warp_instructions: u64,
+    /// Texture-cache lookups and hits of the gt200 profile.
+    pub tex_lookups: u64,
+    /// Texture-cache hits.
+    pub tex_hits: u64,
+    /// Memory transactions of the gt200 profile: global and local segment
+    /// transactions plus texture-cache misses (for the timing model).
+    pub mem_transactions: u64,
+}
+
+/// One scene's flight, per variant.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SceneRun {
+    /// Scene name.
+    pub scene: String,
+    /// Triangles.
+    pub triangles: usize,
+    /// Frames of the flight used.
+    pub frames: u32,
+    /// Image side.
+    pub resolution: u32,
+    /// The variants, in the order measured.
+    pub variants: Vec<Variant>,
+    /// Their totals.
+    pub totals: Vec<Totals>,
+}
+
+impl SceneRun {
+    /// A per-ray quantity of every variant.
+    pub fn per_ray(&self, f: impl Fn(&Totals) -> u64) -> Vec<f64> {
+        self.totals.iter().map(|t| f(t) as f64 / t.rays.max(1) as f64).collect()
+    }
+
+    /// Inner-node traversals per ray (Table 4.5).
+    pub fn inner_per_ray(&self) -> Vec<f64> {
+        self.per_ray(|t| t.inner_nodes)
+    }
+
+    /// Instructions per ray by the thesis' rule: warp instructions × 32 / rays (Tables 4.7, 4.9).
+    pub fn instr_per_ray(&self) -> Vec<f64> {
+        self.per_ray(|t| 32 * t.warp_instructions)
+    }
+}
+
+/// Runs `variants` over `frames` frames of the scene's flight at `res` × `res`
+/// (SIROH trees, gt200 profile).
+pub fn measure(
+    scene: &Scene,
+    frames: u32,
+    res: u32,
+    variants: &[Variant],
+    tick: impl FnMut(u32, Variant),
+) -> Result<SceneRun, SimError> {
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+    measure_tree(scene, &tree, frames, res, variants, tick)
+}
+
+/// As [`measure`], over a given tree.
+pub fn measure_tree(
+    scene: &Scene,
+    tree: &KdTree,
+    frames: u32,
+    res: u32,
+    variants: &[Variant],
+    mut tick: impl FnMut(u32, Variant),
+) -> Result<SceneRun, SimError> {
+    let mut totals = vec![Totals::default(); variants.len()];
+    for f in 0..frames.min(scene.flight.frames) {
+        for (i, v) in variants.iter().enumerate() {
+            tick(f, *v);
+            totals[i].add(&frame(scene, tree, f, res, *v)?);
+        }
+    }
+    Ok(SceneRun {
+        scene: scene.name.clone(),
+        triangles: scene.triangles.len(),
+        frames: frames.min(scene.flight.frames),
+        resolution: res,
+        variants: variants.to_vec(),
+        totals,
+    })
+}
+
+/// The camera of frame `f` of the flight at `res` × `res`.
+pub fn camera(scene: &Scene, f: u32, res: u32) -> Camera {
+    let mut cam = scene.flight.camera(&scene.camera, f);
+    cam.resolution = [res, res];
+    cam
+}
+
+/// One frame of one variant on the emulator (gt200 profile).
+pub fn frame(scene: &Scene, tree: &KdTree, f: u32, res: u32, v: Variant) -> Result<Totals, SimError> {
+    // a fresh device per frame: its memory holds one frame's buffers
+    let mut dev = Device::new();
+    let module = rt_kernels::load(&mut dev)?;
+    let cam = camera(scene, f, res);
+    let k = rt_kernels::render(&mut dev, &module, scene, tree, &cam, scene.flight.light_offset(f), v, Profile::Gt200)?;
+    let m = &k.memory.counters;
+    Ok(Totals {
+        rays: k.trace.rays,
+        inner_nodes: k.trace.inner_nodes,
+        tex_node_fetches: k.trace.tex_node_fetches,
+        local_stack_accesses: k.trace.local_stack_accesses,
+        warp_instructions: k.launch.totals.warp_instructions,
+        tex_lookups: m.texture.sectors,
+        tex_hits: m.texture.hits,
+        mem_transactions: m.global_ld.sectors
+            + m.global_st.sectors
+            + m.local_ld.sectors
+            + m.local_st.sectors
+            + m.global_atom.sectors
+            + m.texture.misses,
+    })
+}
+
+/// The counters' names, in [`Totals`]' field order.
+pub const COUNTERS: [&str; 8] = [
+    "rays",
+    "inner_nodes",
+    "tex_node_fetches",
+    "local_stack_accesses",
+    "warp_instructions",
+    "tex_lookups",
+    "tex_hits",
+    "mem_transactions",
+];
+
+impl Totals {
+    fn fields(&self) -> [u64; 8] {
+        [
+            self.rays,
+            self.inner_nodes,
+            self.tex_node_fetches,
+            self.local_stack_accesses,
+            self.warp_instructions,
+            self.tex_lookups,
+            self.tex_hits,
+            self.mem_transactions,
+        ]
+    }
+
+    fn from_fields(f: [u64; 8]) -> Totals {
+        Totals {
+            rays: f[0],
+            inner_nodes: f[1],
+            tex_node_fetches: f[2],
+            local_stack_accesses: f[3],
+            warp_instructions: f[4],
+            tex_lookups: f[5],
+            tex_hits: f[6],
+            mem_transactions: f[7],
+        }
+    }
+
+    /// Adds another frame's totals.
+    pub fn add(&mut self, o: &Totals) {
+        let (a, b) = (self.fields(), o.fields());
+        *self = Totals::from_fields(std::array::from_fn(|i| a[i] + b[i]));
+    }
+
+    /// As named counters.
+    pub fn counters(&self) -> BTreeMap<String, f64> {
+        COUNTERS.iter().zip(self.fields()).map(|(n, v)| (n.to_string(), v as f64)).collect()
+    }
+
+    /// The totals of `variant` over the measured frames, or `None` when not measured.
+    pub fn from_results(r: &Results, group: &str, scene: &str, variant: &str) -> Option<Totals> {
+        let mut f = [0u64; 8];
+        for (i, c) in COUNTERS.iter().enumerate() {
+            f[i] = r.sum(group, scene, variant, c)? as u64;
+        }
+        Some(Totals::from_fields(f))
+    }
+}
+
+impl SceneRun {
+    /// The run of `variants` (named by `names`) of `group` on `scene`, from raw measurements.
+    pub fn from_results(
+        r: &Results,
+        group: &str,
+        scene: &str,
+        variants: &[Variant],
+        names: &[&str],
+    ) -> Option<SceneRun> {
+        let info = r.scene(scene)?;
+        let totals: Option<Vec<Totals>> = names.iter().map(|n| Totals::from_results(r, group, scene, n)).collect();
+        Some(SceneRun {
+            scene: scene.into(),
+            triangles: info.triangles,
+            frames: info.frames.iter().map(|f| f.len()).sum(),
+            resolution: r.protocol.resolution,
+            variants: variants.to_vec(),
+            totals: totals?,
+        })
+    }
+}
+
+/// Runs `variants` on `tree` over the workspace's frames: one sample per frame and variant.
+pub fn samples(
+    ws: &Workspace,
+    tree: &KdTree,
+    group: &str,
+    variants: &[(Variant, &str)],
+    tick: &mut dyn FnMut(Tick),
+) -> Result<Vec<Sample>, MeasureError> {
+    let mut out = Vec::new();
+    for f in ws.frames.clone() {
+        for (v, name) in variants {
+            tick(Tick { frame: Some(f), variant: name });
+            let t = frame(ws.scene, tree, f, ws.resolution, *v)?;
+            out.push(Sample {
+                group: group.into(),
+                scene: ws.scene.name.clone(),
+                frame: Some(f),
+                variant: name.to_string(),
+                counters: t.counters(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Measurement group `fabianowski/traversal`: the §4.2 traversal variants on SIROH trees.
+pub fn measure_traversal(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    ws.build(Heuristic::Siroh);
+    let tree = ws.tree(Heuristic::Siroh);
+    let v: Vec<(Variant, &str)> = Variant::ALL.iter().map(|v| (*v, v.name())).collect();
+    samples(ws, tree, super::TRAVERSAL, &v, tick)
+}
+
+/// Measurement group `fabianowski/caches`: the §4.3 cache variants on SIROH trees.
+pub fn measure_caches(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    ws.build(Heuristic::Siroh);
+    let tree = ws.tree(Heuristic::Siroh);
+    let v: Vec<(Variant, &str)> = Variant::CACHES.iter().map(|v| (*v, v.name())).collect();
+    samples(ws, tree, super::CACHES, &v, tick)
+}

@@ -1,0 +1,232 @@
+//! The reproduction platform end to end: the registry's addresses and list,
+//! tables with verdicts and scores, shards that merge into exactly what one
+//! run prints, the cluster scripts, and the committed baseline of verdicts.
+
+mod common;
+
+use std::process::Command;
+
+fn warplight(args: &[&str]) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
+
+fn tempdir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("warplight-repro-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn list_shows_every_thesis_and_the_status_of_chapter_4() {
+    let (ok, out, err) = warplight(&["tables", "--list"]);
+    assert!(ok, "{err}");
+    for t in ["fabianowski", "engelhardt", "zeidan", "lin", "purcell"] {
+        assert!(out.lines().any(|l| l.starts_with(t)), "{t} missing:\n{out}");
+    }
+    for (addr, status) in [
+        ("fabianowski:4.1", "modelled"),
+        ("fabianowski:4.2", "partly"),
+        ("fabianowski:4.5", "reproduced"),
+        ("fabianowski:4.10", "modelled"),
+        ("fabianowski:5.1", "missing"),
+        ("purcell:1", "missing"),
+    ] {
+        let line =
+            out.lines().find(|l| l.trim_start().starts_with(&format!("{addr} "))).unwrap_or_else(|| panic!("{addr}"));
+        assert!(line.contains(status), "{line}");
+    }
+    assert!(out.contains("warplight tables fabianowski:4.5"), "{out}");
+}
+
+#[test]
+fn addresses_and_their_errors() {
+    // a table that exists but is not reproduced, a thesis that does not exist, a table id nobody has
+    let (ok, _, err) = warplight(&["tables", "purcell:2"]);
+    assert!(!ok && err.contains("purcell:2 is not reproduced (missing)"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "nobody:1"]);
+    assert!(!ok && err.contains("no thesis \"nobody\"; theses: fabianowski, engelhardt"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "4.11"]);
+    assert!(!ok && err.contains("has no table 4.11"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "4.2", "--format", "xml"]);
+    assert!(!ok && err.contains("expected markdown, table, csv or json"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "4.5", "--frames", "60..70"]);
+    assert!(!ok && err.contains("the protocol has 3 frames"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "4.5", "--protocol", "slow"]);
+    assert!(!ok && err.contains("expected quick or thesis"), "{err}");
+}
+
+#[test]
+fn tables_4_1_and_4_2_print_thesis_as_printed_verdicts_and_scores() {
+    let (ok, out, err) =
+        warplight(&["tables", "4.1", "fabianowski:4.2", "--scenes", "scene6", "--frames", "1", "--resolution", "16"]);
+    assert!(ok, "{err}");
+    // the plan and its estimate come first, on stderr
+    assert!(
+        err.contains("protocol custom: 1 frame(s) of each flight at 16x16") && err.contains("estimated time"),
+        "{err}"
+    );
+    assert!(out.contains("fabianowski Table 4.1: Ray tracing frame rates with the numerical approximation"), "{out}");
+    // printed values exactly as printed (Unicode minus, ±), the printed average and the like-for-like mean
+    assert!(out.contains("| 341.8 |") && out.contains("| Average |") && out.contains("| +3.5% |"), "{out}");
+    assert!(out.contains("| Thesis, mean of our 1 scene |") && out.contains("| +7.5% |"), "{out}");
+    assert!(out.contains("Score: ") && out.contains("cells within tolerance"), "{out}");
+    assert!(out.contains("Light outside 15.1 −3.8%"), "{out}");
+    assert!(out.contains("SIROH does relatively worse for shadow rays from a light outside"), "{out}");
+    // CSV: numeric cells and unique column names
+    let (ok, csv, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "csv"]);
+    assert!(ok && csv.starts_with("table,row,shadow rays,SAH inside,SIROH inside (%),"), "{csv}");
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let mut uniq = header.clone();
+    uniq.sort();
+    uniq.dedup();
+    assert_eq!(uniq.len(), header.len(), "{header:?}");
+    assert!(csv.lines().nth(1).unwrap().starts_with("fabianowski:4.2,scene6,"), "{csv}");
+    let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "table"]);
+    assert!(ok && out.contains("\nscene6 ") && !out.contains("| scene6 |"), "{out}");
+    // JSON is the raw measurements: the same file --out writes
+    let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(ok && v["format"] == 1 && v["samples"].as_array().unwrap().len() == 4, "{out}");
+}
+
+#[test]
+fn unavailable_scenes_are_named_once() {
+    let (ok, out, err) =
+        warplight(&["tables", "4.5", "--scenes", "scene6,fairy", "--frames", "1", "--resolution", "8"]);
+    assert!(ok, "{err}");
+    assert_eq!(out.matches("Unavailable: scenes/fairy.toml").count(), 1, "{out}");
+}
+
+#[test]
+fn two_shards_merge_to_exactly_the_unsplit_run() {
+    let d = tempdir("shards");
+    let p = |n: &str| d.join(n).display().to_string();
+    let base = ["tables", "4.5", "4.7", "4.4", "--scenes", "scene6", "--resolution", "16"];
+    let run = |extra: &[&str]| {
+        let mut a = base.to_vec();
+        a.extend_from_slice(extra);
+        let (ok, out, err) = warplight(&a);
+        assert!(ok, "{err}");
+        out
+    };
+    run(&["--out", &p("whole.json")]);
+    run(&["--frames", "0..1", "--out", &p("a.json")]);
+    run(&["--frames", "1..3", "--out", &p("b.json")]);
+    // build timings differ run to run: print both from their raw measurements
+    let (ok, whole, err) = warplight(&["tables", "merge", &p("whole.json")]);
+    assert!(ok, "{err}");
+    let (ok, merged, err) = warplight(&["tables", "merge", &p("b.json"), &p("a.json")]);
+    assert!(ok, "{err}");
+    // the frame-independent builds come from the shard that starts at frame 0; all else is summed per frame
+    let a: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(p("a.json")).unwrap()).unwrap();
+    let w: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(p("whole.json")).unwrap()).unwrap();
+    let builds = |v: &serde_json::Value| {
+        v["samples"].as_array().unwrap().iter().filter(|s| s["frame"].is_null()).cloned().collect::<Vec<_>>()
+    };
+    // make the unsplit run's timings those of shard a, then both must print byte for byte the same
+    let mut w2 = w.clone();
+    let other: Vec<serde_json::Value> =
+        w["samples"].as_array().unwrap().iter().filter(|s| !s["frame"].is_null()).cloned().collect();
+    let mut samples = builds(&a);
+    samples.extend(other);
+    w2["samples"] = serde_json::Value::Array(samples);
+    std::fs::write(p("whole2.json"), serde_json::to_string_pretty(&w2).unwrap()).unwrap();
+    let (ok, whole2, err) = warplight(&["tables", "merge", &p("whole2.json")]);
+    assert!(ok, "{err}");
+    let (_, merged_sorted, _) = warplight(&["tables", "merge", &p("a.json"), &p("b.json")]);
+    assert_eq!(merged, merged_sorted, "shard order must not matter");
+    assert_eq!(whole2, merged, "merged shards print what the unsplit run prints");
+    assert!(whole.contains("frames 0..3") && merged.contains("frames 0..3"), "{merged}");
+    // refusals: overlap, a gap, another protocol
+    let (ok, _, err) = warplight(&["tables", "merge", &p("a.json"), &p("whole.json")]);
+    assert!(!ok && err.contains("overlap"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "merge", &p("b.json")]);
+    assert!(!ok && err.contains("scene6: frames 0..1 of the protocol are in no shard"), "{err}");
+    let (ok, _, _) = warplight(&["tables", "merge", &p("b.json"), "--partial"]);
+    assert!(ok);
+    let c = p("c.json");
+    let (ok, _, err) = warplight(&[
+        "tables",
+        "4.5",
+        "4.7",
+        "4.4",
+        "--scenes",
+        "scene6",
+        "--resolution",
+        "8",
+        "--frames",
+        "1..3",
+        "--out",
+        &c,
+    ]);
+    assert!(ok, "{err}");
+    let (ok, _, err) = warplight(&["tables", "merge", &p("a.json"), &p("c.json")]);
+    assert!(!ok && err.contains("does not belong with") && err.contains("protocol"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "merge", &p("missing.json")]);
+    assert!(!ok && err.contains("missing.json"), "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn gnu_parallel_runs_shards_and_merges_them() {
+    if common::external("parallel", "apt-get install parallel").is_none() {
+        return;
+    }
+    let d = tempdir("parallel");
+    let o = Command::new("bash")
+        .arg("examples/cluster/parallel.sh")
+        .env("WARPLIGHT", env!("CARGO_BIN_EXE_warplight"))
+        .env("SHARDS", "2")
+        .env("OUT", &d)
+        .env("TABLES", "fabianowski:4.5 fabianowski:4.7")
+        .env("PROTOCOL", "quick")
+        .env("JOBS", "2")
+        .env("EXTRA", "--scenes scene6 --resolution 16")
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{out}{}", String::from_utf8_lossy(&o.stderr));
+    let (ok, whole, err) =
+        warplight(&["tables", "fabianowski:4.5", "fabianowski:4.7", "--scenes", "scene6", "--resolution", "16"]);
+    assert!(ok, "{err}");
+    assert_eq!(std::fs::read_to_string(d.join("tables.md")).unwrap(), whole);
+    // the Slurm script, its array tasks run by hand, then merged
+    for i in ["0", "1"] {
+        let o = Command::new("bash")
+            .arg("examples/cluster/slurm.sh")
+            .env("WARPLIGHT", env!("CARGO_BIN_EXE_warplight"))
+            .env("SLURM_ARRAY_TASK_ID", i)
+            .env("SLURM_ARRAY_TASK_COUNT", "2")
+            .env("PROTOCOL", "quick")
+            .env("OUT", d.join("slurm"))
+            .env("TABLES", "fabianowski:4.5 fabianowski:4.7")
+            .env("EXTRA", "--scenes scene6 --resolution 16")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let s = |i: &str| d.join("slurm").join(format!("shard-{i}.json")).display().to_string();
+    let (ok, merged, err) = warplight(&["tables", "merge", &s("0"), &s("1")]);
+    assert!(ok && merged == whole, "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// Cells recorded as within tolerance in the committed baseline stay within it.
+#[test]
+fn no_cell_drops_out_of_tolerance() {
+    let (ok, out, err) = warplight(&[
+        "tables",
+        "all",
+        "--scenes",
+        "scene6",
+        "--frames",
+        "1",
+        "--resolution",
+        "32",
+        "--baseline",
+        "tests/fixtures/baseline-scene6.json",
+    ]);
+    assert!(ok, "{err}\n{out}");
+    assert!(err.contains("no cell dropped out of tolerance"), "{err}");
+}
