@@ -230,3 +230,39 @@ fn no_cell_drops_out_of_tolerance() {
     assert!(ok, "{err}\n{out}");
     assert!(err.contains("no cell dropped out of tolerance"), "{err}");
 }
+
+/// The docs' generated blocks (`<!-- generated: warplight ARGS -->`) hold what
+/// `warplight ARGS` prints now: `tools/regen-docs.sh` was run after the last change.
+#[test]
+fn generated_doc_blocks_are_current() {
+    let mut files = vec![std::path::PathBuf::from("README.md")];
+    for e in std::fs::read_dir("docs").unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "md") {
+            files.push(p);
+        }
+    }
+    let mut blocks = 0;
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let mut rest = text.as_str();
+        while let Some(i) = rest.find("<!-- generated: warplight ") {
+            let after = &rest[i + "<!-- generated: warplight ".len()..];
+            let (args, body) = after.split_once(" -->\n").unwrap();
+            let (content, tail) = body.split_once("<!-- end generated -->").unwrap();
+            let args: Vec<&str> = args.split_whitespace().collect();
+            let (ok, out, err) = warplight(&args);
+            assert!(ok, "{}: warplight {args:?}: {err}", f.display());
+            assert_eq!(
+                content,
+                out,
+                "{}: the block of `warplight {}` is stale: run tools/regen-docs.sh",
+                f.display(),
+                args.join(" ")
+            );
+            blocks += 1;
+            rest = tail;
+        }
+    }
+    assert!(blocks >= 11, "{blocks} generated blocks");
+}

@@ -97,7 +97,28 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         super::write_atomically(out, serde_json::to_string_pretty(&results)?.as_bytes())?;
         eprintln!("wrote {}", out.display());
     }
-    let tables = render(&results)?;
+    // with --from, the tables named (default: every table of the file)
+    let only = if a.from.is_some() && !a.tables.is_empty() { Some(registry::resolve(&a.tables)?) } else { None };
+    let mut tables = render(&results)?;
+    if let Some(only) = only {
+        let keep: Vec<String> = only.iter().map(|e| e.address()).collect();
+        tables.retain(|t| {
+            keep.iter().any(|k| {
+                t.address == *k
+                    || t.address
+                        .strip_prefix(k.as_str())
+                        .is_some_and(|p| p.len() == 1 && p.chars().all(|c| c.is_ascii_lowercase()))
+            })
+        });
+        if tables.is_empty() {
+            return Err(format!(
+                "{}: holds no measurements of {}",
+                a.from.as_ref().map(|f| f.display().to_string()).unwrap_or_default(),
+                keep.join(" ")
+            )
+            .into());
+        }
+    }
     if let Some(f) = &a.write_baseline {
         let b = Baseline::record(&results.protocol.describe(), &scene_names(&results), &tables);
         super::write_atomically(f, serde_json::to_string_pretty(&b)?.as_bytes())?;
@@ -122,8 +143,9 @@ pub fn list() -> String {
         for table in t.tables {
             let e = Entry { thesis: t, table };
             let cmd = if table.render.is_some() { format!("warplight tables {}", e.address()) } else { "–".into() };
-            let title: String = table.title.chars().take(70).collect();
-            let ell = if table.title.chars().count() > 70 { "…" } else { "" };
+            // the line fits 120 columns
+            let title: String = table.title.chars().take(42).collect();
+            let ell = if table.title.chars().count() > 42 { "…" } else { "" };
             s.push_str(&format!("  {:<16} {:<18} {:<38} {title}{ell}\n", e.address(), table.status.name(), cmd));
         }
         s.push('\n');
@@ -258,8 +280,10 @@ fn format(r: &Results, tables: &[Table], format: &str) -> Result<String, Box<dyn
                 md.push_str(&t.markdown());
                 md.push('\n');
             }
-            let (w, n) = tables.iter().map(Table::score).fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-            md.push_str(&format!("Overall: {w}/{n} compared cells within tolerance.\n"));
+            if tables.len() > 1 {
+                let (w, n) = tables.iter().map(Table::score).fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+                md.push_str(&format!("Overall: {w}/{n} compared cells within tolerance.\n"));
+            }
             for u in &r.unavailable {
                 md.push_str(&format!("Unavailable: {u}\n"));
             }

@@ -433,9 +433,9 @@ impl Table {
             for (i, c) in r.cells.iter().enumerate() {
                 let ours =
                     if r.kind == RowKind::ThesisOurScenes { String::new() } else { self.ours_text(i, c, r.kind) };
-                s.push_str(&format!(" {ours} |"));
+                push_cell(&mut s, &ours);
                 if self.columns[i].has_thesis {
-                    s.push_str(&format!(" {} |", c.thesis.clone().unwrap_or_default()));
+                    push_cell(&mut s, c.thesis.as_deref().unwrap_or(""));
                 }
             }
             s.push('\n');
@@ -525,6 +525,15 @@ impl Table {
             s.push('\n');
         }
         s
+    }
+}
+
+/// ` text |`, or ` |` for an empty cell.
+fn push_cell(s: &mut String, text: &str) {
+    if text.is_empty() {
+        s.push_str(" |");
+    } else {
+        s.push_str(&format!(" {text} |"));
     }
 }
 
