@@ -232,4 +232,3 @@ fn step_log_steps_a_later_launch_and_checks_breakpoints() {
     assert!(ok && out.matches("break at PTX line 97").count() == 3, "{out}");
     assert!(out.contains("4 divergent branches, 8 reconvergences"), "{out}");
 }
-
