@@ -52,6 +52,11 @@ fn addresses_and_their_errors() {
     assert!(!ok && err.contains("expected markdown, table, csv or json"), "{err}");
     let (ok, _, err) = warplight(&["tables", "4.5", "--frames", "60..70"]);
     assert!(!ok && err.contains("the protocol has 3 frames"), "{err}");
+    // --plan prints what would run and the estimate, and runs nothing
+    let (ok, out, err) = warplight(&["tables", "fabianowski:all", "--protocol", "thesis", "--plan"]);
+    assert!(ok && out.contains("protocol thesis: 50 frame(s) of each flight at 512x512"), "{err}");
+    assert!(out.contains("estimated time: ") && out.contains(" h on "), "{out}");
+    assert!(out.contains("unavailable: scenes/fairy.toml"), "{out}");
     let (ok, _, err) = warplight(&["tables", "4.5", "--protocol", "slow"]);
     assert!(!ok && err.contains("expected quick or thesis"), "{err}");
 }

@@ -23,6 +23,7 @@ Examples:
   warplight tables --list                          every table of every thesis, with its status
   warplight tables 4.4                             Table 4.4 of thesis 000 (a bare number works while unambiguous)
   warplight tables fabianowski:4.5 fabianowski:4.7 --protocol quick
+  warplight tables fabianowski:all --protocol thesis --plan   what the published protocol runs, and how long it takes
   warplight tables fabianowski:all --protocol thesis   the published protocol (hours: the estimate is printed first)
   warplight tables 4.5 --protocol thesis --frames 0..25 --out a.json   one shard ...
   warplight tables 4.5 --protocol thesis --frames 25..50 --out b.json  ... and the other
@@ -69,6 +70,9 @@ pub struct TablesArgs {
     /// Write the verdicts as a baseline file.
     #[arg(long)]
     pub write_baseline: Option<PathBuf>,
+    /// Print what would run and the time estimate, and stop.
+    #[arg(long)]
+    pub plan: bool,
 }
 
 /// Runs the command.
@@ -78,6 +82,11 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     if a.list {
         print!("{}", list());
+        return Ok(());
+    }
+    if a.plan {
+        let (plan, scenes, unavailable) = plan(&a)?;
+        print!("{}", plan.describe(&scenes, &unavailable, rayon::current_num_threads()));
         return Ok(());
     }
     let results = if a.tables.first().is_some_and(|t| t == "merge") {
@@ -190,7 +199,8 @@ fn protocol_of(a: &TablesArgs) -> Result<(Protocol, Option<FrameRange>), String>
     Ok((p, range))
 }
 
-fn measure(a: &TablesArgs) -> Result<Results, Box<dyn std::error::Error>> {
+/// The plan of a run with its scenes loaded.
+fn plan(a: &TablesArgs) -> Result<(Plan, Vec<Scene>, Vec<Unavailable>), Box<dyn std::error::Error>> {
     let entries = registry::resolve(&a.tables)?;
     let (protocol, frames) = protocol_of(a)?;
     let plan = Plan::new(entries, &a.scenes, protocol, frames, a.repeats);
@@ -199,6 +209,11 @@ fn measure(a: &TablesArgs) -> Result<Results, Box<dyn std::error::Error>> {
         let why: Vec<String> = unavailable.iter().map(|u| u.why.clone()).collect();
         return Err(format!("no scene of these tables could be loaded: {}", why.join("; ")).into());
     }
+    Ok((plan, scenes, unavailable))
+}
+
+fn measure(a: &TablesArgs) -> Result<Results, Box<dyn std::error::Error>> {
+    let (plan, scenes, unavailable) = plan(a)?;
     let threads = rayon::current_num_threads();
     eprint!("{}", plan.describe(&scenes, &unavailable, threads));
     let bar = bar(plan.units(&scenes));

@@ -151,8 +151,11 @@ pub struct Group {
     pub per_frame: bool,
     /// Variants run per frame (progress units per frame).
     pub variants: usize,
-    /// Estimated core-seconds per pixel, per frame and variant (0 for frame-independent groups).
-    pub seconds_per_pixel: f64,
+    /// Estimated core-seconds per frame and variant, per pixel of the image's
+    /// side: the emulated kernels' time grows about linearly with the side at
+    /// the sizes we run (an emulated Sponza frame of one variant takes about
+    /// 1.1 s at 96 × 96 and 5.5 s at 512 × 512 on two cores).
+    pub seconds_per_side: f64,
     /// Estimated core-seconds per triangle of its own work once per scene (timed builds).
     pub seconds_per_triangle: f64,
     /// The kd-trees it runs on (built once per scene for all groups).
@@ -161,12 +164,13 @@ pub struct Group {
     pub measure: Measure,
 }
 
-/// Estimated core-seconds per triangle to build a tree by `h` (measured on
-/// Sponza on this project's CI machine class: SAH and SIROH 0.27 s, the
-/// numerical approximation about 19 s).
+/// Estimated seconds per triangle to build a tree by `h`, single-threaded
+/// (measured on this project's machine class: SAH and SIROH trees of Sponza
+/// 0.27 s; the numerical approximation's trees of Sponza about 19 s and of
+/// the Conference room about 65 s).
 pub fn tree_seconds_per_triangle(h: Heuristic) -> f64 {
     match h {
-        Heuristic::Numerical => 3e-4,
+        Heuristic::Numerical => 2.5e-4,
         _ => 5e-6,
     }
 }

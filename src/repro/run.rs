@@ -5,6 +5,7 @@
 use super::protocol::{FrameRange, Protocol};
 use super::registry::{Entry, Group, Tick, Workspace, tree_seconds_per_triangle};
 use super::results::{Results, SceneInfo};
+use crate::host::kdtree::Heuristic;
 use crate::host::scene::Scene;
 
 /// A scene that could not be run.
@@ -96,27 +97,41 @@ impl Plan {
         ) as u64
     }
 
-    /// Estimated core-seconds.
-    pub fn core_seconds(&self, scenes: &[Scene]) -> f64 {
-        let px = (self.protocol.resolution as f64).powi(2);
-        self.work(scenes, |g, s, frames| {
-            let per_frame = if g.per_frame { frames as f64 } else { 1.0 };
-            per_frame * g.variants as f64 * px * g.seconds_per_pixel + s.triangles.len() as f64 * g.seconds_per_triangle
-        })
+    /// Estimated seconds on `threads` threads: frames run in parallel, tree builds do not.
+    pub fn seconds(&self, scenes: &[Scene], threads: usize) -> f64 {
+        let side = self.protocol.resolution as f64;
+        let frames = self.work(scenes, |g, _, frames| {
+            let runs = if g.per_frame { frames as f64 } else { 1.0 } * g.variants as f64;
+            runs * side * g.seconds_per_side
+        });
+        let own = self.work(scenes, |g, s, _| s.triangles.len() as f64 * g.seconds_per_triangle);
+        let mut trees = 0.0;
+        for s in scenes {
+            let mut hs: Vec<Heuristic> = Vec::new();
+            for (g, names) in &self.groups {
+                if self.runs(g, names, s) {
+                    hs.extend(g.trees.iter().filter(|h| !hs.contains(h)).collect::<Vec<_>>());
+                }
+            }
+            trees += hs.iter().map(|h| tree_seconds_per_triangle(*h) * s.triangles.len() as f64).sum::<f64>();
+        }
+        frames / threads.max(1) as f64 + own + trees
     }
 
+    /// Whether group `g` (on scenes `names`) runs on `s` in this run.
+    fn runs(&self, g: &Group, names: &[String], s: &Scene) -> bool {
+        names.contains(&s.name) && (g.per_frame || self.takes_frame_independent())
+    }
+
+    /// The sum of `f(group, scene, frames)` over the groups and scenes this run runs.
     fn work(&self, scenes: &[Scene], f: impl Fn(&Group, &Scene, u64) -> f64) -> f64 {
         let mut total = 0.0;
         for s in scenes {
-            let mut trees = Vec::new();
             for (g, names) in &self.groups {
-                if !names.contains(&s.name) || (!g.per_frame && !self.takes_frame_independent()) {
-                    continue;
+                if self.runs(g, names, s) {
+                    total += f(g, s, self.frames_of(s).len() as u64);
                 }
-                total += f(g, s, self.frames_of(s).len() as u64);
-                trees.extend(g.trees.iter().copied().filter(|h| !trees.contains(h)).collect::<Vec<_>>());
             }
-            total += trees.iter().map(|h| tree_seconds_per_triangle(*h) * s.triangles.len() as f64).sum::<f64>();
         }
         total
     }
@@ -140,7 +155,7 @@ impl Plan {
         for u in unavailable {
             s.push_str(&format!("  unavailable: {}\n", u.why));
         }
-        let secs = self.core_seconds(scenes) / threads.max(1) as f64;
+        let secs = self.seconds(scenes, threads);
         s.push_str(&format!("  estimated time: {} on {threads} thread(s)\n", human(secs)));
         s
     }

@@ -43,9 +43,11 @@ pub const SHADOW_LIGHT: &str = "fabianowski/shadow-light";
 /// Group: timed tree builds.
 pub const BUILDS: &str = "fabianowski/builds";
 
-/// Emulated kernels: core-seconds per pixel, frame and variant (an emulated
-/// 512 x 512 frame takes 5.5-7.5 s on two cores, README "Speed").
-const EMULATED: f64 = 5.0e-5;
+/// Emulated kernels: core-seconds per frame and variant per pixel of the
+/// image side (Sponza: 1.1 s at 96 x 96, 5.5 s at 512 x 512, on two cores).
+const EMULATED: f64 = 0.022;
+/// The native caster: a 512 x 512 frame in 0.4 s on two cores (README "Speed").
+const NATIVE: f64 = 0.0016;
 
 /// The thesis and its tables.
 pub static THESIS: Thesis = Thesis {
@@ -67,7 +69,7 @@ static GROUPS: [Group; 6] = [
         what: "5 traversal kernels on the emulator",
         per_frame: true,
         variants: 5,
-        seconds_per_pixel: EMULATED,
+        seconds_per_side: EMULATED,
         seconds_per_triangle: 0.0,
         trees: &[Heuristic::Siroh],
         measure: flight::measure_traversal,
@@ -77,7 +79,7 @@ static GROUPS: [Group; 6] = [
         what: "7 cache kernels on the emulator",
         per_frame: true,
         variants: 7,
-        seconds_per_pixel: EMULATED,
+        seconds_per_side: EMULATED,
         seconds_per_triangle: 0.0,
         trees: &[Heuristic::Siroh],
         measure: flight::measure_caches,
@@ -87,7 +89,7 @@ static GROUPS: [Group; 6] = [
         what: "the stack kernel on SAH, 4.1.2 and SIROH trees on the emulator",
         per_frame: true,
         variants: 3,
-        seconds_per_pixel: EMULATED,
+        seconds_per_side: EMULATED,
         seconds_per_triangle: 0.0,
         trees: &HEURISTIC_TREES,
         measure: table_4_1::measure,
@@ -97,7 +99,7 @@ static GROUPS: [Group; 6] = [
         what: "the native caster on SAH, 4.1.2 and SIROH trees",
         per_frame: true,
         variants: 3,
-        seconds_per_pixel: 2e-6,
+        seconds_per_side: NATIVE,
         seconds_per_triangle: 0.0,
         trees: &HEURISTIC_TREES,
         measure: table_4_3::measure,
@@ -107,7 +109,7 @@ static GROUPS: [Group; 6] = [
         what: "shadow rays from two lights over SAH and SIROH trees (frame 0)",
         per_frame: false,
         variants: 4,
-        seconds_per_pixel: 2e-6,
+        seconds_per_side: NATIVE,
         seconds_per_triangle: 0.0,
         trees: &[Heuristic::Sah, Heuristic::Siroh],
         measure: table_4_2::measure_group,
@@ -117,7 +119,7 @@ static GROUPS: [Group; 6] = [
         what: "timed SAH and SIROH builds",
         per_frame: false,
         variants: 2,
-        seconds_per_pixel: 0.0,
+        seconds_per_side: 0.0,
         seconds_per_triangle: 8e-6,
         trees: &[],
         measure: table_4_4::measure_group,
