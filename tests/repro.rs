@@ -271,3 +271,33 @@ fn generated_doc_blocks_are_current() {
     }
     assert!(blocks >= 11, "{blocks} generated blocks");
 }
+
+/// Every registered table's caption is the seed's, near the lines the registry names.
+#[test]
+fn captions_are_quoted_from_the_seeds_at_their_lines() {
+    let dir = std::path::Path::new("../shared/seeds");
+    if !dir.is_dir() {
+        use std::io::Write;
+        let _ = writeln!(
+            std::io::stderr(),
+            "skipped: captions_are_quoted_from_the_seeds_at_their_lines needs ../shared/seeds"
+        );
+        return;
+    }
+    let norm = |s: &str| s.replace(['*', '\u{a0}'], " ").split_whitespace().collect::<Vec<_>>().join(" ");
+    let mut checked = 0;
+    for e in warplight::repro::registry::entries() {
+        let text = std::fs::read_to_string(dir.join(e.thesis.seed_file)).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let range = e.table.lines.trim_start_matches('L');
+        let (a, b) = range.split_once('-').unwrap_or((range, range));
+        let (a, b): (usize, usize) = (a.parse().unwrap(), b.trim_start_matches('L').parse().unwrap());
+        let window = norm(&lines[a.saturating_sub(15)..(b + 15).min(lines.len())].join(" "));
+        let title = norm(e.table.title);
+        // the first 60 characters: long captions may wrap around footnote marks
+        let head: String = title.chars().take(60).collect();
+        assert!(window.contains(&head), "{}: caption {head:?} not near seed lines {}", e.address(), e.table.lines);
+        checked += 1;
+    }
+    assert!(checked >= 48, "{checked}");
+}

@@ -148,7 +148,7 @@ fn scene_names(r: &Results) -> Vec<String> {
 pub fn list() -> String {
     let mut s = String::new();
     for t in registry::THESES {
-        s.push_str(&format!("{} (seed {}, src/repro/{}/): {}\n", t.short, t.seed, t.dir, t.citation));
+        s.push_str(&format!("{} (seed {}, {}; src/repro/{}/): {}\n", t.short, t.seed, t.seed_file, t.dir, t.citation));
         for table in t.tables {
             let e = Entry { thesis: t, table };
             let cmd = if table.render.is_some() { format!("warplight tables {}", e.address()) } else { "–".into() };

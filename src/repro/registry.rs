@@ -22,6 +22,8 @@ pub struct Thesis {
     pub dir: &'static str,
     /// Seed number in `shared/seeds/`.
     pub seed: &'static str,
+    /// The seed's text file in `shared/seeds/` (line numbers refer to it).
+    pub seed_file: &'static str,
     /// Author(s), year and title.
     pub citation: &'static str,
     /// Its tables, in the document's order.
@@ -343,6 +345,7 @@ mod tests {
             short: "a",
             dir: "a2000",
             seed: "9",
+            seed_file: "",
             citation: "",
             tables: &*A_TABLES,
             groups: &[],
@@ -351,6 +354,7 @@ mod tests {
             short: "b",
             dir: "b2000",
             seed: "9",
+            seed_file: "",
             citation: "",
             tables: &*B_TABLES,
             groups: &[],

@@ -12,6 +12,7 @@ pub static THESIS: Thesis = Thesis {
     short: "engelhardt",
     dir: "engelhardt2013",
     seed: "001",
+    seed_file: "001_c2103f8a7e5630e3.txt",
     citation: "Thomas Engelhardt (2013): Efficient From-Point Visibility for Global Illumination in Virtual Scenes with Participating Media",
     tables: &TABLES,
     groups: &[],

@@ -54,6 +54,7 @@ pub static THESIS: Thesis = Thesis {
     short: "fabianowski",
     dir: "fabianowski2011",
     seed: "000",
+    seed_file: "000_f44e1f0be984c6fd.txt",
     citation: "Bartosz Fabianowski (2011): Interactive Manycore Photon Mapping",
     tables: &TABLES,
     groups: &GROUPS,

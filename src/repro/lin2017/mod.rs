@@ -12,6 +12,7 @@ pub static THESIS: Thesis = Thesis {
     short: "lin",
     dir: "lin2017",
     seed: "003",
+    seed_file: "003_0cecf91ec9b1cabd.txt",
     citation: "Lin Daqi (2017): Real Time Path Tracing on GPU",
     tables: &TABLES,
     groups: &[],

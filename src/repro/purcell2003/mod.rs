@@ -12,6 +12,7 @@ pub static THESIS: Thesis = Thesis {
     short: "purcell",
     dir: "purcell2003",
     seed: "004",
+    seed_file: "004_1476f2f779d00267.txt",
     citation: "Timothy J. Purcell, Craig Donner, Mike Cammarano, Henrik Wann Jensen, Pat Hanrahan (2003): Photon Mapping on Programmable Graphics Hardware",
     tables: &TABLES,
     groups: &[],

@@ -12,6 +12,7 @@ pub static THESIS: Thesis = Thesis {
     short: "zeidan",
     dir: "zeidan2011",
     seed: "002",
+    seed_file: "002_74e6b19bea473f3c.txt",
     citation: "Mahmoud Zeidan (2011): Applying Parallel Processing Approach for Interactive Global Illumination",
     tables: &TABLES,
     groups: &[],
