@@ -4,35 +4,24 @@
 #
 #   TABLES=fabianowski:all PROTOCOL=thesis SHARDS=10 OUT=shards examples/cluster/parallel.sh
 #
-# Environment (defaults in brackets):
-#   WARPLIGHT  the warplight binary [warplight]
-#   TABLES     table addresses [fabianowski:all]
-#   PROTOCOL   quick or thesis [thesis]
-#   FRAMES     frames of the protocol's flights [50 for thesis, 3 for quick]
+# Environment (defaults in brackets): WARPLIGHT, TABLES, PROTOCOL, FRAMES, OUT
+# and EXTRA as in settings.sh, and
 #   SHARDS     number of frame ranges [4]
 #   JOBS       shards run at once on this machine [1: each shard uses every core]
 #   SSH        a GNU parallel --sshlogin list to spread shards over machines
 #              (each needs warplight and the scenes at the same paths) []
-#   OUT        directory for shard-*.json, their logs and the merged tables.md [shards]
-#   EXTRA      more `warplight tables` options, e.g. "--scenes sponza" []
 set -euo pipefail
-WARPLIGHT=${WARPLIGHT:-warplight}
-TABLES=${TABLES:-fabianowski:all}
-PROTOCOL=${PROTOCOL:-thesis}
-case $PROTOCOL in thesis) default_frames=50 ;; *) default_frames=3 ;; esac
-FRAMES=${FRAMES:-$default_frames}
+# shellcheck source=settings.sh
+source "$(dirname "$0")/settings.sh"
 SHARDS=${SHARDS:-4}
 JOBS=${JOBS:-1}
-OUT=${OUT:-shards}
-EXTRA=${EXTRA:-}
 command -v parallel >/dev/null || { echo "GNU parallel is not installed (apt-get install parallel)" >&2; exit 1; }
 mkdir -p "$OUT"
 rm -f "$OUT"/shard-*.json
 ranges=()
 for ((i = 0; i < SHARDS; i++)); do
-  a=$((i * FRAMES / SHARDS))
-  b=$(((i + 1) * FRAMES / SHARDS))
-  if [ "$a" -lt "$b" ]; then ranges+=("$a..$b"); fi
+  r=$(shard_range "$i" "$SHARDS")
+  if [ -n "$r" ]; then ranges+=("$r"); fi
 done
 ssh=()
 if [ -n "${SSH:-}" ]; then ssh=(--sshlogin "$SSH"); fi
