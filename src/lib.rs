@@ -20,6 +20,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod chart;
 pub mod cli;
 pub mod host;
 pub mod launch_spec;

@@ -1,5 +1,6 @@
 //! The `warplight` command line: argument parsing, output formats, progress.
 
+pub mod chart;
 pub mod launch;
 pub mod ptx_info;
 pub mod render;
@@ -17,6 +18,7 @@ use clap::{Parser, Subcommand};
 Examples:
   warplight render --scene cornell-box -o cornell.png   render a scene's first flight frame
   warplight tables 4.4                             kd-tree statistics beside thesis 000's Table 4.4
+  warplight chart table 4.5 --from r.json -o t.svg  a table's values beside the thesis' as a chart
   warplight launch examples/reduce.toml            run a kernel described by a spec, print counters
   warplight launch examples/reduce.toml --per-line counters per CUDA source line
   warplight step examples/if_else.toml             step a warp through an if/else (interactive)
@@ -58,6 +60,13 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Reproduce thesis tables beside the published values (`warplight tables 4.4`).
     Tables(tables::TablesArgs),
+    /// Draw charts (SVG or PNG): a table beside the thesis', counters along a flight, speed vs accuracy.
+    ///
+    /// `chart table 4.5 --from r.json -o t.svg`: a reproduced table's values
+    /// beside the thesis' with the tolerance bands; `chart flight`: a counter
+    /// frame by frame along a flight; `chart scatter`: speed against accuracy
+    /// from JSON.
+    Chart(chart::ChartArgs),
     /// Scenes: `warplight scene info NAME` prints triangles (and the thesis'
     /// count), extent, materials, lights, camera and flight.
     Scene {
@@ -100,6 +109,7 @@ pub fn main() -> i32 {
         Command::Validate { fixture, ptx, markdown } => validate(&fixture, &ptx, markdown),
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
         Command::Tables(a) => tables::run(a),
+        Command::Chart(a) => chart::run(a),
         Command::Render(a) => render::run(a),
         Command::Step(a) => step::run(a),
         Command::Trace(a) => trace::run(a),

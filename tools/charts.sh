@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Redraws the charts in docs/images/ with `warplight chart` (charts in the docs
+# are never drawn by hand):
+#
+#   docs/images/chart-4.5.svg                 Table 4.5, ours beside the thesis with the
+#                                             tolerance bands, from docs/results/fabianowski-quick.json
+#   docs/images/speed-accuracy-example.svg    the generic speed-against-accuracy plot,
+#                                             from tests/fixtures/scatter.json
+#
+# Drawing needs no emulation: the table comes from the committed raw measurements.
+# When those are missing they are measured first (minutes):
+#
+#   warplight tables fabianowski:all --protocol quick --out docs/results/fabianowski-quick.json
+#
+# Usage: tools/charts.sh    (WARPLIGHT: the binary [target/release/warplight];
+#                            RESULTS: the raw measurements [docs/results/fabianowski-quick.json])
+set -euo pipefail
+cd "$(dirname "$0")/.."
+WARPLIGHT=${WARPLIGHT:-target/release/warplight}
+RESULTS=${RESULTS:-docs/results/fabianowski-quick.json}
+[ -x "$WARPLIGHT" ] || cargo build --release
+mkdir -p docs/images
+if [ ! -f "$RESULTS" ]; then
+  echo "charts.sh: $RESULTS is missing: measuring it (warplight tables fabianowski:all --protocol quick)" >&2
+  mkdir -p "$(dirname "$RESULTS")"
+  "$WARPLIGHT" tables fabianowski:all --protocol quick --out "$RESULTS" > /dev/null
+fi
+"$WARPLIGHT" chart table fabianowski:4.5 --from "$RESULTS" -o docs/images/chart-4.5.svg
+"$WARPLIGHT" chart scatter tests/fixtures/scatter.json -o docs/images/speed-accuracy-example.svg
