@@ -33,7 +33,7 @@ pub struct TablesArgs {
     /// Tables: `thesis:id` (`fabianowski:4.5`), a bare id while unambiguous (`4.5`),
     /// `thesis:all` or `all`. `merge FILE...` merges result files instead.
     pub tables: Vec<String>,
-    /// List every table of every thesis with its status and the command that runs it.
+    /// List every table (of the theses named, e.g. `--list purcell`) with its status and the command that runs it.
     #[arg(long)]
     pub list: bool,
     /// quick (3 frames of each flight at 96x96, minutes) or thesis (the published protocol: 50 frames at 512x512).
@@ -51,10 +51,11 @@ pub struct TablesArgs {
     /// Builds per heuristic for build timings; the fastest counts.
     #[arg(long, default_value_t = 1)]
     pub repeats: u32,
-    /// Output: markdown (default), table (aligned columns for a terminal), csv (numeric
-    /// cells, one header per table) or json (the raw measurements, as --out writes them).
-    #[arg(long, default_value = "markdown")]
-    pub format: String,
+    /// Output: markdown (the default for tables), table (aligned columns for a terminal;
+    /// the default for --list), csv (numeric cells, one header per table) or json (the raw
+    /// measurements, as --out writes them). `--list --format markdown`: full captions and notes.
+    #[arg(long)]
+    pub format: Option<String>,
     /// Write the raw measurements (a shard) to this JSON file; `tables merge` reads them.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -77,11 +78,14 @@ pub struct TablesArgs {
 
 /// Runs the command.
 pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if !["markdown", "json", "csv", "table"].contains(&a.format.as_str()) {
-        return Err(format!("--format {}: expected markdown, table, csv or json", a.format).into());
+    if let Some(f) = &a.format
+        && !["markdown", "json", "csv", "table"].contains(&f.as_str())
+    {
+        return Err(format!("--format {f}: expected markdown, table, csv or json").into());
     }
     if a.list {
-        print!("{}", list());
+        let md = a.format.as_deref() == Some("markdown");
+        print!("{}", if md { list_markdown(&a.tables)? } else { list(&a.tables)? });
         return Ok(());
     }
     if a.plan {
@@ -133,7 +137,7 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
         super::write_atomically(f, serde_json::to_string_pretty(&b)?.as_bytes())?;
         eprintln!("wrote {}", f.display());
     }
-    print!("{}", format(&results, &tables, &a.format)?);
+    print!("{}", format(&results, &tables, a.format.as_deref().unwrap_or("markdown"))?);
     if let Some(f) = &a.baseline {
         check_baseline(f, &results, &tables)?;
     }
@@ -144,10 +148,47 @@ fn scene_names(r: &Results) -> Vec<String> {
     r.scenes.iter().map(|s| s.name.clone()).collect()
 }
 
-/// Every table of every thesis: status, address, caption and the command.
-pub fn list() -> String {
+/// The theses named (default: all).
+fn named(theses: &[String]) -> Result<Vec<&'static registry::Thesis>, String> {
+    for t in theses {
+        if !registry::THESES.iter().any(|x| x.short == t || x.dir == t) {
+            let names: Vec<&str> = registry::THESES.iter().map(|x| x.short).collect();
+            return Err(format!("--list {t}: no such thesis; theses: {}", names.join(", ")));
+        }
+    }
+    Ok(registry::THESES
+        .iter()
+        .copied()
+        .filter(|x| theses.is_empty() || theses.iter().any(|n| n == x.short || n == x.dir))
+        .collect())
+}
+
+/// The tables of the named theses as markdown: address, status, caption as printed, seed lines, note.
+pub fn list_markdown(theses: &[String]) -> Result<String, String> {
     let mut s = String::new();
-    for t in registry::THESES {
+    for t in named(theses)? {
+        s.push_str(&format!("{} (seed {}, `{}`): {}\n\n", t.short, t.seed, t.seed_file, t.citation));
+        s.push_str("| table | status | caption as printed | seed lines | note |\n|---|---|---|---|---|\n");
+        for table in t.tables {
+            let e = Entry { thesis: t, table };
+            s.push_str(&format!(
+                "| {} | {} | {} | {} | {} |\n",
+                e.address(),
+                table.status.name(),
+                table.title.replace('|', "\\|"),
+                table.lines,
+                table.note.replace('|', "\\|")
+            ));
+        }
+        s.push('\n');
+    }
+    Ok(s)
+}
+
+/// Every table of the named theses (default: all): status, address, caption and the command.
+pub fn list(theses: &[String]) -> Result<String, String> {
+    let mut s = String::new();
+    for t in named(theses)? {
         s.push_str(&format!("{} (seed {}, {}; src/repro/{}/): {}\n", t.short, t.seed, t.seed_file, t.dir, t.citation));
         for table in t.tables {
             let e = Entry { thesis: t, table };
@@ -159,7 +200,10 @@ pub fn list() -> String {
         }
         s.push('\n');
     }
-    let all = registry::entries();
+    let all: Vec<Entry> = registry::entries()
+        .into_iter()
+        .filter(|e| theses.is_empty() || theses.iter().any(|n| n == e.thesis.short || n == e.thesis.dir))
+        .collect();
     let count = |st: registry::Status| all.iter().filter(|e| e.table.status == st).count();
     s.push_str(&format!(
         "{} tables: {} reproduced, {} modelled, {} partly, {} missing, {} not reproducible, {} not measurements.\n",
@@ -171,7 +215,7 @@ pub fn list() -> String {
         count(registry::Status::NotReproducible),
         count(registry::Status::NotAMeasurement),
     ));
-    s
+    Ok(s)
 }
 
 fn protocol_of(a: &TablesArgs) -> Result<(Protocol, Option<FrameRange>), String> {
@@ -199,8 +243,11 @@ fn protocol_of(a: &TablesArgs) -> Result<(Protocol, Option<FrameRange>), String>
     Ok((p, range))
 }
 
+/// A plan with the scenes it could load and those it could not.
+type Planned = (Plan, Vec<Scene>, Vec<Unavailable>);
+
 /// The plan of a run with its scenes loaded.
-fn plan(a: &TablesArgs) -> Result<(Plan, Vec<Scene>, Vec<Unavailable>), Box<dyn std::error::Error>> {
+fn plan(a: &TablesArgs) -> Result<Planned, Box<dyn std::error::Error>> {
     let entries = registry::resolve(&a.tables)?;
     let (protocol, frames) = protocol_of(a)?;
     let plan = Plan::new(entries, &a.scenes, protocol, frames, a.repeats);

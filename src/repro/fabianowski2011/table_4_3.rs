@@ -147,10 +147,10 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         .filter_map(|s| {
             let p = per_ray(r, s)?;
             let mut v = Vec::new();
-            for q in 0..3 {
-                v.push(p[0][q]);
-                v.push((p[1][q] / p[0][q] - 1.0) * 100.0);
-                v.push((p[2][q] / p[0][q] - 1.0) * 100.0);
+            for ((sah, num), siroh) in p[0].iter().zip(p[1]).zip(p[2]) {
+                v.push(*sah);
+                v.push((num / sah - 1.0) * 100.0);
+                v.push((siroh / sah - 1.0) * 100.0);
             }
             Some((s.clone(), v))
         })
