@@ -89,6 +89,11 @@ fn tables_4_1_and_4_2_print_thesis_as_printed_verdicts_and_scores() {
     assert!(csv.lines().nth(1).unwrap().starts_with("fabianowski:4.2,scene6,"), "{csv}");
     let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "table"]);
     assert!(ok && out.contains("\nscene6 ") && !out.contains("| scene6 |"), "{out}");
+    // the widest tables fit a 120-column terminal
+    let (ok, out, _) =
+        warplight(&["tables", "4.3", "4.8", "--from", "docs/results/fabianowski-quick.json", "--format", "table"]);
+    assert!(ok && out.lines().all(|l| l.chars().count() <= 120), "{out}");
+    assert!(out.contains("Trav. SIROH") && out.contains("7 NC I + SC III"), "{out}");
     // JSON is the raw measurements: the same file --out writes
     let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "json"]);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();

@@ -349,7 +349,11 @@ fn format(r: &Results, tables: &[Table], format: &str) -> Result<String, Box<dyn
             for u in &r.unavailable {
                 md.push_str(&format!("Unavailable: {u}\n"));
             }
-            s.push_str(&if format == "table" { super::table_format::terminal(&md) } else { md });
+            s.push_str(&if format == "table" {
+                super::table_format::terminal(&md, super::table_format::WIDTH)
+            } else {
+                md
+            });
         }
     }
     Ok(s)
