@@ -232,3 +232,21 @@ fn step_log_steps_a_later_launch_and_checks_breakpoints() {
     assert!(ok && out.matches("break at PTX line 97").count() == 3, "{out}");
     assert!(out.contains("4 divergent branches, 8 reconvergences"), "{out}");
 }
+
+#[test]
+fn scenes_are_found_from_any_directory() {
+    let dir = tempdir();
+    let o = Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["scene", "info", "scene6"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && out.starts_with("scene scene6 ("), "{out}{}", String::from_utf8_lossy(&o.stderr));
+    let o = Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["scene", "info", "nosuch"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("nosuch.toml"));
+}

@@ -1,18 +1,13 @@
 //! `warplight scene info NAME`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use crate::host::scene::{Light, MaterialKind};
 use crate::host::scene_file;
 
-/// Resolves a scene name (`sponza`) or path (`scenes/sponza.toml`).
+/// Resolves a scene name (`sponza`) or path (`scenes/sponza.toml`): [`scene_file::resolve`].
 pub fn scene_path(name: &str) -> PathBuf {
-    let p = Path::new(name);
-    if p.extension().is_some() || p.exists() {
-        p.to_path_buf()
-    } else {
-        Path::new("scenes").join(format!("{name}.toml"))
-    }
+    scene_file::resolve(name)
 }
 
 /// Prints a scene's summary.

@@ -22,6 +22,36 @@ pub struct SceneError {
     pub msg: String,
 }
 
+/// The folders a scene name (`sponza`) is looked up in, in order: `scenes/`
+/// in the current directory, `$WARPLIGHT_HOME/scenes`, and the `scenes/` of
+/// the checkout warplight was built from (so that `cargo install --path .`
+/// gives a binary that finds them from anywhere while the checkout exists).
+pub fn scene_dirs() -> Vec<PathBuf> {
+    let mut v = vec![PathBuf::from("scenes")];
+    if let Some(h) = std::env::var_os("WARPLIGHT_HOME") {
+        v.push(Path::new(&h).join("scenes"));
+    }
+    v.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"));
+    v
+}
+
+/// Resolves a scene name (`sponza`: `NAME.toml` in the first of
+/// [`scene_dirs`] that has it) or a path (`scenes/sponza.toml`, anything with
+/// an extension or that exists). A name found nowhere resolves to
+/// `scenes/NAME.toml`, so that the error names the file.
+pub fn resolve(name: &str) -> PathBuf {
+    let p = Path::new(name);
+    if p.extension().is_some() || p.exists() {
+        return p.to_path_buf();
+    }
+    let file = format!("{name}.toml");
+    scene_dirs()
+        .into_iter()
+        .map(|d| d.join(&file))
+        .find(|f| f.is_file())
+        .unwrap_or_else(|| Path::new("scenes").join(file))
+}
+
 struct Cx<'a> {
     file: &'a str,
 }
