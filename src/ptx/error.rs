@@ -36,6 +36,9 @@ pub enum PtxErrorKind {
     /// A well-formed module that breaks a PTX rule (unknown register, type mismatch...).
     #[error("invalid: {0}")]
     Invalid(String),
+    /// Input past one of warplight's own bounds (see docs/limits.md).
+    #[error("over a limit: {0}")]
+    Limit(String),
 }
 
 /// A PTX front-end error with its location.

@@ -24,12 +24,23 @@ pub fn load(src: &str, name: &str) -> PtxResult<Program> {
     let wrap = |(pos, kind): (Pos, PtxErrorKind)| PtxError {
         file: name.to_string(),
         pos,
-        line_text: src.lines().nth(pos.line.saturating_sub(1) as usize).map(|l| l.trim().to_string()),
+        line_text: src.lines().nth(pos.line.saturating_sub(1) as usize).map(|l| shorten(l.trim())),
         kind,
     };
     let toks = lexer::lex(src).map_err(wrap)?;
     let module = parser::parse(&toks).map_err(wrap)?;
     lower::lower(&module, name, src).map_err(wrap)
+}
+
+/// Most characters of a source line an error message quotes.
+const QUOTED_LINE_CHARS: usize = 160;
+
+/// `line`, cut to [`QUOTED_LINE_CHARS`] characters with `…` when longer.
+fn shorten(line: &str) -> String {
+    match line.char_indices().nth(QUOTED_LINE_CHARS) {
+        Some((cut, _)) => format!("{}…", &line[..cut]),
+        None => line.to_string(),
+    }
 }
 
 /// Reads a PTX file and loads it.

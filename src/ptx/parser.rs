@@ -75,15 +75,22 @@ pub const KNOWN_OPCODES: &[&str] = &[
     "nop",
 ];
 
+/// Deepest nesting of `{ }` blocks, initializer braces and operand lists the
+/// parser accepts; deeper input is an error at the brace that goes too deep
+/// (instead of overflowing the stack).
+pub const MAX_NESTING: u32 = 256;
+
 /// Parses a token stream into a module.
 pub fn parse(tokens: &[Token]) -> PResult<Module> {
-    let mut p = Parser { t: tokens, i: 0 };
+    let mut p = Parser { t: tokens, i: 0, depth: 0 };
     p.module()
 }
 
 struct Parser<'a> {
     t: &'a [Token],
     i: usize,
+    /// Current nesting of blocks, initializer braces and operand lists.
+    depth: u32,
 }
 
 fn syntax<T>(pos: Pos, msg: impl Into<String>) -> PResult<T> {
@@ -91,6 +98,17 @@ fn syntax<T>(pos: Pos, msg: impl Into<String>) -> PResult<T> {
 }
 
 impl<'a> Parser<'a> {
+    /// Runs `f` one nesting level deeper, failing at `pos` past [`MAX_NESTING`].
+    fn nested<T>(&mut self, pos: Pos, what: &str, f: impl FnOnce(&mut Self) -> PResult<T>) -> PResult<T> {
+        if self.depth >= MAX_NESTING {
+            return Err((pos, PtxErrorKind::Limit(format!("{what} nested more than {MAX_NESTING} deep"))));
+        }
+        self.depth += 1;
+        let r = f(self);
+        self.depth -= 1;
+        r
+    }
+
     fn peek(&self) -> Option<&'a Tok> {
         self.t.get(self.i).map(|t| &t.tok)
     }
@@ -331,14 +349,17 @@ impl<'a> Parser<'a> {
     }
 
     fn initializer(&mut self, out: &mut Vec<Literal>) -> PResult<()> {
+        let pos = self.pos();
         if self.eat_punct('{') {
-            if !self.is_punct('}') {
-                self.initializer(out)?;
-                while self.eat_punct(',') {
-                    self.initializer(out)?;
+            self.nested(pos, "initializer braces", |p| {
+                if !p.is_punct('}') {
+                    p.initializer(out)?;
+                    while p.eat_punct(',') {
+                        p.initializer(out)?;
+                    }
                 }
-            }
-            self.expect_punct('}')
+                p.expect_punct('}')
+            })
         } else {
             let pos = self.pos();
             match self.literal()? {
@@ -439,7 +460,7 @@ impl<'a> Parser<'a> {
                 }
                 Some(Tok::Punct('{')) => {
                     self.i += 1;
-                    out.push(Stmt::Block(self.block_body()?));
+                    out.push(Stmt::Block(self.nested(pos, "blocks `{ }`", |p| p.block_body())?));
                 }
                 Some(Tok::Dot(d)) => match d.as_str() {
                     "loc" => {
@@ -563,16 +584,19 @@ impl<'a> Parser<'a> {
                 let brace = self.is_punct('{');
                 let close = if brace { '}' } else { ')' };
                 self.i += 1;
-                let mut v = Vec::new();
-                if !self.eat_punct(close) {
-                    loop {
-                        v.push(self.operand()?);
-                        if self.eat_punct(close) {
-                            break;
+                let v = self.nested(pos, "operand lists", |p| {
+                    let mut v = Vec::new();
+                    if !p.eat_punct(close) {
+                        loop {
+                            v.push(p.operand()?);
+                            if p.eat_punct(close) {
+                                break;
+                            }
+                            p.expect_punct(',')?;
                         }
-                        self.expect_punct(',')?;
                     }
-                }
+                    Ok(v)
+                })?;
                 Ok(if brace { Operand::Vector(v) } else { Operand::List(v) })
             }
             Some(Tok::Punct('!')) => {
@@ -622,6 +646,21 @@ mod tests {
         let Stmt::Inst(ld) = &body[3] else { panic!() };
         assert_eq!(ld.full_opcode(), "ld.global.nc.v2.f32");
         assert_eq!(ld.operands[1], Operand::Addr(Some("%rd1".into()), -8));
+    }
+
+    #[test]
+    fn nesting_past_the_limit_is_an_error_at_the_brace() {
+        let n = MAX_NESTING as usize;
+        let ok = format!(".entry k()\n{{\n{}{}}}\n", "{ ".repeat(n), "} ".repeat(n));
+        assert!(parse(&lex(&ok).unwrap()).is_ok());
+        let deep = format!(".entry k()\n{{\n{}\n{{{}}}\n", "{ ".repeat(n), "} ".repeat(n + 1));
+        let (pos, kind) = parse(&lex(&deep).unwrap()).unwrap_err();
+        assert_eq!((pos.line, pos.col), (4, 1));
+        assert!(matches!(kind, PtxErrorKind::Limit(ref m) if m.contains("blocks")), "{kind}");
+        let init = format!(".global .u32 g[1] = {}1{};", "{".repeat(n + 1), "}".repeat(n + 1));
+        let (pos, kind) = parse(&lex(&init).unwrap()).unwrap_err();
+        assert_eq!(pos.col, 21 + n as u32);
+        assert!(matches!(kind, PtxErrorKind::Limit(ref m) if m.contains("initializer")), "{kind}");
     }
 
     #[test]
