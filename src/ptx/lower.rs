@@ -470,8 +470,11 @@ impl<'a> FnLower<'a> {
                 Some(Inst { guard: None, kind: Kind::Ret | Kind::Exit | Kind::Bra { .. } })
             ) || self.labels.values().any(|&i| i as usize == self.out.insts.len());
             if needs_ret {
+                // Falling off the end of a body returns; for a kernel that is an
+                // exit of the thread, as on the GPU.
                 let pos = self.f.pos;
-                self.emit(Kind::Ret, None, pos, "ret".into(), InstClass::Control);
+                let kind = if self.sigs[self.me].is_entry { Kind::Exit } else { Kind::Ret };
+                self.emit(kind, None, pos, "ret".into(), InstClass::Control);
             }
         }
         for (idx, label, pos) in std::mem::take(&mut self.fixups) {
