@@ -18,13 +18,17 @@
 //! Several `[[launch]]` tables (each with `kernel`, `grid`, `block`, `args` and
 //! optionally `shared`) may replace the top-level launch keys; they run in order
 //! on the same buffers.
+//!
+//! Optional top-level limits hold for every launch: `max_instructions` (the
+//! watchdog, warp instructions per launch) and `max_call_depth` (nested
+//! device-function calls per warp); see `docs/limits.md`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use crate::model::{Model, ModelStats, Occupancy, Profile, occupancy};
 use crate::ptx::types::Ty;
-use crate::sim::{Arg, Device, DevicePtr, LaunchConfig, LaunchStats, Module, SimError};
+use crate::sim::{Arg, Device, DevicePtr, LaunchConfig, LaunchStats, Module, SimConfig, SimError};
 
 /// A problem with a spec file, naming the file and the key.
 #[derive(Debug, thiserror::Error)]
@@ -209,6 +213,11 @@ pub struct Spec {
     pub buffers: Vec<BufferSpec>,
     /// Launches in order.
     pub launches: Vec<LaunchSpec>,
+    /// The watchdog: most warp instructions of one launch (`max_instructions`),
+    /// when given.
+    pub max_instructions: Option<u64>,
+    /// Most nested device-function calls per warp (`max_call_depth`), when given.
+    pub max_call_depth: Option<u32>,
 }
 
 struct Ctx<'a> {
@@ -302,6 +311,17 @@ impl Spec {
             None => return cx.err("ptx", "missing; expected the PTX file's path"),
         };
         let device = t.get("device").and_then(|v| v.as_str()).map(|s| s.to_string());
+        let positive = |key: &str, max: u64| -> Result<Option<u64>, SpecError> {
+            match t.get(key) {
+                None => Ok(None),
+                Some(v) => match v.as_integer() {
+                    Some(x) if x >= 1 && x as u64 <= max => Ok(Some(x as u64)),
+                    _ => cx.err(key, format!("expected an integer from 1 to {max}")),
+                },
+            }
+        };
+        let max_instructions = positive("max_instructions", i64::MAX as u64)?;
+        let max_call_depth = positive("max_call_depth", u32::MAX as u64)?.map(|d| d as u32);
         let mut buffers = Vec::new();
         if let Some(b) = t.get("buffer") {
             let Some(arr) = b.as_array() else { return cx.err("buffer", "expected [[buffer]] tables") };
@@ -385,7 +405,21 @@ impl Spec {
                 }
             }
         }
-        Ok(Spec { file: path.to_path_buf(), ptx, device, buffers, launches })
+        Ok(Spec { file: path.to_path_buf(), ptx, device, buffers, launches, max_instructions, max_call_depth })
+    }
+
+    /// The simulator settings for this spec: `threads` host threads, the
+    /// spec's limits, and `max_instructions` (a command-line flag) over the
+    /// spec's `max_instructions`.
+    pub fn sim_config(&self, threads: usize, max_instructions: Option<u64>) -> SimConfig {
+        let mut c = SimConfig { threads, ..SimConfig::default() };
+        if let Some(n) = max_instructions.or(self.max_instructions) {
+            c.schedule.max_warp_instructions = n;
+        }
+        if let Some(d) = self.max_call_depth {
+            c.max_call_depth = d;
+        }
+        c
     }
 
     /// The initial bytes of buffer `b`.
@@ -589,6 +623,26 @@ init = [1, 2, 3]
         let exp: Vec<f32> = (0..8u64).map(|i| (i.wrapping_mul(2654435761) % 16) as f32).collect();
         assert_eq!(first, exp);
         assert_eq!(s.initial_bytes(&s.buffers[1]).unwrap(), vec![1, 2, 3, 0]);
+    }
+
+    #[test]
+    fn limits_come_from_the_flag_then_the_spec_then_the_default() {
+        let base = "ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\n";
+        let s = parse(base).unwrap();
+        assert_eq!((s.max_instructions, s.max_call_depth), (None, None));
+        let c = s.sim_config(3, None);
+        assert_eq!(c.threads, 3);
+        assert_eq!(c.schedule.max_warp_instructions, crate::sim::device::DEFAULT_MAX_WARP_INSTRUCTIONS);
+        assert_eq!(c.max_call_depth, crate::sim::device::DEFAULT_MAX_CALL_DEPTH);
+        assert_eq!(s.sim_config(0, Some(7)).schedule.max_warp_instructions, 7);
+        let s = parse(&format!("max_instructions = 1000\nmax_call_depth = 9\n{base}")).unwrap();
+        assert_eq!(s.sim_config(0, None).schedule.max_warp_instructions, 1000);
+        assert_eq!(s.sim_config(0, Some(7)).schedule.max_warp_instructions, 7);
+        assert_eq!(s.sim_config(0, None).max_call_depth, 9);
+        for bad in ["max_instructions = 0", "max_call_depth = 4294967296", "max_call_depth = 1.5"] {
+            let e = parse(&format!("{bad}\n{base}")).unwrap_err();
+            assert!(e.to_string().contains("expected an integer from 1 to"), "{bad}: {e}");
+        }
     }
 
     #[test]

@@ -62,7 +62,7 @@ fn runaway_kernel_stops_at_budget() {
     let m = load(&mut dev, "divergence", Dialect::Clang);
     let flag = dev.alloc_zeroed::<i32>(1);
     let f = fault_of(dev.launch(&m, "spin", LaunchConfig::linear(1, 32), &[Arg::Ptr(flag)]));
-    assert_eq!(f.kind, FaultKind::Runaway { budget: 50_000 });
+    assert!(matches!(f.kind, FaultKind::Runaway { budget: 50_000, .. }), "{f}");
 }
 
 #[test]

@@ -6,8 +6,9 @@ use std::path::PathBuf;
 use crate::launch_spec::{self, LaunchResult, Spec};
 use crate::model::{InstMem, Profile};
 use crate::ptx::Program;
+use crate::sim::Device;
 use crate::sim::counters::LineCounts;
-use crate::sim::{Device, SimConfig};
+use crate::sim::device::cap_host_threads;
 
 /// Options of `warplight launch`.
 #[derive(Debug, clap::Args)]
@@ -30,9 +31,13 @@ pub struct LaunchArgs {
     /// Also print counts per CUDA source line (per PTX line without .loc).
     #[arg(long)]
     pub per_line: bool,
-    /// Host threads (0 = all cores). Results do not depend on it.
+    /// Host threads (0 = all cores; at most 4 per core and 1024). Results do not depend on it.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// The watchdog: stop a launch as a runaway after this many warp instructions
+    /// (default: the spec's `max_instructions`, else 2^32). See docs/limits.md.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_instructions: Option<u64>,
     /// Device profile for the memory counters: gt200, maxwell or hopper
     /// (default: the spec's `device`, else hopper). See docs/devices.md.
     #[arg(long)]
@@ -56,7 +61,11 @@ pub fn run(a: LaunchArgs) -> Res {
             None => Err(format!("--dump {d}: expected NAME=FILE")),
         })
         .collect::<Result<_, _>>()?;
-    let mut dev = Device::with_config(SimConfig { threads: a.threads, ..SimConfig::default() });
+    let (threads, capped) = cap_host_threads(a.threads);
+    if let Some(why) = capped {
+        eprintln!("warning: --threads {}: {why}", a.threads);
+    }
+    let mut dev = Device::with_config(spec.sim_config(threads, a.max_instructions));
     let prepared = launch_spec::prepare(&spec, &mut dev)?;
     let spinner = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new_spinner();

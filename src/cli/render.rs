@@ -87,7 +87,7 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             (fb, st, None)
         }
         Some(v) => {
-            let mut dev = Device::new();
+            let mut dev = Device::with_config(rt_kernels::sim_config(&cam));
             let module = rt_kernels::load(&mut dev)?;
             let pb = std::io::stderr().is_terminal().then(|| {
                 let pb = indicatif::ProgressBar::new_spinner();

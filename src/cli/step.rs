@@ -51,6 +51,10 @@ pub struct StepArgs {
     /// continue (interactive view).
     #[arg(long, default_value_t = 100_000)]
     pub max_steps: u64,
+    /// The watchdog: stop a launch as a runaway after this many warp instructions
+    /// (default: the spec's `max_instructions`, else 2^32). See docs/limits.md.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_instructions: Option<u64>,
     /// Device profile for the memory panel's transactions, sectors and banks:
     /// gt200, maxwell or hopper.
     #[arg(long, default_value = "hopper")]
@@ -68,7 +72,8 @@ pub fn parse_warp(w: &str) -> Result<(usize, u32), String> {
 
 /// Runs the command.
 pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let session = Session::load_launch(&a.spec, a.launch)?;
+    let mut session = Session::load_launch(&a.spec, a.launch)?;
+    session.max_instructions = a.max_instructions;
     let only = a.warp.as_deref().map(parse_warp).transpose()?;
     let profile =
         Profile::parse(&a.device).ok_or_else(|| format!("--device {}: expected gt200, maxwell or hopper", a.device))?;

@@ -39,6 +39,10 @@ pub struct TraceArgs {
     /// Most instructions kept; the page says when the recording was cut.
     #[arg(long, default_value_t = 20_000)]
     pub max_events: usize,
+    /// The watchdog: stop a launch as a runaway after this many warp instructions
+    /// (default: the spec's `max_instructions`, else 2^32). See docs/limits.md.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub max_instructions: Option<u64>,
     /// Device profile for the memory transactions, sectors and banks: gt200, maxwell or hopper.
     #[arg(long, default_value = "hopper")]
     pub device: String,
@@ -51,7 +55,8 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.from > a.to {
         return Err(format!("--from {} is after --to {}", a.from, a.to).into());
     }
-    let session = Session::load_launch(&a.spec, a.launch)?;
+    let mut session = Session::load_launch(&a.spec, a.launch)?;
+    session.max_instructions = a.max_instructions;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
     let spinner = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new_spinner();

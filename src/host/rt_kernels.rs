@@ -13,7 +13,7 @@ use super::raycast::{EPS_REL, TraceStats};
 use super::scene::{Light, MaterialKind, Scene};
 use crate::model::{Model, ModelStats, Profile};
 use crate::sim::device::to_bytes;
-use crate::sim::{Arg, Device, LaunchConfig, LaunchStats, Module, SimError};
+use crate::sim::{Arg, Device, LaunchConfig, LaunchStats, Module, SimConfig, SimError};
 
 /// Traversal variants of the kernel family (thesis 000 §4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
@@ -129,6 +129,21 @@ pub const PTX: &str = include_str!("../../kernels/fabianowski2011/raytrace.ptx")
 pub const CTAS: u32 = 30;
 /// Threads per CTA.
 pub const THREADS: u32 = 256;
+
+/// Warp instructions per pixel the watchdog allows a kernel render: about
+/// 20 times the most the thesis scenes need (under 800).
+pub const WARP_INSTRUCTIONS_PER_PIXEL: u64 = 1 << 14;
+
+/// The simulator settings for rendering `camera`'s image: the default, with
+/// a watchdog that grows with the pixel count, so that large images are not
+/// taken for runaway kernels.
+pub fn sim_config(camera: &Camera) -> SimConfig {
+    let mut c = SimConfig::default();
+    let pixels = camera.resolution[0] as u64 * camera.resolution[1] as u64;
+    let budget = pixels.saturating_mul(WARP_INSTRUCTIONS_PER_PIXEL);
+    c.schedule.max_warp_instructions = c.schedule.max_warp_instructions.max(budget);
+    c
+}
 
 /// What a kernel render produced.
 #[derive(Debug, Clone)]

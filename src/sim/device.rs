@@ -201,10 +201,45 @@ pub struct SimConfig {
     pub num_sms: u32,
     /// Local memory per thread (call stack and local arrays) in bytes.
     pub local_limit: u32,
+    /// Most device-function frames on a warp's call stack; a deeper call is a
+    /// [`FaultKind::CallDepth`](super::FaultKind::CallDepth) fault.
+    pub max_call_depth: u32,
     /// Largest CTA.
     pub max_threads_per_cta: u32,
     /// Largest shared memory per CTA.
     pub max_shared_per_cta: u32,
+}
+
+/// The default watchdog: warp instructions per launch (2^32, a few minutes of
+/// simulation) before a launch is stopped as a runaway.
+pub const DEFAULT_MAX_WARP_INSTRUCTIONS: u64 = 1 << 32;
+
+/// The default call-depth limit: device-function frames per warp. CUDA's
+/// default 1 KiB stack per thread allows far fewer for real code.
+pub const DEFAULT_MAX_CALL_DEPTH: u32 = 1024;
+
+/// Most host threads per available core that [`cap_host_threads`] allows.
+pub const HOST_THREADS_PER_CORE: usize = 4;
+
+/// Most host threads [`cap_host_threads`] allows at all.
+pub const MAX_HOST_THREADS: usize = 1024;
+
+/// The host threads actually used for a request of `requested` (0 = all
+/// cores): at most [`HOST_THREADS_PER_CORE`] per available core and at most
+/// [`MAX_HOST_THREADS`]. Returns the count and, when it had to be lowered, why.
+pub fn cap_host_threads(requested: usize) -> (usize, Option<String>) {
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let cap = (cores * HOST_THREADS_PER_CORE).min(MAX_HOST_THREADS);
+    if requested > cap {
+        let why = format!(
+            "using {cap} host threads instead of {requested} ({HOST_THREADS_PER_CORE} per core on {cores} core{}, \
+             at most {MAX_HOST_THREADS}); results do not depend on it",
+            if cores == 1 { "" } else { "s" }
+        );
+        (cap, Some(why))
+    } else {
+        (requested, None)
+    }
 }
 
 impl Default for SimConfig {
@@ -215,10 +250,11 @@ impl Default for SimConfig {
                 warp_slice: 1,
                 round_quantum: 20_000,
                 max_resident_ctas: 240,
-                max_warp_instructions: 1 << 36,
+                max_warp_instructions: DEFAULT_MAX_WARP_INSTRUCTIONS,
             },
             num_sms: 30,
             local_limit: 64 * 1024,
+            max_call_depth: DEFAULT_MAX_CALL_DEPTH,
             max_threads_per_cta: 1024,
             max_shared_per_cta: 228 * 1024,
         }
@@ -264,7 +300,8 @@ impl Device {
 
     /// A device with `config`.
     pub fn with_config(config: SimConfig) -> Self {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(config.threads).build().ok();
+        let (threads, _) = cap_host_threads(config.threads);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().ok();
         Device { mem: DeviceMemory::new(), config, pool, sizes: HashMap::new() }
     }
 
@@ -420,6 +457,7 @@ impl Device {
             block: cfg.block,
             num_sms: self.config.num_sms.max(1),
             local_limit: self.config.local_limit,
+            max_call_depth: self.config.max_call_depth,
             observers,
         }
     }

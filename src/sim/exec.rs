@@ -35,6 +35,8 @@ pub struct Ctx<'a> {
     pub num_sms: u32,
     /// Per-thread local memory limit in bytes.
     pub local_limit: u32,
+    /// Most device-function frames on a warp's call stack.
+    pub max_call_depth: u32,
     /// Makes the per-CTA memory observers (counter models), if any.
     pub observers: Option<&'a dyn ObserverFactory>,
 }
@@ -527,7 +529,10 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             }
             return Ok(Effect::Continue);
         }
-        Kind::Exit => {
+        // `ret` in the kernel's own frame (no caller to return to) ends the
+        // thread, as `exit` does; the front end already lowers a kernel's
+        // `ret` to `exit`, this covers hand-built programs.
+        Kind::Exit | Kind::Ret if matches!(inst.kind, Kind::Exit) || w.frames.len() == 1 => {
             advance(w);
             if exec == 0 {
                 return Ok(Effect::Continue);
@@ -565,6 +570,19 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             }
             cta.counters.calls += 1;
             let cf = &ctx.prog.functions[*callee as usize];
+            // Device-function frames on the stack after this call (the kernel's is not one).
+            let depth = w.frames.len() as u64;
+            if depth > ctx.max_call_depth as u64 {
+                let names = w.frames.iter().map(|fr| ctx.prog.functions[fr.func as usize].name.as_str());
+                return Err(fault(
+                    FaultKind::CallDepth {
+                        limit: ctx.max_call_depth,
+                        callee: cf.name.clone(),
+                        chain: call_chain(names),
+                    },
+                    lane_of_mask(exec),
+                ));
+            }
             let caller = w.frame();
             let caller_fn = &ctx.prog.functions[caller.func as usize];
             let lb = (caller.local_base + caller_fn.local_size).div_ceil(cf.local_align) * cf.local_align;
@@ -957,6 +975,19 @@ fn atomic(
     Ok(Effect::Continue)
 }
 
+/// Function names of a call stack (outermost first), consecutive repeats
+/// counted: `k, f, f, f` becomes `[(k, 1), (f, 3)]`.
+pub fn call_chain<'a>(names: impl Iterator<Item = &'a str>) -> Vec<(String, u32)> {
+    let mut out: Vec<(String, u32)> = Vec::new();
+    for n in names {
+        match out.last_mut() {
+            Some((last, k)) if last == n => *k += 1,
+            _ => out.push((n.to_string(), 1)),
+        }
+    }
+    out
+}
+
 /// Pops callee frames whose paths are all gone (their lanes exited).
 fn pop_empty_frames(ctx: &Ctx, w: &mut Warp) {
     while w.frames.len() > 1 && w.stack.entries.len() <= w.frame().stack_base {
@@ -1010,5 +1041,17 @@ pub fn apply_pending(ctx: &Ctx, warps: &mut [Warp], pending: &mut Vec<PendingAto
         if w.state == WarpState::WaitAtomic {
             w.state = WarpState::Ready;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn call_chain_counts_consecutive_repeats() {
+        let names = ["k", "f", "f", "g", "f"];
+        let c = super::call_chain(names.into_iter());
+        let want: Vec<(String, u32)> =
+            [("k", 1), ("f", 2), ("g", 1), ("f", 1)].map(|(n, k)| (n.to_string(), k)).to_vec();
+        assert_eq!(c, want);
     }
 }

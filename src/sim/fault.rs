@@ -43,10 +43,23 @@ pub enum FaultKind {
         /// (warp, barrier id) of each waiting warp.
         waiting: Vec<(u32, u32)>,
     },
-    /// The launch exceeded its warp-instruction budget.
+    /// The launch exceeded its warp-instruction budget (the watchdog).
     Runaway {
         /// The budget.
         budget: u64,
+        /// Where the still-running CTAs spent their instructions, most first
+        /// (at most [`HOT_LINES`] lines): the hot loop.
+        hot: Vec<HotLine>,
+    },
+    /// A call would make a warp's call stack deeper than the limit
+    /// (unbounded recursion without `.local` frames never overflows local memory).
+    CallDepth {
+        /// The limit (device-function frames).
+        limit: u32,
+        /// The function being called.
+        callee: String,
+        /// The call stack, outermost first, consecutive repeats counted.
+        chain: Vec<(String, u32)>,
     },
     /// A thread's local memory (its call stack) outgrew the configured limit.
     LocalStackOverflow {
@@ -77,9 +90,16 @@ impl fmt::Display for FaultKind {
             FaultKind::BarrierDeadlock { waiting } => {
                 write!(f, "barrier deadlock: warps wait at barriers that cannot complete (warp, barrier): {waiting:?}")
             }
-            FaultKind::Runaway { budget } => {
-                write!(f, "runaway kernel: more than {budget} warp instructions")
-            }
+            FaultKind::Runaway { budget, .. } => write!(
+                f,
+                "runaway kernel: more than {budget} warp instructions (the watchdog; raise it with \
+                 --max-instructions or the spec key `max_instructions`)"
+            ),
+            FaultKind::CallDepth { limit, callee, .. } => write!(
+                f,
+                "call stack overflow: calling `{callee}` would nest more than {limit} device-function calls \
+                 (unbounded recursion? the limit is the spec key `max_call_depth`)"
+            ),
             FaultKind::LocalStackOverflow { needed, limit } => {
                 write!(f, "local memory (call stack) needs {needed} bytes per thread, limit is {limit}")
             }
@@ -87,6 +107,41 @@ impl fmt::Display for FaultKind {
             FaultKind::Unsupported(s) => write!(f, "unsupported: {s}"),
         }
     }
+}
+
+/// Most hot lines a [`FaultKind::Runaway`] names.
+pub const HOT_LINES: usize = 5;
+
+/// One PTX line of a runaway kernel's hot loop.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct HotLine {
+    /// PTX line.
+    pub ptx_line: u32,
+    /// Its text.
+    pub ptx_text: String,
+    /// CUDA source file and line from `.loc`, when present.
+    pub source: Option<(String, u32)>,
+    /// Warp instructions the still-running CTAs issued on it.
+    pub warp_instructions: u64,
+    /// Its share of all warp instructions of the still-running CTAs, in percent.
+    pub share_pct: u32,
+    /// Warps whose next instruction is on it when the watchdog fired.
+    pub warps_here: u32,
+}
+
+/// `k → f ×3 → g`, eliding the middle of very long chains (mutual recursion).
+fn show_chain(chain: &[(String, u32)]) -> String {
+    let item = |(n, k): &(String, u32)| if *k > 1 { format!("{n} ×{k}") } else { n.clone() };
+    const HEAD: usize = 4;
+    const TAIL: usize = 6;
+    if chain.len() <= HEAD + TAIL + 1 {
+        return chain.iter().map(item).collect::<Vec<_>>().join(" → ");
+    }
+    let skipped: u64 = chain[HEAD..chain.len() - TAIL].iter().map(|(_, k)| *k as u64).sum();
+    let mut parts: Vec<String> = chain[..HEAD].iter().map(item).collect();
+    parts.push(format!("… {skipped} more …"));
+    parts.extend(chain[chain.len() - TAIL..].iter().map(item));
+    parts.join(" → ")
 }
 
 /// A fault with the place it happened.
@@ -130,8 +185,41 @@ impl fmt::Display for Fault {
         if let Some(l) = self.lane {
             write!(f, ", lane {l} (thread {} of the CTA)", self.warp * 32 + l)?;
         }
+        if let FaultKind::CallDepth { chain, .. } = &self.kind {
+            write!(f, "\n  call chain: {}", show_chain(chain))?;
+        }
+        if let FaultKind::Runaway { hot, .. } = &self.kind
+            && !hot.is_empty()
+        {
+            write!(f, "\n  hot loop (share of the running CTAs' warp instructions; where their warps are now):")?;
+            for h in hot {
+                write!(f, "\n    {}:{}  {:>3}%  {}", self.ptx_file, h.ptx_line, h.share_pct, h.ptx_text.trim())?;
+                if let Some((file, line)) = &h.source {
+                    write!(f, "  [{file}:{line}]")?;
+                }
+                if h.warps_here > 0 {
+                    write!(f, "  <- {} warp{}", h.warps_here, if h.warps_here == 1 { "" } else { "s" })?;
+                }
+            }
+        }
         Ok(())
     }
 }
 
 impl std::error::Error for Fault {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn call_chains_count_repeats_and_elide_long_middles() {
+        let c = |v: &[(&str, u32)]| v.iter().map(|(n, k)| (n.to_string(), *k)).collect::<Vec<_>>();
+        assert_eq!(show_chain(&c(&[("k", 1), ("f", 3), ("g", 1)])), "k → f ×3 → g");
+        let long: Vec<(String, u32)> = (0..20).map(|i| (format!("f{i}"), 1 + i % 2)).collect();
+        assert_eq!(
+            show_chain(&long),
+            "f0 → f1 ×2 → f2 → f3 ×2 → … 15 more … → f14 → f15 ×2 → f16 → f17 ×2 → f18 → f19 ×2"
+        );
+    }
+}

@@ -11,12 +11,14 @@
 //! race on the same global address without atomics see each other's writes in
 //! an order that may depend on host timing, as on a GPU.
 
+use std::collections::BTreeMap;
+
 use rayon::prelude::*;
 
 use super::counters::{Counters, InstProfile, LaunchStats};
 use super::cta::{Cta, CtaFault, Issued};
 use super::exec::Ctx;
-use super::fault::{Fault, FaultKind};
+use super::fault::{Fault, FaultKind, HOT_LINES, HotLine};
 use crate::ptx::ir::Program;
 
 /// Scheduling parameters of the simulated machine (not of the host).
@@ -159,7 +161,7 @@ impl<'a> GridRun<'a> {
                 .map(|w| (w.id, w.frame().func, w.stack.top().map(|t| t.pc).unwrap_or(0)))
                 .unwrap_or((0, self.kernel, 0));
             let f = CtaFault {
-                kind: FaultKind::Runaway { budget: self.sched.max_warp_instructions },
+                kind: FaultKind::Runaway { budget: self.sched.max_warp_instructions, hot: self.hot_lines() },
                 warp,
                 func,
                 pc,
@@ -168,6 +170,55 @@ impl<'a> GridRun<'a> {
             return Err(self.locate(c, &f));
         }
         Ok(())
+    }
+
+    /// The PTX lines the resident (still running) CTAs issued most warp
+    /// instructions on, with the warps whose next instruction is there: where
+    /// a runaway kernel loops.
+    fn hot_lines(&self) -> Vec<HotLine> {
+        let prog = self.ctx.prog;
+        // ptx line -> (warp instructions, warps here, a (func, pc) on it)
+        let mut lines: BTreeMap<u32, (u64, u32, (usize, usize))> = BTreeMap::new();
+        let mut total = 0u64;
+        for c in &self.resident {
+            for (f, counts) in c.profile.per_fn.iter().enumerate() {
+                for (pc, n) in counts.iter().enumerate() {
+                    if n.warp == 0 {
+                        continue;
+                    }
+                    total += n.warp;
+                    let line = prog.functions[f].info[pc].ptx_line;
+                    lines.entry(line).or_insert((0, 0, (f, pc))).0 += n.warp;
+                }
+            }
+            for w in c.warps.iter().filter(|w| w.state != super::warp::WarpState::Done) {
+                let (f, Some(pc)) = (w.frame().func as usize, w.stack.top().map(|t| t.pc as usize)) else { continue };
+                if let Some(info) = prog.functions[f].info.get(pc) {
+                    lines.entry(info.ptx_line).or_insert((0, 0, (f, pc))).1 += 1;
+                }
+            }
+        }
+        // Lines with a real share of the work, or with warps on them now.
+        let mut v: Vec<_> =
+            lines.into_iter().filter(|(_, (n, here, _))| *n as u128 * 100 >= total as u128 || *here > 0).collect();
+        v.sort_by(|a, b| (b.1.0, b.1.1).cmp(&(a.1.0, a.1.1)).then(a.0.cmp(&b.0)));
+        v.truncate(HOT_LINES);
+        v.into_iter()
+            .map(|(line, (n, here, (f, pc)))| {
+                let info = &prog.functions[f].info[pc];
+                HotLine {
+                    ptx_line: line,
+                    ptx_text: prog.ptx_lines.get(line.saturating_sub(1) as usize).cloned().unwrap_or_default(),
+                    source: info
+                        .src
+                        .filter(|s| s.line > 0)
+                        .map(|s| (prog.files.get(s.file as usize).cloned().unwrap_or_default(), s.line)),
+                    warp_instructions: n,
+                    share_pct: (n as u128 * 100 / total.max(1) as u128) as u32,
+                    warps_here: here,
+                }
+            })
+            .collect()
     }
 
     /// Runs the whole grid.

@@ -18,6 +18,9 @@ pub struct Session {
     pub launch: usize,
     /// Its kernel name.
     pub kernel: String,
+    /// The watchdog (warp instructions per launch) over the spec's
+    /// `max_instructions`, when given (`--max-instructions`).
+    pub max_instructions: Option<u64>,
 }
 
 /// Errors of the teaching views.
@@ -45,7 +48,7 @@ impl Session {
             .into());
         }
         let kernel = spec.launches[n - 1].kernel.clone();
-        Ok(Session { spec, launch: n - 1, kernel })
+        Ok(Session { spec, launch: n - 1, kernel, max_instructions: None })
     }
 
     /// The stepped launch's spec.
@@ -61,7 +64,7 @@ impl Session {
     /// Runs `f` on a fresh stepper at the start of the launch (fresh buffers),
     /// recording memory accesses.
     pub fn with_stepper<R>(&self, f: impl FnOnce(&mut Stepper) -> Result<R, Error>) -> Result<R, Error> {
-        let mut dev = Device::new();
+        let mut dev = Device::with_config(self.spec.sim_config(0, self.max_instructions));
         let prepared = launch_spec::prepare(&self.spec, &mut dev)?;
         let config =
             |l: &launch_spec::LaunchSpec| LaunchConfig { grid: l.grid, block: l.block, dynamic_shared: l.shared };
