@@ -22,6 +22,7 @@
 
 pub mod chart;
 pub mod cli;
+pub mod compile;
 pub mod host;
 pub mod launch_spec;
 pub mod model;

@@ -1,6 +1,7 @@
 //! The `warplight` command line: argument parsing, output formats, progress.
 
 pub mod chart;
+pub mod compile;
 pub mod launch;
 pub mod ptx_info;
 pub mod render;
@@ -58,6 +59,8 @@ pub enum Command {
     },
     /// Render a frame of a scene's camera flight to PNG or EXR and print its counters.
     Render(render::RenderArgs),
+    /// Compile CUDA C to PTX with clang-16 (or nvcc) and warplight's prelude: `warplight compile k.cu`.
+    Compile(compile::CompileArgs),
     /// Reproduce thesis tables beside the published values (`warplight tables 4.4`).
     Tables(tables::TablesArgs),
     /// Draw charts (SVG or PNG): a table beside the thesis', counters along a flight, speed vs accuracy.
@@ -109,6 +112,7 @@ pub fn main() -> i32 {
         Command::Validate { fixture, ptx, markdown } => validate(&fixture, &ptx, markdown),
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
         Command::Tables(a) => tables::run(a),
+        Command::Compile(a) => compile::run(a),
         Command::Chart(a) => chart::run(a),
         Command::Render(a) => render::run(a),
         Command::Step(a) => step::run(a),

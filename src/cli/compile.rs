@@ -1,0 +1,57 @@
+//! `warplight compile kernel.cu`: CUDA C to PTX with clang-16 or nvcc, the
+//! project's flags and the prelude (`crate::compile`).
+
+use std::path::PathBuf;
+
+use crate::compile::{Dialect, compile, demangle};
+
+/// Options of `warplight compile`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+The prelude (kernels/prelude.h: the CUDA keywords, threadIdx & co., atomics, shuffles, votes,
+__syncthreads, __ldg) is included first, so a .cu needs no #include. Kernels declared
+`extern \"C\" __global__` keep their names; others get C++ names (_Z5saxpyifPfS_), which
+`compile` lists beside the plain name.
+
+Examples:
+  warplight compile saxpy.cu                   writes saxpy.ptx beside it
+  warplight compile saxpy.cu -o /tmp/s.ptx --dialect nvcc
+  warplight launch spec.toml                   with ptx = \"saxpy.ptx\" in the spec")]
+pub struct CompileArgs {
+    /// The CUDA source.
+    pub source: PathBuf,
+    /// The PTX file to write (default: the source with the extension .ptx).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// clang (Debian's clang-16, the default) or nvcc.
+    #[arg(long, default_value = "clang")]
+    pub dialect: String,
+}
+
+/// Runs the command.
+pub fn run(a: CompileArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let d = Dialect::named(&a.dialect)?;
+    let out = a.output.clone().unwrap_or_else(|| a.source.with_extension("ptx"));
+    if out == a.source {
+        return Err(format!("{}: the output would overwrite the source", out.display()).into());
+    }
+    let ptx = compile(&a.source, d)?;
+    // check that warplight can run what was made before writing it
+    let prog = crate::ptx::load(&ptx, &out.display().to_string())?;
+    super::write_atomically(&out, ptx.as_bytes())?;
+    println!("wrote {}", out.display());
+    let mut mangled = false;
+    for name in prog.kernel_names() {
+        match demangle(name) {
+            Some(plain) => {
+                mangled = true;
+                println!("  kernel {plain} (PTX name {name})");
+            }
+            None => println!("  kernel {name}"),
+        }
+    }
+    if mangled {
+        println!("  (declare kernels `extern \"C\" __global__` to keep their plain names in the PTX)");
+    }
+    Ok(())
+}
