@@ -114,6 +114,19 @@ fn the_implicit_end_of_a_kernel_is_an_exit_and_of_a_function_a_return() {
 }
 
 #[test]
+fn a_kernel_without_a_body_is_a_launch_error() {
+    let src = module(".visible .entry k(.param .u64 out);\n");
+    let mut dev = device(|_| {});
+    let m = dev.load_ptx(&src, "decl.ptx").unwrap();
+    let out = dev.alloc_zeroed::<u32>(1);
+    let e = dev.launch(&m, "k", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err();
+    assert!(matches!(e, SimError::BadLaunch(_)), "{e}");
+    assert!(e.to_string().contains("kernel `k` is declared without a body in decl.ptx"), "{e}");
+    let e = dev.stepper(&m, "k", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).err().expect("an error");
+    assert!(matches!(e, SimError::BadLaunch(_)), "{e}");
+}
+
+#[test]
 fn ret_in_the_kernel_frame_exits_even_in_hand_built_ir() {
     // A program built without the front end may end a kernel with `Ret`.
     let src = module(FALLS_OFF_THE_END[1].1);

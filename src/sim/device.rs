@@ -398,6 +398,13 @@ impl Device {
             available: m.prog.kernel_names().join(", "),
         })?;
         let f = &m.prog.functions[k as usize];
+        if f.insts.is_empty() {
+            // Only declared (`.entry k(...);`): a body, even an empty one, has an exit.
+            return Err(SimError::BadLaunch(format!(
+                "kernel `{kernel}` is declared without a body in {}",
+                m.prog.source_name
+            )));
+        }
         if args.len() != f.params.len() {
             return Err(SimError::ArgCount { kernel: kernel.into(), expected: f.params.len(), got: args.len() });
         }
