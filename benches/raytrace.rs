@@ -37,8 +37,9 @@ fn emulated(s: &Scene, tree: &KdTree, cam: &Camera, threads: usize) -> u64 {
     cfg.threads = threads;
     let mut dev = Device::with_config(cfg);
     let module = rt_kernels::load(&mut dev).expect("kernels");
-    let k = rt_kernels::render(&mut dev, &module, s, tree, cam, s.flight.light_offset(0), Variant::Stack, Profile::Gt200)
-        .expect("render");
+    let k =
+        rt_kernels::render(&mut dev, &module, s, tree, cam, s.flight.light_offset(0), Variant::Stack, Profile::Gt200)
+            .expect("render");
     k.trace.rays
 }
 
@@ -63,7 +64,10 @@ fn report() {
     eprintln!("  native caster            {tn:>8.3} s");
     eprintln!("  emulated trace_stack     {te:>8.3} s  (gt200 counters)");
     eprintln!("  emulated / native        {:>8.1} x   (target: <= 20 x)", te / tn);
-    eprintln!("  emulated, 1 thread       {t1:>8.3} s  -> {threads} threads scale {:.2} x (target: >= 1.8 x)\n", t1 / te);
+    eprintln!(
+        "  emulated, 1 thread       {t1:>8.3} s  -> {threads} threads scale {:.2} x (target: >= 1.8 x)\n",
+        t1 / te
+    );
 }
 
 fn bench(c: &mut Criterion) {

@@ -119,10 +119,11 @@ pub fn camera(scene: &Scene, f: u32, res: u32) -> Camera {
 
 /// One frame of one variant on the emulator (gt200 profile).
 pub fn frame(scene: &Scene, tree: &KdTree, f: u32, res: u32, v: Variant) -> Result<Totals, SimError> {
-    // a fresh device per frame: its memory holds one frame's buffers
-    let mut dev = Device::new();
-    let module = rt_kernels::load(&mut dev)?;
+    // a fresh device per frame: its memory holds one frame's buffers; the
+    // watchdog's budget grows with the pixels
     let cam = camera(scene, f, res);
+    let mut dev = Device::with_config(rt_kernels::sim_config(&cam));
+    let module = rt_kernels::load(&mut dev)?;
     let k = rt_kernels::render(&mut dev, &module, scene, tree, &cam, scene.flight.light_offset(f), v, Profile::Gt200)?;
     let m = &k.memory.counters;
     Ok(Totals {
