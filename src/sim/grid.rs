@@ -286,8 +286,7 @@ pub fn make_fault(prog: &Program, kernel: &str, cta: [u32; 3], f: &CtaFault) -> 
     let func = &prog.functions[f.func as usize];
     let info = func.info.get(f.pc as usize);
     let ptx_line = info.map(|i| i.ptx_line).unwrap_or(0);
-    let ptx_text =
-        ptx_line.checked_sub(1).and_then(|l| prog.ptx_lines.get(l as usize)).cloned().unwrap_or_default();
+    let ptx_text = ptx_line.checked_sub(1).and_then(|l| prog.ptx_lines.get(l as usize)).cloned().unwrap_or_default();
     let source = info
         .and_then(|i| i.src)
         .filter(|s| s.line > 0)
