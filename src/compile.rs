@@ -131,14 +131,7 @@ pub fn compile(src: &Path, d: Dialect) -> Result<String, CompileError> {
     result
 }
 
-/// The plain name of an Itanium-mangled function name (`_Z5saxpyifPfS_` →
-/// `saxpy`), or `None` for names that are not mangled.
-pub fn demangle(name: &str) -> Option<String> {
-    let rest = name.strip_prefix("_Z")?;
-    let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
-    let n: usize = digits.parse().ok()?;
-    rest.get(digits.len()..digits.len() + n).map(str::to_string)
-}
+pub use crate::ptx::ir::demangle;
 
 #[cfg(test)]
 mod tests {

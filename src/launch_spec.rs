@@ -470,10 +470,16 @@ pub struct Prepared {
     pub buffers: BTreeMap<String, (DevicePtr, BufferSpec)>,
 }
 
-/// Loads the spec's PTX and allocates and fills its buffers.
+/// Loads the spec's PTX (a `.cu` is compiled with clang-16 first,
+/// `crate::compile`) and allocates and fills its buffers.
 pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
-    let src = std::fs::read_to_string(&spec.ptx)
-        .map_err(|e| SpecError::Io { file: spec.ptx.display().to_string(), msg: e.to_string() })?;
+    let src = if spec.ptx.extension().is_some_and(|e| e == "cu") {
+        crate::compile::compile(&spec.ptx, crate::compile::Dialect::Clang)
+            .map_err(|e| SpecError::Io { file: spec.file.display().to_string(), msg: format!("ptx: {e}") })?
+    } else {
+        std::fs::read_to_string(&spec.ptx)
+            .map_err(|e| SpecError::Io { file: spec.ptx.display().to_string(), msg: e.to_string() })?
+    };
     let module = dev.load_ptx(&src, &spec.ptx.display().to_string())?;
     let mut buffers = BTreeMap::new();
     for b in &spec.buffers {

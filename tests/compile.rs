@@ -40,6 +40,14 @@ fn a_cu_file_compiles_and_runs_from_any_directory() {
         .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
         .collect();
     assert!(y.iter().enumerate().all(|(i, v)| *v == 3.0 * i as f32), "{:?}", &y[..8]);
+    // a spec may name the .cu itself, and a C++ kernel by its plain name
+    let spec_cu = SPEC.replace("saxpy.ptx", "saxpy.cu").replace("_Z5saxpyifPKfPf", "saxpy");
+    std::fs::write(dir.join("saxpy_cu.toml"), spec_cu).unwrap();
+    let (ok, out, err) = warplight_in(&dir, &["launch", "saxpy_cu.toml", "--dump", "y=y2.bin"], None);
+    assert!(ok, "{err}{out}");
+    assert_eq!(std::fs::read(dir.join("y2.bin")).unwrap(), std::fs::read(dir.join("y.bin")).unwrap());
+    let (ok, out, err) = warplight_in(&dir, &["step", "saxpy_cu.toml", "--log", "--break-src", "saxpy.cu:3"], None);
+    assert!(ok && out.contains("stepping saxpy") && out.contains("break at source line 3"), "{err}{out}");
     // compiler errors come with the compiler's messages
     std::fs::write(dir.join("bad.cu"), "__global__ void k() { undeclared = 1; }\n").unwrap();
     let (ok, _, err) = warplight_in(&dir, &["compile", "bad.cu"], None);

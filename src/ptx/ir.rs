@@ -464,7 +464,20 @@ pub struct Program {
 impl Program {
     /// Finds a kernel (an `.entry`) by name.
     pub fn kernel(&self, name: &str) -> Option<u32> {
-        self.functions.iter().position(|f| f.is_entry && f.name == name).map(|i| i as u32)
+        let exact = self.functions.iter().position(|f| f.is_entry && f.name == name);
+        // a C++ kernel by its plain name (`saxpy` for `_Z5saxpyifPfS_`), when only one has it
+        let plain = || {
+            let mut m = self
+                .functions
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| f.is_entry && demangle(&f.name).as_deref() == Some(name));
+            match (m.next(), m.next()) {
+                (Some((i, _)), None) => Some(i),
+                _ => None,
+            }
+        };
+        exact.or_else(plain).map(|i| i as u32)
     }
 
     /// Static shared memory `kernel` itself needs in bytes: the shared variables
@@ -494,8 +507,17 @@ impl Program {
         size
     }
 
-    /// Names of all kernels.
+    /// Names of all kernels (as in the PTX; C++ kernels mangled).
     pub fn kernel_names(&self) -> Vec<&str> {
         self.functions.iter().filter(|f| f.is_entry).map(|f| f.name.as_str()).collect()
     }
+}
+
+/// The plain name of an Itanium-mangled function name (`_Z5saxpyifPfS_` →
+/// `saxpy`), or `None` for names that are not mangled (`extern "C"` kernels).
+pub fn demangle(name: &str) -> Option<String> {
+    let rest = name.strip_prefix("_Z")?;
+    let digits: String = rest.chars().take_while(|c| c.is_ascii_digit()).collect();
+    let n: usize = digits.parse().ok()?;
+    rest.get(digits.len()..digits.len() + n).map(str::to_string)
 }
