@@ -48,6 +48,39 @@ fn a_cu_file_compiles_and_runs_from_any_directory() {
     assert_eq!(std::fs::read(dir.join("y2.bin")).unwrap(), std::fs::read(dir.join("y.bin")).unwrap());
     let (ok, out, err) = warplight_in(&dir, &["step", "saxpy_cu.toml", "--log", "--break-src", "saxpy.cu:3"], None);
     assert!(ok && out.contains("stepping saxpy") && out.contains("break at source line 3"), "{err}{out}");
+    // `warplight run`: the same launch from the command line, no spec file
+    let (ok, out, err) = warplight_in(
+        &dir,
+        &[
+            "run",
+            "saxpy.cu",
+            "--kernel",
+            "saxpy",
+            "--grid",
+            "4",
+            "--block",
+            "256",
+            "--buffer",
+            "x=f32:1000:iota",
+            "--buffer",
+            "y=f32:1000:iota",
+            "--args",
+            "1000,2.0,x,y",
+            "--dump",
+            "y=y3.bin",
+        ],
+        None,
+    );
+    assert!(ok, "{err}{out}");
+    assert_eq!(std::fs::read(dir.join("y3.bin")).unwrap(), std::fs::read(dir.join("y.bin")).unwrap());
+    let (ok, _, err) = warplight_in(&dir, &["run", "saxpy.cu", "--grid", "1", "--block", "32"], None);
+    assert!(!ok && err.contains("saxpy.cu has 2 kernels; name one with --kernel: saxpy, scale"), "{err}");
+    let (ok, _, err) = warplight_in(
+        &dir,
+        &["run", "saxpy.cu", "--kernel", "scale", "--grid", "1", "--block", "32", "--args", "nope,2"],
+        None,
+    );
+    assert!(!ok && err.contains("\"nope\" is neither a number nor a --buffer name"), "{err}");
     // compiler errors come with the compiler's messages
     std::fs::write(dir.join("bad.cu"), "__global__ void k() { undeclared = 1; }\n").unwrap();
     let (ok, _, err) = warplight_in(&dir, &["compile", "bad.cu"], None);

@@ -49,6 +49,11 @@ type Res = Result<(), Box<dyn std::error::Error>>;
 /// Runs the command.
 pub fn run(a: LaunchArgs) -> Res {
     let spec = Spec::load(&a.spec)?;
+    run_spec(spec, &a)
+}
+
+/// Runs a spec (loaded from a file, or made from `warplight run`'s options) with `a`'s options.
+pub fn run_spec(spec: Spec, a: &LaunchArgs) -> Res {
     let dev_name = a.device.clone().or(spec.device.clone()).unwrap_or_else(|| "hopper".into());
     let profile = Profile::parse(&dev_name)
         .ok_or_else(|| format!("unknown device profile `{dev_name}`; known: gt200, maxwell, hopper"))?;

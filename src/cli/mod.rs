@@ -5,6 +5,7 @@ pub mod compile;
 pub mod launch;
 pub mod ptx_info;
 pub mod render;
+pub mod run;
 pub mod scene_info;
 pub mod step;
 pub mod table_format;
@@ -59,6 +60,9 @@ pub enum Command {
     },
     /// Render a frame of a scene's camera flight to PNG or EXR and print its counters.
     Render(render::RenderArgs),
+    /// Compile a .cu and launch one kernel of it, buffers and arguments on the command line
+    /// (`warplight run saxpy.cu --grid 4 --block 256 --buffer x=f32:1000:iota --args 1000,x`).
+    Run(run::RunArgs),
     /// Compile CUDA C to PTX with clang-16 (or nvcc) and warplight's prelude: `warplight compile k.cu`.
     Compile(compile::CompileArgs),
     /// Reproduce thesis tables beside the published values (`warplight tables 4.4`).
@@ -113,6 +117,7 @@ pub fn main() -> i32 {
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
         Command::Tables(a) => tables::run(a),
         Command::Compile(a) => compile::run(a),
+        Command::Run(a) => run::run(a),
         Command::Chart(a) => chart::run(a),
         Command::Render(a) => render::run(a),
         Command::Step(a) => step::run(a),
