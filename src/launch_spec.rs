@@ -290,6 +290,55 @@ impl Ctx<'_> {
     }
 }
 
+/// The keys a spec knows: at the top, in `[[buffer]]` and in `[[launch]]` tables.
+const TOP_KEYS: [&str; 11] = [
+    "ptx",
+    "device",
+    "max_instructions",
+    "max_call_depth",
+    "buffer",
+    "launch",
+    "kernel",
+    "grid",
+    "block",
+    "shared",
+    "args",
+];
+const BUFFER_KEYS: [&str; 4] = ["name", "type", "len", "init"];
+const LAUNCH_KEYS: [&str; 5] = ["kernel", "grid", "block", "shared", "args"];
+
+/// Edit distance (insertions, deletions, substitutions).
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur.push((prev[j] + usize::from(ca != *cb)).min(prev[j + 1] + 1).min(cur[j] + 1));
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+impl Ctx<'_> {
+    /// An error for the first key of `t` not in `known`, with the nearest known key.
+    fn known_keys(&self, t: &toml::Table, known: &[&str], prefix: &str) -> Result<(), SpecError> {
+        for k in t.keys() {
+            if known.contains(&k.as_str()) {
+                continue;
+            }
+            let near = known.iter().map(|n| (distance(k, n), *n)).min().filter(|(d, _)| *d <= 2);
+            let hint = match near {
+                Some((_, n)) => format!("unknown key; did you mean `{n}`?"),
+                None => format!("unknown key; known: {}", known.join(", ")),
+            };
+            return self.err(&format!("{prefix}{k}"), hint);
+        }
+        Ok(())
+    }
+}
+
 impl Spec {
     /// Reads and validates a spec file.
     pub fn load(path: &Path) -> Result<Spec, SpecError> {
@@ -305,6 +354,7 @@ impl Spec {
         let cx = Ctx { file: &file };
         let t: toml::Table =
             toml::from_str(text).map_err(|e| SpecError::Toml { file: file.clone(), msg: e.to_string() })?;
+        cx.known_keys(&t, &TOP_KEYS, "")?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let ptx = match t.get("ptx").and_then(|v| v.as_str()) {
             Some(p) => dir.join(p),
@@ -328,6 +378,7 @@ impl Spec {
             for (i, v) in arr.iter().enumerate() {
                 let k = |f: &str| format!("buffer[{i}].{f}");
                 let Some(bt) = v.as_table() else { return cx.err(&format!("buffer[{i}]"), "expected a table") };
+                cx.known_keys(bt, &BUFFER_KEYS, &format!("buffer[{i}]."))?;
                 let name = match bt.get("name").and_then(|v| v.as_str()) {
                     Some(n) => n.to_string(),
                     None => return cx.err(&k("name"), "missing"),
@@ -384,7 +435,10 @@ impl Spec {
                 .iter()
                 .enumerate()
                 .map(|(i, v)| match v.as_table() {
-                    Some(lt) => cx.launch(lt, &format!("launch[{i}].")),
+                    Some(lt) => {
+                        cx.known_keys(lt, &LAUNCH_KEYS, &format!("launch[{i}]."))?;
+                        cx.launch(lt, &format!("launch[{i}]."))
+                    }
                     None => cx.err(&format!("launch[{i}]"), "expected a table"),
                 })
                 .collect::<Result<Vec<_>, _>>()?,
@@ -659,6 +713,12 @@ init = [1, 2, 3]
         assert!(e.to_string().contains("`args[0]`: no buffer named `nope`"), "{e}");
         let e = parse("ptx = \"a.ptx\"\n[[buffer]]\nname = \"b\"\ntype = \"f16\"\nlen = 1\n").unwrap_err();
         assert!(e.to_string().contains("`buffer[0].type`"), "{e}");
+        let e = parse("ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\nshraed = 256\n").unwrap_err();
+        assert!(e.to_string().contains("`shraed`: unknown key; did you mean `shared`?"), "{e}");
+        let e = parse("ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\n[[buffer]]\nname = \"b\"\ntype = \"f32\"\nlen = 1\nint = \"iota\"\n").unwrap_err();
+        assert!(e.to_string().contains("`buffer[0].int`: unknown key; did you mean `init`?"), "{e}");
+        let e = parse("ptx = \"a.ptx\"\nwhatever = 1\n").unwrap_err();
+        assert!(e.to_string().contains("`whatever`: unknown key; known: ptx, device"), "{e}");
         let e = parse("ptx = 3").unwrap_err();
         assert!(e.to_string().contains("`ptx`: missing"), "{e}");
         let e = parse("ptx = \"a.ptx\"\nkernel = [").unwrap_err();
