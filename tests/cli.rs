@@ -250,3 +250,21 @@ fn scenes_are_found_from_any_directory() {
         .unwrap();
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("nosuch.toml"));
 }
+
+#[test]
+fn render_checks_its_output_before_working_and_never_leaves_a_partial_file() {
+    let dir = tempdir();
+    let out = |n: &str| dir.join(n).display().to_string();
+    let (ok, _, err) = warplight(&["render", "--scene", "cornell-box", "-o", &out("x.jpg")]);
+    assert!(!ok && err.contains("expected a .png or .exr file") && !dir.join("x.jpg").exists(), "{err}");
+    let (ok, _, err) =
+        warplight(&["render", "--scene", "cornell-box", "--resolution", "100000x100000", "-o", &out("x.png")]);
+    assert!(!ok && err.contains("10000000000 pixels is more than"), "{err}");
+    let (ok, _, err) = warplight(&["render", "--scene", "cornell-box", "-o", &out("no/such/x.png")]);
+    assert!(!ok && err.contains("does not exist"), "{err}");
+    let (ok, _, err) = warplight(&["render", "--scene", "cornell-box", "--resolution", "16x16", "-o", &out("y.png")]);
+    assert!(ok, "{err}");
+    let names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(names, ["y.png"], "only the finished image is left");
+}

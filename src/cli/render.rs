@@ -47,6 +47,9 @@ pub struct RenderArgs {
     pub json: Option<PathBuf>,
 }
 
+/// The largest image `render` makes (its frame buffer holds 12 bytes a pixel).
+const MAX_PIXELS: u64 = 16384 * 16384;
+
 /// Runs the command.
 pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let kernel_variant = match a.variant.as_str() {
@@ -62,6 +65,15 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         "siroh" => Heuristic::Siroh,
         o => return Err(format!("unknown heuristic `{o}`; expected sah or siroh").into()),
     };
+    // the output is checked before any work: its format, and that its folder exists
+    let ext = a.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("png" | "exr")) {
+        return Err(format!("-o {}: expected a .png or .exr file", a.output.display()).into());
+    }
+    let parent = a.output.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    if !parent.is_dir() {
+        return Err(format!("-o {}: the folder {} does not exist", a.output.display(), parent.display()).into());
+    }
     let scene = scene_file::load(&scene_path(&a.scene))?;
     if a.frame >= scene.flight.frames {
         return Err(format!("frame {} is past the flight's {} frames", a.frame, scene.flight.frames).into());
@@ -73,6 +85,13 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
             .filter(|(w, h)| *w > 0 && *h > 0)
             .ok_or_else(|| format!("--resolution {r}: expected WIDTHxHEIGHT, e.g. 512x512"))?;
+        if w as u64 * h as u64 > MAX_PIXELS {
+            return Err(format!(
+                "--resolution {r}: {} pixels is more than {MAX_PIXELS} (16384 x 16384); render in tiles or smaller",
+                w as u64 * h as u64
+            )
+            .into());
+        }
         cam.resolution = [w, h];
     }
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
@@ -118,12 +137,21 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let render_s = t1.elapsed().as_secs_f64();
-    let is_exr = a.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    if is_exr {
-        fb.write_exr(&a.output)?
-    } else {
-        fb.write_png(&a.output, a.exposure)?
-    };
+    // written beside the output under a temporary name, then renamed: never a partial image
+    let tmp = parent.join(format!(
+        ".{}.warplight-tmp.{}",
+        a.output.file_stem().and_then(|s| s.to_str()).unwrap_or("render"),
+        ext.as_deref().unwrap_or("png")
+    ));
+    let written = if ext.as_deref() == Some("exr") { fb.write_exr(&tmp) } else { fb.write_png(&tmp, a.exposure) };
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e.into());
+    }
+    std::fs::rename(&tmp, &a.output).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: {e}", a.output.display())
+    })?;
     let ts = tree.stats();
     println!(
         "{} frame {} ({}x{}), {} triangles, {} tree: {} inner nodes, {} references, depth {} (built in {:.3} s)",
@@ -183,7 +211,7 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
                 "totals": k.launch.totals, "memory": k.memory.metrics(&k.launch.totals).into_iter().collect::<std::collections::BTreeMap<_, _>>(),
             })),
         });
-        std::fs::write(j, serde_json::to_string_pretty(&v)?)?;
+        super::write_atomically(j, serde_json::to_string_pretty(&v)?.as_bytes())?;
     }
     Ok(())
 }
