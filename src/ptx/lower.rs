@@ -536,6 +536,20 @@ impl<'a> FnLower<'a> {
                 if d.vector.is_some() || !d.dims.is_empty() {
                     return unsupported(d.pos, "vector or array registers");
                 }
+                // the count is checked before any name is made (`.reg .b32 %r<4294967295>`)
+                if let Some(n) = d.range {
+                    let (have, cap) = if d.ty == Ty::Pred {
+                        (self.out.num_preds as usize, u16::MAX as usize)
+                    } else {
+                        (self.out.reg_masks.len(), Dst::SINK as usize)
+                    };
+                    if n as usize > cap.saturating_sub(have) {
+                        return invalid(
+                            d.pos,
+                            format!("`{}<{n}>`: more registers than a function can have ({cap} in all)", d.name),
+                        );
+                    }
+                }
                 let names: Vec<String> = match d.range {
                     Some(n) => (0..n).map(|i| format!("{}{i}", d.name)).collect(),
                     None => vec![d.name.clone()],
