@@ -290,6 +290,9 @@ impl Ctx<'_> {
     }
 }
 
+/// The largest buffer a spec may declare (the host must hold it, and a copy).
+pub const MAX_BUFFER_BYTES: u64 = 8 << 30;
+
 /// The keys a spec knows: at the top, in `[[buffer]]` and in `[[launch]]` tables.
 const TOP_KEYS: [&str; 11] = [
     "ptx",
@@ -391,6 +394,20 @@ impl Spec {
                     Some(n) if n >= 0 => n as usize,
                     _ => return cx.err(&k("len"), "expected a non-negative element count"),
                 };
+                // checked before anything is allocated (`len = 2^62` wrapped to 0 bytes)
+                match len.checked_mul(ty.size()) {
+                    Some(bytes) if bytes as u64 <= MAX_BUFFER_BYTES => {}
+                    _ => {
+                        return cx.err(
+                            &k("len"),
+                            format!(
+                                "{len} elements of {} bytes is more than a buffer may hold ({} GiB)",
+                                ty.size(),
+                                MAX_BUFFER_BYTES >> 30
+                            ),
+                        );
+                    }
+                }
                 let init = match bt.get("init") {
                     None => Init::Zeros,
                     Some(toml::Value::String(s)) if s == "zeros" => Init::Zeros,
@@ -719,6 +736,9 @@ init = [1, 2, 3]
         assert!(e.to_string().contains("`buffer[0].int`: unknown key; did you mean `init`?"), "{e}");
         let e = parse("ptx = \"a.ptx\"\nwhatever = 1\n").unwrap_err();
         assert!(e.to_string().contains("`whatever`: unknown key; known: ptx, device"), "{e}");
+        let big = "ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\n[[buffer]]\nname = \"b\"\ntype = \"f32\"\nlen = 4611686018427387904\n";
+        let e = parse(big).unwrap_err();
+        assert!(e.to_string().contains("is more than a buffer may hold (8 GiB)"), "{e}");
         let e = parse("ptx = 3").unwrap_err();
         assert!(e.to_string().contains("`ptx`: missing"), "{e}");
         let e = parse("ptx = \"a.ptx\"\nkernel = [").unwrap_err();

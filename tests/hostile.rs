@@ -455,7 +455,8 @@ fn too_many_host_threads_are_capped_with_a_warning() {
 /// `.reg %r<N>` with a huge N is an error before any register is made (it was an abort).
 #[test]
 fn a_huge_register_range_is_an_error_not_an_abort() {
-    let ptx = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n.reg .b32 %r<4294967295>;\nret;\n}\n";
+    let ptx =
+        ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n.reg .b32 %r<4294967295>;\nret;\n}\n";
     let e = warplight::ptx::load(ptx, "big.ptx").unwrap_err().to_string();
     assert!(e.contains("big.ptx:6:1") && e.contains("more registers than a function can have"), "{e}");
     let p = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n.reg .pred %p<70000>;\nret;\n}\n";
