@@ -101,6 +101,9 @@ pub struct Address {
     pub base: Src,
     /// Byte offset added to the base.
     pub offset: i64,
+    /// Whether the base is 64 bits wide; a 32-bit register base is added to
+    /// the offset modulo 2^32 and then zero-extended.
+    pub wide: bool,
 }
 
 /// Floating-point rounding modes, and integer rounding of floats.

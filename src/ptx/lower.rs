@@ -653,6 +653,8 @@ impl<'a> FnLower<'a> {
                 Some(Sym::Func(_)) => unsupported(pos, format!("address of function `{n}`")),
                 None => match special_reg(n) {
                     Some(s) => Ok(Src::Special(s)),
+                    // PTX's predefined constant (nvcc writes it for `warpSize`)
+                    None if n == "WARP_SZ" => Ok(Src::Imm(32)),
                     None if n.starts_with('%') => invalid(pos, format!("undeclared register `{n}`")),
                     None => invalid(pos, format!("undeclared name `{n}`")),
                 },
@@ -668,7 +670,7 @@ impl<'a> FnLower<'a> {
             return invalid(pos, "expected an address `[...]`");
         };
         let Some(name) = base else {
-            return Ok((Address { base: Src::Imm(0), offset: *off }, None));
+            return Ok((Address { base: Src::Imm(0), offset: *off, wide: true }, None));
         };
         let (b, space) = match self.lookup(name) {
             Some(Sym::Reg(id)) => (Src::Reg(id), None),
@@ -683,7 +685,13 @@ impl<'a> FnLower<'a> {
             }
             None => return invalid(pos, format!("undeclared name `{name}`")),
         };
-        Ok((Address { base: b, offset: *off }, space))
+        // a 32-bit register base is added to the offset in 32 bits (nvcc's `[%r4+68]` with
+        // %r4 = 0xFFFFFFC0 addresses 4), then widened
+        let wide = match b {
+            Src::Reg(id) => self.out.reg_masks.get(id as usize).is_none_or(|m| *m > u32::MAX as u64),
+            _ => true,
+        };
+        Ok((Address { base: b, offset: *off, wide }, space))
     }
 
     fn mods(&self, i: &ast::Instruction) -> Mods {

@@ -472,7 +472,11 @@ fn count_space(c: &mut super::counters::SpaceCounts, r: Resolved) {
 
 fn addresses(ctx: &Ctx, w: &Warp, cta: &CtaMut, a: &Address) -> Lanes {
     let base = operand(ctx, w, cta, a.base);
-    map1(&base, |b| b.wrapping_add(a.offset as u64))
+    if a.wide {
+        map1(&base, |b| b.wrapping_add(a.offset as u64))
+    } else {
+        map1(&base, |b| (b as u32).wrapping_add(a.offset as u32) as u64)
+    }
 }
 
 /// Executes the next instruction of warp `w`. Returns its function and PC (for

@@ -1,0 +1,47 @@
+//! PTX forms that nvcc emits for ordinary kernels (issue 20): the predefined
+//! constant `WARP_SZ`, and 32-bit register addresses that wrap at 2^32 before
+//! the offset is added (`[%r4+68]` with %r4 = 0xFFFFFFC0 is offset 4).
+
+use warplight::sim::{Arg, Device, LaunchConfig};
+
+fn run(body: &str, out_words: usize) -> Vec<u32> {
+    let ptx =
+        format!(".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k(.param .u64 out)\n{{\n{body}\n}}\n");
+    let mut dev = Device::new();
+    let m = dev.load_ptx(&ptx, "k.ptx").unwrap_or_else(|e| panic!("{e}"));
+    let out = dev.alloc_zeroed::<u32>(out_words);
+    dev.launch(&m, "k", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_or_else(|e| panic!("{e}"));
+    dev.read::<u32>(out, out_words)
+}
+
+#[test]
+fn warp_sz_is_32() {
+    let out = run(
+        ".reg .b32 %r<2>;\n.reg .b64 %rd<2>;\nld.param.u64 %rd1, [out];\nmov.u32 %r1, WARP_SZ;\nst.global.u32 [%rd1], %r1;\nret;",
+        1,
+    );
+    assert_eq!(out, [32]);
+}
+
+#[test]
+fn a_32_bit_base_wraps_before_the_offset_is_added() {
+    // shared: store 7 at [%r4+68] with %r4 = 0xFFFFFFC0 (offset 4), read it back at [s+4]
+    let out = run(
+        ".shared .align 4 .b8 s[128];\n.reg .b32 %r<6>;\n.reg .b64 %rd<2>;\n\
+         ld.param.u64 %rd1, [out];\nmov.u32 %r1, s;\nadd.u32 %r4, %r1, -64;\nmov.u32 %r2, 7;\n\
+         st.shared.u32 [%r4+68], %r2;\nld.shared.u32 %r3, [s+4];\nst.global.u32 [%rd1], %r3;\nret;",
+        1,
+    );
+    assert_eq!(out, [7], "the store must land at offset 4 of s");
+}
+
+#[test]
+fn a_64_bit_base_does_not_wrap() {
+    // the same arithmetic in 64 bits stays an ordinary 64-bit address: out + 4
+    let out = run(
+        ".reg .b32 %r<2>;\n.reg .b64 %rd<4>;\nld.param.u64 %rd1, [out];\nadd.u64 %rd2, %rd1, -64;\n\
+         mov.u32 %r1, 9;\nst.global.u32 [%rd2+68], %r1;\nret;",
+        2,
+    );
+    assert_eq!(out, [0, 9]);
+}
