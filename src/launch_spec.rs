@@ -177,8 +177,8 @@ pub struct BufferSpec {
 /// A kernel argument as written.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ArgSpec {
-    /// A buffer's address.
-    Buffer(String),
+    /// A buffer's address plus a byte offset (`"x"`, `"x+16"`, `{ buffer = "x", offset = 16 }`).
+    Buffer(String, u64),
     /// An integer scalar.
     Int(i64),
     /// A float scalar.
@@ -264,7 +264,24 @@ impl Ctx<'_> {
                 .iter()
                 .enumerate()
                 .map(|(i, v)| match v {
-                    toml::Value::String(s) => Ok(ArgSpec::Buffer(s.clone())),
+                    toml::Value::String(s) => match s.split_once('+') {
+                        None => Ok(ArgSpec::Buffer(s.trim().to_string(), 0)),
+                        Some((n, o)) => match o.trim().parse::<u64>() {
+                            Ok(o) => Ok(ArgSpec::Buffer(n.trim().to_string(), o)),
+                            Err(_) => self.err(
+                                &format!("{prefix}args[{i}]"),
+                                format!("{s:?}: expected NAME or NAME+BYTES (a byte offset into the buffer)"),
+                            ),
+                        },
+                    },
+                    toml::Value::Table(t) => match (t.get("buffer").and_then(|v| v.as_str()), t.get("offset")) {
+                        (Some(n), None) => Ok(ArgSpec::Buffer(n.to_string(), 0)),
+                        (Some(n), Some(o)) => match o.as_integer() {
+                            Some(o) if o >= 0 => Ok(ArgSpec::Buffer(n.to_string(), o as u64)),
+                            _ => self.err(&format!("{prefix}args[{i}].offset"), "expected a non-negative byte offset"),
+                        },
+                        _ => self.err(&format!("{prefix}args[{i}]"), "expected { buffer = \"NAME\", offset = BYTES }"),
+                    },
                     toml::Value::Integer(x) => Ok(ArgSpec::Int(*x)),
                     toml::Value::Float(x) => Ok(ArgSpec::Float(*x)),
                     toml::Value::Boolean(b) => Ok(ArgSpec::Int(*b as i64)),
@@ -464,15 +481,22 @@ impl Spec {
         };
         for (li, l) in launches.iter().enumerate() {
             for (ai, a) in l.args.iter().enumerate() {
-                if let ArgSpec::Buffer(n) = a
-                    && !buffers.iter().any(|b| &b.name == n)
-                {
+                if let ArgSpec::Buffer(n, off) = a {
                     let key = if t.contains_key("launch") {
                         format!("launch[{li}].args[{ai}]")
                     } else {
                         format!("args[{ai}]")
                     };
-                    return cx.err(&key, format!("no buffer named `{n}`"));
+                    match buffers.iter().find(|b| &b.name == n) {
+                        None => return cx.err(&key, format!("no buffer named `{n}`")),
+                        Some(b) if *off > (b.len * b.ty.size()) as u64 => {
+                            return cx.err(
+                                &key,
+                                format!("offset {off} is past the end of `{n}` ({} bytes)", b.len * b.ty.size()),
+                            );
+                        }
+                        Some(_) => {}
+                    }
                 }
             }
         }
@@ -586,14 +610,14 @@ pub fn arguments(spec: &Spec, p: &Prepared, l: &LaunchSpec) -> Result<Vec<Arg>, 
     for (i, (a, prm)) in l.args.iter().zip(&f.params).enumerate() {
         let bad = |msg: String| SpecError::Key { file: file.clone(), key: format!("args[{i}]"), msg };
         out.push(match a {
-            ArgSpec::Buffer(n) => {
+            ArgSpec::Buffer(n, off) => {
                 if prm.size != 8 {
                     return Err(bad(format!(
                         "buffer `{n}` passed to `{}`, a {}-byte .{} parameter",
                         prm.name, prm.size, prm.ty
                     )));
                 }
-                Arg::Ptr(p.buffers[n].0)
+                Arg::Ptr(DevicePtr(p.buffers[n].0.0 + off))
             }
             ArgSpec::Int(x) => match (prm.ty, prm.size) {
                 (Ty::F32, _) => Arg::F32(*x as f32),

@@ -45,3 +45,43 @@ fn a_64_bit_base_does_not_wrap() {
     );
     assert_eq!(out, [0, 9]);
 }
+
+/// A spec passes `buffer + offset` as a pointer argument (`"out+8"`, `{ buffer = "out", offset = 8 }`).
+#[test]
+fn a_spec_passes_an_address_inside_a_buffer() {
+    let dir = std::env::temp_dir().join(format!("warplight-offset-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("k.ptx"),
+        ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k(.param .u64 out)\n{\n.reg .b32 %r<2>;\n.reg .b64 %rd<2>;\nld.param.u64 %rd1, [out];\nmov.u32 %r1, 5;\nst.global.u32 [%rd1], %r1;\nret;\n}\n",
+    )
+    .unwrap();
+    let spec = |arg: &str| {
+        format!(
+            "ptx = \"k.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 1\nargs = [{arg}]\n[[buffer]]\nname = \"out\"\ntype = \"u32\"\nlen = 4\n"
+        )
+    };
+    for (i, arg) in ["\"out+8\"", "{ buffer = \"out\", offset = 8 }"].iter().enumerate() {
+        let file = dir.join(format!("s{i}.toml"));
+        std::fs::write(&file, spec(arg)).unwrap();
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight"))
+            .args(["launch", file.to_str().unwrap(), "--dump", &format!("out={}", dir.join("o.bin").display())])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let words: Vec<u32> = std::fs::read(dir.join("o.bin"))
+            .unwrap()
+            .chunks(4)
+            .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        assert_eq!(words, [0, 0, 5, 0], "{arg}");
+    }
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, spec("\"out+32\"")).unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["launch", bad.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&o.stderr).contains("offset 32 is past the end of `out` (16 bytes)"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -12,7 +12,8 @@ use crate::launch_spec::Spec;
 #[command(after_help = "\
 Buffers: NAME=TYPE:LEN[:INIT], TYPE one of u8 u16 u32 u64 i8 i16 i32 i64 f32 f64,
 INIT zeros (the default), iota (0, 1, 2, ...), hash=M/N (element i is i*M mod N) or file=PATH.
-Arguments: --args in the kernel's parameter order, buffer names or numbers.
+Arguments: --args in the kernel's parameter order: buffer names (NAME+BYTES for an address
+inside a buffer) or numbers.
 
 Example (saxpy.cu: __global__ void saxpy(int n, float a, const float *x, float *y)):
   warplight run saxpy.cu --grid 4 --block 256 --buffer x=f32:1000:iota --buffer y=f32:1000 \\
@@ -114,7 +115,8 @@ pub fn spec_text(a: &RunArgs, kernel: &str) -> Result<String, String> {
         .iter()
         .map(|x| {
             let x = x.trim();
-            if names.iter().any(|n| n == x) {
+            let buffer = x.split_once('+').map_or(x, |(n, _)| n.trim());
+            if names.iter().any(|n| n == buffer) {
                 Ok(toml_str(x))
             } else if x.parse::<i64>().is_ok() || x.parse::<f64>().is_ok_and(f64::is_finite) {
                 Ok(x.to_string())
