@@ -211,6 +211,8 @@ pub struct Spec {
     pub device: Option<String>,
     /// Buffers in declaration order.
     pub buffers: Vec<BufferSpec>,
+    /// `__constant__` variables of the module to fill before the launches (`[[constant]]`).
+    pub constants: Vec<BufferSpec>,
     /// Launches in order.
     pub launches: Vec<LaunchSpec>,
     /// The watchdog: most warp instructions of one launch (`max_instructions`),
@@ -311,12 +313,13 @@ impl Ctx<'_> {
 pub const MAX_BUFFER_BYTES: u64 = 8 << 30;
 
 /// The keys a spec knows: at the top, in `[[buffer]]` and in `[[launch]]` tables.
-const TOP_KEYS: [&str; 11] = [
+const TOP_KEYS: [&str; 12] = [
     "ptx",
     "device",
     "max_instructions",
     "max_call_depth",
     "buffer",
+    "constant",
     "launch",
     "kernel",
     "grid",
@@ -342,63 +345,16 @@ fn distance(a: &str, b: &str) -> usize {
 }
 
 impl Ctx<'_> {
-    /// An error for the first key of `t` not in `known`, with the nearest known key.
-    fn known_keys(&self, t: &toml::Table, known: &[&str], prefix: &str) -> Result<(), SpecError> {
-        for k in t.keys() {
-            if known.contains(&k.as_str()) {
-                continue;
-            }
-            let near = known.iter().map(|n| (distance(k, n), *n)).min().filter(|(d, _)| *d <= 2);
-            let hint = match near {
-                Some((_, n)) => format!("unknown key; did you mean `{n}`?"),
-                None => format!("unknown key; known: {}", known.join(", ")),
-            };
-            return self.err(&format!("{prefix}{k}"), hint);
-        }
-        Ok(())
-    }
-}
-
-impl Spec {
-    /// Reads and validates a spec file.
-    pub fn load(path: &Path) -> Result<Spec, SpecError> {
-        let file = path.display().to_string();
-        let text =
-            std::fs::read_to_string(path).map_err(|e| SpecError::Io { file: file.clone(), msg: e.to_string() })?;
-        Spec::parse(&text, path)
-    }
-
-    /// Parses spec text; `path` resolves relative file names and names errors.
-    pub fn parse(text: &str, path: &Path) -> Result<Spec, SpecError> {
-        let file = path.display().to_string();
-        let cx = Ctx { file: &file };
-        let t: toml::Table =
-            toml::from_str(text).map_err(|e| SpecError::Toml { file: file.clone(), msg: e.to_string() })?;
-        cx.known_keys(&t, &TOP_KEYS, "")?;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let ptx = match t.get("ptx").and_then(|v| v.as_str()) {
-            Some(p) => dir.join(p),
-            None => return cx.err("ptx", "missing; expected the PTX file's path"),
-        };
-        let device = t.get("device").and_then(|v| v.as_str()).map(|s| s.to_string());
-        let positive = |key: &str, max: u64| -> Result<Option<u64>, SpecError> {
-            match t.get(key) {
-                None => Ok(None),
-                Some(v) => match v.as_integer() {
-                    Some(x) if x >= 1 && x as u64 <= max => Ok(Some(x as u64)),
-                    _ => cx.err(key, format!("expected an integer from 1 to {max}")),
-                },
-            }
-        };
-        let max_instructions = positive("max_instructions", i64::MAX as u64)?;
-        let max_call_depth = positive("max_call_depth", u32::MAX as u64)?.map(|d| d as u32);
+    /// The `[[buffer]]` (or `[[constant]]`) tables under `key`.
+    fn buffers(&self, t: &toml::Table, key: &str, dir: &Path) -> Result<Vec<BufferSpec>, SpecError> {
+        let cx = self;
         let mut buffers = Vec::new();
-        if let Some(b) = t.get("buffer") {
-            let Some(arr) = b.as_array() else { return cx.err("buffer", "expected [[buffer]] tables") };
+        if let Some(b) = t.get(key) {
+            let Some(arr) = b.as_array() else { return cx.err(key, format!("expected [[{key}]] tables")) };
             for (i, v) in arr.iter().enumerate() {
-                let k = |f: &str| format!("buffer[{i}].{f}");
-                let Some(bt) = v.as_table() else { return cx.err(&format!("buffer[{i}]"), "expected a table") };
-                cx.known_keys(bt, &BUFFER_KEYS, &format!("buffer[{i}]."))?;
+                let k = |f: &str| format!("{key}[{i}].{f}");
+                let Some(bt) = v.as_table() else { return cx.err(&format!("{key}[{i}]"), "expected a table") };
+                cx.known_keys(bt, &BUFFER_KEYS, &format!("{key}[{i}]."))?;
                 let name = match bt.get("name").and_then(|v| v.as_str()) {
                     Some(n) => n.to_string(),
                     None => return cx.err(&k("name"), "missing"),
@@ -464,6 +420,61 @@ impl Spec {
                 buffers.push(BufferSpec { name, ty, len, init });
             }
         }
+        Ok(buffers)
+    }
+
+    /// An error for the first key of `t` not in `known`, with the nearest known key.
+    fn known_keys(&self, t: &toml::Table, known: &[&str], prefix: &str) -> Result<(), SpecError> {
+        for k in t.keys() {
+            if known.contains(&k.as_str()) {
+                continue;
+            }
+            let near = known.iter().map(|n| (distance(k, n), *n)).min().filter(|(d, _)| *d <= 2);
+            let hint = match near {
+                Some((_, n)) => format!("unknown key; did you mean `{n}`?"),
+                None => format!("unknown key; known: {}", known.join(", ")),
+            };
+            return self.err(&format!("{prefix}{k}"), hint);
+        }
+        Ok(())
+    }
+}
+
+impl Spec {
+    /// Reads and validates a spec file.
+    pub fn load(path: &Path) -> Result<Spec, SpecError> {
+        let file = path.display().to_string();
+        let text =
+            std::fs::read_to_string(path).map_err(|e| SpecError::Io { file: file.clone(), msg: e.to_string() })?;
+        Spec::parse(&text, path)
+    }
+
+    /// Parses spec text; `path` resolves relative file names and names errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Spec, SpecError> {
+        let file = path.display().to_string();
+        let cx = Ctx { file: &file };
+        let t: toml::Table =
+            toml::from_str(text).map_err(|e| SpecError::Toml { file: file.clone(), msg: e.to_string() })?;
+        cx.known_keys(&t, &TOP_KEYS, "")?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let ptx = match t.get("ptx").and_then(|v| v.as_str()) {
+            Some(p) => dir.join(p),
+            None => return cx.err("ptx", "missing; expected the PTX file's path"),
+        };
+        let device = t.get("device").and_then(|v| v.as_str()).map(|s| s.to_string());
+        let positive = |key: &str, max: u64| -> Result<Option<u64>, SpecError> {
+            match t.get(key) {
+                None => Ok(None),
+                Some(v) => match v.as_integer() {
+                    Some(x) if x >= 1 && x as u64 <= max => Ok(Some(x as u64)),
+                    _ => cx.err(key, format!("expected an integer from 1 to {max}")),
+                },
+            }
+        };
+        let max_instructions = positive("max_instructions", i64::MAX as u64)?;
+        let max_call_depth = positive("max_call_depth", u32::MAX as u64)?.map(|d| d as u32);
+        let buffers = cx.buffers(&t, "buffer", dir)?;
+        let constants = cx.buffers(&t, "constant", dir)?;
         let launches = match t.get("launch") {
             Some(toml::Value::Array(a)) => a
                 .iter()
@@ -500,7 +511,16 @@ impl Spec {
                 }
             }
         }
-        Ok(Spec { file: path.to_path_buf(), ptx, device, buffers, launches, max_instructions, max_call_depth })
+        Ok(Spec {
+            file: path.to_path_buf(),
+            ptx,
+            device,
+            buffers,
+            constants,
+            launches,
+            max_instructions,
+            max_call_depth,
+        })
     }
 
     /// The simulator settings for this spec: `threads` host threads, the
@@ -575,7 +595,15 @@ pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
         std::fs::read_to_string(&spec.ptx)
             .map_err(|e| SpecError::Io { file: spec.ptx.display().to_string(), msg: e.to_string() })?
     };
-    let module = dev.load_ptx(&src, &spec.ptx.display().to_string())?;
+    let mut module = dev.load_ptx(&src, &spec.ptx.display().to_string())?;
+    for (i, c) in spec.constants.iter().enumerate() {
+        let bytes = spec.initial_bytes(c)?;
+        module.write_constant(&c.name, &bytes).map_err(|msg| SpecError::Key {
+            file: spec.file.display().to_string(),
+            key: format!("constant[{i}]"),
+            msg,
+        })?;
+    }
     let mut buffers = BTreeMap::new();
     for b in &spec.buffers {
         let bytes = spec.initial_bytes(b)?;

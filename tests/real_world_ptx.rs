@@ -85,3 +85,39 @@ fn a_spec_passes_an_address_inside_a_buffer() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("offset 32 is past the end of `out` (16 bytes)"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A spec fills `__constant__` memory (`[[constant]]`, as cudaMemcpyToSymbol does).
+#[test]
+fn a_spec_initialises_constant_memory() {
+    let dir = std::env::temp_dir().join(format!("warplight-const-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("k.ptx"),
+        ".version 7.8\n.target sm_90\n.address_size 64\n.const .align 4 .b8 taps[16];\n.visible .entry k(.param .u64 out)\n{\n.reg .b32 %r<2>;\n.reg .b64 %rd<2>;\nld.param.u64 %rd1, [out];\nld.const.u32 %r1, [taps+8];\nst.global.u32 [%rd1], %r1;\nret;\n}\n",
+    )
+    .unwrap();
+    let spec = |c: &str| {
+        format!(
+            "ptx = \"k.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 1\nargs = [\"out\"]\n[[buffer]]\nname = \"out\"\ntype = \"u32\"\nlen = 1\n{c}"
+        )
+    };
+    let launch = |file: &std::path::Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_warplight"))
+            .args(["launch", file.to_str().unwrap(), "--dump", &format!("out={}", dir.join("o.bin").display())])
+            .output()
+            .unwrap()
+    };
+    let f = dir.join("s.toml");
+    std::fs::write(&f, spec("[[constant]]\nname = \"taps\"\ntype = \"u32\"\nlen = 4\ninit = [1, 2, 3, 4]\n")).unwrap();
+    let o = launch(&f);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(std::fs::read(dir.join("o.bin")).unwrap(), 3u32.to_le_bytes());
+    // a name the module lacks, and more bytes than the variable holds
+    std::fs::write(&f, spec("[[constant]]\nname = \"tap\"\ntype = \"u32\"\nlen = 1\n")).unwrap();
+    let e = String::from_utf8_lossy(&launch(&f).stderr).into_owned();
+    assert!(e.contains("constant[0]") && e.contains("no __constant__ `tap` (it has: taps)"), "{e}");
+    std::fs::write(&f, spec("[[constant]]\nname = \"taps\"\ntype = \"u32\"\nlen = 5\n")).unwrap();
+    let e = String::from_utf8_lossy(&launch(&f).stderr).into_owned();
+    assert!(e.contains("20 bytes do not fit `taps` (16 bytes)"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -458,6 +458,8 @@ pub struct Program {
     pub globals: Vec<GlobalVar>,
     /// The `.const` bank image.
     pub const_bank: Vec<u8>,
+    /// Module `.const` variables: name, offset in the bank and size in bytes.
+    pub const_vars: Vec<(String, u32, u32)>,
     /// Shared variables with offsets.
     pub shared_vars: Vec<SharedVar>,
     /// Static shared memory per CTA in bytes (dynamic shared starts here, 16-aligned).

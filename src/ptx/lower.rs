@@ -48,6 +48,7 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
         functions: Vec::new(),
         globals: Vec::new(),
         const_bank: Vec::new(),
+        const_vars: Vec::new(),
         shared_vars: Vec::new(),
         static_shared_size: 0,
     };
@@ -91,6 +92,7 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
                 let bytes = init_bytes(v)?;
                 prog.const_bank.resize(off as usize, 0);
                 prog.const_bank.extend_from_slice(&bytes);
+                prog.const_vars.push((v.name.clone(), off as u32, bytes.len() as u32));
                 module_syms.insert(v.name.clone(), Sym::Const(off as u32));
             }
             Space::Global => {

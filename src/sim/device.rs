@@ -276,6 +276,19 @@ impl Module {
     pub fn global(&self, name: &str) -> Option<DevicePtr> {
         self.prog.globals.iter().position(|g| g.name == name).map(|i| DevicePtr(self.globals[i]))
     }
+
+    /// Overwrites the start of module `.const` variable `name` (`cudaMemcpyToSymbol`).
+    pub fn write_constant(&mut self, name: &str, bytes: &[u8]) -> Result<(), String> {
+        let Some((_, off, size)) = self.prog.const_vars.iter().find(|c| c.0 == name) else {
+            let names: Vec<&str> = self.prog.const_vars.iter().map(|c| c.0.as_str()).collect();
+            return Err(format!("the module has no __constant__ `{name}` (it has: {})", names.join(", ")));
+        };
+        if bytes.len() > *size as usize {
+            return Err(format!("{} bytes do not fit `{name}` ({size} bytes)", bytes.len()));
+        }
+        self.prog.const_bank[*off as usize..*off as usize + bytes.len()].copy_from_slice(bytes);
+        Ok(())
+    }
 }
 
 /// A simulated GPU: memory plus a host thread pool.
