@@ -15,6 +15,14 @@ use crate::sim::device::cap_host_threads;
 pub struct LaunchArgs {
     /// The launch spec (TOML): PTX file, kernel, grid, block, buffers, arguments.
     pub spec: PathBuf,
+    /// How to run and what to print.
+    #[command(flatten)]
+    pub options: LaunchOptions,
+}
+
+/// How `launch` (and `run`) run a spec and what they print.
+#[derive(Debug, Clone, clap::Args)]
+pub struct LaunchOptions {
     /// Print every counter as JSON (stable names) instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -49,11 +57,11 @@ type Res = Result<(), Box<dyn std::error::Error>>;
 /// Runs the command.
 pub fn run(a: LaunchArgs) -> Res {
     let spec = Spec::load(&a.spec)?;
-    run_spec(spec, &a)
+    run_spec(spec, &a.options)
 }
 
-/// Runs a spec (loaded from a file, or made from `warplight run`'s options) with `a`'s options.
-pub fn run_spec(spec: Spec, a: &LaunchArgs) -> Res {
+/// Runs a spec (loaded from a file, or made from `warplight run`'s options).
+pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     let dev_name = a.device.clone().or(spec.device.clone()).unwrap_or_else(|| "hopper".into());
     let profile = Profile::parse(&dev_name)
         .ok_or_else(|| format!("unknown device profile `{dev_name}`; known: gt200, maxwell, hopper"))?;

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use super::launch::{LaunchArgs, run_spec};
+use super::launch::{LaunchOptions, run_spec};
 use crate::launch_spec::Spec;
 
 /// Options of `warplight run`.
@@ -39,30 +39,9 @@ pub struct RunArgs {
     /// The kernel's arguments, comma-separated: buffer names or numbers.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub args: Vec<String>,
-    /// Print every counter as JSON.
-    #[arg(long)]
-    pub json: bool,
-    /// Only these metrics.
-    #[arg(long, value_delimiter = ',')]
-    pub metrics: Vec<String>,
-    /// CSV output.
-    #[arg(long)]
-    pub csv: bool,
-    /// Write a buffer's bytes after the run: NAME=FILE.
-    #[arg(long, value_name = "NAME=FILE")]
-    pub dump: Vec<String>,
-    /// Counters per CUDA source line.
-    #[arg(long)]
-    pub per_line: bool,
-    /// Host threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Stop after this many warp instructions.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    pub max_instructions: Option<u64>,
-    /// Device profile: gt200, maxwell or hopper (default).
-    #[arg(long)]
-    pub device: Option<String>,
+    /// How to run and what to print (as `launch`).
+    #[command(flatten)]
+    pub options: LaunchOptions,
 }
 
 fn dims(what: &str, s: &str) -> Result<String, String> {
@@ -145,18 +124,7 @@ pub fn run(a: RunArgs) -> Result<(), Box<dyn std::error::Error>> {
     let text = spec_text(&a, &kernel)?;
     // relative paths in the spec (the source, file= inits) are relative to the current directory
     let spec = Spec::parse(&text, std::path::Path::new("command line"))?;
-    let la = LaunchArgs {
-        spec: a.source.clone(),
-        json: a.json,
-        metrics: a.metrics.clone(),
-        csv: a.csv,
-        dump: a.dump.clone(),
-        per_line: a.per_line,
-        threads: a.threads,
-        max_instructions: a.max_instructions,
-        device: a.device.clone(),
-    };
-    run_spec(spec, &la)
+    run_spec(spec, &a.options)
 }
 
 /// The plain name of the file's only kernel, or an error listing them.
