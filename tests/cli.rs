@@ -268,3 +268,28 @@ fn render_checks_its_output_before_working_and_never_leaves_a_partial_file() {
         std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert_eq!(names, ["y.png"], "only the finished image is left");
 }
+
+#[test]
+fn emulated_renders_report_no_false_zeros() {
+    let dir = tempdir();
+    let json = dir.join("s.json").display().to_string();
+    let png = dir.join("s.png").display().to_string();
+    let (ok, out, err) = warplight(&[
+        "render",
+        "--scene",
+        "scene6",
+        "--variant",
+        "stack",
+        "--resolution",
+        "16x16",
+        "-o",
+        &png,
+        "--json",
+        &json,
+    ]);
+    assert!(ok && out.contains("(kinds counted by the native caster only)"), "{err}{out}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(v["counters"]["shadow"].is_null() && v["counters"]["rays"].as_u64().unwrap() > 0, "{v}");
+    let (ok, out, _) = warplight(&["render", "--scene", "scene6", "--resolution", "16x16", "-o", &png]);
+    assert!(ok && out.contains("primary 256,"), "{out}");
+}
