@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::chart::{BarSeries, Bars, Chart, Format, Lines, Scatter, Series};
 use crate::repro::compare::Tolerance;
 use crate::repro::results::Results;
-use crate::repro::table::{RowKind, Table, Unit};
+use crate::repro::table::{RowKind, Table, Unit, is_part_of};
 
 /// Options of `warplight chart`.
 #[derive(Debug, clap::Args)]
@@ -222,9 +222,7 @@ pub fn address_matches(want: &str, table: &str) -> bool {
     if w_thesis.is_some_and(|t| t != thesis) {
         return false;
     }
-    w_id == "all"
-        || w_id == id
-        || id.strip_prefix(w_id).is_some_and(|part| !part.is_empty() && part.chars().all(|c| c.is_ascii_lowercase()))
+    w_id == "all" || is_part_of(id, w_id)
 }
 
 fn relative(u: Unit) -> bool {

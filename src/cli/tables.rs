@@ -14,7 +14,7 @@ use crate::repro::protocol::{FrameRange, Protocol};
 use crate::repro::registry::{self, Entry};
 use crate::repro::results::Results;
 use crate::repro::run::{self, Plan, Unavailable};
-use crate::repro::table::Table;
+use crate::repro::table::{Table, is_part_of};
 
 /// Options of `warplight tables`.
 #[derive(Debug, clap::Args)]
@@ -115,14 +115,7 @@ pub fn run(a: TablesArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut tables = render(&results)?;
     if let Some(only) = only {
         let keep: Vec<String> = only.iter().map(|e| e.address()).collect();
-        tables.retain(|t| {
-            keep.iter().any(|k| {
-                t.address == *k
-                    || t.address
-                        .strip_prefix(k.as_str())
-                        .is_some_and(|p| p.len() == 1 && p.chars().all(|c| c.is_ascii_lowercase()))
-            })
-        });
+        tables.retain(|t| keep.iter().any(|k| is_part_of(&t.address, k)));
         if tables.is_empty() {
             return Err(format!(
                 "{}: holds no measurements of {}",
@@ -187,8 +180,9 @@ pub fn list_markdown(theses: &[String]) -> Result<String, String> {
 
 /// Every table of the named theses (default: all): status, address, caption and the command.
 pub fn list(theses: &[String]) -> Result<String, String> {
+    let chosen = named(theses)?;
     let mut s = String::new();
-    for t in named(theses)? {
+    for &t in &chosen {
         s.push_str(&format!("{} (seed {}, {}; src/repro/{}/): {}\n", t.short, t.seed, t.seed_file, t.dir, t.citation));
         for table in t.tables {
             let e = Entry { thesis: t, table };
@@ -200,10 +194,7 @@ pub fn list(theses: &[String]) -> Result<String, String> {
         }
         s.push('\n');
     }
-    let all: Vec<Entry> = registry::entries()
-        .into_iter()
-        .filter(|e| theses.is_empty() || theses.iter().any(|n| n == e.thesis.short || n == e.thesis.dir))
-        .collect();
+    let all = registry::entries_of(&chosen);
     let count = |st: registry::Status| all.iter().filter(|e| e.table.status == st).count();
     s.push_str(&format!(
         "{} tables: {} reproduced, {} modelled, {} partly, {} missing, {} not reproducible, {} not measurements.\n",

@@ -212,7 +212,12 @@ impl Entry {
 
 /// Every table of every thesis.
 pub fn entries() -> Vec<Entry> {
-    THESES.iter().flat_map(|t| t.tables.iter().map(move |table| Entry { thesis: t, table })).collect()
+    entries_of(&THESES)
+}
+
+/// Every table of `theses`.
+pub fn entries_of(theses: &[&'static Thesis]) -> Vec<Entry> {
+    theses.iter().flat_map(|t| t.tables.iter().map(move |table| Entry { thesis: t, table })).collect()
 }
 
 /// Why an address did not resolve.
@@ -239,8 +244,7 @@ pub fn resolve(addresses: &[String]) -> Result<Vec<Entry>, AddressError> {
 
 /// [`resolve`] among `theses`.
 pub fn resolve_in(theses: &[&'static Thesis], addresses: &[String]) -> Result<Vec<Entry>, AddressError> {
-    let all: Vec<Entry> =
-        theses.iter().flat_map(|t| t.tables.iter().map(move |table| Entry { thesis: t, table })).collect();
+    let all = entries_of(theses);
     let runnable = |e: &Entry| e.table.render.is_some();
     let mut out: Vec<Entry> = Vec::new();
     let push = |e: Entry, out: &mut Vec<Entry>| {

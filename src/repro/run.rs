@@ -108,9 +108,11 @@ impl Plan {
         let mut trees = 0.0;
         for s in scenes {
             let mut hs: Vec<Heuristic> = Vec::new();
-            for (g, names) in &self.groups {
-                if self.runs(g, names, s) {
-                    hs.extend(g.trees.iter().filter(|h| !hs.contains(h)).collect::<Vec<_>>());
+            for (g, _) in self.groups.iter().filter(|(g, names)| self.runs(g, names, s)) {
+                for h in g.trees {
+                    if !hs.contains(h) {
+                        hs.push(*h);
+                    }
                 }
             }
             trees += hs.iter().map(|h| tree_seconds_per_triangle(*h) * s.triangles.len() as f64).sum::<f64>();
@@ -202,10 +204,7 @@ pub fn execute(
         ws.repeats = plan.repeats;
         let mut ran = false;
         for (g, names) in &plan.groups {
-            if !names.contains(&s.name) || (!g.per_frame && !plan.takes_frame_independent()) {
-                continue;
-            }
-            if g.per_frame && frames.is_empty() {
+            if !plan.runs(g, names, s) || (g.per_frame && frames.is_empty()) {
                 continue;
             }
             let mut tick =

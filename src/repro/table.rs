@@ -217,6 +217,13 @@ pub struct Table {
     pub notes: Vec<String>,
 }
 
+/// Whether table `address` is the table `of` or one of its parts (`fabianowski:4.8a`
+/// of `fabianowski:4.8`). Works on bare ids too (`4.8a` of `4.8`).
+pub fn is_part_of(address: &str, of: &str) -> bool {
+    address == of
+        || address.strip_prefix(of).is_some_and(|p| !p.is_empty() && p.chars().all(|c| c.is_ascii_lowercase()))
+}
+
 /// A published table row: our scene name and the cells as printed (`""` for blanks).
 #[derive(Debug, Clone, Copy)]
 pub struct PublishedRow {
