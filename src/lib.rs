@@ -30,3 +30,4 @@ pub mod ptx;
 pub mod repro;
 pub mod sim;
 pub mod teach;
+pub mod timing;
