@@ -5,6 +5,11 @@
 //! giving it measurement groups and a render function, as
 //! `src/repro/fabianowski2011/` does.
 
+pub mod bitonic;
+pub mod grid;
+pub mod passes;
+pub mod photons;
+
 use crate::repro::registry::{Status, TableDef, Thesis};
 
 /// The seed and its tables.
