@@ -3,7 +3,7 @@
 //! runs on the emulator; the other tables are registered with their status.
 //!
 //! Measurement groups (one run serves several tables):
-//! - [`TRAVERSAL`]: the five §4.2 traversal kernels over the flights (Tables 4.5–4.7, 4.1's fit);
+//! - [`TRAVERSAL`]: the five §4.2 traversal kernels over the flights (Tables 4.5–4.7);
 //! - [`CACHES`]: the seven §4.3 cache kernels (Tables 4.8–4.10);
 //! - [`HEURISTICS`]: the stack kernel on SAH, 4.1.2 and SIROH trees (Table 4.1);
 //! - [`HEURISTIC_COUNTS`]: the native caster's counts on the three trees (Table 4.3);
@@ -144,7 +144,7 @@ static TABLES: [TableDef; N] = [
         title: "Ray tracing frame rates with the numerical approximation from section 4.1.2 and SIROH for two CUDA benchmark environments, relative to the SAH",
         lines: "L1664-1674",
         status: Status::Modelled,
-        note: "frame rates of the stack kernel on SAH, 4.1.2 and SIROH trees through the GT200 timing model; code base I's absolute rates not reproducible",
+        note: "frame rates of the stack kernel on SAH, 4.1.2 and SIROH trees through the GTX 280 timing model; code base I's absolute rates not reproducible",
         scenes: &SCENES,
         groups: &[HEURISTICS],
         render: Some(table_4_1::render),
@@ -194,7 +194,7 @@ static TABLES: [TableDef; N] = [
         title: "Ray tracing frame rates with stackless traversal, relative to a stack-based traversal",
         lines: "L1902-1912",
         status: Status::Modelled,
-        note: "the GT200 timing model on the emulator's counts, fitted to the stack-based column",
+        note: "the GTX 280 timing model (specifications and microbenchmarks, no fit) on the emulator's counts",
         scenes: &SCENES,
         groups: &[TRAVERSAL],
         render: Some(traversal::render_4_6),
@@ -234,7 +234,7 @@ static TABLES: [TableDef; N] = [
         title: "Ray tracing frame rates with explicitly managed caches, relative to baseline without",
         lines: "L2146-2157",
         status: Status::Modelled,
-        note: "the GT200 timing model on the emulator's counts, fitted to the baseline column",
+        note: "the GTX 280 timing model (specifications and microbenchmarks, no fit) on the emulator's counts",
         scenes: &SCENES,
         groups: &[CACHES],
         render: Some(caches::render_4_10),
@@ -455,7 +455,9 @@ pub fn flight_table(
     t
 }
 
-/// A frame-rate table through the GT200 timing model fitted to the published baseline column.
+/// A frame-rate table through the GTX 280 timing model ([`timing`]; no
+/// parameter from the thesis): every column predicted, the absolute one
+/// compared within ±15 %, the relative ones within the ratio tolerance.
 pub fn timing_table(
     e: &Entry,
     r: &Results,
@@ -464,39 +466,35 @@ pub fn timing_table(
     names: &[&str],
     published: &Published,
 ) -> Table {
-    let vnames: Vec<&str> = variants.iter().map(|v| v.name()).collect();
     let scenes = scenes_of(r, group);
-    let runs: Vec<SceneRun> =
-        scenes.iter().filter_map(|s| SceneRun::from_results(r, group, s, variants, &vnames)).collect();
-    let baselines: Vec<(&str, f64)> = published.rows.iter().map(|row| (row.scene, row.cells[0].value())).collect();
-    let fit = timing::fit(&runs, &baselines);
-    let model = timing::describe(&fit);
-    let ours: Vec<(String, Vec<f64>)> = runs
+    let ours: Vec<(String, Vec<f64>)> = scenes
         .iter()
-        .map(|run| {
-            let p: Vec<f64> = (0..run.totals.len()).map(|i| timing::fps(&fit, run, i)).collect();
+        .map(|s| {
+            let p: Vec<f64> = variants.iter().map(|v| timing::fps(r, group, s, v.name())).collect();
             let row = (0..p.len()).map(|i| if i == 0 { p[0] } else { (p[i] / p[0] - 1.0) * 100.0 }).collect();
-            (run.scene.clone(), row)
+            (s.clone(), row)
         })
         .collect();
+    let model = "GTX 280 timing model";
     let mut cols = vec![Column::modelled(
         names[0],
         crate::repro::table::Unit::Number(1),
-        "GT200 timing model",
+        model,
+        Some(timing::FPS_TOLERANCE),
         None,
-        Some("the model is fitted to this column"),
     )];
     cols.extend(names[1..].iter().map(|n| {
         Column::modelled(
             n,
             crate::repro::table::Unit::Change,
-            "GT200 timing model",
+            model,
             Some(crate::repro::compare::Tolerance::RATIO),
             None,
         )
     }));
     let mut t = Table::compare(&e.address(), &e.heading(), cols, published, &ours);
-    t.notes.push(format!("{model}."));
+    t.notes.push(format!("{}.", timing::describe()));
+    t.notes.push(timing::error_note(&t));
     t.notes.push(run_note(r, &scenes, "SIROH trees, counts scaled to 512 x 512"));
     t
 }
