@@ -539,7 +539,7 @@ def finish(raw_path, env_path, out_path):
         "driver": re.search(r"Driver Version: (\S+)", env).group(1),
         "ptxas": raw["ptxas_version"],
         "builds": {"default": "ptxas -arch=sm_90 contraction.ptx", "fmad_false": "ptxas -arch=sm_90 --fmad=false "
-                   "contraction.ptx", "jit": "the driver's JIT compiler (cuModuleLoad of the PTX, default options)"},
+                   "contraction.ptx", "jit": "CuPy RawModule(path=the PTX file): the driver's JIT compiler, default options"},
         "command": "python3 tools/device/contraction.py gen DIR && python3 tools/device/contraction.py run DIR OUT",
         "layout": "each kernel (u64 in, u64 out): thread i loads a, b, c, d = in[4i..4i+4] and stores o0, o1 at "
                   "out[2i..2i+2] (o1 is +0 unless the body writes it); one block of 64 threads; values are f32 or "
