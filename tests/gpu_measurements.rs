@@ -3,7 +3,8 @@
 //!
 //! - FFMA contraction by ptxas (`tests/fixtures/gpu_fma_contraction.json`):
 //!   every case kernel must give exactly the bits of the `ptxas --fmad=false`
-//!   build, since warplight rounds each `mul`/`add` as written. Known
+//!   build (the f32 and f64 cases; f16 arithmetic is not supported yet),
+//!   since warplight rounds each `mul`/`add` as written. Known
 //!   difference: warplight does not model ptxas's default contraction, so
 //!   precisely the cases that ptxas contracts differ from the default build.
 //! - SFU approximations (`tests/fixtures/gpu_sfu_{approx,samples}.json`):
@@ -58,6 +59,10 @@ fn contraction_cases_equal_ptxas_fmad_false_and_differ_exactly_where_ptxas_contr
     let (mut mismatches, mut differ, mut contracted) = (Vec::new(), Vec::new(), Vec::new());
     for c in cases {
         let name = c["name"].as_str().unwrap();
+        if c["type"] == "f16" {
+            // Data for the f16 arithmetic still to come (issue 20, "Also"); same rule as f32.
+            continue;
+        }
         let src = format!("{HEADER}{}", one_name_per_reg(c["ptx"].as_str().unwrap()));
         let m = dev.load_ptx(&src, name).unwrap_or_else(|e| panic!("{name}: {e}"));
         let rows = c["inputs"].as_array().unwrap();

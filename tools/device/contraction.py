@@ -31,7 +31,9 @@ class Fmt:
         self.name, self.mant, self.emin, self.emax, self.width = name, mant, emin, emax, width
 
     def to_frac(self, bits):
-        if self.width == 32:
+        if self.width == 16:
+            v = struct.unpack("<e", struct.pack("<H", bits))[0]
+        elif self.width == 32:
             v = struct.unpack("<f", struct.pack("<I", bits))[0]
         else:
             v = struct.unpack("<d", struct.pack("<Q", bits))[0]
@@ -66,15 +68,18 @@ class Fmt:
         maxv = (2 - Fraction(2) ** (1 - self.mant)) * Fraction(2) ** self.emax
         if v > maxv:
             if mode == "rn" or (mode == "ru" and not sign) or (mode == "rd" and sign):
-                return (0xFF800000 if self.width == 32 else 0xFFF0000000000000) if sign else (
-                    0x7F800000 if self.width == 32 else 0x7FF0000000000000)
+                inf = {16: 0x7C00, 32: 0x7F800000, 64: 0x7FF0000000000000}[self.width]
+                return inf | (1 << (self.width - 1)) if sign else inf
             v = maxv
         f = float(v) * (-1 if sign else 1)
+        if self.width == 16:
+            return struct.unpack("<H", struct.pack("<e", f))[0]
         if self.width == 32:
             return struct.unpack("<I", struct.pack("<f", f))[0]
         return struct.unpack("<Q", struct.pack("<d", f))[0]
 
 
+F16 = Fmt("f16", 11, -14, 15, 16)
 F32 = Fmt("f32", 24, -126, 127, 32)
 F64 = Fmt("f64", 53, -1022, 1023, 64)
 
@@ -122,7 +127,7 @@ class Ar:
         return x
 
 
-A32, A64 = Ar(F32), Ar(F64)
+A16, A32, A64 = Ar(F16), Ar(F32), Ar(F64)
 
 # ----------------------------------------------------------------- the cases
 # body: PTX using %fa %fb %fc %fd (inputs), %fo0 %fo1 (outputs), %ft0..%ft3, %p1..%p3, %n, %i (thread index).
@@ -304,6 +309,27 @@ case("f64_product_used_by_setp", "mul.f64 %ft0, %fa, %fb;\nadd.f64 %fo0, %ft0, %
       "unfused": lambda A, a, b, c, d, i: (A.add(A.mul(a, b), c), _gt(A, A.mul(a, b), d))},
      gen="cancel_d_near_ab", ty="f64")
 
+# Third batch: definitions rather than register names, uses in two blocks, f16.
+case("redefined_after_use", "mul.f32 %ft0, %fa, %fb;\nadd.f32 %fo0, %ft0, %fc;\nmul.f32 %ft0, %fd, %fd;\n"
+     "mov.f32 %fo1, %ft0;",
+     {"fused": lambda A, a, b, c, d, i: (A.fma(a, b, c), A.mul(d, d)),
+      "unfused": lambda A, a, b, c, d, i: (A.add(A.mul(a, b), c), A.mul(d, d))},
+     note="the product's register is reassigned (and stored) after its only use")
+case("same_and_other_block_adds", "mul.f32 %ft0, %fa, %fb;\nadd.f32 %fo0, %ft0, %fc;\n"
+     "setp.gt.f32 %p1, %fa, 0f7F000000;\n@%p1 bra $L_skip;\nadd.f32 %fo1, %ft0, %fd;\n$L_skip:",
+     {"both fused": lambda A, a, b, c, d, i: (A.fma(a, b, c), A.fma(a, b, d)),
+      "first fused": lambda A, a, b, c, d, i: (A.fma(a, b, c), A.add(A.mul(a, b), d)),
+      "second fused": lambda A, a, b, c, d, i: (A.add(A.mul(a, b), c), A.fma(a, b, d)),
+      "neither": lambda A, a, b, c, d, i: (A.add(A.mul(a, b), c), A.add(A.mul(a, b), d))},
+     gen="two_cancel", note="one add in the mul's block, one in the next block (branch never taken at run time)")
+case("f16_mul_add", "mul.f16 %ft0, %fa, %fb;\nadd.f16 %fo0, %ft0, %fc;",
+     {"fused": fused, "unfused": unfused}, ty="f16", note="f16 in .b16 registers")
+case("f16_mul_rn_add", "mul.rn.f16 %ft0, %fa, %fb;\nadd.f16 %fo0, %ft0, %fc;",
+     {"fused": fused, "unfused": unfused}, ty="f16")
+case("f16_product_also_stored", "mul.f16 %ft0, %fa, %fb;\nadd.f16 %fo0, %ft0, %fc;\nmov.b16 %fo1, %ft0;",
+     {"fused, product stored": lambda A, a, b, c, d, i: (A.fma(a, b, c), A.mul(a, b)),
+      "unfused": lambda A, a, b, c, d, i: (A.add(A.mul(a, b), c), A.mul(a, b))}, ty="f16")
+
 
 def _gt(A, x, y):
     one = 0x3F800000 if A.f.width == 32 else 0x3FF0000000000000
@@ -326,6 +352,8 @@ def _acc(A, a, b, c, i, f):
 def rnd_val(rng, fmt, lo_exp=-2, hi_exp=2, sign=None):
     s = rng.randrange(2) if sign is None else sign
     e = rng.randint(lo_exp, hi_exp)
+    if fmt.width == 16:
+        return (s << 15) | ((e + 15) << 10) | rng.getrandbits(10)
     if fmt.width == 32:
         return (s << 31) | ((e + 127) << 23) | rng.getrandbits(23)
     return (s << 63) | ((e + 1023) << 52) | rng.getrandbits(52)
@@ -333,6 +361,7 @@ def rnd_val(rng, fmt, lo_exp=-2, hi_exp=2, sign=None):
 
 def near(rng, A, x, neg, spread=4096):
     """A value within `spread` ulps of x (x negated if neg)."""
+    spread = min(spread, 1 << (A.f.mant - 4))
     y = x + rng.randint(-spread, spread)
     y &= (1 << A.f.width) - 1
     return A.neg(y) if neg else y
@@ -383,7 +412,7 @@ NTHREADS = 64
 
 
 def make_inputs(cs, seed):
-    A = A32 if cs["ty"] == "f32" else A64
+    A = {"f16": A16, "f32": A32, "f64": A64}[cs["ty"]]
     rng = random.Random(seed)
     rows, cands = [], {k: [] for k in cs["cands"]}
     tries = 0
@@ -418,18 +447,20 @@ def _bad(A, x):
 
 def kernel_ptx(cs):
     t = cs["ty"]
-    w = 4 if t == "f32" else 8
+    w = {"f16": 2, "f32": 4, "f64": 8}[t]
     body = cs["body"].replace("%T", t).replace("$L_", "$L_%s_" % cs["name"])
     body = "\n".join("    " + ln if not ln.startswith("$") else ln for ln in body.split("\n"))
-    zero = "0f00000000" if t == "f32" else "0d0000000000000000"
-    ld = ("    ld.global.v4.f32 {%fa, %fb, %fc, %fd}, [%rd3];" if t == "f32" else
-          "    ld.global.v2.f64 {%fa, %fb}, [%rd3];\n    ld.global.v2.f64 {%fc, %fd}, [%rd3+16];")
+    zero = {"f16": "0", "f32": "0f00000000", "f64": "0d0000000000000000"}[t]
+    ld = {"f32": "    ld.global.v4.f32 {%fa, %fb, %fc, %fd}, [%rd3];",
+          "f16": "    ld.global.v4.b16 {%fa, %fb, %fc, %fd}, [%rd3];",
+          "f64": "    ld.global.v2.f64 {%fa, %fb}, [%rd3];\n    ld.global.v2.f64 {%fc, %fd}, [%rd3+16];"}[t]
+    rt = "b16" if t == "f16" else t  # f16 values live in .b16 registers (as nvcc writes them)
     return f""".visible .entry {cs['name']}(.param .u64 pin, .param .u64 pout)
 {{
     .reg .pred %p<4>;
     .reg .b32 %i, %n, %r<4>;
     .reg .b64 %rd<8>;
-    .reg .{t} %fa, %fb, %fc, %fd, %fo0, %fo1, %ft<4>;
+    .reg .{rt} %fa, %fb, %fc, %fd, %fo0, %fo1, %ft<4>;
     ld.param.u64 %rd0, [pin];
     ld.param.u64 %rd1, [pout];
     cvta.to.global.u64 %rd0, %rd0;
@@ -441,11 +472,11 @@ def kernel_ptx(cs):
     mul.wide.u32 %rd2, %i, {4 * w};
     add.u64 %rd3, %rd0, %rd2;
 {ld}
-    mov.{t} %fo1, {zero};
+    mov.{rt} %fo1, {zero};
 {body}
     mul.wide.u32 %rd4, %i, {2 * w};
     add.u64 %rd5, %rd1, %rd4;
-    st.global.v2.{t} [%rd5], {{%fo0, %fo1}};
+    st.global.v2.{rt} [%rd5], {{%fo0, %fo1}};
     ret;
 }}
 """
@@ -482,7 +513,8 @@ def sass_ops(sass):
         m = re.search(r"/\*[0-9a-f]{4}\*/\s+(@!?U?P\w+\s+)?([A-Z][A-Z0-9_.]+)", ln)
         if cur and m:
             op = m.group(2)
-            if re.match(r"^(FFMA|FMUL|FADD|DFMA|DMUL|DADD|FMNMX|FSETP|FSEL|FMUL32I|FADD32I|FFMA32I)", op):
+            # HFMA2.MMA RZ-forms are how ptxas materialises constants (a move), not arithmetic
+            if re.match(r"^(FFMA|FMUL|FADD|DFMA|DMUL|DADD|HFMA2|HMUL2|HADD2|FMNMX|FSETP|FSEL)", op) and op != "HFMA2.MMA":
                 out[cur].append(op)
     return out
 
@@ -509,7 +541,7 @@ def run(d, out):
            "cuobjdump": "cuobjdump -sass", "cases": []}
     for cs in CASES:
         nm, ty = cs["name"], cs["ty"]
-        dt = cp.uint32 if ty == "f32" else cp.uint64
+        dt = {"f16": cp.uint16, "f32": cp.uint32, "f64": cp.uint64}[ty]
         rows = data[nm]["inputs"]
         cands = data[nm]["candidates"]
         din = cp.asarray([x for r in rows for x in r], dtype=dt)
@@ -550,6 +582,8 @@ def finish(raw_path, env_path, out_path):
         "cases": [],
     }
     for c in raw["cases"]:
+        for k in c["sass"]:  # drop constant moves (see sass_ops) from lists made before that filter
+            c["sass"][k] = [op for op in c["sass"][k] if op != "HFMA2.MMA"]
         m = c["matches"]
         c["contracted"] = bool(m["default"]) and m["default"] != m["fmad_false"]
         c["jit_equals_default"] = c["results"]["jit"] == c["results"]["default"]

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Second batch on the GPU machine: the contraction cases again (with the added
 # ones) and tools/device/sfu_extra.cu (ex2 structure, rcp/rsqrt/sqrt/lg2 tables).
+# CONTRACTION_ONLY=1: the contraction cases alone.
 # Writes into $OUT: run.log, gpu_fma_contraction.json, contraction_sass_default.txt,
 # sfu_extra.json and the four tables as .i8.xz.
 set -uo pipefail
@@ -12,6 +13,7 @@ log="$OUT/run.log"
 python3 tools/device/contraction.py gen /tmp/ctr >> "$log" 2>&1
 python3 tools/device/contraction.py run /tmp/ctr /tmp/ctr >> "$log" 2>&1
 cp /tmp/ctr/gpu_fma_contraction.json /tmp/ctr/contraction_sass_default.txt "$OUT/"
+if [ -n "${CONTRACTION_ONLY:-}" ]; then date -u >> "$log"; exit 0; fi
 nvcc -O3 -arch=sm_90 -o /tmp/sfu_extra tools/device/sfu_extra.cu >> "$log" 2>&1
 mkdir -p /tmp/tab
 timeout 300 /tmp/sfu_extra /tmp/tab > "$OUT/sfu_extra.json" 2>> "$log"
