@@ -1,12 +1,14 @@
 //! The ray-tracing kernels on the emulator agree with the native reference
 //! caster: the same primary hit triangle for every pixel, the same colours,
-//! and (stack-based) the same traversal work, ray for ray.
+//! and (stack-based) the same traversal work, ray for ray. The work the
+//! emulator reads off its per-line counters equals what the instrumented
+//! build tallies in the kernel.
 
 use std::path::Path;
 
 use warplight::host::kdtree::{BuildParams, Heuristic, KdTree, build};
 use warplight::host::raycast::{Caster, TraceStats, render};
-use warplight::host::rt_kernels::{self, Variant};
+use warplight::host::rt_kernels::{self, Build, Variant};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::model::Profile;
@@ -241,5 +243,52 @@ fn emulated_renders_match_the_reference_images() {
         let got = k.image.to_srgb8(0.0);
         let worst = got.iter().zip(&want).map(|(a, b)| (*a as i32 - *b as i32).abs()).max().unwrap();
         assert!(worst <= 1, "{name}: the emulated render differs by {worst} steps");
+    }
+}
+
+/// Item by item, the counts the emulator reads off the `@count` lines of the
+/// plain build equal the instrumented build's in-kernel tallies, for every
+/// variant; the tallies cost instructions the plain build does not execute.
+#[test]
+fn emulator_counts_equal_the_instrumented_tallies() {
+    let mut dev = Device::new();
+    let plain = rt_kernels::load_build(&mut dev, Build::Plain).unwrap();
+    let inst = rt_kernels::load_build(&mut dev, Build::Instrumented).unwrap();
+    for (name, variants) in [("scene6", &Variant::EVERY[..]), ("sponza", &Variant::CACHES[..])] {
+        let (scene, tree, cam) = setup(name, 12);
+        for &v in variants {
+            let mut run = |m, b| {
+                rt_kernels::render_build(&mut dev, m, b, &scene, &tree, &cam, glam::Vec3::ZERO, v, Profile::Gt200)
+                    .unwrap()
+            };
+            let (a, b) = (run(&plain, Build::Plain), run(&inst, Build::Instrumented));
+            assert_eq!(a.trace, b.trace, "{name} {v:?}: emulator counts vs in-kernel tallies");
+            assert_eq!(a.hit_tri, b.hit_tri, "{name} {v:?}");
+            assert!(a.trace.inner_nodes > 0 && a.trace.leaves > 0 && a.trace.plane_tests > 0, "{name} {v:?}");
+            assert!(
+                a.launch.totals.warp_instructions < b.launch.totals.warp_instructions,
+                "{name} {v:?}: the plain build executes no tallies"
+            );
+        }
+    }
+}
+
+/// Every `@count` tag of the kernel source names an opcode that the PTX
+/// places on the tagged line: a recompiled kernel cannot silently count nothing.
+#[test]
+fn every_count_tag_has_its_instruction_in_the_ptx() {
+    let tags = rt_kernels::count_tags(rt_kernels::SOURCE);
+    let names: std::collections::BTreeSet<&str> = tags.iter().map(|t| t.name.as_str()).collect();
+    for n in ["rays", "inner", "leaves", "planes", "barys", "push", "pop", "cached_node"] {
+        assert!(names.contains(n), "no @count tag for {n}: {names:?}");
+    }
+    let mut dev = Device::new();
+    let m = rt_kernels::load(&mut dev).unwrap();
+    let file = m.prog.files.iter().position(|f| f.ends_with("fabianowski2011/raytrace.cu")).unwrap() as u32;
+    for t in &tags {
+        let found = m.prog.functions.iter().flat_map(|f| &f.info).any(|i| {
+            i.src.is_some_and(|s| s.file == file && s.line == t.line) && i.opcode == t.opcode
+        });
+        assert!(found, "raytrace.cu:{}: no {} for @count {}", t.line, t.opcode, t.name);
     }
 }

@@ -13,6 +13,17 @@
 //   trace_pushdown_shortstack  Alg. 4.2, both
 // The native caster (src/host/raycast.rs) performs the same float operations
 // in the same order, so hits agree bit for bit; keep the two in step.
+//
+// Counting. This file compiles to the kernels as the thesis runs them: no
+// tallies. The work the tables count (rays, inner-node steps, leaf visits,
+// plane and barycentric tests, local-memory stack pushes and pops) is read off
+// the emulator's per-instruction counters: a line ending in the comment
+// `@count NAME OPCODE` executes exactly one OPCODE instruction per NAME event,
+// and src/host/rt_kernels.rs sums, over every PTX instruction that `.loc`
+// places on such a line, the lanes that executed it. Comments cost nothing.
+// raytrace_stats.cu compiles the same source with RAYTRACE_STATS defined: the
+// `TALLY` statements then count in the kernel and write a stats buffer, the
+// cross-check that both agree (tests/raytrace.rs).
 #include "../prelude.h"
 
 #if defined(__clang__) && !defined(__NVCC__)
@@ -67,7 +78,13 @@ struct Scene {
   const float *aabbs;      // 6 floats per heap node (node cache II)
 };
 
+#ifdef RAYTRACE_STATS
 struct Stats { unsigned inner, leaves, planes, barys, rays, tex_nodes, local_stack; };
+#define TALLY(x) (x)
+#else
+struct Stats {};
+#define TALLY(x) ((void)0)
+#endif
 
 // A node fetch: from the shared-memory node cache when `i` is cached (NC I:
 // index < 2^10, NC II: index < 2^8), else 8 bytes through the texture path.
@@ -75,7 +92,7 @@ template <int NC>
 static __device__ __forceinline__ uint2 node_at(const Scene &s, unsigned i, bool *tex) {
   if ((NC == 1 && i < NC1_NODES) || (NC == 2 && i < NC2_NODES)) {
     *tex = false;
-    return node_cache[i];
+    return node_cache[i];                             // @count cached_node ld.shared.v2.u32
   }
   *tex = true;
   const unsigned *w = (const unsigned *)(s.nodes + i);
@@ -92,14 +109,16 @@ static __device__ __forceinline__ bool wald(const Scene &s, unsigned t, V3 o, V3
   float n0 = __ldg(w), n1 = __ldg(w + 1), n2 = __ldg(w + 2);
   int k = __float_as_int(__ldg(w + 3));
   int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;   // (k + 1) mod 3, (k + 2) mod 3
-  st.planes++;
+  TALLY(st.planes++);
   // line 3: the plane intersection
-  float tt = (n2 - comp(o, k) - n0 * comp(o, a) - n1 * comp(o, b)) / (comp(d, k) + n0 * comp(d, a) + n1 * comp(d, b));
+  float num = n2 - comp(o, k) - n0 * comp(o, a) - n1 * comp(o, b);
+  float tt = num / (comp(d, k) + n0 * comp(d, a) + n1 * comp(d, b));   // @count planes div.rn.f32
   // lines 4-6: early out before e'1, e'2 are loaded
   if (!(tt >= t_min && tt <= *t_hit)) return false;
-  st.barys++;
+  TALLY(st.barys++);
   // lines 7-8: barycentric coordinates
-  float hx = comp(o, a) + tt * comp(d, a), hy = comp(o, b) + tt * comp(d, b);
+  float hx = comp(o, a) + tt * comp(d, a);            // @count barys add.rn.f32
+  float hy = comp(o, b) + tt * comp(d, b);
   float u = __ldg(w + 8) * hx + __ldg(w + 9) * hy + __ldg(w + 10);
   float v = __ldg(w + 4) * hx + __ldg(w + 5) * hy + __ldg(w + 6);
   if (u < 0.0f || v < 0.0f || u + v > 1.0f) return false;
@@ -110,10 +129,11 @@ static __device__ __forceinline__ bool wald(const Scene &s, unsigned t, V3 o, V3
 // Tests the leaf's triangles for t in [max(t_a - eps, t_min), min(t_hit, t_b + eps)].
 static __device__ __forceinline__ int visit_leaf(const Scene &s, uint2 n, V3 o, V3 d, float t_min, float t_a,
                                                  float t_b, bool any, float *t_hit, Stats &st) {
-  st.leaves++;
+  TALLY(st.leaves++);
   float lo = fmaxf(t_a - s.p->eps, t_min);
   float saved = *t_hit;
-  *t_hit = fminf(*t_hit, t_b + s.p->eps);
+  float hi = t_b + s.p->eps;                          // @count leaves add.rn.f32
+  *t_hit = fminf(*t_hit, hi);
   int found = -1;
   unsigned first = n.y >> 2, count = n.x;
   for (unsigned r = 0; r < count; r++) {
@@ -132,8 +152,9 @@ static __device__ __forceinline__ int visit_leaf(const Scene &s, uint2 n, V3 o, 
 template <int V, int NC = 0, int SC = 0>
 static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out, Stats &st,
                             float *short_stack) {
-  st.rays++;
-  V3 inv = v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+  TALLY(st.rays++);
+  float inv_x = 1.0f / d.x;                           // @count rays rcp.rn.f32
+  V3 inv = v3(inv_x, 1.0f / d.y, 1.0f / d.z);
   const Params *p = s.p;
   // clip to the scene box
   float t0x = (p->lo[0] - o.x) * inv.x, t1x = (p->hi[0] - o.x) * inv.x;
@@ -161,10 +182,10 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
       bool tex;
       uint2 n = node_at<NC>(s, node, &tex);
       while ((n.y & 3) != 3) {                        // inner node: one traversal step
-        st.inner++;
-        if (tex) st.tex_nodes++;
+        TALLY(st.inner++);
+        TALLY(st.tex_nodes += tex);
         int k = n.y & 3;
-        float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);
+        float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);   // @count inner mul.rn.f32
         unsigned left = 2 * (n.y >> 2) + 1, right = left + 1;
         bool neg = __float_as_int(comp(d, k)) < 0;    // the IEEE sign bit: works for d_k = -0
         unsigned near = neg ? right : left, far = neg ? left : right;
@@ -175,10 +196,10 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
         } else {
           if (SC == 1) {                              // Alg. 4.3
             if (head_node > 0) {
-              stack[size].node = head_node;
+              stack[size].node = head_node;           // @count push st.local.u32
               stack[size].tb = head_tb;
               size++;
-              st.local_stack++;
+              TALLY(st.local_stack++);
             }
             head_node = far;
             head_tb = tb;
@@ -186,10 +207,10 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
             if (top1 < (1u << 24)) top1 = (top1 << 8) | far;
             else top2 = (top2 << 8) | far;
           } else {                                    // push the far child and the end of its interval
-            stack[size].node = far;
+            stack[size].node = far;                   // @count push st.local.u32
             stack[size].tb = tb;
             size++;
-            st.local_stack++;
+            TALLY(st.local_stack++);
           }
           tb = ts;
           node = near;
@@ -227,10 +248,10 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
         head_node = 0;
       } else if (size > 0) {
         size--;
-        st.local_stack++;
+        TALLY(st.local_stack++);
         ta = tb;                                      // the start is the previous end
         tb = stack[size].tb;
-        node = stack[size].node;
+        node = stack[size].node;                      // @count pop ld.local.u32
       } else if (SC == 2 && (top1 > 0 || top2 > 0)) { // Alg. 4.6 lines 4-12
         if (top2 > 0) {
           node = top2 & 255;
@@ -282,10 +303,10 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
       bool tex;
       uint2 n = node_at<NC>(s, node, &tex);
       while ((n.y & 3) != 3) {                        // line 17
-        st.inner++;
-        if (tex) st.tex_nodes++;
+        TALLY(st.inner++);
+        TALLY(st.tex_nodes += tex);
         int k = n.y & 3;
-        float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);
+        float ts = (__int_as_float(n.x) - comp(o, k)) * comp(inv, k);   // @count inner mul.rn.f32
         unsigned left = 2 * (n.y >> 2) + 1, right = left + 1;
         bool neg = __float_as_int(comp(d, k)) < 0;
         unsigned near = neg ? right : left, far = neg ? left : right;
@@ -343,7 +364,7 @@ static __device__ V3 normal_of(const Scene &s, unsigned t, V3 d) {
   return v;
 }
 
-// Emission plus diffuse direct light from the point light (one shadow ray).
+// Emission plus diffuse direct light from the point light (one shadow ray, cast from the light).
 template <int V, int NC, int SC>
 static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, Stats &st, float *ss) {
   unsigned m = __ldg(s.tri_mat + tri);
@@ -356,13 +377,16 @@ static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, S
   V3 pt = v3(o.x + d.x * t, o.y + d.y * t, o.z + d.z * t);
   V3 n = normal_of(s, tri, d);
   if (p->has_light) {
-    V3 to = v3(p->light_pos[0] - pt.x, p->light_pos[1] - pt.y, p->light_pos[2] - pt.z);
-    float dist = sqrtf(dot3(to, to));
-    V3 dir = v3(to.x / dist, to.y / dist, to.z / dist);
-    float cos = dot3(n, dir);
+    // the shadow ray goes from the point light toward the hit point (seed 000
+    // L3411, L1561) and ends eps before it
+    V3 lp = v3(p->light_pos[0], p->light_pos[1], p->light_pos[2]);
+    V3 from = v3(pt.x - lp.x, pt.y - lp.y, pt.z - lp.z);
+    float dist = sqrtf(dot3(from, from));
+    V3 dir = v3(from.x / dist, from.y / dist, from.z / dist);
+    float cos = -dot3(n, dir);
     if (cos > 0.0f) {
       float ts;
-      if (trace<V, NC, SC>(s, pt, dir, p->eps, dist - p->eps, true, &ts, st, ss) < 0) {
+      if (trace<V, NC, SC>(s, lp, dir, p->eps, dist - p->eps, true, &ts, st, ss) < 0) {
         float g = cos / (dist * dist) / 3.14159265358979323846f;
         c.x += col.x * p->light_int[0] * g;
         c.y += col.y * p->light_int[1] * g;
@@ -410,7 +434,11 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     int pix = (int)base + lane;
     if (pix >= p->num_pixels) continue;
     int x = pix % p->width, y = pix / p->width;
+#ifdef RAYTRACE_STATS
     Stats st = {0, 0, 0, 0, 0, 0, 0};
+#else
+    Stats st;
+#endif
     float px = (((float)x + 0.5f) / (float)p->width * 2.0f - 1.0f) * p->tan_half * p->aspect;
     float py = (1.0f - ((float)y + 0.5f) / (float)p->height * 2.0f) * p->tan_half;
     V3 o = v3(p->cam_pos[0], p->cam_pos[1], p->cam_pos[2]);
@@ -441,6 +469,7 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     }
     color[pix] = make_float4(c.x, c.y, c.z, 1.0f);
     hit_tri[pix] = h;
+#ifdef RAYTRACE_STATS
     unsigned *sp = stats + 8 * pix;
     sp[0] = st.inner;
     sp[1] = st.leaves;
@@ -449,6 +478,9 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     sp[4] = st.rays;
     sp[5] = st.tex_nodes;
     sp[6] = st.local_stack;
+#else
+    (void)stats;
+#endif
   }
 }
 

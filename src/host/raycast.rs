@@ -1,8 +1,8 @@
 //! The native-Rust reference ray caster: stack-based kd-tree traversal (thesis
 //! 000 §3.2.4.1, the reconstruction in the seed extract §4.4), Wald's triangle
 //! test (Alg. 3.3) and Whitted shading — a primary ray, a mirror reflection
-//! ray where the surface seen is specular, and a shadow ray from each hit to
-//! each point light: up to four rays per pixel. It is the oracle for the
+//! ray where the surface seen is specular, and a shadow ray from each point
+//! light toward each hit (as the thesis casts them): up to four rays per pixel. It is the oracle for the
 //! ray-tracing kernels and the native speed baseline.
 
 use glam::Vec3;
@@ -248,16 +248,17 @@ impl<'a> Caster<'a> {
         for l in &self.scene.lights {
             if let Light::Point { position, intensity } = l {
                 let lp = Vec3::from(*position) + light_offset;
-                let to = lp - p;
-                let dist = to.length();
-                let dir = to / dist;
-                let cos = n.dot(dir);
+                // the shadow ray goes from the light toward the hit point (seed 000 L3411, L1561)
+                let from = p - lp;
+                let dist = from.length();
+                let dir = from / dist;
+                let cos = -n.dot(dir);
                 if cos <= 0.0 {
                     continue;
                 }
                 st.shadow += 1;
-                // occluded only if a hit lies before the light by more than epsilon
-                let sr = Ray { origin: p, dir };
+                // occluded only if a hit lies before the surface by more than epsilon
+                let sr = Ray { origin: lp, dir };
                 if self.intersect(&sr, self.eps, dist - self.eps, true, st).is_some() {
                     continue;
                 }

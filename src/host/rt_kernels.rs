@@ -1,7 +1,17 @@
 //! Runs thesis 000's ray-tracing kernels (`kernels/fabianowski2011/raytrace.cu`) on
 //! the emulator: uploads the laid-out kd-tree, triangles, materials and camera,
 //! launches 30 persistent CTAs of 256 threads, and reads back the image, the
-//! primary hit of each pixel and the per-ray work the kernel counted.
+//! primary hit of each pixel and the work traced.
+//!
+//! The work is counted by the emulator, not the kernel: the plain build
+//! ([`Build::Plain`], what the tables run) has no tallies, and [`line_counts`]
+//! reads rays, inner-node steps, leaf visits, plane and barycentric tests and
+//! local-memory stack pushes and pops off the per-instruction counters of the
+//! source lines tagged `@count` in `raytrace.cu`; a node-cache observer
+//! ([`NodeCacheFetches`]) tells inner nodes from leaves among the shared-memory
+//! node fetches, so that the texture fetches of inner nodes follow. The
+//! instrumented build ([`Build::Instrumented`]) tallies the same quantities in
+//! the kernel, for the cross-check that both agree.
 
 use glam::Vec3;
 
@@ -12,7 +22,9 @@ use super::kdtree::layout::layout;
 use super::raycast::{EPS_REL, TraceStats};
 use super::scene::{Light, MaterialKind, Scene};
 use crate::model::{Model, ModelStats, Profile};
+use crate::ptx::ir::{MemSpace, Program};
 use crate::sim::device::to_bytes;
+use crate::sim::observer::{MemEvent, MemObserver, MemOp, ObserverFactory};
 use crate::sim::{Arg, Device, LaunchConfig, LaunchStats, Module, SimConfig, SimError};
 
 /// Traversal variants of the kernel family (thesis 000 §4.2).
@@ -122,8 +134,164 @@ impl Variant {
     }
 }
 
-/// The kernels' PTX, compiled in (`kernels/fabianowski2011/raytrace.ptx`).
+/// The kernels' PTX, compiled in (`kernels/fabianowski2011/raytrace.ptx`): no tallies.
 pub const PTX: &str = include_str!("../../kernels/fabianowski2011/raytrace.ptx");
+/// The instrumented build's PTX (`raytrace_stats.cu`: the same source with its tallies compiled in).
+pub const PTX_STATS: &str = include_str!("../../kernels/fabianowski2011/raytrace_stats.ptx");
+/// The kernels' CUDA source, whose `@count` tags name the lines counted.
+pub const SOURCE: &str = include_str!("../../kernels/fabianowski2011/raytrace.cu");
+/// The source's path as the PTX's `.file` directive names it (suffix).
+const SOURCE_FILE: &str = "kernels/fabianowski2011/raytrace.cu";
+
+/// Which build of the kernels runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Build {
+    /// The kernels as the thesis runs them; the emulator counts the work.
+    Plain,
+    /// The kernels with in-kernel tallies written to a stats buffer (the cross-check).
+    Instrumented,
+}
+
+/// A counted source line: each `NAME` event executes exactly one `opcode`
+/// instruction that `.loc` places on `line` (a comment `@count NAME OPCODE`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CountTag {
+    /// 1-based line in `raytrace.cu`.
+    pub line: u32,
+    /// The event counted.
+    pub name: String,
+    /// The PTX opcode, as written, that stands for one event.
+    pub opcode: String,
+}
+
+/// The `@count` tags of `source`, in line order.
+pub fn count_tags(source: &str) -> Vec<CountTag> {
+    source
+        .lines()
+        .enumerate()
+        .filter_map(|(i, l)| {
+            let (_, tag) = l.split_once("// @count ")?;
+            let mut w = tag.split_whitespace();
+            let (name, opcode) = (w.next()?, w.next()?);
+            Some(CountTag { line: i as u32 + 1, name: name.into(), opcode: opcode.into() })
+        })
+        .collect()
+}
+
+/// Per tag name, the lanes that executed the tagged instruction (guard true),
+/// summed over every PTX instruction on a tagged line of `raytrace.cu` whose
+/// opcode is the tag's: the events the kernel performed.
+pub fn line_counts(prog: &Program, stats: &LaunchStats, tags: &[CountTag]) -> std::collections::BTreeMap<String, u64> {
+    let mut out: std::collections::BTreeMap<String, u64> = tags.iter().map(|t| (t.name.clone(), 0)).collect();
+    let Some(file) = prog.files.iter().position(|f| f.ends_with(SOURCE_FILE)) else { return out };
+    for (f, counts) in stats.profile.per_fn.iter().enumerate() {
+        for (pc, c) in counts.iter().enumerate() {
+            let info = &prog.functions[f].info[pc];
+            let Some(src) = info.src else { continue };
+            if src.file as usize != file || c.pred_on == 0 {
+                continue;
+            }
+            for t in tags.iter().filter(|t| t.line == src.line && t.opcode == info.opcode) {
+                *out.entry(t.name.clone()).or_default() += c.pred_on;
+            }
+        }
+    }
+    out
+}
+
+/// Counts, lane by lane, the shared-memory loads of 8-byte nodes from the
+/// node cache (`node_cache` in `raytrace.cu`) whose node is an inner node:
+/// node fetches the cache served, so not through the texture path.
+pub struct NodeCacheFetches<'a> {
+    /// The model that observes the same launch.
+    model: &'a Model,
+    /// Offset of `node_cache` in shared memory, if the module has it.
+    base: Option<u64>,
+    /// Whether node `i` of the laid-out tree is an inner node.
+    inner: std::sync::Arc<Vec<bool>>,
+    /// Inner-node fetches served by the cache, over retired CTAs.
+    served: std::sync::Mutex<u64>,
+}
+
+struct CacheObserver {
+    model: Box<dyn MemObserver>,
+    base: Option<u64>,
+    inner: std::sync::Arc<Vec<bool>>,
+    served: u64,
+}
+
+impl MemObserver for CacheObserver {
+    fn access(&mut self, ev: &MemEvent) {
+        self.model.access(ev);
+        let Some(base) = self.base else { return };
+        if ev.space != MemSpace::Shared || ev.op != MemOp::Load || ev.bytes != 8 {
+            return;
+        }
+        for lane in 0..32 {
+            if ev.mask & (1 << lane) == 0 {
+                continue;
+            }
+            let a = ev.addrs[lane];
+            if a >= base && a < base + 8 * self.inner.len() as u64 && (a - base) % 8 == 0 {
+                self.served += self.inner[((a - base) / 8) as usize] as u64;
+            }
+        }
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn std::any::Any> {
+        self
+    }
+
+    fn as_any_mut(&mut self) -> Option<&mut dyn std::any::Any> {
+        Some(self)
+    }
+}
+
+impl<'a> NodeCacheFetches<'a> {
+    /// Observes `prog`'s node cache over `nodes` (the laid-out tree, 8 bytes a node), alongside `model`.
+    pub fn new(model: &'a Model, prog: &Program, nodes: &[u8]) -> Self {
+        let base = prog.shared_vars.iter().find(|v| v.name == "node_cache").map(|v| v.offset as u64);
+        let inner = nodes.chunks_exact(8).map(|n| u32::from_le_bytes([n[4], n[5], n[6], n[7]]) & 3 != 3).collect();
+        NodeCacheFetches { model, base, inner: std::sync::Arc::new(inner), served: std::sync::Mutex::new(0) }
+    }
+
+    /// Inner-node fetches the cache served.
+    pub fn served(&self) -> u64 {
+        *self.served.lock().expect("node cache counter")
+    }
+}
+
+/// The observer in `b`, for as long as `b` is borrowed.
+fn shorten<'a>(b: &'a mut Box<dyn MemObserver>) -> &'a mut (dyn MemObserver + 'a) {
+    &mut **b
+}
+
+impl ObserverFactory for NodeCacheFetches<'_> {
+    fn create(&self, cta: u32) -> Box<dyn MemObserver> {
+        Box::new(CacheObserver { model: self.model.create(cta), base: self.base, inner: self.inner.clone(), served: 0 })
+    }
+
+    fn retire(&self, obs: Box<dyn MemObserver>) {
+        match obs.into_any().downcast::<CacheObserver>() {
+            Ok(o) => {
+                *self.served.lock().expect("node cache counter") += o.served;
+                self.model.retire(o.model);
+            }
+            Err(_) => unreachable!("NodeCacheFetches made every observer of this launch"),
+        }
+    }
+
+    fn end_round(&self, observers: &mut [(u32, &mut dyn MemObserver)]) {
+        let mut inner: Vec<(u32, &mut dyn MemObserver)> = observers
+            .iter_mut()
+            .filter_map(|(cta, o)| {
+                let c = o.as_any_mut()?.downcast_mut::<CacheObserver>()?;
+                Some((*cta, shorten(&mut c.model)))
+            })
+            .collect();
+        self.model.end_round(&mut inner);
+    }
+}
 
 /// CTAs of the persistent-threads launch (one per GTX 280 SM).
 pub const CTAS: u32 = 30;
@@ -169,6 +337,22 @@ fn f32s(v: &[f32]) -> Vec<u8> {
 pub fn render(
     dev: &mut Device,
     module: &Module,
+    scene: &Scene,
+    tree: &KdTree,
+    camera: &Camera,
+    light_offset: Vec3,
+    variant: Variant,
+    profile: Profile,
+) -> Result<KernelRender, SimError> {
+    render_build(dev, module, Build::Plain, scene, tree, camera, light_offset, variant, profile)
+}
+
+/// As [`render`], with `module` loaded from `build` ([`load_build`]).
+#[allow(clippy::too_many_arguments)]
+pub fn render_build(
+    dev: &mut Device,
+    module: &Module,
+    build: Build,
     scene: &Scene,
     tree: &KdTree,
     camera: &Camera,
@@ -257,30 +441,54 @@ pub fn render(
     let hit = dev.alloc_zeroed::<i32>(npix);
     let stats = dev.alloc_zeroed::<u32>(8 * npix);
     let model = Model::new(profile, &module.prog);
+    let cache = NodeCacheFetches::new(&model, &module.prog, &lay.nodes);
     let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, ab, next, color, hit, stats].into_iter().map(Arg::Ptr).collect();
     let launch =
-        dev.launch_observed(module, variant.kernel(), LaunchConfig::linear(CTAS, THREADS), &args, Some(&model))?;
+        dev.launch_observed(module, variant.kernel(), LaunchConfig::linear(CTAS, THREADS), &args, Some(&cache))?;
     let rgba = dev.read::<f32>(color, 4 * npix);
     let mut image = FrameBuffer::new(w, h);
     for (i, px) in rgba.chunks_exact(4).enumerate() {
         image.pixels[i] = [px[0], px[1], px[2]];
     }
-    let st = dev.read::<u32>(stats, 8 * npix);
     let mut trace = TraceStats::default();
-    for s in st.chunks_exact(8) {
-        trace.inner_nodes += s[0] as u64;
-        trace.leaves += s[1] as u64;
-        trace.plane_tests += s[2] as u64;
-        trace.barycentric_tests += s[3] as u64;
-        trace.rays += s[4] as u64;
-        trace.tex_node_fetches += s[5] as u64;
-        trace.local_stack_accesses += s[6] as u64;
+    match build {
+        Build::Instrumented => {
+            let st = dev.read::<u32>(stats, 8 * npix);
+            for s in st.chunks_exact(8) {
+                trace.inner_nodes += s[0] as u64;
+                trace.leaves += s[1] as u64;
+                trace.plane_tests += s[2] as u64;
+                trace.barycentric_tests += s[3] as u64;
+                trace.rays += s[4] as u64;
+                trace.tex_node_fetches += s[5] as u64;
+                trace.local_stack_accesses += s[6] as u64;
+            }
+        }
+        Build::Plain => {
+            let c = line_counts(&module.prog, &launch, &count_tags(SOURCE));
+            let get = |n: &str| c.get(n).copied().unwrap_or(0);
+            trace.rays = get("rays");
+            trace.inner_nodes = get("inner");
+            trace.leaves = get("leaves");
+            trace.plane_tests = get("planes");
+            trace.barycentric_tests = get("barys");
+            trace.local_stack_accesses = get("push") + get("pop");
+            trace.tex_node_fetches = trace.inner_nodes - cache.served().min(trace.inner_nodes);
+        }
     }
     trace.primary = npix as u64;
     Ok(KernelRender { image, hit_tri: dev.read::<i32>(hit, npix), trace, launch, memory: model.finish() })
 }
 
-/// Loads the kernels' PTX on `dev`.
+/// Loads the kernels' PTX (the plain build) on `dev`.
 pub fn load(dev: &mut Device) -> Result<Module, SimError> {
-    dev.load_ptx(PTX, "kernels/fabianowski2011/raytrace.ptx")
+    load_build(dev, Build::Plain)
+}
+
+/// Loads `build` of the kernels on `dev`.
+pub fn load_build(dev: &mut Device, build: Build) -> Result<Module, SimError> {
+    match build {
+        Build::Plain => dev.load_ptx(PTX, "kernels/fabianowski2011/raytrace.ptx"),
+        Build::Instrumented => dev.load_ptx(PTX_STATS, "kernels/fabianowski2011/raytrace_stats.ptx"),
+    }
 }
