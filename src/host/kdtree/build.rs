@@ -29,12 +29,31 @@ pub struct BuildParams {
     pub empty_volume: f32,
     /// Maximum depth (the root has depth 0).
     pub max_depth: u32,
+    /// Most triangle references per triangle of the scene: a split that
+    /// would take the tree past `max_refs_per_triangle · n` references makes
+    /// a leaf instead. Not a thesis parameter: a bound for scenes whose
+    /// bounding boxes overlap without end, as in a flat fan of triangles
+    /// (`docs/kdtree.md#the-reference-budget`); the scenes of the thesis stay
+    /// below 6.
+    pub max_refs_per_triangle: u32,
 }
+
+/// The default reference budget per triangle ([`BuildParams::max_refs_per_triangle`]).
+pub const MAX_REFS_PER_TRIANGLE: u32 = 32;
 
 impl BuildParams {
     /// Thesis 000's parameters with heuristic `h`.
     pub fn thesis(h: Heuristic) -> Self {
-        BuildParams { heuristic: h, c_t: 1.0, c_i: 3.0, leaf_max: 4, empty_bias: 0.8, empty_volume: 0.3, max_depth: 32 }
+        BuildParams {
+            heuristic: h,
+            c_t: 1.0,
+            c_i: 3.0,
+            leaf_max: 4,
+            empty_bias: 0.8,
+            empty_volume: 0.3,
+            max_depth: 32,
+            max_refs_per_triangle: MAX_REFS_PER_TRIANGLE,
+        }
     }
 }
 
@@ -102,6 +121,13 @@ struct Builder<'a> {
     nodes: Vec<Node>,
     refs: Vec<u32>,
     depth: u32,
+    /// References the tree will hold: those of its leaves plus the
+    /// triangles of the nodes still to be built.
+    planned: u64,
+    /// The most references the tree may hold.
+    budget: u64,
+    /// True when the budget turned a node that would have split into a leaf.
+    budget_hit: bool,
 }
 
 /// Builds a kd-tree over triangles (each three vertices).
@@ -131,12 +157,30 @@ pub fn build(tris: &[[Vec3; 3]], p: BuildParams) -> KdTree {
         }
         ev.sort_unstable_by(ev_cmp);
     }
-    let mut b =
-        Builder { p, model, boxes: &boxes, side: vec![0; tris.len()], nodes: Vec::new(), refs: Vec::new(), depth: 0 };
+    let n = tris.len() as u64;
+    let mut b = Builder {
+        p,
+        model,
+        boxes: &boxes,
+        side: vec![0; tris.len()],
+        nodes: Vec::new(),
+        refs: Vec::new(),
+        depth: 0,
+        planned: n,
+        budget: n.saturating_mul(p.max_refs_per_triangle.max(1) as u64),
+        budget_hit: false,
+    };
     let all: Vec<u32> = (0..tris.len() as u32).collect();
     let root = model.root();
     b.node(bounds, root, all, events, 0);
-    KdTree { nodes: b.nodes, tri_refs: b.refs, bounds, depth: b.depth, heuristic: p.heuristic }
+    KdTree {
+        nodes: b.nodes,
+        tri_refs: b.refs,
+        bounds,
+        depth: b.depth,
+        heuristic: p.heuristic,
+        budget_hit: b.budget_hit,
+    }
 }
 
 impl Builder<'_> {
@@ -188,6 +232,16 @@ impl Builder<'_> {
                 }
             }
         }
+        // the straddlers are referenced twice: within the budget, or a leaf
+        if self.planned + both.len() as u64 > self.budget {
+            for &t in &tris {
+                self.side[t as usize] = 0;
+            }
+            self.budget_hit = true;
+            self.leaf(at, &tris);
+            return at as u32;
+        }
+        self.planned += both.len() as u64;
         // split the sorted event lists; regenerate the straddlers' events in each child
         let mut le: [Vec<Event>; 3] = Default::default();
         let mut re: [Vec<Event>; 3] = Default::default();
@@ -366,5 +420,46 @@ mod tests {
         let b = build(&s, BuildParams::thesis(Heuristic::Siroh));
         assert_eq!(a.nodes, b.nodes);
         assert_eq!(a.tri_refs, b.tri_refs);
+    }
+
+    /// A flat disc: `n` thin triangles fanned around the origin in y = 0.
+    fn disc(n: usize) -> Vec<[Vec3; 3]> {
+        let rim = |i: usize| {
+            let a = std::f32::consts::TAU * (i % n) as f32 / n as f32;
+            Vec3::new(a.cos(), 0.0, a.sin())
+        };
+        (0..n).map(|i| [Vec3::ZERO, rim(i), rim(i + 1)]).collect()
+    }
+
+    #[test]
+    fn a_flat_disc_blows_up_without_the_reference_budget() {
+        // In a flat node the children's surface areas add up to the parent's,
+        // so the SAH charges nothing for straddlers, and the fan's boxes
+        // overlap: the tree refines to the cells of the boxes' edges.
+        let s = disc(200);
+        let unbounded = BuildParams { max_refs_per_triangle: u32::MAX, ..BuildParams::thesis(Heuristic::Sah) };
+        let t = build(&s, unbounded);
+        assert!(!t.budget_hit);
+        assert!(t.stats().tri_refs > 200 * 200, "{:?}", t.stats());
+    }
+
+    #[test]
+    fn the_reference_budget_bounds_a_flat_disc() {
+        // issue 17's case: 1,998 triangles took 33 s and 667 MB
+        let s = disc(1998);
+        for h in [Heuristic::Sah, Heuristic::Siroh] {
+            let t = build(&s, BuildParams::thesis(h));
+            check(&t, &s);
+            let st = t.stats();
+            assert!(t.budget_hit, "{h}");
+            assert!(st.tri_refs <= 1998 * MAX_REFS_PER_TRIANGLE as u64, "{h}: {st:?}");
+            assert!(st.tri_refs > 1998 * 8, "{h}: the budget is used, not a single leaf: {st:?}");
+        }
+        // a scene in three dimensions never meets it
+        let s = grid_scene(12);
+        for h in [Heuristic::Sah, Heuristic::Siroh, Heuristic::Numerical] {
+            let t = build(&s, BuildParams::thesis(h));
+            assert!(!t.budget_hit, "{h}");
+        }
     }
 }

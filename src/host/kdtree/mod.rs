@@ -10,6 +10,8 @@
 //! of more than 30 % of the parent's volume costs 20 % less; triangle bounds
 //! are clamped to the node but not clipped. Depth is limited to 32 levels (the
 //! stackless traversal's flags register). Tie rules: `docs/kdtree.md`.
+//! A reference budget (32 per triangle, not a thesis parameter) bounds the
+//! trees of scenes whose triangles' boxes overlap without end.
 
 pub mod build;
 pub mod cost;
@@ -98,6 +100,9 @@ pub struct KdTree {
     pub depth: u32,
     /// The heuristic used.
     pub heuristic: Heuristic,
+    /// True when the reference budget ([`BuildParams::max_refs_per_triangle`])
+    /// made leaves of nodes the heuristic would have split.
+    pub budget_hit: bool,
 }
 
 /// Counts of Table 4.4.
