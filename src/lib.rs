@@ -25,6 +25,7 @@ pub mod cli;
 pub mod compile;
 pub mod host;
 pub mod launch_spec;
+pub mod limits;
 pub mod model;
 pub mod ptx;
 pub mod repro;
