@@ -364,7 +364,7 @@ pub fn render_build(
     let lay = layout(tree, &tris, variant.heap_levels());
     let (r, u, f) = camera.frame();
     let [w, h] = camera.resolution;
-    let npix = (w * h) as usize;
+    let npix = w as usize * h as usize; // not w * h in u32: it wraps past 4 Gi pixels
     let light = scene.lights.iter().find_map(|l| match l {
         Light::Point { position, intensity } => Some((Vec3::from(*position) + light_offset, *intensity)),
         _ => None,
