@@ -293,3 +293,104 @@ fn emulated_renders_report_no_false_zeros() {
     let (ok, out, _) = warplight(&["render", "--scene", "scene6", "--resolution", "16x16", "-o", &png]);
     assert!(ok && out.contains("primary 256,"), "{out}");
 }
+
+#[test]
+fn launch_prints_a_header_and_sections_without_zero_counters() {
+    let (ok, out, err) = warplight(&["launch", "examples/lessons/coalescing.toml"]);
+    assert!(ok, "{err}");
+    let mut head = out.lines();
+    assert_eq!(head.next().unwrap(), "device hopper (H100, compute capability 9.0, 132 SMs)", "{out}");
+    let spec = head.next().unwrap();
+    assert!(spec.contains("coalescing.toml: 3 launches of kernels/lessons/coalescing.ptx"), "{out}");
+    assert!(out.contains("launch 2 of 3: strided_read<<<(4,1,1), (256,1,1)>>>(out, in, 2)  1,024 threads"), "{out}");
+    for section in ["  Launch", "  Instructions", "  Memory workload (hopper model)", "  Occupancy"] {
+        assert!(out.lines().any(|l| l == section), "no section {section:?}:\n{out}");
+    }
+    assert!(out.lines().any(|l| l.starts_with("    mem.global_ld.sectors") && l.ends_with("128 sectors")), "{out}");
+    assert!(
+        out.lines().any(|l| l.starts_with("    thread_instructions ") && l.ends_with("17,408 thread inst")),
+        "{out}"
+    );
+    // zero counters and the profiler's names are left out, and the reader is told
+    assert!(!out.contains("atomics.global") && !out.contains("smsp__"), "{out}");
+    assert!(out.contains("zero counters and profiler names not shown: --all shows them"), "{out}");
+    assert!(out.lines().all(|l| l.chars().count() <= 120), "fits 120 columns:\n{out}");
+    let (ok, all, _) = warplight(&["launch", "examples/lessons/coalescing.toml", "--all"]);
+    assert!(ok && all.contains("atomics.global") && all.contains("Profiler names (Nsight Compute)"), "{all}");
+    assert!(all.contains("smsp__inst_executed.sum"), "{all}");
+}
+
+#[test]
+fn launch_checks_metric_names_before_running_and_lists_them() {
+    // a spec whose kernel would fault: a bad metric name is reported first
+    let dir = tempdir();
+    let spec = dir.join("bad.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "ptx = \"{}/kernels/tests/memory.ptx\"\nkernel = \"out_of_bounds\"\ngrid = 2\nblock = 32\nargs = [\"out\"]\n[[buffer]]\nname = \"out\"\ntype = \"i32\"\nlen = 40\n",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+    )
+    .unwrap();
+    let (ok, _, err) = warplight(&["launch", spec.to_str().unwrap(), "--metrics", "warp_instruction"]);
+    assert!(!ok && err.contains("unknown metric `warp_instruction`; did you mean warp_instructions"), "{err}");
+    assert!(!err.contains("out-of-bounds"), "the kernel must not have run: {err}");
+    // --list-metrics runs nothing either, and names what a launch reports
+    let (ok, list, err) = warplight(&["launch", spec.to_str().unwrap(), "--list-metrics", "--device", "gt200"]);
+    assert!(ok, "{err}");
+    assert!(list.contains("  Memory workload (gt200 model)") && list.contains("gld_64b"), "{list}");
+    let (ok, out, err) = warplight(&["launch", "examples/reduce.toml", "--json", "--device", "gt200"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for name in v["launches"][0]["counters"].as_object().unwrap().keys() {
+        assert!(list.lines().any(|l| l.split_whitespace().next() == Some(name.as_str())), "{name} not listed");
+    }
+}
+
+#[test]
+fn launch_prints_result_buffers() {
+    let (ok, out, err) = warplight(&["launch", "examples/reduce.toml", "--print", "sums", "--print", "input:8..10"]);
+    assert!(ok, "{err}");
+    let exp: Vec<i32> = (0..8)
+        .map(|b| (b * 256..(b + 1) * 256).map(|i: u64| (i.wrapping_mul(2654435761) % 100) as i32).sum())
+        .collect();
+    assert!(out.contains("\nsums[0..8]:\n"), "{out}");
+    let row = out.lines().find(|l| l.starts_with("  [0]")).expect("a row of sums");
+    let got: Vec<i32> = row[5..].split_whitespace().map(|x| x.parse().unwrap()).collect();
+    assert_eq!(got, exp);
+    let input = |i: u64| (i * 2654435761) % 100;
+    assert!(out.contains(&format!("input[8..10]:\n  [ 8] {:>6} {:>6}", input(8), input(9))), "{out}");
+    let (ok, out, _) = warplight(&["launch", "examples/reduce.toml", "--json", "--print", "sums:1"]);
+    assert!(ok);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["print"]["sums:1..2"]["values"][0], exp[1]);
+    let (ok, _, err) = warplight(&["launch", "examples/reduce.toml", "--print", "sums:4..9"]);
+    assert!(!ok && err.contains("elements 4..9 are not within `sums` (0..8)"), "{err}");
+}
+
+#[test]
+fn per_line_charges_inlined_library_code_to_the_calling_line() {
+    let (ok, out, err) = warplight(&["launch", "examples/lessons/votes.toml", "--per-line"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("votes.cu:12"), "{out}");
+    assert!(!out.contains("prelude.h:") && !out.contains("builtin_vars.h:"), "{out}");
+}
+
+#[test]
+fn step_and_trace_use_the_specs_device() {
+    let dir = tempdir();
+    let spec = dir.join("gt200.toml");
+    let src = std::fs::read_to_string("examples/if_else.toml").unwrap();
+    let src = src.replace("ptx = \"../", &format!("ptx = \"{}/", env!("CARGO_MANIFEST_DIR")));
+    std::fs::write(&spec, format!("device = \"gt200\"\n{src}")).unwrap();
+    let page = dir.join("t.html");
+    let (ok, _, err) = warplight(&["trace", spec.to_str().unwrap(), "-o", page.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("\"profile\":\"gt200\"") && html.contains("gt200 2 transactions"), "the spec's device");
+    let (ok, _, err) =
+        warplight(&["trace", spec.to_str().unwrap(), "-o", page.to_str().unwrap(), "--device", "hopper"]);
+    assert!(ok, "{err}");
+    assert!(std::fs::read_to_string(&page).unwrap().contains("\"profile\":\"hopper\""), "--device wins");
+}

@@ -68,7 +68,7 @@ fn step_view_in_a_pseudo_terminal() {
     // `; sleep` keeps the pane open after a crash so that its message can be read
     let Some(t) = Tmux::start(&format!("{bin} step examples/if_else.toml --device gt200 || sleep 30")) else { return };
     let s = t.wait_for("step 0");
-    assert!(s.contains("PTX if_else") && s.contains("gt200"), "{s}");
+    assert!(s.contains("divergence.cu") && s.contains("PTX 24: ld.param") && s.contains("gt200"), "{s}");
     assert!(s.contains("################################ active ffffffff (32)"), "{s}");
     assert!(s.lines().count() <= 24 && s.lines().all(|l| l.chars().count() <= 80), "fits 80x24:\n{s}");
     for _ in 0..12 {
@@ -82,12 +82,16 @@ fn step_view_in_a_pseudo_terminal() {
     t.keys(&["u"]);
     t.wait_for("step 11 ");
     t.keys(&["g", "5", "5", "Enter"]);
+    t.wait_for("PTX 55: st.global.u32");
+    // v shows the PTX pane instead of the source
+    t.keys(&["v"]);
     t.wait_for(">  55 st.global.u32");
     t.keys(&["s", "3"]);
     let s = t.wait_for("global store");
     assert!(s.contains("global store 4B x16: gt200 2 transactions, 128 B moved for 64 B used"), "{s}");
     t.keys(&["?"]);
-    t.wait_for("keys (any key closes)");
+    let s = t.wait_for("keys (any key closes)");
+    assert!(s.contains("Lanes: # running"), "the help fits 80x24:\n{s}");
     t.keys(&["Enter"]);
     t.keys(&["q"]);
     let start = Instant::now();

@@ -54,7 +54,9 @@ fn the_view_starts_at_the_first_instruction_with_all_lanes() {
     let (rows, app) = screen("examples/if_else.toml", options(Profile::Hopper), "");
     let t = text(&rows);
     assert!(rows[0].contains("if_else") && rows[0].contains("step 0"), "{t}");
-    assert!(t.contains("PTX if_else"), "{t}");
+    // at 80 columns one code pane: the source, the next PTX instruction under it
+    assert!(rows[1].contains("divergence.cu") && rows[1].contains("v: PTX"), "{t}");
+    assert!(t.contains("PTX 24: mov.u32  %r10, %tid.x;"), "{t}");
     assert!(t.contains("lanes 0-31 ################################ active ffffffff (32)"), "{t}");
     assert!(t.contains("stack[0] pc 0"), "{t}");
     assert_eq!(app.steps, 0);
@@ -93,12 +95,16 @@ fn stepping_back_restores_the_same_screen() {
 fn source_line_steps_and_goto_and_breakpoints() {
     // `n` runs until the warp leaves its CUDA line: from the first instruction of
     // line 10 (`if (t % 2)`, step 5) through the compiler's line-0 instructions to the branch
+    // line 10 ends in the branch that splits the warp: `n` stops there first
     let (rows, a) = screen("examples/if_else.toml", options(Profile::Hopper), "sssssn");
-    assert!(a.steps >= 12, "line 10 is several instructions: {}", a.steps);
+    assert_eq!(a.steps, 12, "line 10 is several instructions up to the branch");
+    assert!(a.message.ends_with("diverged"), "{}", a.message);
+    assert!(text(&rows).contains(">  10"), "{}", text(&rows));
+    let (rows, _) = screen("examples/if_else.toml", options(Profile::Hopper), "sssssnn");
     let t = text(&rows);
     assert!(!t.contains(">  10") && t.contains(">  11"), "the source pane moved on to line 11:\n{t}");
     // g 71 Enter: the warp runs to the reconvergence point
-    let (rows, a) = screen("examples/if_else.toml", options(Profile::Hopper), "g71\n");
+    let (rows, a) = screen("examples/if_else.toml", options(Profile::Hopper), "g71\nv");
     assert!(text(&rows).contains(">  71"), "{}", text(&rows));
     assert!(rows[11].contains("################################"), "reconverged: {}", rows[11]);
     assert!(a.steps > 20);
@@ -129,19 +135,20 @@ fn register_panel_and_warp_selection() {
     let mut o = options(Profile::Hopper);
     o.watches = vec!["%r10".into()];
     // after 2 instructions %r10 = tid.x; radix cycles dec -> hex
+    // one row a register, one column a lane (8 lanes at 80 columns; l shows the next 8)
     let (rows, _) = screen("examples/if_else.toml", o.clone(), "ss2");
     let t = text(&rows);
-    assert!(t.contains("%r10"), "{t}");
-    assert!(
-        rows.iter().any(|r| r.contains(" 24       24       25       26       27       28       29       30       31")),
-        "{t}"
-    );
-    let (rows, _) = screen("examples/if_else.toml", o, "ss2x");
-    assert!(
-        rows.iter().any(|r| r.contains("24       18       19       1a       1b       1c       1d       1e       1f")),
-        "{}",
-        text(&rows)
-    );
+    assert!(t.contains("registers 1-7 of"), "several registers at once:\n{t}");
+    let row = |name: &str, cells: &[&str]| {
+        format!("│{name:<7}{}", cells.iter().map(|c| format!("{c:>9}")).collect::<String>())
+    };
+    assert!(rows.iter().any(|r| r.starts_with(&row("%r10", &["0", "1", "2", "3", "4", "5", "6", "7"]))), "{t}");
+    let (rows, _) = screen("examples/if_else.toml", o.clone(), "ss2lll");
+    let t = text(&rows);
+    assert!(rows.iter().any(|r| r.starts_with(&row("lane", &["24", "25", "26"]))), "{t}");
+    assert!(rows.iter().any(|r| r.starts_with(&row("%r10", &["24", "25", "26"]))), "{t}");
+    let (rows, _) = screen("examples/if_else.toml", o, "ss2lllx");
+    assert!(rows.iter().any(|r| r.starts_with(&row("%r10", &["18", "19", "1a", "1b"]))), "{}", text(&rows));
     // a CTA of 256 threads has 8 warps: w moves to warp 1, W back, W wraps to 7
     let (_, a) = screen("examples/reduce.toml", options(Profile::Hopper), "w");
     assert_eq!(a.sel, (0, 1));
@@ -256,7 +263,9 @@ fn a_fault_keeps_the_view_on_the_faulting_warp() {
     assert!(app.fault.as_deref().is_some_and(|f| f.contains("out-of-bounds")), "{:?}", app.fault);
     assert!(t.contains("fault (u steps back)") && t.contains("CTA (1, 0, 0), warp 0, lane 5"), "{t}");
     assert_eq!(app.sel, (1, 0), "the faulting CTA's warp is selected");
-    assert!(t.contains("> 234 st.global.u32"), "the PTX pane shows the faulting store:\n{t}");
+    assert!(t.contains("PTX 234: st.global.u32"), "the faulting store is named under the source:\n{t}");
+    let (rows, _) = screen(&spec, options(Profile::Hopper), "cv");
+    assert!(text(&rows).contains("> 234 st.global.u32"), "the PTX pane shows the faulting store:\n{}", text(&rows));
     // stepping on is refused; stepping back clears the fault
     let (_, app) = screen(&spec, options(Profile::Hopper), "cs");
     assert_eq!(app.message, "the launch faulted: u steps back, q quits");
@@ -274,4 +283,104 @@ fn the_view_survives_small_and_large_terminals() {
         let app = tui::drive(&mut term, &s, options(Profile::Gt200), || Ok(k.next())).expect("view runs");
         assert!(app.steps > 0, "{w}x{h}");
     }
+}
+
+/// Runs the view of launch `launch` of `spec` in a `w`×`h` terminal over `script`.
+fn screen_at(spec: &str, launch: usize, (w, h): (u16, u16), script: &str) -> (Vec<String>, tui::App) {
+    let s = Session::load_launch(&Path::new(env!("CARGO_MANIFEST_DIR")).join(spec), launch).expect("spec loads");
+    let mut term = Terminal::new(TestBackend::new(w, h)).unwrap();
+    let mut k = keys(script).into_iter();
+    let app = tui::drive(&mut term, &s, options(Profile::Hopper), || Ok(k.next())).expect("view runs");
+    let buf = term.backend().buffer();
+    let rows = (0..h).map(|y| (0..w).map(|x| buf[(x, y)].symbol().to_string()).collect::<String>()).collect();
+    (rows, app)
+}
+
+/// The active-lane count the lane strip ends with: `... active 00ffffff (24)`.
+fn active_lanes(strip: &str) -> u32 {
+    let n = strip.trim_end().rsplit('(').next().unwrap().trim_end_matches(')');
+    n.parse().unwrap_or_else(|_| panic!("no lane count in {strip:?}"))
+}
+
+#[test]
+fn next_line_stops_where_the_loop_thins_the_warp_out() {
+    // lesson 1's uneven loop: lane t runs t % 4 + 1 iterations, so the loop's exit
+    // branch diverges after iterations 1, 2 and 3 and the lane strip thins out
+    // 32 -> 24 -> 16 -> 8; `n` must stop there although the loop is one line
+    let mut seen = Vec::new();
+    for n in 1..=40 {
+        let (rows, app) = screen_at("examples/lessons/divergence.toml", 2, (80, 24), &"n".repeat(n));
+        seen.push(active_lanes(&rows[11]));
+        if app.message.contains("finished") || app.steps > 200 {
+            break;
+        }
+    }
+    let thin: Vec<u32> = seen.iter().copied().filter(|c| [24, 16, 8].contains(c)).collect();
+    let mut order = thin.clone();
+    order.dedup();
+    assert_eq!(order, [24, 16, 8], "lane counts after each n: {seen:?}");
+}
+
+#[test]
+fn the_source_pane_stays_on_the_users_file() {
+    // votes.cu reads threadIdx.x (clang's header) and calls the prelude's
+    // __ballot_sync and __shfl_down_sync: the pane never leaves votes.cu
+    for k in 0..24 {
+        let (rows, _) = screen_at("examples/lessons/votes.toml", 1, (80, 24), &"s".repeat(k));
+        assert!(rows[1].contains("votes.cu"), "after {k} steps:\n{}", text(&rows));
+        assert!(rows[2..10].iter().any(|r| r.contains("│>")), "the current line is marked:\n{}", text(&rows));
+    }
+    for k in 1..8 {
+        let (rows, _) = screen_at("examples/lessons/votes.toml", 1, (80, 24), &"n".repeat(k));
+        assert!(rows[1].contains("votes.cu"), "after {k} n:\n{}", text(&rows));
+    }
+}
+
+#[test]
+fn wide_terminals_show_both_panes_and_narrow_ones_toggle_and_scroll() {
+    let (rows, _) = screen_at("examples/if_else.toml", 1, (120, 30), "sssss");
+    assert!(rows[1].contains("divergence.cu") && rows[1].contains("PTX if_else"), "{}", text(&rows));
+    let (rows, app) = screen_at("examples/if_else.toml", 1, (80, 24), "sssssv");
+    assert_eq!(app.code, tui::CodePane::Ptx);
+    assert!(rows[1].contains("PTX if_else") && rows[1].contains("v: source"), "{}", text(&rows));
+    assert!(rows[10].contains("line 10: if (t % 2) {"), "the source line under the PTX:\n{}", text(&rows));
+    // > scrolls the code 8 columns right; the line numbers stay
+    let (rows, _) = screen_at("examples/if_else.toml", 1, (80, 24), "sssss>");
+    assert!(rows.iter().any(|r| r.contains(">  10 % 2) {")), "{}", text(&rows));
+    // the help fits 80x24 whole
+    let (rows, _) = screen_at("examples/if_else.toml", 1, (80, 24), "?");
+    let t = text(&rows);
+    assert!(t.contains("keys (any key closes)") && t.contains("Lanes: # running"), "{t}");
+    assert!(
+        rows.iter().any(|r| r.contains("│x         decimal (signed), hex or float;  j k  scroll;  l  more lanes│")),
+        "{t}"
+    );
+}
+
+#[test]
+fn memory_panel_shows_shared_variables_and_buffers_by_name() {
+    // warp 0 of reduce_sum runs to its barrier: s[t] = in[t] for its 32 lanes
+    let (rows, _) = screen_at("examples/reduce.toml", 1, (80, 24), "a4");
+    let t = text(&rows);
+    assert!(t.contains("[reduce_sum::s]") && t.contains("input") && t.contains("sums"), "{t}");
+    assert!(t.contains("shared _ZZ10reduce_sumE1s (1024 B"), "{t}");
+    let input = |i: u64| (i * 2654435761) % 100;
+    let first: String = (0..8).map(|i| format!("{:>8} ", input(i))).collect();
+    assert!(rows.iter().any(|r| r.contains(&format!("    0 {}", first.trim_end()))), "s[0..8] = in[0..8]:\n{t}");
+    // o: the next region, the spec's buffer `input`
+    let (rows, _) = screen_at("examples/reduce.toml", 1, (80, 24), "a4o");
+    let t = text(&rows);
+    assert!(t.contains("[input]") && t.contains("buffer input (2048 x i32)"), "{t}");
+    assert!(rows.iter().any(|r| r.contains(&format!("    0 {}", first.trim_end()))), "{t}");
+}
+
+#[test]
+fn trace_shows_the_users_line_for_generated_and_library_code() {
+    let t = trace::record(&session("examples/lessons/votes.toml"), &trace_options()).unwrap();
+    let user = t.sources.iter().position(|s| s.name.ends_with("votes.cu")).unwrap() as u32;
+    assert!(t.events.iter().all(|e| e.src.is_some_and(|(f, l)| f == user && l > 0)), "every event on votes.cu");
+    // the shuffles come from the prelude and are shown at a calling line of votes.cu
+    let shfl: Vec<&trace::TraceEvent> = t.events.iter().filter(|e| e.op.starts_with("shfl")).collect();
+    assert!(!shfl.is_empty() && shfl.iter().all(|e| e.src_inherited), "shuffles are inlined library code");
+    assert!(t.events.iter().any(|e| !e.src_inherited), "the kernel's own lines are its own");
 }

@@ -90,3 +90,42 @@ fn trace_page_steps_in_headless_chromium() {
     assert!(colours.len() > 50, "the screenshot is nearly blank ({} colours)", colours.len());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_trace_of_128_warps_folds_and_loads_cleanly() {
+    let Some(chromium) = chromium() else { return };
+    let dir = std::env::temp_dir().join(format!("warplight-trace128-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // reduce_sum over 16 CTAs of 8 warps
+    let spec = dir.join("wide.toml");
+    std::fs::write(
+        &spec,
+        format!(
+            "ptx = \"{}/kernels/tests/shared.ptx\"\nkernel = \"reduce_sum\"\ngrid = 16\nblock = 256\nargs = [\"sums\", \"input\"]\n\
+             [[buffer]]\nname = \"input\"\ntype = \"i32\"\nlen = 4096\ninit = \"iota\"\n\
+             [[buffer]]\nname = \"sums\"\ntype = \"i32\"\nlen = 16\n",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+    )
+    .unwrap();
+    let page = dir.join("wide.html");
+    let o = Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["trace", spec.to_str().unwrap(), "--max-events", "100000", "-o"])
+        .arg(&page)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("128 warps"), "{}", String::from_utf8_lossy(&o.stdout));
+    let url = format!("file://{}#selftest=40", page.display());
+    let (dom, err) = headless(&chromium, &dir, &url, &["--dump-dom"]);
+    assert!(console_lines(&err).is_empty(), "console output: {:?}", console_lines(&err));
+    assert!(
+        dom.contains("selftest ok"),
+        "{}",
+        dom.lines().filter(|l| l.contains("selftest")).collect::<Vec<_>>().join("\n")
+    );
+    // many warps start folded: 128 rows of 8 pixels, not 40
+    assert!(dom.contains("id=\"fold\" type=\"checkbox\"") && dom.contains("height: 1028px"), "folded timeline");
+    let _ = std::fs::remove_dir_all(&dir);
+}

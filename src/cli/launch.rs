@@ -1,14 +1,21 @@
-//! `warplight launch SPEC.toml`: run kernels described by a spec and print counters.
+//! `warplight launch SPEC.toml`: run kernels described by a spec and print
+//! counters — for people, a header per launch and the counters in sections
+//! with units ([`report`]); for programs, JSON or CSV — and result buffers
+//! ([`print_buffer`]).
+
+pub mod print_buffer;
+pub mod report;
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::launch_spec::{self, LaunchResult, Spec};
+use crate::launch_spec::{self, ArgSpec, LaunchResult, Spec};
 use crate::model::{InstMem, Profile};
 use crate::ptx::Program;
 use crate::sim::Device;
 use crate::sim::counters::LineCounts;
 use crate::sim::device::cap_host_threads;
+use crate::teach::{sources, user_lines};
 
 /// Options of `warplight launch`.
 #[derive(Debug, clap::Args)]
@@ -50,6 +57,16 @@ pub struct LaunchOptions {
     /// (default: the spec's `device`, else hopper). See docs/devices.md.
     #[arg(long)]
     pub device: Option<String>,
+    /// Also list zero counters and the profiler's names of the counters.
+    #[arg(long)]
+    pub all: bool,
+    /// After all launches succeed, print buffer NAME's elements (repeatable): NAME (the
+    /// first 256), NAME:I, NAME:A..B (B excluded), NAME:A.. or NAME:..B.
+    #[arg(long, value_name = "NAME[:RANGE]")]
+    pub print: Vec<String>,
+    /// List the counter names of the spec's device by section, without running.
+    #[arg(long)]
+    pub list_metrics: bool,
 }
 
 type Res = Result<(), Box<dyn std::error::Error>>;
@@ -74,14 +91,28 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
             None => Err(format!("--dump {d}: expected NAME=FILE")),
         })
         .collect::<Result<_, _>>()?;
+    let prints: Vec<print_buffer::PrintRequest> =
+        a.print.iter().map(|p| print_buffer::parse(p, &spec.buffers)).collect::<Result<_, _>>()?;
+    if a.csv && !prints.is_empty() {
+        return Err("--print writes text or JSON, not CSV: leave out --csv or --print".into());
+    }
     let (threads, capped) = cap_host_threads(a.threads);
     if let Some(why) = capped {
         eprintln!("warning: --threads {}: {why}", a.threads);
     }
     let mut dev = Device::with_config(spec.sim_config(threads, a.max_instructions));
     let prepared = launch_spec::prepare(&spec, &mut dev)?;
+    let prog = &prepared.module.prog;
+    // metric names are known before anything runs: list them, or check --metrics
+    let known = report::metric_names(profile, prog);
+    if a.list_metrics {
+        list_metrics(&known, profile);
+        return Ok(());
+    }
+    report::check_metrics(&a.metrics, &known)?;
     let spinner = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new_spinner();
+        pb.set_style(indicatif::ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("template"));
         pb.set_message(format!(
             "running {}",
             spec.launches.iter().map(|l| l.kernel.as_str()).collect::<Vec<_>>().join(", ")
@@ -100,7 +131,15 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
         let bytes = dev.read::<u8>(*p, b.len * b.ty.size());
         crate::cli::write_atomically(file, &bytes)?;
     }
-    let prog = &prepared.module.prog;
+    let printed: Vec<(&print_buffer::PrintRequest, launch_spec::ElemType, Vec<u8>)> = prints
+        .iter()
+        .map(|r| {
+            let (p, b) = &prepared.buffers[&r.name];
+            let size = b.ty.size();
+            let at = crate::sim::DevicePtr(p.0 + (r.first * size) as u64);
+            (r, b.ty, dev.read::<u8>(at, (r.end - r.first) * size))
+        })
+        .collect();
     if a.json {
         let launches: Vec<serde_json::Value> = stats
             .iter()
@@ -113,16 +152,26 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
                     "counters": counters, "occupancy": s.occupancy,
                 });
                 if a.per_line {
-                    o["per_source_line"] = serde_json::to_value(s.stats.per_source_line(prog))?;
+                    o["per_source_line"] = serde_json::to_value(user_lines::per_user_line(&s.stats, prog))?;
                     o["per_ptx_line"] = serde_json::to_value(s.stats.per_ptx_line(prog))?;
                     o["memory_per_ptx_line"] = serde_json::to_value(memory_per_ptx_line(prog, &s.memory.per_inst))?;
                 }
                 Ok(o)
             })
             .collect::<Result<_, Box<dyn std::error::Error>>>()?;
-        let out = serde_json::json!({
+        let mut out = serde_json::json!({
             "spec": spec.file, "ptx": spec.ptx, "device": profile.params(), "launches": launches,
         });
+        if !printed.is_empty() {
+            let bufs: serde_json::Map<String, serde_json::Value> = printed
+                .iter()
+                .map(|(r, ty, bytes)| {
+                    let v = serde_json::json!({ "first": r.first, "values": print_buffer::json(*ty, bytes) });
+                    (format!("{}:{}..{}", r.name, r.first, r.end), v)
+                })
+                .collect();
+            out["print"] = bufs.into();
+        }
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
@@ -135,26 +184,119 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
         }
         return Ok(());
     }
-    for (s, l) in stats.iter().zip(&spec.launches) {
-        println!("kernel {}  grid {:?}  block {:?}  ({})", l.kernel, l.grid, l.block, spec.ptx.display());
-        for (k, v) in selected(s, &a.metrics)? {
-            println!("  {k:<40} {v:>16}");
-        }
+    let p = profile.params();
+    println!("device {} ({}, compute capability {}, {} SMs)", p.name, p.gpu, p.cc, p.sms);
+    println!(
+        "{}: {} launch{} of {}",
+        tidy(&spec.file),
+        spec.launches.len(),
+        if spec.launches.len() == 1 { "" } else { "es" },
+        tidy(&spec.ptx)
+    );
+    let n = stats.len();
+    for (i, (s, l)) in stats.iter().zip(&spec.launches).enumerate() {
+        println!("\n{}", launch_header(i, n, l));
         if a.metrics.is_empty() {
+            let (lines, hidden) = report::sections(&s.metrics(), profile, a.all);
+            for line in lines {
+                println!("{line}");
+            }
             let o = &s.occupancy;
             println!(
-                "  occupancy: {} CTAs/SM ({}% of warps), limited by {}; {} registers/thread (PTX), {} B shared/CTA",
-                o.ctas_per_sm, o.occupancy_pct, o.limiter, o.registers_per_thread, o.shared_per_cta
+                "    limited by {}; {} registers/thread (PTX), {} B shared/CTA",
+                o.limiter, o.registers_per_thread, o.shared_per_cta
             );
+            if hidden > 0 {
+                println!("  ({hidden} zero counters and profiler names not shown: --all shows them)");
+            }
+        } else {
+            for (k, v) in selected(s, &a.metrics)? {
+                let unit = report::classify(&k).1;
+                println!("  {k:<44} {:>15} {unit}", report::group_digits(v));
+            }
         }
         if a.per_line {
-            let src = s.stats.per_source_line(prog);
-            let lines = if src.is_empty() { s.stats.per_ptx_line(prog) } else { src };
-            let src_empty = |st: &crate::sim::LaunchStats, p: &Program| st.per_source_line(p).is_empty();
-            print_lines(&lines, &spec, &memory_by_line(prog, &s.memory.per_inst, !src_empty(&s.stats, prog)));
+            let src = user_lines::per_user_line(&s.stats, prog);
+            let by_source = !src.is_empty();
+            let lines = if by_source { src } else { s.stats.per_ptx_line(prog) };
+            print_lines(&lines, &spec, &memory_by_line(prog, &s.memory.per_inst, by_source));
+        }
+    }
+    for (r, ty, bytes) in &printed {
+        println!(
+            "\n{}[{}..{}]{}:",
+            r.name,
+            r.first,
+            r.end,
+            if r.cut { " (the first 256; NAME:A..B for others)" } else { "" }
+        );
+        for line in print_buffer::lines(*ty, r.first, bytes) {
+            println!("{line}");
         }
     }
     Ok(())
+}
+
+/// `p` without `dir/..` pairs (`examples/lessons/../../kernels/x.ptx` is
+/// `kernels/x.ptx`), for display.
+fn tidy(p: &std::path::Path) -> String {
+    use std::path::Component;
+    let mut out: Vec<Component> = Vec::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    out.iter().collect::<PathBuf>().display().to_string()
+}
+
+/// `launch 2 of 3: kernel<<<(4,1,1), (256,1,1)>>>(out, in, 1)` with the thread count.
+fn launch_header(i: usize, n: usize, l: &launch_spec::LaunchSpec) -> String {
+    let dim = |d: [u32; 3]| format!("({},{},{})", d[0], d[1], d[2]);
+    let args: Vec<String> = l
+        .args
+        .iter()
+        .map(|a| match a {
+            ArgSpec::Buffer(b, 0) => b.clone(),
+            ArgSpec::Buffer(b, off) => format!("{b}+{off}"),
+            ArgSpec::Int(v) => v.to_string(),
+            ArgSpec::Float(v) => v.to_string(),
+        })
+        .collect();
+    let threads: u64 = l.grid.iter().chain(&l.block).map(|&x| x as u64).product();
+    let shared = if l.shared > 0 { format!(", {} B dynamic shared", l.shared) } else { String::new() };
+    format!(
+        "launch {} of {n}: {}<<<{}, {}>>>({})  {} threads{shared}",
+        i + 1,
+        l.kernel,
+        dim(l.grid),
+        dim(l.block),
+        args.join(", "),
+        report::group_digits(threads)
+    )
+}
+
+/// `--list-metrics`: every counter name by section, with its unit.
+fn list_metrics(known: &[String], profile: Profile) {
+    let mut by: std::collections::BTreeMap<report::Section, Vec<(&str, &str)>> = Default::default();
+    for k in known {
+        let (s, unit) = report::classify(k);
+        by.entry(s).or_default().push((k, unit));
+    }
+    println!(
+        "counters of a launch on {} (for --metrics; Nsight Compute names of the core counters work on every device)",
+        profile.params().name
+    );
+    for (s, rows) in by {
+        println!("\n  {}", s.title(profile));
+        for (k, unit) in rows {
+            println!("    {k:<60} {unit}");
+        }
+    }
 }
 
 fn selected(s: &LaunchResult, metrics: &[String]) -> Result<Vec<(String, u64)>, String> {
@@ -192,18 +334,21 @@ fn memory_per_ptx_line(prog: &Program, per_inst: &[Vec<InstMem>]) -> Vec<(u32, I
     map.into_iter().collect()
 }
 
-/// Memory counts per (file, line): CUDA source lines when `by_source`, else PTX lines.
+/// Memory counts per (file, line): the user's CUDA source lines when
+/// `by_source` (library code charged to its calling line, as
+/// [`user_lines::attribute`] says), else PTX lines.
 fn memory_by_line(
     prog: &Program,
     per_inst: &[Vec<InstMem>],
     by_source: bool,
 ) -> std::collections::HashMap<(String, u32), InstMem> {
+    let user = user_lines::attribute(prog);
     let mut map: std::collections::HashMap<(String, u32), InstMem> = Default::default();
     for (f, v) in per_inst.iter().enumerate() {
         for (pc, m) in v.iter().enumerate() {
             let info = &prog.functions[f].info[pc];
             let key = if by_source {
-                match info.src {
+                match user[f][pc] {
                     Some(l) => (prog.files.get(l.file as usize).cloned().unwrap_or_default(), l.line),
                     None => continue,
                 }
@@ -229,15 +374,7 @@ fn print_lines(lines: &[LineCounts], spec: &Spec, mem: &std::collections::HashMa
     for l in lines {
         let text = cache
             .entry(l.file.clone())
-            .or_insert_with(|| {
-                let candidates =
-                    [PathBuf::from(&l.file), spec.ptx.parent().unwrap_or(std::path::Path::new(".")).join(&l.file)];
-                candidates
-                    .iter()
-                    .find_map(|p| std::fs::read_to_string(p).ok())
-                    .map(|s| s.lines().map(|x| x.to_string()).collect())
-                    .unwrap_or_default()
-            })
+            .or_insert_with(|| sources::read(&spec.ptx, &l.file).unwrap_or_default())
             .get(l.line.saturating_sub(1) as usize)
             .map(|s| s.trim().to_string())
             .unwrap_or_default();

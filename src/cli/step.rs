@@ -56,9 +56,9 @@ pub struct StepArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub max_instructions: Option<u64>,
     /// Device profile for the memory panel's transactions, sectors and banks:
-    /// gt200, maxwell or hopper.
-    #[arg(long, default_value = "hopper")]
-    pub device: String,
+    /// gt200, maxwell or hopper (default: the spec's `device`, else hopper).
+    #[arg(long)]
+    pub device: Option<String>,
 }
 
 /// Parses `SLOT:WARP`.
@@ -70,13 +70,20 @@ pub fn parse_warp(w: &str) -> Result<(usize, u32), String> {
     ))
 }
 
+/// The profile of `--device`, else of the spec's `device`, else hopper.
+pub fn profile(session: &Session, device: Option<&str>) -> Result<Profile, Box<dyn std::error::Error>> {
+    match device {
+        Some(d) => Ok(Profile::parse(d).ok_or_else(|| format!("--device {d}: expected gt200, maxwell or hopper"))?),
+        None => session.spec_profile(),
+    }
+}
+
 /// Runs the command.
 pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut session = Session::load_launch(&a.spec, a.launch)?;
     session.max_instructions = a.max_instructions;
     let only = a.warp.as_deref().map(parse_warp).transpose()?;
-    let profile =
-        Profile::parse(&a.device).ok_or_else(|| format!("--device {}: expected gt200, maxwell or hopper", a.device))?;
+    let profile = profile(&session, a.device.as_deref())?;
     let breaks = session.with_stepper(|st| Ok(Breakpoints::new(&st.module().prog, &a.breaks, &a.src_breaks)?))?;
     let interactive = !a.log && !a.trace && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
     if interactive {

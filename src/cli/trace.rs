@@ -4,7 +4,6 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::model::Profile;
 use crate::teach::session::Session;
 use crate::teach::trace::{self, TraceOptions};
 
@@ -43,19 +42,19 @@ pub struct TraceArgs {
     /// (default: the spec's `max_instructions`, else 2^32). See docs/limits.md.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub max_instructions: Option<u64>,
-    /// Device profile for the memory transactions, sectors and banks: gt200, maxwell or hopper.
-    #[arg(long, default_value = "hopper")]
-    pub device: String,
+    /// Device profile for the memory transactions, sectors and banks: gt200, maxwell or hopper
+    /// (default: the spec's `device`, else hopper).
+    #[arg(long)]
+    pub device: Option<String>,
 }
 
 /// Runs the command.
 pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let profile =
-        Profile::parse(&a.device).ok_or_else(|| format!("--device {}: expected gt200, maxwell or hopper", a.device))?;
     if a.from > a.to {
         return Err(format!("--from {} is after --to {}", a.from, a.to).into());
     }
     let mut session = Session::load_launch(&a.spec, a.launch)?;
+    let profile = crate::cli::step::profile(&session, a.device.as_deref())?;
     session.max_instructions = a.max_instructions;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
     let spinner = std::io::stderr().is_terminal().then(|| {

@@ -2,7 +2,8 @@
 //! `warplight step` ([`tui`]), its text log ([`log`]), and the HTML timeline
 //! of `warplight trace` ([`trace`]). They share a replayable launch
 //! ([`session`]), source-file lookup ([`sources`]) and the per-step notes on
-//! divergence and reconvergence ([`track`]).
+//! divergence and reconvergence ([`track`]), and which line of the user's
+//! source an instruction belongs to ([`user_lines`]).
 
 pub mod breakpoints;
 pub mod log;
@@ -11,3 +12,4 @@ pub mod sources;
 pub mod trace;
 pub mod track;
 pub mod tui;
+pub mod user_lines;

@@ -3,12 +3,14 @@
 //! launch (new device memory, same spec) for *n* steps: that is how the
 //! terminal view steps back.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use crate::launch_spec::{self, Spec};
+use crate::launch_spec::{self, BufferSpec, ElemType, Spec};
+use crate::model::Profile;
 use crate::sim::access_log::AccessLog;
 use crate::sim::stepper::Stepper;
-use crate::sim::{Device, LaunchConfig};
+use crate::sim::{Device, DevicePtr, LaunchConfig};
 
 /// A launch spec, ready to be stepped.
 pub struct Session {
@@ -61,9 +63,26 @@ impl Session {
         self.spec.ptx.clone()
     }
 
+    /// The device profile of the spec (`device = ...`), else `hopper`; an
+    /// unknown name is an error.
+    pub fn spec_profile(&self) -> Result<Profile, Error> {
+        let name = self.spec.device.as_deref().unwrap_or("hopper");
+        Profile::parse(name).ok_or_else(|| {
+            format!("{}: device `{name}`: expected gt200, maxwell or hopper", self.spec.file.display()).into()
+        })
+    }
+
     /// Runs `f` on a fresh stepper at the start of the launch (fresh buffers),
     /// recording memory accesses.
     pub fn with_stepper<R>(&self, f: impl FnOnce(&mut Stepper) -> Result<R, Error>) -> Result<R, Error> {
+        self.with_stepper_and_buffers(|st, _| f(st))
+    }
+
+    /// As [`Session::with_stepper`], with the spec's buffers readable while stepping.
+    pub fn with_stepper_and_buffers<R>(
+        &self,
+        f: impl FnOnce(&mut Stepper, &Buffers) -> Result<R, Error>,
+    ) -> Result<R, Error> {
         let mut dev = Device::with_config(self.spec.sim_config(0, self.max_instructions));
         let prepared = launch_spec::prepare(&self.spec, &mut dev)?;
         let config =
@@ -77,6 +96,33 @@ impl Session {
         let cfg = config(l);
         let log = AccessLog::new();
         let mut st = dev.stepper_logged(&prepared.module, &l.kernel, cfg, &args, &log)?;
-        f(&mut st)
+        let buffers = Buffers { dev: &dev, list: &prepared.buffers, order: &self.spec.buffers };
+        f(&mut st, &buffers)
+    }
+}
+
+/// The spec's buffers in device memory, readable while a launch is stepped.
+pub struct Buffers<'a> {
+    dev: &'a Device,
+    list: &'a BTreeMap<String, (DevicePtr, BufferSpec)>,
+    order: &'a [BufferSpec],
+}
+
+impl Buffers<'_> {
+    /// The buffers as the spec declares them, in its order.
+    pub fn specs(&self) -> &[BufferSpec] {
+        self.order
+    }
+
+    /// Elements `first..first + n` of buffer `name` (cut at its end), as
+    /// little-endian bytes with the element type; `None` for an unknown name.
+    pub fn read(&self, name: &str, first: usize, n: usize) -> Option<(ElemType, Vec<u8>)> {
+        let (p, b) = self.list.get(name)?;
+        let first = first.min(b.len);
+        let n = n.min(b.len - first);
+        let size = b.ty.size();
+        let at = DevicePtr(p.0 + (first * size) as u64);
+        let bytes = if n == 0 { Vec::new() } else { self.dev.try_read::<u8>(at, n * size).ok()? };
+        Some((b.ty, bytes))
     }
 }

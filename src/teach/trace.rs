@@ -11,6 +11,7 @@ use serde::Serialize;
 use super::session::{Error, Session};
 use super::sources;
 use super::track::Tracker;
+use super::user_lines;
 use crate::model::Profile;
 use crate::model::explain;
 
@@ -66,8 +67,13 @@ pub struct TraceEvent {
     pub w: usize,
     /// PTX line.
     pub line: u32,
-    /// Source file index and line.
+    /// The user's source file index and line (library code shows its calling
+    /// line, compiler-generated code the line the warp last ran; see
+    /// [`user_lines`]).
     pub src: Option<(u32, u32)>,
+    /// Whether the instruction's own line is not `src`: compiler-generated
+    /// (`.loc` line 0) or inlined from a library file.
+    pub src_inherited: bool,
     /// Opcode.
     pub op: String,
     /// Lanes that ran it.
@@ -149,6 +155,8 @@ pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64
             finished: false,
         };
         let mut tracker = Tracker::default();
+        let user = user_lines::attribute(prog);
+        let mut last_user: std::collections::HashMap<([u32; 3], u32), (u32, u32)> = Default::default();
         let mut step = 0u64;
         while step < o.to {
             let Some(ev) = st.step()? else {
@@ -161,6 +169,14 @@ pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64
             }
             let w = st.warp(ev.cta_slot, ev.warp).ok_or("stepped warp vanished")?;
             let fx = tracker.observe(&ev, &w);
+            let fi = prog.functions.iter().position(|f| f.name == ev.function);
+            let own = fi.and_then(|f| prog.functions[f].info[ev.pc as usize].src);
+            let charged = fi.and_then(|f| user_lines::user_loc(prog, user[f][ev.pc as usize]));
+            if let Some(c) = charged {
+                last_user.insert((ev.cta, ev.warp), (c.file, c.line));
+            }
+            let src = charged.map(|c| (c.file, c.line)).or_else(|| last_user.get(&(ev.cta, ev.warp)).copied());
+            let src_inherited = own.map(|o| (o.file, o.line)) != src;
             let linear = ev.cta[0] + grid[0] * (ev.cta[1] + grid[1] * ev.cta[2]);
             let keep = step >= o.from
                 && (o.ctas.is_empty() || o.ctas.contains(&linear))
@@ -187,8 +203,6 @@ pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64
                 .iter()
                 .map(|e| (e.pc, line_of(e.pc), if e.rpc == u32::MAX { 0 } else { line_of(e.rpc) }, e.mask))
                 .collect();
-            let src_func = prog.functions.iter().find(|f| f.name == ev.function);
-            let src = src_func.and_then(|f| f.info[ev.pc as usize].src).map(|s| (s.file, s.line));
             let mem = ev
                 .accesses
                 .iter()
@@ -213,6 +227,7 @@ pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64
                 w: wi,
                 line: ev.ptx_line,
                 src,
+                src_inherited,
                 op: ev.opcode.clone(),
                 mask: ev.mask,
                 next: w.active,

@@ -1,9 +1,15 @@
-//! The interactive terminal view of `warplight step`: CUDA source and PTX
-//! side by side at the selected warp's next instruction, its 32-lane active
-//! mask, and below one of three panels — the SIMT reconvergence stack (with the
-//! CTA's warps), per-lane register values, or the last memory instruction's
-//! per-lane addresses with the transactions, sectors or banks they form under
-//! the chosen device profile. Fits an 80×24 terminal.
+//! The interactive terminal view of `warplight step`: CUDA source and PTX at
+//! the selected warp's next instruction (side by side from 100 columns, one
+//! pane with `v` to switch below that), its 32-lane active mask, and below one
+//! of four panels — the SIMT reconvergence stack (with the CTA's warps),
+//! per-lane register values, the last memory instruction's per-lane addresses
+//! with the transactions, sectors or banks they form under the chosen device
+//! profile, or memory contents (the CTA's shared variables and the spec's
+//! buffers by name). Fits an 80×24 terminal.
+//!
+//! The source pane stays on the user's file: lines of library headers and the
+//! compiler's line 0 show the user's line they belong to (see
+//! [`super::user_lines`]).
 //!
 //! Stepping back replays the launch from the start to an earlier step (see
 //! [`super::session`]); every action records the step count it started from.
@@ -23,13 +29,18 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Clear, Paragraph};
 
 use super::breakpoints::Breakpoints;
-use super::session::{Error, Session};
+use super::session::{Buffers, Error, Session};
 use super::sources;
 use super::track::{Effect, Tracker};
+use super::user_lines;
 use crate::model::Profile;
 use crate::model::explain;
+use crate::ptx::ir::SrcLoc;
 use crate::sim::access_log::Access;
 use crate::sim::stepper::{StepEvent, Stepper, WarpView};
+
+/// From this width on, source and PTX are shown side by side.
+pub const WIDE: u16 = 100;
 
 /// Options of the view.
 #[derive(Debug, Clone)]
@@ -73,10 +84,10 @@ pub fn drive<B: Backend>(
     let mut app = App::new(session, o)?;
     let mut target = 0u64;
     loop {
-        let exit = session.with_stepper(|st| {
+        let exit = session.with_stepper_and_buffers(|st, bufs| {
             app.replay(st, target)?;
             loop {
-                terminal.draw(|f| app.draw(f, st))?;
+                terminal.draw(|f| app.draw(f, st, bufs))?;
                 let Some(key) = next_key()? else { return Ok(Exit::Quit) };
                 match app.handle(key, st)? {
                     Exit::Stay => {}
@@ -108,6 +119,17 @@ pub enum Panel {
     Registers,
     /// The last memory instruction.
     Memory,
+    /// Memory contents: shared variables and the spec's buffers.
+    Data,
+}
+
+/// The code pane shown below [`WIDE`] columns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CodePane {
+    /// The CUDA source.
+    Source,
+    /// The PTX.
+    Ptx,
 }
 
 /// How register values are shown.
@@ -139,6 +161,19 @@ pub struct App {
     pub panel: Panel,
     radix: Radix,
     reg_first: usize,
+    /// First lane of the register panel's columns.
+    lane_first: usize,
+    /// The code pane shown in narrow terminals.
+    pub code: CodePane,
+    /// Columns the code panes are scrolled right by.
+    hscroll: usize,
+    /// The region of the memory-contents panel and its first row.
+    data_region: usize,
+    data_first: usize,
+    /// [`user_lines::attribute`] of the program.
+    user: Vec<Vec<Option<SrcLoc>>>,
+    /// Each warp's last user source line.
+    last_user: HashMap<(usize, u32), SrcLoc>,
     last: HashMap<(usize, u32), (StepEvent, Effect)>,
     last_mem: HashMap<(usize, u32), (StepEvent, Vec<Access>)>,
     tracker: Tracker,
@@ -154,7 +189,10 @@ pub struct App {
 
 impl App {
     fn new(session: &Session, o: TuiOptions) -> Result<App, Error> {
-        let sources = session.with_stepper(|st| Ok(sources::read_all(&st.module().prog, &session.ptx_path())))?;
+        let (sources, user) = session.with_stepper(|st| {
+            let prog = &st.module().prog;
+            Ok((sources::read_all(prog, &session.ptx_path()), user_lines::attribute(prog)))
+        })?;
         Ok(App {
             sel: o.start,
             o,
@@ -165,6 +203,13 @@ impl App {
             panel: Panel::Stack,
             radix: Radix::Dec,
             reg_first: 0,
+            lane_first: 0,
+            code: CodePane::Source,
+            hscroll: 0,
+            data_region: 0,
+            data_first: 0,
+            user,
+            last_user: HashMap::new(),
             last: HashMap::new(),
             last_mem: HashMap::new(),
             tracker: Tracker::default(),
@@ -183,6 +228,7 @@ impl App {
         self.fault_line = None;
         self.last.clear();
         self.last_mem.clear();
+        self.last_user.clear();
         self.tracker = Tracker::default();
         while self.steps < target {
             if self.step_one(st)?.is_none() {
@@ -199,6 +245,9 @@ impl App {
         let key = (ev.cta_slot, ev.warp);
         let w = st.warp(ev.cta_slot, ev.warp).ok_or("stepped warp vanished")?;
         let fx = self.tracker.observe(&ev, &w);
+        if let Some(u) = self.user_at(st, &ev.function, Some(ev.pc)) {
+            self.last_user.insert(key, u);
+        }
         if !ev.accesses.is_empty() {
             self.last_mem.insert(key, (ev.clone(), ev.accesses.clone()));
         }
@@ -210,7 +259,7 @@ impl App {
     fn run_until(
         &mut self,
         st: &mut Stepper,
-        mut stop: impl FnMut(&Self, &StepEvent, &WarpView) -> bool,
+        mut stop: impl FnMut(&Self, &Stepper, &StepEvent, &WarpView) -> bool,
     ) -> Result<Option<StepEvent>, Error> {
         for _ in 0..self.o.max_steps {
             match self.step_one(st)? {
@@ -219,7 +268,7 @@ impl App {
                     return Ok(None);
                 }
                 Some((ev, w)) => {
-                    if stop(self, &ev, &w) {
+                    if stop(self, st, &ev, &w) {
                         return Ok(Some(ev));
                     }
                 }
@@ -231,6 +280,22 @@ impl App {
 
     fn selected_view(&self, st: &Stepper) -> Option<WarpView> {
         st.warp(self.sel.0, self.sel.1)
+    }
+
+    /// The user source line of instruction `pc` of `function` (a line > 0 of
+    /// the user's file: library code counts as its calling line).
+    fn user_at(&self, st: &Stepper, function: &str, pc: Option<u32>) -> Option<SrcLoc> {
+        let prog = &st.module().prog;
+        let f = prog.functions.iter().position(|x| x.name == function)?;
+        let loc = (*self.user.get(f)?.get(pc? as usize)?)?;
+        user_lines::user_loc(prog, Some(loc))
+    }
+
+    /// The user source line the view shows for warp `key` in state `w`: that
+    /// of its next instruction, else (compiler-generated code) the last user
+    /// line it ran.
+    fn shown_line(&self, st: &Stepper, key: (usize, u32), w: &WarpView) -> Option<SrcLoc> {
+        self.user_at(st, &w.function, w.next_pc).or_else(|| self.last_user.get(&key).copied())
     }
 
     fn describe(&self, ev: &StepEvent) -> String {
@@ -286,12 +351,30 @@ impl App {
             KeyCode::Char('1') => self.panel = Panel::Stack,
             KeyCode::Char('2') => self.panel = Panel::Registers,
             KeyCode::Char('3') | KeyCode::Char('m') => self.panel = Panel::Memory,
+            KeyCode::Char('4') => self.panel = Panel::Data,
+            KeyCode::Char('v') => {
+                self.code = match self.code {
+                    CodePane::Source => CodePane::Ptx,
+                    CodePane::Ptx => CodePane::Source,
+                }
+            }
+            KeyCode::Char('>') | KeyCode::Right => self.hscroll += 8,
+            KeyCode::Char('<') => self.hscroll = self.hscroll.saturating_sub(8),
+            KeyCode::Char('l') => self.lane_first = (self.lane_first + 8) % 32,
+            KeyCode::Char('o') => {
+                self.data_region += 1;
+                self.data_first = 0;
+            }
             KeyCode::Char('x') => {
                 self.radix = match self.radix {
                     Radix::Dec => Radix::Hex,
                     Radix::Hex => Radix::Float,
                     Radix::Float => Radix::Dec,
                 }
+            }
+            KeyCode::Char('j') | KeyCode::PageDown if self.panel == Panel::Data => self.data_first += 1,
+            KeyCode::Char('k') | KeyCode::PageUp | KeyCode::Up if self.panel == Panel::Data => {
+                self.data_first = self.data_first.saturating_sub(1)
             }
             KeyCode::Char('j') | KeyCode::PageDown => self.reg_first += 1,
             KeyCode::Char('k') | KeyCode::PageUp | KeyCode::Up => self.reg_first = self.reg_first.saturating_sub(1),
@@ -357,17 +440,23 @@ impl App {
             self.message = format!("warp {}:{} has finished; w selects another", sel.0, sel.1);
             return Ok(());
         }
-        let start_line = w0.next_source.map(|s| (s.file, s.line));
+        let start_line = self.shown_line(st, sel, &w0);
         let is_sel = move |ev: &StepEvent| (ev.cta_slot, ev.warp) == sel;
         let result = match a {
-            Action::Instruction => self.run_until(st, |_, ev, _| is_sel(ev)),
-            Action::SourceLine => self.run_until(st, |_, ev, w| {
-                let line = w.next_source.map(|s| (s.file, s.line));
-                is_sel(ev) && (w.next_pc.is_none() || (line != start_line && line.is_none_or(|l| l.1 != 0)))
+            Action::Instruction => self.run_until(st, |_, _, ev, _| is_sel(ev)),
+            // the next source line, or a change of the warp's lanes (divergence,
+            // reconvergence, a switch to the waiting path), whichever comes first
+            Action::SourceLine => self.run_until(st, |app, st, ev, w| {
+                if !is_sel(ev) {
+                    return false;
+                }
+                let fx = app.last.get(&sel).map(|x| x.1).unwrap_or_default();
+                let line = app.shown_line(st, sel, w);
+                w.next_pc.is_none() || fx.diverged || fx.reconverged || fx.switched || line != start_line
             }),
-            Action::Goto(l) => self.run_until(st, |_, ev, w| is_sel(ev) && w.next_ptx_line == Some(l)),
-            Action::Barrier => self.run_until(st, |_, ev, _| is_sel(ev) && ev.opcode.starts_with("bar")),
-            Action::Continue => self.run_until(st, |app, ev, w| app.o.breaks.hit(ev, w).is_some()),
+            Action::Goto(l) => self.run_until(st, |_, _, ev, w| is_sel(ev) && w.next_ptx_line == Some(l)),
+            Action::Barrier => self.run_until(st, |_, _, ev, _| is_sel(ev) && ev.opcode.starts_with("bar")),
+            Action::Continue => self.run_until(st, |app, _, ev, w| app.o.breaks.hit(ev, w).is_some()),
         };
         if self.steps > start {
             self.history.push(start);
@@ -418,7 +507,7 @@ impl App {
     }
 
     /// Draws the whole screen.
-    pub fn draw(&self, f: &mut Frame, st: &Stepper) {
+    pub fn draw(&self, f: &mut Frame, st: &Stepper, bufs: &Buffers) {
         let [title, panes, mask, lower, msg, keys] = Layout::vertical([
             Constraint::Length(1),
             Constraint::Min(6),
@@ -442,14 +531,23 @@ impl App {
             self.o.profile.params().name
         );
         f.render_widget(Paragraph::new(t).style(Style::new().add_modifier(Modifier::REVERSED)), title);
-        let [left, right] = Layout::horizontal([Constraint::Percentage(50), Constraint::Percentage(50)]).areas(panes);
-        self.draw_source(f, left, st, w.as_ref());
-        self.draw_ptx(f, right, st, w.as_ref());
+        if panes.width >= WIDE {
+            let [left, right] =
+                Layout::horizontal([Constraint::Percentage(50), Constraint::Percentage(50)]).areas(panes);
+            self.draw_source(f, left, st, w.as_ref(), false);
+            self.draw_ptx(f, right, st, w.as_ref(), false);
+        } else {
+            match self.code {
+                CodePane::Source => self.draw_source(f, panes, st, w.as_ref(), true),
+                CodePane::Ptx => self.draw_ptx(f, panes, st, w.as_ref(), true),
+            }
+        }
         f.render_widget(Paragraph::new(mask_line(w.as_ref())), mask);
         match self.panel {
             Panel::Stack => self.draw_stack(f, lower, st, w.as_ref()),
             Panel::Registers => self.draw_registers(f, lower, st, w.as_ref()),
             Panel::Memory => self.draw_memory(f, lower, st),
+            Panel::Data => self.draw_data(f, lower, st, bufs),
         }
         if let Some(fault) = &self.fault {
             f.render_widget(Clear, lower);
@@ -468,12 +566,14 @@ impl App {
         };
         f.render_widget(Paragraph::new(m).style(Style::new().fg(Color::Yellow)), msg);
         f.render_widget(
-            Paragraph::new("s step n line c cont g goto b brk a bar u back w warp ] CTA 1-3 x q")
+            Paragraph::new("s step n line c cont g goto b brk a bar u back w warp v pane 1-4 panel ? help q")
                 .style(Style::new().add_modifier(Modifier::DIM)),
             keys,
         );
         if self.help {
-            let area = centered(f.area(), 64, 20);
+            let lines = HELP.lines().count() as u16 + 2;
+            let width = HELP.lines().map(|l| l.chars().count()).max().unwrap_or(0) as u16 + 2;
+            let area = centered(f.area(), width, lines);
             f.render_widget(Clear, area);
             f.render_widget(
                 Paragraph::new(HELP).block(Block::default().borders(Borders::ALL).title(" keys (any key closes) ")),
@@ -482,13 +582,10 @@ impl App {
         }
     }
 
-    fn draw_source(&self, f: &mut Frame, area: Rect, st: &Stepper, w: Option<&WarpView>) {
-        // compiler-generated instructions (line 0) show the line the warp was last on
-        let loc = w.and_then(|w| w.next_source).filter(|s| s.line > 0).or_else(|| {
-            let (ev, _) = self.last.get(&self.sel)?;
-            let func = st.module().prog.functions.iter().find(|x| x.name == ev.function)?;
-            func.info[ev.pc as usize].src
-        });
+    fn draw_source(&self, f: &mut Frame, area: Rect, st: &Stepper, w: Option<&WarpView>, single: bool) {
+        // the user's line: library code shows its calling line, compiler-generated
+        // instructions (line 0) the line the warp was last on
+        let loc = w.and_then(|w| self.shown_line(st, self.sel, w));
         let prog = &st.module().prog;
         let (title, lines, cur) = match loc {
             Some(s) => {
@@ -500,14 +597,25 @@ impl App {
             }
             None => ("source (no line info)".to_string(), &[][..], 0),
         };
-        let body = window(lines, cur, area, false, |n| if n == cur { ('>', reversed()) } else { (' ', Style::new()) });
-        f.render_widget(Paragraph::new(body).block(Block::default().borders(Borders::ALL).title(title)), area);
+        let body = window(lines, cur, area, false, self.hscroll, |n| {
+            if n == cur { ('>', reversed()) } else { (' ', Style::new()) }
+        });
+        let mut block = Block::default().borders(Borders::ALL).title(format!(" {title} "));
+        if single {
+            // the PTX instruction about to run, under the source
+            let line = self.fault_line.or_else(|| w.and_then(|w| w.next_ptx_line)).unwrap_or(0);
+            let text = prog.ptx_lines.get((line as usize).wrapping_sub(1)).map(|s| s.trim().replace('\t', " "));
+            block = block
+                .title(Line::raw(" v: PTX ").right_aligned())
+                .title_bottom(format!(" PTX {line}: {} ", text.unwrap_or_default()));
+        }
+        f.render_widget(Paragraph::new(body).block(block), area);
     }
 
-    fn draw_ptx(&self, f: &mut Frame, area: Rect, st: &Stepper, w: Option<&WarpView>) {
+    fn draw_ptx(&self, f: &mut Frame, area: Rect, st: &Stepper, w: Option<&WarpView>, single: bool) {
         let prog = &st.module().prog;
         let cur = self.fault_line.or_else(|| w.and_then(|w| w.next_ptx_line)).unwrap_or(0) as usize;
-        let body = window(&prog.ptx_lines, cur, area, true, |n| {
+        let body = window(&prog.ptx_lines, cur, area, true, self.hscroll, |n| {
             if n == cur {
                 ('>', reversed())
             } else if self.o.breaks.ptx.contains(&(n as u32)) {
@@ -516,8 +624,22 @@ impl App {
                 (' ', Style::new())
             }
         });
-        let title = format!("PTX {}", w.map(|w| w.function.as_str()).unwrap_or("(finished)"));
-        f.render_widget(Paragraph::new(body).block(Block::default().borders(Borders::ALL).title(title)), area);
+        let title = format!(" PTX {} ", w.map(|w| w.function.as_str()).unwrap_or("(finished)"));
+        let mut block = Block::default().borders(Borders::ALL).title(title);
+        if single {
+            let src = w.and_then(|w| self.shown_line(st, self.sel, w)).map(|s| {
+                let text = self
+                    .sources
+                    .get(s.file as usize)
+                    .and_then(|x| x.as_ref())
+                    .and_then(|t| t.get(s.line as usize - 1))
+                    .map(|t| t.trim().to_string())
+                    .unwrap_or_default();
+                format!(" line {}: {text} ", s.line)
+            });
+            block = block.title(Line::raw(" v: source ").right_aligned()).title_bottom(src.unwrap_or_default());
+        }
+        f.render_widget(Paragraph::new(body).block(block), area);
     }
 
     fn draw_stack(&self, f: &mut Frame, area: Rect, st: &Stepper, w: Option<&WarpView>) {
@@ -579,54 +701,133 @@ impl App {
             }
         }
         let active = w.map(|w| w.active).unwrap_or(0);
-        let mut lines = Vec::new();
+        let prog = &st.module().prog;
+        let func = w.and_then(|w| prog.functions.iter().find(|x| x.name == w.function));
+        // width of a register in bits (predicates: 1)
+        let bits = |name: &str| {
+            func.and_then(|f| f.reg_names.iter().position(|n| n == name).map(|i| f.reg_masks[i].count_ones()))
+                .unwrap_or(1)
+        };
+        // one row a register, one column a lane: as many lanes as fit, 8 at least
+        let inner = area.width.saturating_sub(2) as usize;
+        const NAME: usize = 7;
+        const CELL: usize = 9;
+        let lanes = match inner.saturating_sub(NAME) / CELL {
+            n if n >= 32 => 32,
+            n if n >= 16 => 16,
+            _ => 8,
+        };
+        let lane0 = if lanes == 32 { 0 } else { self.lane_first / lanes * lanes };
+        let rows = area.height.saturating_sub(3) as usize;
         let first = self.reg_first.min(names.len().saturating_sub(1));
-        for name in names.iter().skip(first).take(2) {
+        let mut lines = vec![Line::styled(
+            format!("{:<NAME$}{}", "lane", (lane0..lane0 + lanes).map(|l| format!("{l:>CELL$}")).collect::<String>()),
+            Style::new().add_modifier(Modifier::BOLD),
+        )];
+        for name in names.iter().skip(first).take(rows) {
             let Some(v) = st.register(self.sel.0, self.sel.1, name) else {
                 lines.push(Line::raw(format!("{name}: no such register here")));
                 continue;
             };
-            lines.push(Line::styled(name.clone(), Style::new().add_modifier(Modifier::BOLD)));
-            for row in 0..4 {
-                let spans: Vec<Span> = (row * 8..row * 8 + 8)
-                    .map(|l| {
-                        let s = format!("{:>9}", self.format_value(v[l]));
-                        if active >> l & 1 != 0 {
-                            Span::raw(s)
-                        } else {
-                            Span::styled(s, Style::new().fg(Color::DarkGray))
-                        }
-                    })
-                    .collect();
-                let mut all = vec![Span::raw(format!("{:>3}", row * 8))];
-                all.extend(spans);
-                lines.push(Line::from(all));
+            let b = bits(name);
+            let mut spans = vec![Span::styled(format!("{name:<NAME$}"), Style::new().add_modifier(Modifier::BOLD))];
+            for l in lane0..lane0 + lanes {
+                let s = format!("{:>CELL$}", self.format_value(v[l], b));
+                spans.push(if active >> l & 1 != 0 {
+                    Span::raw(s)
+                } else {
+                    Span::styled(s, Style::new().fg(Color::DarkGray))
+                });
             }
+            lines.push(Line::from(spans));
         }
+        let last = (first + rows).min(names.len());
         let title = format!(
-            " 2 registers {}-{} of {} (j/k scroll, x {}) ",
+            " 2 registers {}-{last} of {} (j/k, l lanes, x {}) ",
             first + 1,
-            (first + 2).min(names.len()),
             names.len(),
             match self.radix {
                 Radix::Dec => "dec",
                 Radix::Hex => "hex",
-                Radix::Float => "f32",
+                Radix::Float => "float",
             }
         );
         f.render_widget(Paragraph::new(lines).block(Block::default().borders(Borders::ALL).title(title)), area);
     }
 
-    fn format_value(&self, v: u64) -> String {
+    /// A register value of `bits` bits in the chosen radix, at most 8 characters:
+    /// decimal is signed (two's complement of the register's width), float reads
+    /// 32-bit registers as f32 and 64-bit ones as f64.
+    fn format_value(&self, v: u64, bits: u32) -> String {
         let s = match self.radix {
-            Radix::Dec => (v as i64).to_string(),
+            Radix::Dec => signed(v, bits).to_string(),
             Radix::Hex => format!("{v:x}"),
             Radix::Float => {
-                let x = f32::from_bits(v as u32);
+                let x = if bits == 64 { f64::from_bits(v) } else { f32::from_bits(v as u32) as f64 };
                 if x.abs() >= 1e5 || (x != 0.0 && x.abs() < 1e-3) { format!("{x:.2e}") } else { format!("{x:.4}") }
             }
         };
-        if s.len() > 8 { format!("{}~", &s[..7]) } else { s }
+        if s.chars().count() > 8 { format!("{}~", &s[..7]) } else { s }
+    }
+
+    fn draw_data(&self, f: &mut Frame, area: Rect, st: &Stepper, bufs: &Buffers) {
+        let regions = data_regions(st, &self.kernel, self.sel.0, bufs);
+        let mut lines = Vec::new();
+        let title;
+        if regions.is_empty() {
+            title = " 4 memory: no shared variables or buffers ".to_string();
+        } else {
+            let r = &regions[self.data_region % regions.len()];
+            let names: Vec<String> = regions
+                .iter()
+                .enumerate()
+                .map(
+                    |(i, x)| {
+                        if i == self.data_region % regions.len() { format!("[{}]", x.name) } else { x.name.clone() }
+                    },
+                )
+                .collect();
+            title = format!(" 4 memory {} (o next, j/k) ", r.kind);
+            lines.push(Line::styled(names.join(" "), Style::new().fg(Color::Cyan)));
+            let inner = area.width.saturating_sub(2) as usize;
+            let cell = 9usize;
+            let per_row = if inner >= 6 + 16 * cell { 16 } else { 8 };
+            let rows = area.height.saturating_sub(3) as usize;
+            let first = self.data_first.min(r.len.saturating_sub(1) / per_row) * per_row;
+            let values = match &r.source {
+                DataSource::Shared { offset } => st.shared(self.sel.0).map(|sh| {
+                    let start = (*offset + first * 4).min(sh.len());
+                    let end = (start + rows * per_row * 4).min(*offset + r.len * 4).min(sh.len());
+                    sh[start..end].chunks(4).map(|c| self.format_word(c)).collect::<Vec<_>>()
+                }),
+                DataSource::Buffer => bufs.read(&r.name, first, rows * per_row).map(|(ty, bytes)| {
+                    bytes
+                        .chunks(ty.size())
+                        .map(|c| if self.radix == Radix::Hex { hex(c) } else { ty.show(c) })
+                        .map(|s| if s.chars().count() > 8 { format!("{}~", &s[..7]) } else { s })
+                        .collect()
+                }),
+            };
+            let values = values.unwrap_or_default();
+            for (i, row) in values.chunks(per_row).enumerate() {
+                let mut s = format!("{:>5} ", first + i * per_row);
+                for v in row {
+                    s.push_str(&format!("{v:>8} "));
+                }
+                lines.push(Line::raw(s));
+            }
+            if values.is_empty() {
+                lines.push(Line::raw("(empty)"));
+            }
+        }
+        f.render_widget(Paragraph::new(lines).block(Block::default().borders(Borders::ALL).title(title)), area);
+    }
+
+    /// A 4-byte shared-memory word in the chosen radix (decimal: signed 32-bit).
+    fn format_word(&self, c: &[u8]) -> String {
+        let mut w = [0u8; 4];
+        w[..c.len()].copy_from_slice(c);
+        self.format_value(u32::from_le_bytes(w) as u64, 32)
     }
 
     fn draw_memory(&self, f: &mut Frame, area: Rect, st: &Stepper) {
@@ -705,13 +906,15 @@ fn reversed() -> Style {
 }
 
 /// The lines of a listing that fit `area` (inside its border), centred on line
-/// `cur` (1-based), each numbered, with the mark and style `mark(n)` gives.
-/// `trim` drops leading whitespace (PTX indents with tabs).
+/// `cur` (1-based), each numbered, with the mark and style `mark(n)` gives,
+/// the text scrolled `hscroll` columns right (the numbers stay). `trim` drops
+/// leading whitespace (PTX indents with tabs).
 fn window(
     lines: &[String],
     cur: usize,
     area: Rect,
     trim: bool,
+    hscroll: usize,
     mark: impl Fn(usize) -> (char, Style),
 ) -> Vec<Line<'static>> {
     let inner = area.height.saturating_sub(2) as usize;
@@ -725,9 +928,101 @@ fn window(
             let n = i + 1;
             let (m, style) = mark(n);
             let text = if trim { l.trim().replace('\t', " ") } else { l.trim_end().replace('\t', "    ") };
+            let text: String = text.chars().skip(hscroll).collect();
             Line::styled(format!("{m}{n:>4} {text}"), style)
         })
         .collect()
+}
+
+/// `v`'s low `bits` bits as a two's-complement number.
+fn signed(v: u64, bits: u32) -> i64 {
+    match bits {
+        0 | 1 => v as i64 & 1,
+        b if b >= 64 => v as i64,
+        b => ((v << (64 - b)) as i64) >> (64 - b),
+    }
+}
+
+/// Little-endian bytes as one hexadecimal number.
+fn hex(c: &[u8]) -> String {
+    let mut w = [0u8; 8];
+    w[..c.len().min(8)].copy_from_slice(&c[..c.len().min(8)]);
+    format!("{:x}", u64::from_le_bytes(w))
+}
+
+/// Where a region of the memory-contents panel lives.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum DataSource {
+    /// The CTA's shared memory from this byte offset, as 4-byte words.
+    Shared { offset: usize },
+    /// A buffer of the spec, by its name.
+    Buffer,
+}
+
+/// A region of the memory-contents panel.
+#[derive(Debug, Clone, PartialEq, Eq)]
+struct DataRegion {
+    /// Its name: the source name of a shared variable, a buffer's name.
+    name: String,
+    /// A word for the title.
+    kind: String,
+    /// Elements.
+    len: usize,
+    source: DataSource,
+}
+
+/// The shared variables `kernel` names, in CTA slot `slot` (by source name,
+/// from their mangled PTX names), then the spec's buffers.
+fn data_regions(st: &Stepper, kernel: &str, slot: usize, bufs: &Buffers) -> Vec<DataRegion> {
+    let prog = &st.module().prog;
+    let shared_len = st.shared(slot).map(|s| s.len()).unwrap_or(0);
+    let refs = prog.functions.iter().find(|f| f.name == kernel).map(|f| f.shared_refs.clone()).unwrap_or_default();
+    let mut v: Vec<DataRegion> = prog
+        .shared_vars
+        .iter()
+        .filter(|s| refs.is_empty() || refs.contains(&s.offset))
+        .map(|s| {
+            let bytes = if s.size == 0 { shared_len.saturating_sub(s.offset as usize) } else { s.size as usize };
+            DataRegion {
+                name: source_name(&s.name),
+                kind: format!("shared {} ({bytes} B at {:#x}, 4-byte words)", s.name, s.offset),
+                len: bytes / 4,
+                source: DataSource::Shared { offset: s.offset as usize },
+            }
+        })
+        .filter(|r| r.len > 0)
+        .collect();
+    for b in bufs.specs() {
+        v.push(DataRegion {
+            name: b.name.clone(),
+            kind: format!("buffer {} ({} x {:?})", b.name, b.len, b.ty).to_lowercase(),
+            len: b.len,
+            source: DataSource::Buffer,
+        });
+    }
+    v
+}
+
+/// The source name of a PTX variable: a function-local static's mangled name
+/// `_ZZ<n>funcE<n>name` (as clang and nvcc write `__shared__` arrays declared
+/// in a kernel) becomes `func::name`; other names stay as they are.
+pub fn source_name(ptx: &str) -> String {
+    fn part(s: &str) -> Option<(&str, &str)> {
+        let digits = s.chars().take_while(|c| c.is_ascii_digit()).count();
+        let n: usize = s[..digits].parse().ok()?;
+        let rest = &s[digits..];
+        (rest.len() >= n).then(|| rest.split_at(n))
+    }
+    let Some(rest) = ptx.strip_prefix("_ZZ") else {
+        return ptx.to_string();
+    };
+    let Some((func, rest)) = part(rest) else { return ptx.to_string() };
+    // a C++ function's parameter types follow its name up to `E`
+    let Some((_, rest)) = rest.split_once('E') else { return ptx.to_string() };
+    match part(rest) {
+        Some((name, _)) => format!("{func}::{name}"),
+        None => ptx.to_string(),
+    }
 }
 
 fn centered(r: Rect, w: u16, h: u16) -> Rect {
@@ -737,20 +1032,41 @@ fn centered(r: Rect, w: u16, h: u16) -> Rect {
 }
 
 const HELP: &str = "\
-s, space   step: run until the selected warp issues one instruction
-n          step a source line (until the warp leaves its CUDA line)
-c          continue until any warp reaches a breakpoint
-g N Enter  run the selected warp to PTX line N
-b N Enter  toggle a breakpoint at PTX line N (empty: current line)
-a          continue until the selected warp reaches a barrier
-u, <-      step back (undo the last action by replaying)
-w / W      next / previous warp of the CTA  (Tab / Shift-Tab)
-] / [      next / previous resident CTA
-1 2 3      panel: SIMT stack, registers, memory (also m)
-x          registers in decimal, hex or f32
-j / k      scroll the registers
-q, Esc     quit
+s, space  step: run until the selected warp issues one instruction
+n         next line: until the warp leaves its CUDA line, diverges or
+          reconverges
+c         continue until any warp reaches a breakpoint
+g N Enter run the selected warp to PTX line N
+b N Enter toggle a breakpoint at PTX line N (empty: current line)
+a         continue until the selected warp reaches a barrier
+u, <-     step back (undo the last action by replaying)
+w W Tab   next / previous warp of the CTA;  ] [  next / previous CTA
+v         source or PTX (narrow terminals);  > <  scroll code sideways
+1 2 3 4   panel: SIMT stack, registers, last memory access, memory
+x         decimal (signed), hex or float;  j k  scroll;  l  more lanes
+o         memory panel: next shared variable or buffer
+q, Esc    quit
+Lanes: # running, . waiting on another path, blank exited.";
 
-Lanes: # running, . waiting on another path, blank exited.
-Memory units are the transactions, sectors or banks the lanes'
-addresses form under the device profile (--device).";
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decimal_is_signed_in_the_register_width() {
+        assert_eq!(signed(0xffff_ffff, 32), -1);
+        assert_eq!(signed(0x7fff_ffff, 32), i32::MAX as i64);
+        assert_eq!(signed(0xffff, 16), -1);
+        assert_eq!(signed(u64::MAX, 64), -1);
+        assert_eq!(signed(1, 1), 1);
+        assert_eq!(hex(&[0x34, 0x12]), "1234");
+    }
+
+    #[test]
+    fn shared_variables_get_their_source_names() {
+        assert_eq!(source_name("_ZZ10reduce_sumE1s"), "reduce_sum::s");
+        assert_eq!(source_name("_ZZ6reduceiE4part"), "reduce::part");
+        assert_eq!(source_name("buf"), "buf");
+        assert_eq!(source_name("_ZZ99x"), "_ZZ99x");
+    }
+}
