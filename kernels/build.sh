@@ -13,10 +13,13 @@ check=0
 out_dir=.
 [ $check = 1 ] && out_dir=$(mktemp -d)
 status=0
+# .file paths: the sources relative to the repository (-fdebug-compilation-dir),
+# clang's own headers as clang/include/... rather than its install location
+clang_include=$("$CLANG" -print-resource-dir)/include
 clang_ptx() { # src out
   "$CLANG" -x cuda --cuda-device-only -nocudainc -nocudalib --cuda-gpu-arch=sm_90 \
     -Xclang -target-feature -Xclang +ptx78 -O3 -ffp-contract=on -gline-tables-only -fdebug-compilation-dir=. \
-    -Ikernels -S -o "$2" "$1"
+    -fdebug-prefix-map="$clang_include"=clang/include -Ikernels -S -o "$2" "$1"
 }
 nvcc_ptx() { # src out
   "$NVCC" -arch=sm_90 -O3 -ptx -lineinfo -Ikernels -o "$2" "$1"
