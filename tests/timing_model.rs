@@ -36,7 +36,13 @@ fn an_issue_bound_kernel_takes_four_cycles_per_warp_instruction_per_sm() {
 #[test]
 fn doubling_the_instructions_of_an_issue_bound_kernel_halves_the_frame_rate() {
     // loads whose latency the 8 warps hide: one texture hit per 200 instructions
-    let c = KernelCounts { warp_instructions: 6e7, texture_loads: 3e5, texel_fetches: 9.6e6, ..Default::default() };
+    let c = KernelCounts {
+        warp_instructions: 6e7,
+        texture_waits: 3e5,
+        texture_loads: 3e5,
+        texel_fetches: 9.6e6,
+        ..Default::default()
+    };
     let one = predict(&GTX_280, &Launch { counts: c, shape: THESIS_LAUNCH }).unwrap();
     assert_eq!(one.bound, Bound::Issue);
     let mut c2 = c;
@@ -96,7 +102,7 @@ fn too_few_warps_expose_the_register_latency() {
 #[test]
 fn a_latency_bound_kernel_speeds_up_with_resident_warps() {
     // every 5 instructions a dependent global load of 440 cycles
-    let c = KernelCounts { warp_instructions: 5e6 * 30.0, global_loads: 1e6 * 30.0, ..Default::default() };
+    let c = KernelCounts { warp_instructions: 5e6 * 30.0, global_waits: 1e6 * 30.0, ..Default::default() };
     let few = LaunchShape { threads_per_cta: 64, registers_per_thread: 16, ..THESIS_LAUNCH };
     let many = LaunchShape { threads_per_cta: 512, registers_per_thread: 16, ..THESIS_LAUNCH };
     let (a, b) = (
@@ -122,7 +128,7 @@ fn a_bandwidth_bound_kernel_runs_at_the_dram_bandwidth() {
     let bytes = 2e9;
     let c = KernelCounts {
         warp_instructions: 5.0 * bytes / 256.0,
-        global_loads: bytes / 256.0,
+        global_waits: bytes / 256.0,
         dram_bytes: bytes,
         ..Default::default()
     };
@@ -135,7 +141,13 @@ fn a_bandwidth_bound_kernel_runs_at_the_dram_bandwidth() {
 
 #[test]
 fn texture_misses_lengthen_a_latency_bound_kernel() {
-    let hit = KernelCounts { warp_instructions: 3e6, texture_loads: 3e6, texel_fetches: 3e6, ..Default::default() };
+    let hit = KernelCounts {
+        warp_instructions: 3e6,
+        texture_waits: 3e6,
+        texture_loads: 3e6,
+        texel_fetches: 3e6,
+        ..Default::default()
+    };
     let miss = KernelCounts { texture_misses: 3e6, ..hit };
     let shape = LaunchShape { threads_per_cta: 32, ..THESIS_LAUNCH };
     let ratio = seconds(miss, shape) / seconds(hit, shape);
@@ -314,7 +326,7 @@ fn measure_chapter_4_frames() {
                             Profile::Gt200,
                         )
                         .unwrap();
-                        let c = fab_timing::counts_of(&k.launch, &k.memory);
+                        let c = fab_timing::counts_of(&module.prog, &k.launch, &k.memory);
                         eprintln!("{name} frame {f} {group} {vname}: {c:?}");
                         samples.lock().unwrap().push(Sample {
                             group: group.to_string(),

@@ -1,6 +1,6 @@
 //! The counters of one kernel launch that the timing model reads: what the
-//! emulator counts (instructions issued per warp, memory instructions and
-//! transactions per space, texture cache misses) and the launch's shape.
+//! emulator counts (instructions issued per warp, waits on loads per space,
+//! texture loads, misses and texels, DRAM bytes) and the launch's shape.
 
 use std::collections::BTreeMap;
 
@@ -15,12 +15,12 @@ pub struct KernelCounts {
     pub sfu_instructions: f64,
     /// Shared-memory passes beyond one per half-warp (bank conflicts).
     pub shared_extra_passes: f64,
-    /// Warp-level shared-memory loads.
-    pub shared_loads: f64,
-    /// Warp-level global loads and atomics with a result.
-    pub global_loads: f64,
-    /// Warp-level local loads.
-    pub local_loads: f64,
+    /// Warp-level waits on shared loads alone ([`super::waits`]).
+    pub shared_waits: f64,
+    /// Warp-level waits on global or local loads or atomics with a result.
+    pub global_waits: f64,
+    /// Warp-level waits on texture (read-only path) loads alone.
+    pub texture_waits: f64,
     /// Warp-level texture (read-only path) loads.
     pub texture_loads: f64,
     /// Thread-level 32-bit texel fetches.
@@ -36,9 +36,9 @@ pub const NAMES: [&str; 10] = [
     "warp_instructions",
     "sfu_instructions",
     "shared_extra_passes",
-    "shared_loads",
-    "global_loads",
-    "local_loads",
+    "shared_waits",
+    "global_waits",
+    "texture_waits",
     "texture_loads",
     "texel_fetches",
     "texture_misses",
@@ -54,9 +54,9 @@ impl KernelCounts {
             self.warp_instructions,
             self.sfu_instructions,
             self.shared_extra_passes,
-            self.shared_loads,
-            self.global_loads,
-            self.local_loads,
+            self.shared_waits,
+            self.global_waits,
+            self.texture_waits,
             self.texture_loads,
             self.texel_fetches,
             self.texture_misses,
@@ -69,9 +69,9 @@ impl KernelCounts {
             warp_instructions: f[0],
             sfu_instructions: f[1],
             shared_extra_passes: f[2],
-            shared_loads: f[3],
-            global_loads: f[4],
-            local_loads: f[5],
+            shared_waits: f[3],
+            global_waits: f[4],
+            texture_waits: f[5],
             texture_loads: f[6],
             texel_fetches: f[7],
             texture_misses: f[8],

@@ -1,6 +1,6 @@
 //! Per-GPU timing model: predicts a kernel's time from the emulator's counters
-//! (instructions issued per warp, memory instructions and transactions per
-//! space, texture cache misses) and the launch's residency, with parameters
+//! (instructions issued per warp, waits on loads per space, texture
+//! fetches and misses, DRAM transactions) and the launch's residency, with parameters
 //! from the GPU's specifications and published microbenchmarks only — never
 //! from the frame rates it is compared with. Model and sources:
 //! `docs/timing-model.md`.
@@ -18,10 +18,12 @@ pub mod counts;
 pub mod gpu;
 pub mod prediction;
 pub mod queueing;
+pub mod waits;
 
 pub use counts::{KernelCounts, Launch};
 pub use gpu::{GTX_280, GpuTiming, LaunchShape, Residency};
 pub use prediction::{Bound, Prediction, predict};
+pub use waits::{Waits, waits};
 
 /// Why a prediction cannot be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

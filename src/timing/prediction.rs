@@ -1,10 +1,11 @@
 //! The model: one SM as a closed queueing network. Its resident warps
-//! alternate between issuing instructions and waiting on a memory load; while
+//! alternate between issuing instructions and waiting on memory loads; while
 //! one waits the others issue. Stations with a service rate: the SM's issue
 //! port (4 cycles a warp instruction, 16 on the SFUs, 2 per bank-conflict
 //! pass), its share of the texture units and of DRAM bandwidth. A pure delay:
-//! the loads' latencies. Mean value analysis gives the rounds per cycle; the
-//! kernel takes (loads per SM) / (rounds per cycle). All SMs get equal work.
+//! the latencies of the waits. Mean value analysis gives the rounds per
+//! cycle; the kernel takes (waits per SM) / (rounds per cycle). All SMs get
+//! equal work.
 
 use super::counts::Launch;
 use super::gpu::{GpuTiming, Residency};
@@ -38,8 +39,8 @@ pub struct Prediction {
     pub dram_cycles: f64,
     /// Memory latency per SM summed over its loads (overlapped by other warps).
     pub latency_cycles: f64,
-    /// Loads a warp waits on, per SM.
-    pub loads_per_sm: f64,
+    /// Waits on loads, per SM.
+    pub waits_per_sm: f64,
     /// Resident warps per SM.
     pub warps_per_sm: u32,
     /// Issue-port utilisation (0–1).
@@ -63,9 +64,9 @@ pub fn predict(gpu: &GpuTiming, launch: &Launch) -> Result<Prediction, TimingErr
         c.warp_instructions,
         c.sfu_instructions,
         c.shared_extra_passes,
-        c.shared_loads,
-        c.global_loads,
-        c.local_loads,
+        c.shared_waits,
+        c.global_waits,
+        c.texture_waits,
         c.texture_loads,
         c.texel_fetches,
         c.texture_misses,
@@ -88,18 +89,18 @@ pub fn predict(gpu: &GpuTiming, launch: &Launch) -> Result<Prediction, TimingErr
     let texture_cycles = c.texel_fetches / gpu.texels_per_sm_cycle() / sms;
     // DRAM is shared: the SM's share of the bytes over its share of the bandwidth
     let dram_cycles = c.dram_bytes / gpu.dram_bytes_per_cycle();
-    let miss = if c.texture_loads > 0.0 { (c.texture_misses / c.texture_loads).min(1.0) } else { 0.0 };
+    // a texture wait pays the miss latency if one of its loads missed: at most every miss in another wait
+    let miss = if c.texture_waits > 0.0 { (c.texture_misses / c.texture_waits).min(1.0) } else { 0.0 };
     let tex_latency = gpu.texture_hit_latency + miss * (gpu.texture_miss_latency - gpu.texture_hit_latency);
-    let loads = (c.shared_loads + c.global_loads + c.local_loads + c.texture_loads) / sms;
-    let latency_cycles = ((c.global_loads + c.local_loads) * gpu.global_latency
-        + c.texture_loads * tex_latency
-        + c.shared_loads * gpu.shared_latency)
-        / sms;
+    let rounds = (c.shared_waits + c.global_waits + c.texture_waits) / sms;
+    let latency_cycles =
+        (c.global_waits * gpu.global_latency + c.texture_waits * tex_latency + c.shared_waits * gpu.shared_latency)
+            / sms;
     let stations = [issue_cycles, texture_cycles, dram_cycles];
-    let cycles = if loads > 0.0 {
-        let d: Vec<f64> = stations.iter().map(|s| s / loads).collect();
-        let x = queueing::throughput(&d, latency_cycles / loads, w);
-        loads / x
+    let cycles = if rounds > 0.0 {
+        let d: Vec<f64> = stations.iter().map(|s| s / rounds).collect();
+        let x = queueing::throughput(&d, latency_cycles / rounds, w);
+        rounds / x
     } else {
         stations.iter().copied().fold(0.0, f64::max)
     };
@@ -118,7 +119,7 @@ pub fn predict(gpu: &GpuTiming, launch: &Launch) -> Result<Prediction, TimingErr
         texture_cycles,
         dram_cycles,
         latency_cycles,
-        loads_per_sm: loads,
+        waits_per_sm: rounds,
         warps_per_sm: w,
         issue_utilisation: util(issue_cycles),
         bound: if u >= 0.5 { busiest } else { Bound::Latency },

@@ -17,7 +17,7 @@ use crate::repro::compare::Tolerance;
 use crate::repro::results::Results;
 use crate::repro::table::{RowKind, Table};
 use crate::sim::LaunchStats;
-use crate::timing::{GTX_280, KernelCounts, Launch, LaunchShape, Prediction, predict};
+use crate::timing::{GTX_280, KernelCounts, Launch, LaunchShape, Prediction, predict, waits};
 
 /// Registers per thread of the thesis' kernel: "a single CUDA kernel using 54
 /// registers, allowing 256 threads to be resident per SM" (seed 000 L1896).
@@ -41,15 +41,17 @@ pub fn shape(prog: &Program, kernel: &str) -> LaunchShape {
     LaunchShape { ctas: CTAS, threads_per_cta: THREADS, registers_per_thread: REGISTERS, shared_per_cta: shared }
 }
 
-/// The timing model's counters of one launch on the gt200 profile: warp
-/// instructions (SFU class apart), shared-memory loads and bank-conflict
-/// passes, warp-level global (with atomics), local and texture loads,
-/// 32-bit texel fetches (texture bytes / 4), texture L1 misses, and DRAM
-/// bytes (32/64/128-byte segment transactions of global and local accesses,
-/// 32-byte texture lines that missed).
-pub fn counts_of(launch: &LaunchStats, memory: &ModelStats) -> KernelCounts {
+/// The timing model's counters of one launch of `prog` on the gt200
+/// profile: warp instructions (SFU class apart), shared-memory bank-conflict
+/// passes, waits on shared, global/local and texture loads
+/// ([`crate::timing::waits`]), warp-level texture loads, 32-bit texel fetches
+/// (texture bytes / 4), texture L1 misses, and DRAM bytes (32/64/128-byte
+/// segment transactions of global and local accesses, 32-byte texture lines
+/// that missed).
+pub fn counts_of(prog: &Program, launch: &LaunchStats, memory: &ModelStats) -> KernelCounts {
     let m = &memory.counters;
     let t = &launch.totals;
+    let w = waits(prog, &launch.profile);
     let seg = |a: &crate::model::AccessCounts| (a.t32 * 32 + a.t64 * 64 + a.t128 * 128) as f64;
     let line = crate::model::Profile::Gt200.params().tex_line as f64;
     KernelCounts {
@@ -57,9 +59,9 @@ pub fn counts_of(launch: &LaunchStats, memory: &ModelStats) -> KernelCounts {
         sfu_instructions: t.by_class.sfu as f64,
         shared_extra_passes: (m.shared_ld.bank_conflicts + m.shared_st.bank_conflicts + m.shared_atom.bank_conflicts)
             as f64,
-        shared_loads: m.shared_ld.instructions as f64,
-        global_loads: (m.global_ld.instructions + m.global_atom.instructions) as f64,
-        local_loads: m.local_ld.instructions as f64,
+        shared_waits: w.shared as f64,
+        global_waits: w.global as f64,
+        texture_waits: w.texture as f64,
         texture_loads: m.texture.instructions as f64,
         texel_fetches: m.texture.bytes as f64 / 4.0,
         texture_misses: m.texture.misses as f64,
