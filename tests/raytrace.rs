@@ -108,10 +108,13 @@ fn table_4_3_counts_with_three_trees() {
     assert!(rays[0] == rays[1] && rays[1] == rays[2] && rays[0] > 0.0, "{rays:?}");
     let p = table_4_3::per_ray(&r, "scene6").unwrap();
     assert!(p.iter().flatten().all(|&x| x > 0.0), "{p:?}");
-    // the thesis' SAH value beside ours
+    // every compared cell of the scene's row has a verdict (the verdicts
+    // themselves: tests/repro.rs, against the committed baseline)
     let e = resolve(&["fabianowski:4.3".into()]).unwrap()[0];
-    let md = table_4_3::render(&e, &r)[0].markdown();
-    assert!(md.contains("| scene6 |") && md.contains("| 9.68 |") && md.contains("| −24.9% |"), "{md}");
+    let t = &table_4_3::render(&e, &r)[0];
+    let row = t.rows.iter().find(|r| r.label == "scene6").unwrap();
+    let compared = t.columns.iter().filter(|c| c.tolerance.is_some()).count();
+    assert_eq!(row.cells.iter().filter(|c| c.verdict.is_some()).count(), compared, "{}", t.markdown());
 }
 
 /// Fig. 4.3's failure cases of restart-based traversal: zero-volume nodes

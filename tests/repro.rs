@@ -227,7 +227,7 @@ fn gnu_parallel_runs_shards_and_merges_them() {
 fn no_cell_drops_out_of_tolerance() {
     let (ok, out, err) = warplight(&[
         "tables",
-        "all",
+        "fabianowski:all",
         "--scenes",
         "scene6",
         "--frames",
@@ -305,4 +305,64 @@ fn captions_are_quoted_from_the_seeds_at_their_lines() {
         checked += 1;
     }
     assert!(checked >= 48, "{checked}");
+}
+
+/// The count tables of Scene 6 (Tables 4.3, 4.4's tree statistics, 4.5, 4.8
+/// (a), (b), (d)) give exactly the verdicts the committed baseline records,
+/// cell for cell: a count that moves across a tolerance either way fails until
+/// the baseline is re-recorded (`warplight tables all --scenes scene6 --frames
+/// 1 --resolution 32 --write-baseline tests/fixtures/baseline-scene6.json`).
+#[test]
+fn scene6_count_verdicts_are_the_baselines() {
+    use warplight::repro::baseline::Baseline;
+    use warplight::repro::fabianowski2011::{
+        BUILDS, CACHES, HEURISTIC_COUNTS, TRAVERSAL, flight, table_4_3, table_4_4,
+    };
+    use warplight::repro::protocol::Protocol;
+    use warplight::repro::registry::{Workspace, resolve};
+    use warplight::repro::results::{Results, SceneInfo};
+    let text = std::fs::read_to_string("tests/fixtures/baseline-scene6.json").unwrap();
+    let base: Baseline = serde_json::from_str(&text).unwrap();
+    assert_eq!(base.protocol, "custom: 1 frame(s) of each flight at 32x32");
+    let scene = warplight::host::scene_file::load(std::path::Path::new("scenes/scene6.toml")).unwrap();
+    let mut ws = Workspace::new(&scene, 0..1, 32);
+    let mut samples = table_4_4::measure_group(&mut ws, &mut |_| {}).unwrap();
+    samples.extend(table_4_3::measure(&mut ws, &mut |_| {}).unwrap());
+    samples.extend(flight::measure_traversal(&mut ws, &mut |_| {}).unwrap());
+    samples.extend(flight::measure_caches(&mut ws, &mut |_| {}).unwrap());
+    let mut r = Results::new(
+        "test",
+        Protocol::quick().with(Some(1), Some(32)),
+        vec!["fabianowski:all".into()],
+        vec![BUILDS.into(), HEURISTIC_COUNTS.into(), TRAVERSAL.into(), CACHES.into()],
+    );
+    r.scenes.push(SceneInfo {
+        name: "scene6".into(),
+        triangles: scene.triangles.len(),
+        thesis_triangles: scene.thesis.map(|t| t.triangles),
+        flight_frames: scene.flight.frames,
+        frames: vec![warplight::repro::protocol::FrameRange { start: 0, end: 1 }],
+    });
+    r.samples = samples;
+    let mut tables = Vec::new();
+    for id in ["fabianowski:4.3", "fabianowski:4.4", "fabianowski:4.5", "fabianowski:4.8"] {
+        let e = resolve(&[id.into()]).unwrap()[0];
+        tables.extend((e.table.render.unwrap())(&e, &r));
+    }
+    let now = Baseline::record(&base.protocol, &base.scenes, &tables);
+    let mut checked = 0;
+    for addr in [
+        "fabianowski:4.3",
+        "fabianowski:4.4",
+        "fabianowski:4.5",
+        "fabianowski:4.8a",
+        "fabianowski:4.8b",
+        "fabianowski:4.8d",
+    ] {
+        let (want, got) = (&base.tables[addr], &now.tables[addr]);
+        assert!(!want.is_empty(), "{addr}: the baseline records verdicts");
+        assert_eq!(got, want, "{addr}: verdicts differ from the committed baseline");
+        checked += want.len();
+    }
+    assert!(checked > 60, "{checked} cells");
 }
