@@ -62,6 +62,9 @@ pub enum SpecError {
     /// Loading or running failed.
     #[error("{0}")]
     Sim(#[from] SimError),
+    /// The spec asks for more than a limit allows (`docs/limits.md`).
+    #[error("{0}")]
+    Limit(#[from] crate::limits::LimitError),
 }
 
 /// Element types of buffers.
@@ -104,6 +107,54 @@ impl ElemType {
             ElemType::U16 | ElemType::I16 => 2,
             ElemType::U32 | ElemType::I32 | ElemType::F32 => 4,
             ElemType::U64 | ElemType::I64 | ElemType::F64 => 8,
+        }
+    }
+
+    /// The range of an integer type, as i128.
+    fn int_range(self) -> Option<(i128, i128)> {
+        Some(match self {
+            ElemType::U8 => (0, u8::MAX as i128),
+            ElemType::U16 => (0, u16::MAX as i128),
+            ElemType::U32 => (0, u32::MAX as i128),
+            ElemType::U64 => (0, u64::MAX as i128),
+            ElemType::I8 => (i8::MIN as i128, i8::MAX as i128),
+            ElemType::I16 => (i16::MIN as i128, i16::MAX as i128),
+            ElemType::I32 => (i32::MIN as i128, i32::MAX as i128),
+            ElemType::I64 => (i64::MIN as i128, i64::MAX as i128),
+            ElemType::F32 | ElemType::F64 => return None,
+        })
+    }
+
+    /// An error unless `v` is a number this type holds exactly: integers
+    /// within range, floats for integer types only when whole and in range,
+    /// and finite floats within f32's range for `f32` (`inf` and `nan`
+    /// written as such are kept). Values never wrap.
+    pub fn check_value(self, v: &toml::Value) -> Result<(), String> {
+        let name = format!("{self:?}").to_ascii_lowercase();
+        match (v, self.int_range()) {
+            (toml::Value::Integer(x), Some((lo, hi))) => {
+                if (lo..=hi).contains(&(*x as i128)) {
+                    Ok(())
+                } else {
+                    Err(format!("{x} is out of range for {name} ({lo} to {hi})"))
+                }
+            }
+            (toml::Value::Float(x), Some((lo, hi))) => {
+                if x.fract() == 0.0 && *x >= lo as f64 && *x <= hi as f64 {
+                    Ok(())
+                } else {
+                    Err(format!("{x} is not a whole number from {lo} to {hi} ({name})"))
+                }
+            }
+            (toml::Value::Integer(_), None) => Ok(()),
+            (toml::Value::Float(x), None) => {
+                if self == ElemType::F32 && x.is_finite() && x.abs() > f32::MAX as f64 {
+                    Err(format!("{x} is out of range for f32 (it would become infinity)"))
+                } else {
+                    Ok(())
+                }
+            }
+            _ => Err("expected a number".into()),
         }
     }
 
@@ -249,9 +300,14 @@ impl Ctx<'_> {
         for (i, n) in nums.iter().enumerate() {
             match n.as_integer() {
                 Some(x) if x >= 1 && x <= u32::MAX as i64 => d[i] = x as u32,
+                Some(x) if x > u32::MAX as i64 => {
+                    let axis = ["x", "y", "z"][i];
+                    return self.err(&k, format!("{key}.{axis} = {x} is more than CUDA allows"));
+                }
                 _ => return self.err(&k, "dimensions are positive integers"),
             }
         }
+        crate::limits::check_dims(key, d).or_else(|m| self.err(&k, m))?;
         Ok(d)
     }
 
@@ -295,8 +351,16 @@ impl Ctx<'_> {
         let shared = match t.get("shared") {
             None => 0,
             Some(v) => match v.as_integer() {
-                Some(x) if x >= 0 => x as u32,
-                _ => return self.err(&format!("{prefix}shared"), "expected bytes of dynamic shared memory"),
+                Some(x) if x >= 0 && x <= MAX_DYNAMIC_SHARED as i64 => x as u32,
+                _ => {
+                    return self.err(
+                        &format!("{prefix}shared"),
+                        format!(
+                            "expected bytes of dynamic shared memory, at most {MAX_DYNAMIC_SHARED} \
+                             (the simulated device's shared memory per CTA)"
+                        ),
+                    );
+                }
             },
         };
         Ok(LaunchSpec {
@@ -309,8 +373,13 @@ impl Ctx<'_> {
     }
 }
 
-/// The largest buffer a spec may declare (the host must hold it, and a copy).
+/// The largest buffer a spec may declare (the host must hold it, and a copy);
+/// the host-memory budget ([`crate::limits::memory_budget`]) may allow less.
 pub const MAX_BUFFER_BYTES: u64 = 8 << 30;
+
+/// The most dynamic shared memory a launch may ask for: the simulated
+/// device's shared memory per CTA (`SimConfig::max_shared_per_cta`).
+pub const MAX_DYNAMIC_SHARED: u32 = 228 * 1024;
 
 /// The keys a spec knows: at the top, in `[[buffer]]` and in `[[launch]]` tables.
 const TOP_KEYS: [&str; 12] = [
@@ -384,13 +453,18 @@ impl Ctx<'_> {
                 let init = match bt.get("init") {
                     None => Init::Zeros,
                     Some(toml::Value::String(s)) if s == "zeros" => Init::Zeros,
-                    Some(toml::Value::String(s)) if s == "iota" => Init::Iota,
+                    Some(toml::Value::String(s)) if s == "iota" => {
+                        let last = len.saturating_sub(1).min(i64::MAX as usize) as i64;
+                        ty.check_value(&toml::Value::Integer(last))
+                            .or_else(|e| cx.err(&k("init"), format!("iota over {len} elements reaches {last}: {e}")))?;
+                        Init::Iota
+                    }
                     Some(toml::Value::Array(a)) => {
                         if a.len() > len {
                             return cx.err(&k("init"), format!("{} values for {len} elements", a.len()));
                         }
-                        if let Some(bad) = a.iter().position(|v| v.as_integer().is_none() && v.as_float().is_none()) {
-                            return cx.err(&format!("buffer[{i}].init[{bad}]"), "expected a number");
+                        for (j, v) in a.iter().enumerate() {
+                            ty.check_value(v).or_else(|m| cx.err(&format!("{key}[{i}].init[{j}]"), m))?;
                         }
                         Init::Values(a.clone())
                     }
@@ -402,7 +476,12 @@ impl Ctx<'_> {
                                 it.get("hash").and_then(|v| v.as_integer()),
                                 it.get("modulo").and_then(|v| v.as_integer()),
                             ) {
-                                (Some(m), Some(n)) if n > 0 && m >= 0 => Init::Hash { mul: m as u64, modulo: n as u64 },
+                                (Some(m), Some(n)) if n > 0 && m >= 0 => {
+                                    ty.check_value(&toml::Value::Integer(n - 1)).or_else(|e| {
+                                        cx.err(&k("init"), format!("modulo {n} gives values up to {}: {e}", n - 1))
+                                    })?;
+                                    Init::Hash { mul: m as u64, modulo: n as u64 }
+                                }
                                 _ => {
                                     return cx.err(
                                         &k("init"),
@@ -490,6 +569,9 @@ impl Spec {
             Some(_) => return cx.err("launch", "expected [[launch]] tables"),
             None => vec![cx.launch(&t, "")?],
         };
+        if launches.is_empty() {
+            return cx.err("launch", "no launch: an empty list runs nothing; give at least one [[launch]] table");
+        }
         for (li, l) in launches.iter().enumerate() {
             for (ai, a) in l.args.iter().enumerate() {
                 if let ArgSpec::Buffer(n, off) = a {
@@ -549,8 +631,20 @@ impl Spec {
                 b.ty.encode(v as i128, v as f64, false, &mut out)
             }),
             Init::File(p) => {
-                let data = std::fs::read(p)
-                    .map_err(|e| SpecError::Io { file: p.display().to_string(), msg: e.to_string() })?;
+                let io = |msg: String| SpecError::Io { file: p.display().to_string(), msg };
+                // only a regular file, and only as much as the buffer holds: never /dev/zero or a FIFO
+                let meta = std::fs::metadata(p).map_err(|e| io(e.to_string()))?;
+                if !meta.is_file() {
+                    return Err(io("not a regular file (a buffer is filled from a file's bytes)".into()));
+                }
+                if meta.len() > (b.len * size) as u64 {
+                    return Err(SpecError::Key {
+                        file: self.file.display().to_string(),
+                        key: format!("buffer `{}`.init.file", b.name),
+                        msg: format!("{} has {} bytes; the buffer holds {}", p.display(), meta.len(), b.len * size),
+                    });
+                }
+                let data = std::fs::read(p).map_err(|e| io(e.to_string()))?;
                 if data.len() > b.len * size {
                     return Err(SpecError::Key {
                         file: self.file.display().to_string(),
@@ -595,7 +689,9 @@ pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
         std::fs::read_to_string(&spec.ptx)
             .map_err(|e| SpecError::Io { file: spec.ptx.display().to_string(), msg: e.to_string() })?
     };
-    let mut module = dev.load_ptx(&src, &spec.ptx.display().to_string())?;
+    let prog = crate::ptx::load(&src, &spec.ptx.display().to_string()).map_err(SimError::from)?;
+    check_resources(spec, &prog, dev.config())?;
+    let mut module = dev.load(prog);
     for (i, c) in spec.constants.iter().enumerate() {
         let bytes = spec.initial_bytes(c)?;
         module.write_constant(&c.name, &bytes).map_err(|msg| SpecError::Key {
@@ -612,6 +708,86 @@ pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
         buffers.insert(b.name.clone(), (p, b.clone()));
     }
     Ok(Prepared { module, buffers })
+}
+
+/// Host bytes the simulator holds for one resident CTA of `kernel` with
+/// `threads` threads and `shared` bytes of shared memory: per warp, the
+/// kernel's registers (8 bytes × 32 lanes each), predicates, parameter area
+/// and `.local` frame (32 lanes), and one frame of the largest device
+/// function besides. An estimate of `src/sim/{cta,warp}.rs`'s layout; deep
+/// calls need more (`docs/limits.md`).
+pub fn cta_host_bytes(prog: &crate::ptx::Program, kernel: u32, threads: u64, shared: u64) -> u64 {
+    let frame = |f: &crate::ptx::ir::Function| -> u64 {
+        f.reg_masks.len() as u64 * 256 + f.num_preds as u64 * 4 + (f.frame_param_size as u64 + f.local_size as u64) * 32
+    };
+    let k = &prog.functions[kernel as usize];
+    let callee = prog.functions.iter().filter(|f| !f.is_entry).map(frame).max().unwrap_or(0);
+    threads.div_ceil(32) * (frame(k) + callee) + shared
+}
+
+/// Checks the spec against the module and the device before anything is
+/// allocated: each launched kernel's `.local` frame against the device's
+/// local memory, and the buffers, module variables and resident CTAs'
+/// state against the host-memory budget ([`crate::limits::memory_budget`]).
+pub fn check_resources(spec: &Spec, prog: &crate::ptx::Program, config: &SimConfig) -> Result<(), SpecError> {
+    use crate::limits::{LimitError, check_memory, show_bytes};
+    let file = spec.file.display().to_string();
+    let bytes = |b: &BufferSpec| (b.len * b.ty.size()) as u64;
+    let globals: u64 = prog.globals.iter().map(|g| g.size.max(1).div_ceil(4) * 4).fold(0, u64::saturating_add);
+    let buffers: u64 = spec.buffers.iter().map(bytes).fold(0, u64::saturating_add);
+    let staging = spec.buffers.iter().chain(&spec.constants).map(bytes).max().unwrap_or(0);
+    let largest_global = prog.globals.iter().max_by_key(|g| g.size);
+    let memory = globals.saturating_add(buffers);
+    let what = || match largest_global {
+        Some(g) if g.size > buffers => format!(
+            "{}: the module's .global variables ({}; `{}` alone is {})",
+            spec.ptx.display(),
+            show_bytes(globals),
+            g.name,
+            show_bytes(g.size)
+        ),
+        _ => format!("{file}: the buffers and the module's .global variables ({})", show_bytes(memory)),
+    };
+    check_memory(what, memory.saturating_add(staging)).map_err(SpecError::Limit)?;
+    let multi = spec.launches.len() > 1;
+    for (i, l) in spec.launches.iter().enumerate() {
+        let key = if multi { format!("launch[{i}].kernel") } else { "kernel".to_string() };
+        let Some(k) = prog.kernel(&l.kernel) else { continue };
+        let f = &prog.functions[k as usize];
+        if f.local_size > config.local_limit {
+            return Err(SpecError::Key {
+                file,
+                key,
+                msg: format!(
+                    "kernel `{}` has {} of .local memory per thread; the simulated device has {} (docs/limits.md)",
+                    l.kernel,
+                    show_bytes(f.local_size as u64),
+                    show_bytes(config.local_limit as u64)
+                ),
+            });
+        }
+        let threads: u64 = l.block.iter().map(|&x| x as u64).product();
+        let ctas: u64 = l.grid.iter().map(|&x| x as u64).product();
+        let resident = ctas.min(config.schedule.max_resident_ctas.max(1) as u64);
+        let shared = prog.static_shared_size as u64 + l.shared as u64;
+        let per_cta = cta_host_bytes(prog, k, threads, shared);
+        let need = memory.saturating_add(resident.saturating_mul(per_cta));
+        check_memory(
+            || {
+                format!(
+                    "{file}: `{key}`: kernel `{}` ({} registers, {} .local per thread) with {resident} resident CTAs of \
+                     {threads} threads ({} each) beside the buffers",
+                    l.kernel,
+                    f.reg_masks.len(),
+                    show_bytes(f.local_size as u64),
+                    show_bytes(per_cta)
+                )
+            },
+            need,
+        )
+        .map_err(|e: LimitError| SpecError::Limit(e))?;
+    }
+    Ok(())
 }
 
 /// The kernel arguments of launch `l`, typed by the kernel's parameters.

@@ -31,6 +31,14 @@ pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+    /// Most host memory a command may plan to use (4G, 512M, bytes); default:
+    /// $WARPLIGHT_MEMORY_BUDGET, else half of this machine's memory. See docs/limits.md.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = crate::limits::parse_bytes)]
+    pub memory_budget: Option<u64>,
+    /// A folder of scene files searched first for scene names (before scenes/,
+    /// $WARPLIGHT_HOME/scenes and the checkout's scenes/).
+    #[arg(long, global = true, value_name = "DIR")]
+    pub scenes: Option<std::path::PathBuf>,
 }
 
 /// Subcommands.
@@ -109,11 +117,20 @@ pub enum SceneCommand {
 /// Runs the CLI; returns the process exit code.
 pub fn main() -> i32 {
     let cli = Cli::parse();
+    if let Some(b) = cli.memory_budget {
+        crate::limits::set_memory_budget(b);
+    }
+    if let Some(d) = cli.scenes {
+        crate::host::scene_file::set_scene_dir(d);
+    }
     let r = match cli.command {
         Command::Launch(a) => launch::run(a),
         Command::Kernels { ptx } => ptx_info::kernels(&ptx),
         Command::Check { ptx } => ptx_info::check(&ptx),
-        Command::Validate { fixture, ptx, markdown } => validate(&fixture, &ptx, markdown),
+        Command::Validate { fixture, ptx, markdown } => {
+            use crate::host::scene_file::data_file;
+            validate(&data_file(&fixture), &data_file(&ptx), markdown)
+        }
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
         Command::Tables(a) => tables::run(a),
         Command::Compile(a) => compile::run(a),

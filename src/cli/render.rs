@@ -60,7 +60,14 @@ fn counters_json(st: &crate::host::raycast::TraceStats, emulated: bool) -> serde
 }
 
 /// The largest image `render` makes (its frame buffer holds 12 bytes a pixel).
-const MAX_PIXELS: u64 = 16384 * 16384;
+const MAX_PIXELS: u64 = crate::limits::MAX_PIXELS;
+
+/// Host bytes a pixel costs: the native caster's frame buffer and the image
+/// written; an emulated render adds the kernels' device buffers (colour, hit
+/// and counters: 52 bytes) and their copies.
+fn bytes_per_pixel(emulated: bool) -> u64 {
+    if emulated { 128 } else { 32 }
+}
 
 /// Runs the command.
 pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
@@ -106,6 +113,11 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
         cam.resolution = [w, h];
     }
+    let [width, height] = cam.resolution;
+    crate::limits::check_memory(
+        || format!("a render of {width} x {height} pixels"),
+        (width as u64 * height as u64).saturating_mul(bytes_per_pixel(kernel_variant.is_some())),
+    )?;
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let t0 = Instant::now();
     let tree = build(&tris, BuildParams::thesis(h));

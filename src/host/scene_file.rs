@@ -12,7 +12,7 @@ use super::scene::{Light, Material, MaterialKind, Scene, ThesisScene, Triangle};
 
 /// A scene file that could not be loaded.
 #[derive(Debug, thiserror::Error)]
-#[error("{file}: {key}: {msg}")]
+#[error("{file}: {}{msg}", if key == "-" { String::new() } else { format!("{key}: ") })]
 pub struct SceneError {
     /// The file.
     pub file: String,
@@ -22,17 +22,42 @@ pub struct SceneError {
     pub msg: String,
 }
 
-/// The folders a scene name (`sponza`) is looked up in, in order: `scenes/`
-/// in the current directory, `$WARPLIGHT_HOME/scenes`, and the `scenes/` of
-/// the checkout warplight was built from (so that `cargo install --path .`
-/// gives a binary that finds them from anywhere while the checkout exists).
+static SCENES_FLAG: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+
+/// Sets the folder of `--scenes DIR`, searched before every other (once, before any work).
+pub fn set_scene_dir(dir: PathBuf) {
+    let _ = SCENES_FLAG.set(dir);
+}
+
+/// The folders a scene name (`sponza`) is looked up in, in order: the
+/// `--scenes DIR` folder, `scenes/` in the current directory,
+/// `$WARPLIGHT_HOME/scenes`, and the `scenes/` of the checkout warplight was
+/// built from (so that `cargo install --path .` gives a binary that finds
+/// them from anywhere while the checkout exists).
 pub fn scene_dirs() -> Vec<PathBuf> {
-    let mut v = vec![PathBuf::from("scenes")];
+    let mut v: Vec<PathBuf> = SCENES_FLAG.get().cloned().into_iter().collect();
+    v.push(PathBuf::from("scenes"));
     if let Some(h) = std::env::var_os("WARPLIGHT_HOME") {
         v.push(Path::new(&h).join("scenes"));
     }
     v.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"));
     v
+}
+
+/// A data file of the distribution (`tests/fixtures/h100_micro.json`,
+/// `kernels/micro/micro.ptx`) named relative to the checkout: the path as
+/// given when it exists (or is absolute), else under `$WARPLIGHT_HOME`, else
+/// under the checkout warplight was built from; the path as given when none
+/// has it, so that the error names it.
+pub fn data_file(rel: &Path) -> PathBuf {
+    if rel.is_absolute() || rel.exists() {
+        return rel.to_path_buf();
+    }
+    let home = std::env::var_os("WARPLIGHT_HOME").map(|h| Path::new(&h).join(rel));
+    home.into_iter()
+        .chain([Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)])
+        .find(|p| p.exists())
+        .unwrap_or_else(|| rel.to_path_buf())
 }
 
 /// Resolves a scene name (`sponza`: `NAME.toml` in the first of
@@ -62,11 +87,16 @@ impl Cx<'_> {
     }
 
     fn num(&self, v: &toml::Value, key: &str) -> Result<f32, SceneError> {
-        match v {
-            toml::Value::Float(f) => Ok(*f as f32),
-            toml::Value::Integer(i) => Ok(*i as f32),
-            _ => self.err(key, "expected a number"),
+        let x = match v {
+            toml::Value::Float(f) => *f as f32,
+            toml::Value::Integer(i) => *i as f32,
+            _ => return self.err(key, "expected a number"),
+        };
+        // NaN and infinities (and floats past f32) made black images with exit 0
+        if !x.is_finite() {
+            return self.err(key, format!("{v} is not a finite number"));
         }
+        Ok(x)
     }
 
     fn vec3(
@@ -136,10 +166,13 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<Material, SceneError> 
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let file = path.display().to_string();
     let cx = Cx { file: &file };
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
-        file: file.clone(),
-        key: "-".into(),
-        msg: e.to_string(),
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        let mut msg = e.to_string();
+        if e.kind() == std::io::ErrorKind::NotFound && path.starts_with("scenes") {
+            let dirs: Vec<String> = scene_dirs().iter().map(|d| d.display().to_string()).collect();
+            msg = format!("{msg} (no such scene in {}; give a path, --scenes DIR or WARPLIGHT_HOME)", dirs.join(", "));
+        }
+        SceneError { file: file.clone(), key: "-".into(), msg }
     })?;
     let t: toml::Table =
         toml::from_str(&text).map_err(|e| SceneError { file: file.clone(), key: "-".into(), msg: e.to_string() })?;
@@ -155,6 +188,9 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     }
     let by_name = |ms: &[Material], n: &str| ms.iter().position(|m| m.name == n).map(|i| i as u32);
     let scale = cx.float(&t, "scale", "", 1.0)?;
+    if scale == 0.0 {
+        return cx.err("scale", "must not be zero");
+    }
     let translate = Vec3::from(cx.vec3(&t, "translate", "", Some([0.0; 3]))?);
     let tris = match (t.get("obj"), t.get("procedural")) {
         (Some(_), Some(_)) => return cx.err("obj", "give either `obj` or `procedural`, not both"),
@@ -234,6 +270,12 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
                 let w = a[0].as_integer().filter(|&x| x > 0);
                 let h = a[1].as_integer().filter(|&x| x > 0);
                 match (w, h) {
+                    (Some(w), Some(h)) if (w as u64).saturating_mul(h as u64) > crate::limits::MAX_PIXELS => {
+                        return cx.err(
+                            "camera.resolution",
+                            format!("{w} x {h} pixels is more than {} (16384 x 16384)", crate::limits::MAX_PIXELS),
+                        );
+                    }
                     (Some(w), Some(h)) => [w as u32, h as u32],
                     _ => return cx.err("camera.resolution", "expected [width, height] of positive integers"),
                 }
@@ -248,21 +290,25 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         if Vec3::from(direction).length() == 0.0 {
             return cx.err("camera.direction", "must not be zero");
         }
-        scene.camera = Camera {
-            position: cx.vec3(c, "position", p, None)?,
-            direction,
-            up: cx.vec3(c, "up", p, Some([0.0, 1.0, 0.0]))?,
-            fov_y: fov,
-            resolution: res,
-        };
+        let up = cx.vec3(c, "up", p, Some([0.0, 1.0, 0.0]))?;
+        if Vec3::from(direction).normalize().cross(Vec3::from(up)).length() < 1e-6 {
+            return cx.err("camera.up", "must not be zero or parallel to the direction");
+        }
+        scene.camera =
+            Camera { position: cx.vec3(c, "position", p, None)?, direction, up, fov_y: fov, resolution: res };
     }
     if let Some(f) = cx.table(&t, "flight")? {
         let p = "flight.";
         let frames = match f.get("frames") {
             None => 50,
             Some(v) => match v.as_integer() {
-                Some(n) if n > 0 => n as u32,
-                _ => return cx.err("flight.frames", "expected a positive integer"),
+                Some(n) if n > 0 && n <= crate::limits::MAX_FLIGHT_FRAMES as i64 => n as u32,
+                _ => {
+                    return cx.err(
+                        "flight.frames",
+                        format!("expected a positive integer, at most {}", crate::limits::MAX_FLIGHT_FRAMES),
+                    );
+                }
             },
         };
         scene.flight = Flight {
