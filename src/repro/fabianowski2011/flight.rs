@@ -119,14 +119,27 @@ pub fn camera(scene: &Scene, f: u32, res: u32) -> Camera {
 
 /// One frame of one variant on the emulator (gt200 profile).
 pub fn frame(scene: &Scene, tree: &KdTree, f: u32, res: u32, v: Variant) -> Result<Totals, SimError> {
+    Ok(frame_timed(scene, tree, f, res, v)?.0)
+}
+
+/// As [`frame`], with the GTX 280 timing model's counters of the launch
+/// ([`super::timing::counts_of`]).
+pub fn frame_timed(
+    scene: &Scene,
+    tree: &KdTree,
+    f: u32,
+    res: u32,
+    v: Variant,
+) -> Result<(Totals, crate::timing::KernelCounts), SimError> {
     // a fresh device per frame: its memory holds one frame's buffers; the
     // watchdog's budget grows with the pixels
     let cam = camera(scene, f, res);
     let mut dev = Device::with_config(rt_kernels::sim_config(&cam));
     let module = rt_kernels::load(&mut dev)?;
     let k = rt_kernels::render(&mut dev, &module, scene, tree, &cam, scene.flight.light_offset(f), v, Profile::Gt200)?;
+    let timing = super::timing::counts_of(&module.prog, &k.launch, &k.memory);
     let m = &k.memory.counters;
-    Ok(Totals {
+    let totals = Totals {
         rays: k.trace.rays,
         inner_nodes: k.trace.inner_nodes,
         tex_node_fetches: k.trace.tex_node_fetches,
@@ -140,7 +153,8 @@ pub fn frame(scene: &Scene, tree: &KdTree, f: u32, res: u32, v: Variant) -> Resu
             + m.local_st.sectors
             + m.global_atom.sectors
             + m.texture.misses,
-    })
+    };
+    Ok((totals, timing))
 }
 
 /// The counters' names, in [`Totals`]' field order.
@@ -225,7 +239,8 @@ impl SceneRun {
     }
 }
 
-/// Runs `variants` on `tree` over the workspace's frames: one sample per frame and variant.
+/// Runs `variants` on `tree` over the workspace's frames: one sample per
+/// frame and variant, with the timing model's `timing_*` counters beside [`COUNTERS`].
 pub fn samples(
     ws: &Workspace,
     tree: &KdTree,
@@ -237,13 +252,15 @@ pub fn samples(
     for f in ws.frames.clone() {
         for (v, name) in variants {
             tick(Tick { frame: Some(f), variant: name });
-            let t = frame(ws.scene, tree, f, ws.resolution, *v)?;
+            let (t, timing) = frame_timed(ws.scene, tree, f, ws.resolution, *v)?;
+            let mut counters = t.counters();
+            counters.extend(timing.counters());
             out.push(Sample {
                 group: group.into(),
                 scene: ws.scene.name.clone(),
                 frame: Some(f),
                 variant: name.to_string(),
-                counters: t.counters(),
+                counters,
             });
         }
     }
