@@ -68,7 +68,7 @@ fn step_view_in_a_pseudo_terminal() {
     // `; sleep` keeps the pane open after a crash so that its message can be read
     let Some(t) = Tmux::start(&format!("{bin} step examples/if_else.toml --device gt200 || sleep 30")) else { return };
     let s = t.wait_for("step 0");
-    assert!(s.contains("divergence.cu") && s.contains("PTX 24: ld.param") && s.contains("gt200"), "{s}");
+    assert!(s.contains("divergence.cu") && s.contains("PTX 24: mov.u32") && s.contains("gt200"), "{s}");
     assert!(s.contains("################################ active ffffffff (32)"), "{s}");
     assert!(s.lines().count() <= 24 && s.lines().all(|l| l.chars().count() <= 80), "fits 80x24:\n{s}");
     for _ in 0..12 {

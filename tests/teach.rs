@@ -140,7 +140,7 @@ fn register_panel_and_warp_selection() {
     let t = text(&rows);
     assert!(t.contains("registers 1-7 of"), "several registers at once:\n{t}");
     let row = |name: &str, cells: &[&str]| {
-        format!("│{name:<7}{}", cells.iter().map(|c| format!("{c:>9}")).collect::<String>())
+        format!("│{name:<6}{}", cells.iter().map(|c| format!("{c:>9}")).collect::<String>())
     };
     assert!(rows.iter().any(|r| r.starts_with(&row("%r10", &["0", "1", "2", "3", "4", "5", "6", "7"]))), "{t}");
     let (rows, _) = screen("examples/if_else.toml", o.clone(), "ss2lll");

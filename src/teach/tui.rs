@@ -710,7 +710,7 @@ impl App {
         };
         // one row a register, one column a lane: as many lanes as fit, 8 at least
         let inner = area.width.saturating_sub(2) as usize;
-        const NAME: usize = 7;
+        const NAME: usize = 6;
         const CELL: usize = 9;
         let lanes = match inner.saturating_sub(NAME) / CELL {
             n if n >= 32 => 32,
@@ -731,8 +731,8 @@ impl App {
             };
             let b = bits(name);
             let mut spans = vec![Span::styled(format!("{name:<NAME$}"), Style::new().add_modifier(Modifier::BOLD))];
-            for l in lane0..lane0 + lanes {
-                let s = format!("{:>CELL$}", self.format_value(v[l], b));
+            for (l, &x) in v.iter().enumerate().skip(lane0).take(lanes) {
+                let s = format!("{:>CELL$}", self.format_value(x, b));
                 spans.push(if active >> l & 1 != 0 {
                     Span::raw(s)
                 } else {
