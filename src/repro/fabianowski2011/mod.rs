@@ -12,6 +12,7 @@
 
 pub mod caches;
 pub mod flight;
+pub mod photons;
 pub mod table_4_1;
 pub mod table_4_2;
 pub mod table_4_3;

@@ -1,0 +1,396 @@
+//! Thesis 000 §5.1: photon tracing with photon differentials, on the emulator
+//! (`kernels/fabianowski2011/photons.cu`) and natively ([`reference`]).
+//!
+//! An isotropic point light emits `n` photons of equal flux; each carries its
+//! position, direction and four differentials, pre-scaled so that one global
+//! Δp = √(4π/n) applies (eqs. 5.9–5.11). Surface hits propagate the
+//! differentials (eqs. 3.7–3.9, [`propagate`]); mirrors reflect them (eqs.
+//! 3.10–3.11 with ∂n/∂p = 0 on flat triangles, [`reflect`]); diffuse surfaces
+//! absorb and re-emit with cosine sampling and the virtual offset t_v (eqs.
+//! 5.22–5.29); Russian roulette scales survivors' differentials by ρ^(−1/2)
+//! (§5.1.4). The 2nd and 3rd surface interactions on diffuse surfaces are
+//! stored ([`Photon`]). Random numbers are counter based ([`rng`]), so the
+//! native reference replays each photon with the kernel's float operations in
+//! the kernel's order, and both agree bit for bit (`tests/photons.rs`).
+//! Fixtures the thesis leaves open are listed in `docs/photon-mapping.md`.
+
+use std::f32::consts::{FRAC_1_SQRT_2, FRAC_PI_2, FRAC_PI_4, PI};
+
+use glam::Vec3;
+
+use crate::host::camera::Ray;
+use crate::host::kdtree::KdTree;
+use crate::host::kdtree::layout::layout;
+use crate::host::raycast::{Caster, EPS_REL, TraceStats};
+use crate::host::scene::{Light, MaterialKind, Scene};
+use crate::sim::device::to_bytes;
+use crate::sim::{Arg, Device, LaunchConfig, LaunchStats, Module, SimError};
+
+/// The kernel's PTX (clang-16), compiled in.
+pub const PTX: &str = include_str!("../../../kernels/fabianowski2011/photons.ptx");
+/// The kernel's entry point.
+pub const KERNEL: &str = "trace_photons";
+/// Floats per stored slot in the kernel's output (two slots per photon).
+pub const SLOT: usize = 24;
+/// Threads per CTA of the launch.
+pub const THREADS: u32 = 256;
+/// At most this many CTAs (one per GTX 280 SM); threads loop over photons.
+pub const MAX_CTAS: u32 = 30;
+/// The last surface interaction traced (seed 000 L2468: "until their third surface interaction").
+pub const LAST_INTERACTION: u32 = 3;
+
+/// Why photons could not be traced.
+#[derive(Debug, thiserror::Error)]
+pub enum PhotonError {
+    /// The scene has no point light to emit from.
+    #[error("scene `{0}` has no point light: photon emission needs one (seed 000 §5.1.1)")]
+    NoPointLight(String),
+    /// More photons than the kernel's 32-bit index addresses.
+    #[error("{0} photons: at most {max} can be traced in one launch", max = i32::MAX)]
+    TooMany(usize),
+    /// The emulator failed.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+/// A stored photon interaction (a surface hit on a diffuse surface).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Photon {
+    /// Position z.
+    pub z: [f32; 3],
+    /// Flux arriving (RGB, W), before Russian roulette at this hit.
+    pub flux: [f32; 3],
+    /// Position differentials ∂z/∂p1, ∂z/∂p2 after propagation to the hit.
+    pub dz: [[f32; 3]; 2],
+    /// Direction differentials ∂ω/∂p1, ∂ω/∂p2 of the incoming photon.
+    pub dw: [[f32; 3]; 2],
+    /// Geometric normal, facing the incoming photon.
+    pub normal: [f32; 3],
+    /// Triangle hit.
+    pub tri: u32,
+    /// Surface interaction (2 or 3).
+    pub interaction: u32,
+}
+
+impl Photon {
+    /// The fields' bits, for exact comparison.
+    pub fn bits(&self) -> Vec<u32> {
+        let mut v: Vec<u32> = Vec::with_capacity(SLOT);
+        for a in [self.z, self.flux, self.dz[0], self.dz[1], self.dw[0], self.dw[1], self.normal] {
+            v.extend(a.iter().map(|x| x.to_bits()));
+        }
+        v.push(self.tri);
+        v.push(self.interaction);
+        v
+    }
+
+    /// The footprint's spanning vectors Δp·∂z/∂p_i (eq. 3.4) for `n` photons emitted (Δp = √(4π/n), eq. 5.11).
+    pub fn footprint(&self, n: usize) -> [Vec3; 2] {
+        let dp = delta_p(n);
+        [Vec3::from(self.dz[0]) * dp, Vec3::from(self.dz[1]) * dp]
+    }
+}
+
+/// The global parameter distance Δp = √(4π/n) (eq. 5.11).
+pub fn delta_p(n: usize) -> f32 {
+    (4.0 * PI / n as f32).sqrt()
+}
+
+/// The counter-based generator: a uniform float in [0, 1) with 24 random bits for
+/// photon `i`, dimension `d` (two rounds of a 32-bit integer hash). Dimensions:
+/// 0, 1 emission; at interaction k, 4k−2 roulette, 4k−1 and 4k re-emission.
+pub fn rng(i: u32, d: u32) -> f32 {
+    let mut h = i.wrapping_mul(0x9e37_79b9) ^ d.wrapping_add(1).wrapping_mul(0x85eb_ca6b);
+    for _ in 0..2 {
+        h ^= h >> 16;
+        h = h.wrapping_mul(0x7feb_352d);
+        h ^= h >> 15;
+        h = h.wrapping_mul(0x846c_a68b);
+        h ^= h >> 16;
+    }
+    (h >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// (cos, sin) of the azimuth 2πy for y in [0, 1), as the kernel computes them:
+/// a quarter turn q = ⌊4y⌋, the rest in [−π/4, π/4) by Taylor polynomials
+/// (error below 1e-7), rotated by π/4 and q quarter turns.
+pub fn azimuth(y: f32) -> (f32, f32) {
+    let f4 = y * 4.0;
+    let q = f4 as i32;
+    let x = (f4 - q as f32) * FRAC_PI_2 - FRAC_PI_4;
+    let x2 = x * x;
+    let sx = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+    let cx = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0))));
+    let h = FRAC_1_SQRT_2;
+    let (cr, sr) = ((cx - sx) * h, (sx + cx) * h);
+    match q {
+        0 => (cr, sr),
+        1 => (-sr, cr),
+        2 => (-cr, -sr),
+        _ => (sr, -cr),
+    }
+}
+
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn scale(a: [f32; 3], s: f32) -> [f32; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+fn len(a: [f32; 3]) -> f32 {
+    dot(a, a).sqrt()
+}
+
+/// A photon in flight: position, direction and the four differentials.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Differentials {
+    /// Position z.
+    pub z: [f32; 3],
+    /// Direction ω.
+    pub w: [f32; 3],
+    /// ∂z/∂p1, ∂z/∂p2.
+    pub dz: [[f32; 3]; 2],
+    /// ∂ω/∂p1, ∂ω/∂p2.
+    pub dw: [[f32; 3]; 2],
+}
+
+/// The photon emitted by an isotropic point light at `z` for parameters
+/// cos p1 = `cp1`, (cos p2, sin p2) = `c2` (eqs. 5.1, 5.9, 5.10 with α = π, R = I).
+pub fn emit(z: [f32; 3], cp1: f32, c2: (f32, f32)) -> Differentials {
+    let sp1 = (1.0 - cp1 * cp1).max(0.0).sqrt();
+    let (cp2, sp2) = c2;
+    Differentials {
+        z,
+        w: [cp2 * sp1, sp2 * sp1, cp1],
+        dz: [[0.0; 3]; 2],
+        dw: [[cp2 * cp1, sp2 * cp1, -sp1], [-sp2, cp2, 0.0]],
+    }
+}
+
+/// Propagates `p` by `t` to a surface with unit normal `n` (eqs. 3.7–3.9):
+/// ∂z'/∂p = ∂z/∂p + t ∂ω/∂p + (∂t/∂p) ω with ∂t/∂p = −((∂z/∂p + t ∂ω/∂p)·n)/(ω·n).
+pub fn propagate(p: &mut Differentials, t: f32, n: [f32; 3]) {
+    let wn = dot(p.w, n);
+    for i in 0..2 {
+        let a = add(p.dz[i], scale(p.dw[i], t));
+        let dt = -dot(a, n) / wn;
+        p.dz[i] = add(a, scale(p.w, dt));
+    }
+    p.z = [p.z[0] + p.w[0] * t, p.z[1] + p.w[1] * t, p.z[2] + p.w[2] * t];
+}
+
+/// Mirror reflection about unit normal `n` (eqs. 3.10–3.11 with ∂n/∂p = 0):
+/// ω' = ω − 2(ω·n)n, ∂z'/∂p = ∂z/∂p, ∂ω'/∂p = ∂ω/∂p − 2(∂ω/∂p·n)n.
+pub fn reflect(p: &mut Differentials, n: [f32; 3]) {
+    let s2 = 2.0 * dot(p.w, n);
+    p.w = [p.w[0] - s2 * n[0], p.w[1] - s2 * n[1], p.w[2] - s2 * n[2]];
+    for i in 0..2 {
+        let s = 2.0 * dot(p.dw[i], n);
+        p.dw[i] = [p.dw[i][0] - s * n[0], p.dw[i][1] - s * n[1], p.dw[i][2] - s * n[2]];
+    }
+}
+
+/// Diffuse absorption and re-emission about unit normal `n` (eqs. 5.22–5.29):
+/// cos p'1 = √(1−y1), azimuth (cos, sin) `c2`; the virtual offset
+/// t_v = √(2‖∂z/∂p1 × ∂z/∂p2‖) from the incoming position differentials, then
+/// ∂ω'/∂p'1 = √(1/(4 cos p'1)) R(cos p'2 cos p'1, sin p'2 cos p'1, −sin p'1),
+/// ∂ω'/∂p'2 = √(1/(4 cos p'1)) R(−sin p'2, cos p'2, 0), ∂z'/∂p'i = t_v ∂ω'/∂p'i.
+/// The frame R: tangent from the x axis (the y axis when |n_x| ≥ 1/2), bitangent n × tangent.
+pub fn reemit(p: &mut Differentials, n: [f32; 3], y1: f32, c2: (f32, f32)) {
+    let tv = (2.0 * len(cross(p.dz[0], p.dz[1]))).sqrt();
+    let (c1, s1) = ((1.0 - y1).sqrt(), y1.sqrt());
+    let (c2, s2) = c2;
+    let ax = if n[0].abs() < 0.5 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let tg = add(ax, scale(n, -dot(ax, n)));
+    let tg = scale(tg, 1.0 / len(tg));
+    let bt = cross(n, tg);
+    let sc = (1.0 / (4.0 * c1)).sqrt();
+    p.w = add(add(scale(tg, c2 * s1), scale(bt, s2 * s1)), scale(n, c1));
+    p.dw[0] = add(add(scale(tg, c2 * c1 * sc), scale(bt, s2 * c1 * sc)), scale(n, -s1 * sc));
+    p.dw[1] = add(scale(tg, -s2 * sc), scale(bt, c2 * sc));
+    p.dz = [scale(p.dw[0], tv), scale(p.dw[1], tv)];
+}
+
+/// What the photon tracer needs of a scene: the first point light and each photon's flux.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Emission {
+    /// The light's position.
+    pub position: [f32; 3],
+    /// Flux per photon: Φ/n with Φ = 4π I for radiant intensity I (an isotropic point light).
+    pub flux: [f32; 3],
+    /// Photons emitted.
+    pub n: usize,
+}
+
+impl Emission {
+    /// Emission of `n` photons from `scene`'s first point light.
+    pub fn of(scene: &Scene, n: usize) -> Result<Emission, PhotonError> {
+        if n > i32::MAX as usize {
+            return Err(PhotonError::TooMany(n));
+        }
+        let (position, intensity) = scene
+            .lights
+            .iter()
+            .find_map(|l| match l {
+                Light::Point { position, intensity } => Some((*position, *intensity)),
+                _ => None,
+            })
+            .ok_or_else(|| PhotonError::NoPointLight(scene.name.clone()))?;
+        let flux = intensity.map(|i| 4.0 * PI * i / n as f32);
+        Ok(Emission { position, flux, n })
+    }
+}
+
+/// Material kind as the kernel encodes it: 0 diffuse, 1 mirror (glass too), 2 emitter.
+fn kind_code(k: MaterialKind) -> f32 {
+    match k {
+        MaterialKind::Diffuse => 0.0,
+        MaterialKind::Mirror | MaterialKind::Glass { .. } => 1.0,
+        MaterialKind::Emitter => 2.0,
+    }
+}
+
+/// Traces photon `i` natively through `caster`: the kernel's path, operation for operation.
+pub fn trace_one(caster: &Caster, e: &Emission, i: u32) -> [Option<Photon>; 2] {
+    let mut out = [None, None];
+    let cp1 = rng(i, 0) * 2.0 - 1.0;
+    let mut p = emit(e.position, cp1, azimuth(rng(i, 1)));
+    let mut flux = e.flux;
+    let mut st = TraceStats::default();
+    for k in 1..=LAST_INTERACTION {
+        let ray = Ray { origin: Vec3::from(p.z), dir: Vec3::from(p.w) };
+        let Some(h) = caster.intersect(&ray, caster.eps(), f32::INFINITY, false, &mut st) else { break };
+        let n = caster.normal(h.tri, ray.dir).to_array();
+        propagate(&mut p, h.t, n);
+        let m = &caster.scene.materials[caster.scene.triangles[h.tri as usize].material as usize];
+        let kind = kind_code(m.kind);
+        if kind == 2.0 {
+            break;
+        }
+        let diffuse = kind == 0.0;
+        if diffuse && k >= 2 {
+            out[(k - 2) as usize] =
+                Some(Photon { z: p.z, flux, dz: p.dz, dw: p.dw, normal: n, tri: h.tri, interaction: k });
+        }
+        if k == LAST_INTERACTION {
+            break;
+        }
+        let col = m.color;
+        let rho = (col[0] + col[1] + col[2]) / 3.0;
+        if !(rng(i, 4 * k - 2) < rho) {
+            break;
+        }
+        flux = [flux[0] * (col[0] / rho), flux[1] * (col[1] / rho), flux[2] * (col[2] / rho)];
+        let g = 1.0 / rho.sqrt();
+        p.dz = [scale(p.dz[0], g), scale(p.dz[1], g)];
+        p.dw = [scale(p.dw[0], g), scale(p.dw[1], g)];
+        if diffuse {
+            reemit(&mut p, n, rng(i, 4 * k - 1), azimuth(rng(i, 4 * k)));
+        } else {
+            reflect(&mut p, n);
+        }
+    }
+    out
+}
+
+/// The native reference: every photon of `e` traced through `scene`'s `tree`.
+pub fn reference(scene: &Scene, tree: &KdTree, e: &Emission) -> Vec<[Option<Photon>; 2]> {
+    let caster = Caster::new(scene, tree);
+    (0..e.n as u32).map(|i| trace_one(&caster, e, i)).collect()
+}
+
+/// What the emulated kernel produced.
+#[derive(Debug, Clone)]
+pub struct KernelPhotons {
+    /// Per photon, its stored 2nd and 3rd interactions.
+    pub photons: Vec<[Option<Photon>; 2]>,
+    /// The emulator's counters.
+    pub launch: LaunchStats,
+}
+
+fn f32s(v: &[f32]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+fn slot(s: &[f32]) -> Option<Photon> {
+    if s[23] != 1.0 {
+        return None;
+    }
+    let v = |a: usize| [s[a], s[a + 1], s[a + 2]];
+    Some(Photon {
+        z: v(0),
+        flux: v(3),
+        dz: [v(6), v(9)],
+        dw: [v(12), v(15)],
+        normal: v(18),
+        tri: s[21].to_bits(),
+        interaction: s[22].to_bits(),
+    })
+}
+
+/// Loads the photon kernel's PTX on `dev`.
+pub fn load(dev: &mut Device) -> Result<Module, SimError> {
+    dev.load_ptx(PTX, "kernels/fabianowski2011/photons.ptx")
+}
+
+/// Runs the photon kernel for `e` over `scene`'s `tree` (laid out as chapter 4's kernels read it).
+pub fn trace_kernel(
+    dev: &mut Device,
+    module: &Module,
+    scene: &Scene,
+    tree: &KdTree,
+    e: &Emission,
+) -> Result<KernelPhotons, PhotonError> {
+    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let lay = layout(tree, &tris, 0);
+    let eps = tree.bounds.size().length().max(1e-3) * EPS_REL;
+    let (lo, hi) = (tree.bounds.lo, tree.bounds.hi);
+    let mut params = f32s(&[
+        e.position[0],
+        e.position[1],
+        e.position[2],
+        e.flux[0],
+        e.flux[1],
+        e.flux[2],
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z,
+        eps,
+    ]);
+    params.extend_from_slice(&(e.n as i32).to_le_bytes());
+    let mut mats = Vec::new();
+    for m in &scene.materials {
+        mats.extend_from_slice(&[m.color[0], m.color[1], m.color[2], kind_code(m.kind)]);
+        mats.extend_from_slice(&[m.emission[0], m.emission[1], m.emission[2], 0.0]);
+    }
+    let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
+    let up = |dev: &mut Device, bytes: &[u8], name: &str| -> Result<crate::sim::DevicePtr, SimError> {
+        let p = dev.alloc_bytes(bytes.len().max(4) as u64, name);
+        if !bytes.is_empty() {
+            dev.write(p, bytes)?;
+        }
+        Ok(p)
+    };
+    let pp = up(dev, &params, "params")?;
+    let nodes = up(dev, &lay.nodes, "nodes")?;
+    let refs = up(dev, &lay.tri_refs, "tri_refs")?;
+    let tb = up(dev, &lay.triangles, "triangles")?;
+    let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
+    let mb = up(dev, &f32s(&mats), "materials")?;
+    let out = dev.alloc_zeroed::<f32>(2 * SLOT * e.n.max(1));
+    let ctas = (e.n.div_ceil(THREADS as usize) as u32).clamp(1, MAX_CTAS);
+    let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, out].into_iter().map(Arg::Ptr).collect();
+    let launch = dev.launch(module, KERNEL, LaunchConfig::linear(ctas, THREADS), &args)?;
+    let raw = dev.read::<f32>(out, 2 * SLOT * e.n);
+    let photons = raw.chunks_exact(2 * SLOT).map(|p| [slot(&p[..SLOT]), slot(&p[SLOT..])]).collect();
+    Ok(KernelPhotons { photons, launch })
+}
