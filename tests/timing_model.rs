@@ -222,10 +222,7 @@ fn chapter_4_frame_rates_come_from_the_model_alone() {
     // an issue-bound frame at 256 x 256: 1/4 of the 512 x 512 work
     let base = KernelCounts { warp_instructions: 30.0 * 1e6, ..Default::default() };
     let slower = base.scaled(1.25);
-    let variants = ["stack", "stackless", "pushdown", "shortstack", "pushdown_shortstack"];
-    let names: Vec<&str> =
-        warplight::host::rt_kernels::Variant::ALL.iter().map(|v| v.name()).collect::<Vec<_>>().leak().to_vec();
-    assert_eq!(names.len(), variants.len());
+    let names: Vec<&str> = warplight::host::rt_kernels::Variant::ALL.iter().map(|v| v.name()).collect();
     let rows: Vec<(&str, &str, KernelCounts)> =
         names.iter().enumerate().map(|(i, n)| (fab::TRAVERSAL, *n, if i == 0 { base } else { slower })).collect();
     let r = results_with(&rows, 256);
