@@ -210,3 +210,231 @@ fn map_a_sorts_photons_by_cell_and_the_binary_search_finds_each_cells_first_phot
     assert_eq!(map.photons, stored);
     assert!(stored > 50);
 }
+
+use warplight::repro::purcell2003::knn::{self, Map, Params, RADIANCE_ESTIMATE};
+use warplight::repro::purcell2003::photons::{PhotonArrays, Queries};
+use warplight::repro::purcell2003::stencil;
+
+/// Photon arrays holding `photons` (position, power) in frame 1 (stored,
+/// arriving straight down), frame 0 empty.
+fn photon_arrays(p: &mut Passes, photons: &[(Vec3, f32)]) -> PhotonArrays {
+    let n = photons.len();
+    let mut pos = vec![0.0f32; 8 * n];
+    let mut pow = vec![0.0f32; 8 * n];
+    let mut dir = vec![0.0f32; 8 * n];
+    for (i, (x, w)) in photons.iter().enumerate() {
+        let s = 4 * (n + i);
+        pos[s..s + 4].copy_from_slice(&[x.x, x.y, x.z, 1.0]);
+        pow[s..s + 4].copy_from_slice(&[*w, *w, *w, 0.0]);
+        dir[s..s + 4].copy_from_slice(&[0.0, -1.0, 0.0, 0.0]);
+    }
+    let out = p.dev.alloc_zeroed::<f32>(8 * n);
+    PhotonArrays {
+        n,
+        frames: 2,
+        pos: p.upload(&pos).unwrap(),
+        pow: p.upload(&pow).unwrap(),
+        dir: p.upload(&dir).unwrap(),
+        out,
+    }
+}
+
+/// Query points (facing up) on a `w` x `h` image.
+fn queries(p: &mut Passes, w: u32, h: u32, points: &[Option<Vec3>]) -> Queries {
+    let q: Vec<f32> = points.iter().flat_map(|x| x.map_or([0.0; 4], |v| [v.x, v.y, v.z, 1.0])).collect();
+    let nrm: Vec<f32> = points.iter().flat_map(|_| [0.0, 1.0, 0.0, 0.0]).collect();
+    let alb: Vec<f32> = points.iter().flat_map(|_| [1.0, 1.0, 1.0, 0.0]).collect();
+    Queries {
+        width: w,
+        height: h,
+        query: p.upload(&q).unwrap(),
+        normal: p.upload(&nrm).unwrap(),
+        albedo: p.upload(&alb).unwrap(),
+    }
+}
+
+#[test]
+fn stencil_routing_keeps_the_first_m2_photons_of_each_cell_in_draw_order_and_redistributes_power() {
+    // 4 x 1 x 4 cells of 1 x 1; m = 2 (4 slots, as Fig. 5); 40 photons drawn
+    // into cell 5 (x 1, z 1), 3 into cell 0, the rest nowhere
+    let grid = Grid::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(4.0, 1.0, 4.0), [4, 1, 4]);
+    let mut photons = Vec::new();
+    for i in 0..43 {
+        let x = if i % 14 == 3 { Vec3::new(0.5, 0.5, 0.5) } else { Vec3::new(1.5, 0.5, 1.5) };
+        photons.push((x, 1.0 + i as f32));
+    }
+    let mut p = Passes::new(None).unwrap();
+    let ph = photon_arrays(&mut p, &photons);
+    let map = stencil::build(&mut p, grid, &ph, 4).unwrap();
+    assert_eq!(p.phase(BUILD_MAP).launches, 2, "one routing pass and one fill pass");
+    let slots = p.dev.read::<u32>(map.cell_slots, 16 * 4);
+    let in5: Vec<u32> = (0..43).filter(|i| i % 14 != 3).map(|i| (43 + i) as u32).collect();
+    let in0: Vec<u32> = (0..43).filter(|i| i % 14 == 3).map(|i| (43 + i) as u32).collect();
+    assert_eq!(&slots[5 * 4..6 * 4], &in5[..4], "the first four in draw order");
+    assert_eq!(&slots[..3], &in0[..]);
+    assert_eq!(slots[3], u32::MAX, "an empty slot");
+    for c in (1..16).filter(|&c| c != 5) {
+        assert!(slots[4 * c..4 * c + 4].iter().all(|&s| s == u32::MAX), "cell {c} empty");
+    }
+    let occ = stencil::occupancy(&p, &map);
+    assert_eq!(occ.destined, 43);
+    assert_eq!(occ.stored, 7);
+    assert_eq!(occ.lost(), 36);
+    assert_eq!(occ.overflowing_cells, 1);
+    let scale = p.dev.read::<f32>(map.scale, 16);
+    assert_eq!(scale[5], 40.0 / 4.0);
+    assert_eq!(scale[0], 1.0);
+    let bpow = p.dev.read::<f32>(map.pow, 4 * 16 * 4);
+    assert_eq!(bpow[4 * 20], photons[(in5[0] - 43) as usize].1, "the block holds the routed photon's data");
+    // the same slots when every photon is drawn by a CTA of its own (CTAs
+    // run in any order on the host's threads)
+    let cs = p.upload(&vec![u32::MAX; 64]).unwrap();
+    let ds = p.dev.alloc_zeroed::<u32>(16);
+    let args = [grid.arg(), Arg::Ptr(ph.pos), Arg::I32(43), Arg::I32(43), Arg::I32(4), Arg::Ptr(cs), Arg::Ptr(ds)];
+    p.launch("again", Kernels::Grid, "stencil_route", warplight::sim::LaunchConfig::linear(43, 1), &args).unwrap();
+    assert_eq!(p.dev.read::<u32>(cs, 64), slots);
+}
+
+/// Fig. 6 with k = 4 (004:L154): a query at the centre of cell (2, 2) of a
+/// 5 x 1 x 5 grid of unit cells, maximum radius 1.4.
+fn fig6_photons() -> Vec<(Vec3, f32)> {
+    let at = |x: f32, z: f32| (Vec3::new(x, 0.5, z), 1.0);
+    vec![
+        at(2.8, 2.5),  // (b-c) first cell: added, d = 0.30
+        at(2.05, 2.5), // (b-c) added, d = 0.45, the radius grows
+        at(1.9, 1.83), // (d) next cell: added, d = 0.90, the radius grows
+        at(1.1, 1.5),  // (d) rejected: d = 1.72 > r_max
+        at(2.5, 1.7),  // (e) added, d = 0.80: k = 4 reached
+        at(2.5, 1.3),  // (e) rejected: d = 1.2 outside the radius, which no longer grows
+        at(3.1, 1.9),  // (f) added: d = 0.85 within the radius
+        at(1.6, 3.4),  // (g) rejected: d = 1.27 outside the radius
+    ]
+}
+
+#[test]
+fn knn_grid_follows_fig_6s_accept_reject_sequence_with_k_4() {
+    let grid = Grid::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.0, 1.0, 5.0), [5, 1, 5]);
+    let mut p = Passes::new(None).unwrap();
+    let ph = photon_arrays(&mut p, &fig6_photons());
+    // the stencil map keeps a cell's photons in draw order, so the order of lookups is the list's
+    let smap = stencil::build(&mut p, grid, &ph, 4).unwrap();
+    let q = queries(&mut p, 1, 1, &[Some(Vec3::new(2.5, 0.5, 2.5))]);
+    let params = Params { k: 4, r_max: 1.4, iters: 1, tiled: false };
+    let map = Map::Stencil(&smap);
+    let state = knn::start_states(&mut p, &q).unwrap();
+    let mut prev = knn::states(&p, state, 1)[0];
+    let mut events = String::new();
+    for _ in 0..40 {
+        knn::pass(&mut p, "fig6", &map, &q, &params, state).unwrap();
+        let s = knn::states(&p, state, 1)[0];
+        if s.local > prev.local {
+            events.push(if s.n > prev.n { 'A' } else { 'R' });
+        } else {
+            events.push('|');
+        }
+        prev = s;
+        if s.done {
+            break;
+        }
+    }
+    // cells in order: (2,2) | ring 1: (1,1) (2,1) (3,1) | (1,2) (3,2) | (1,3) (2,3) (3,3)
+    assert_eq!(events, "AA|AR|AR|A|||R|||");
+    assert!(prev.done && prev.ring == 1);
+    assert_eq!(prev.n, 5);
+    assert!((prev.r - 0.9).abs() < 1e-3, "radius {}", prev.r);
+    assert_eq!(prev.sum, [5.0; 3]);
+    // on the bitonic map (whose sort orders a cell's photons its own way) the
+    // search also ends with every photon within its radius, at least k
+    let bmap = bitonic::build(&mut p, grid, &ph).unwrap();
+    let e = knn::estimate(&mut p, &Map::Bitonic(&bmap, &ph), &q, &Params { iters: 4, ..params }, 100).unwrap();
+    assert!(e.finished);
+    let s = e.states[0];
+    let within = fig6_photons().iter().filter(|(x, _)| (*x - Vec3::new(2.5, 0.5, 2.5)).length() <= s.r).count();
+    assert!(s.n >= 4 && s.n as usize == within, "{s:?}");
+    assert_eq!(s.used, prev.used, "one lookup per photon or cell end, on both maps");
+}
+
+#[test]
+fn knn_grid_finds_every_photon_within_its_sphere_and_fewer_than_k_only_at_r_max() {
+    // random photons on the plane y = 0.5 of a 16 x 1 x 16 grid; queries on a 16 x 16 image
+    let grid = Grid::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(16.0, 1.0, 16.0), [16, 1, 16]);
+    let u = |i: u32, d: u32| photons::rng_unit(11, i, 0, d);
+    let mut pts = Vec::new();
+    for i in 0..400 {
+        // denser towards x = 0
+        let x = 16.0 * u(i, 0) * u(i, 0);
+        pts.push((Vec3::new(x, 0.5, 16.0 * u(i, 1)), 1.0));
+    }
+    let mut p = Passes::new(None).unwrap();
+    let ph = photon_arrays(&mut p, &pts);
+    let bmap = bitonic::build(&mut p, grid, &ph).unwrap();
+    let qs: Vec<Option<Vec3>> =
+        (0..256).map(|i| Some(Vec3::new((i % 16) as f32 + 0.5, 0.5, (i / 16) as f32 + 0.5))).collect();
+    let q = queries(&mut p, 16, 16, &qs);
+    let params = Params { k: 8, r_max: 3.0, iters: 16, tiled: false };
+    let check = |states: &[knn::State]| {
+        for (i, s) in states.iter().enumerate() {
+            let x = qs[i].unwrap();
+            let mut d: Vec<f32> = pts.iter().map(|(y, _)| (*y - x).length()).collect();
+            d.sort_by(|a, b| a.partial_cmp(b).unwrap());
+            let within_max = d.iter().filter(|&&v| v <= 3.0).count();
+            if within_max < 8 {
+                // fewer than k within r_max: all of them
+                assert_eq!(s.n as usize, within_max, "pixel {i}");
+            } else {
+                // at least k: exactly the photons within the radius, which is the k-th nearest's or more
+                assert!(s.n >= 8, "pixel {i}");
+                assert!(s.r >= d[7] - 1e-5, "pixel {i}: radius {} below the 8th nearest {}", s.r, d[7]);
+                let inside = d.iter().filter(|&&v| v <= s.r).count();
+                assert_eq!(s.n as usize, inside, "pixel {i}");
+            }
+        }
+    };
+    let e = knn::estimate(&mut p, &Map::Bitonic(&bmap, &ph), &q, &params, 1000).unwrap();
+    assert!(e.finished);
+    check(&e.states);
+    // the stencil map with room for every photon: the same property (the
+    // radius itself depends on the order a cell's photons are looked at,
+    // which differs between the maps)
+    let smap = stencil::build(&mut p, grid, &ph, 64).unwrap();
+    assert_eq!(stencil::occupancy(&p, &smap).lost(), 0);
+    let e2 = knn::estimate(&mut p, &Map::Stencil(&smap), &q, &params, 1000).unwrap();
+    assert!(e2.finished);
+    check(&e2.states);
+}
+
+#[test]
+fn tiles_that_finish_stop_being_drawn_and_the_saving_follows_from_per_pixel_lookups() {
+    // 32 x 32 pixels (four 16 x 16 tiles); photons only near one corner, so
+    // pixels there finish fast and far pixels search out to r_max
+    let grid = Grid::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(32.0, 1.0, 32.0), [32, 1, 32]);
+    let mut pts = Vec::new();
+    for i in 0..300u32 {
+        let (a, b) = (photons::rng_unit(5, i, 0, 0), photons::rng_unit(5, i, 0, 1));
+        pts.push((Vec3::new(12.0 * a, 0.5, 12.0 * b), 1.0));
+    }
+    let mut p = Passes::new(None).unwrap();
+    let ph = photon_arrays(&mut p, &pts);
+    let smap = stencil::build(&mut p, grid, &ph, 16).unwrap();
+    let qs: Vec<Option<Vec3>> =
+        (0..1024).map(|i| Some(Vec3::new((i % 32) as f32 + 0.5, 0.5, (i / 32) as f32 + 0.5))).collect();
+    let q = queries(&mut p, 32, 32, &qs);
+    let single = Params { k: 4, r_max: 6.0, iters: 8, tiled: false };
+    let tiled = Params { tiled: true, ..single };
+    let map = Map::Stencil(&smap);
+    let a = knn::estimate(&mut p, &map, &q, &single, 10_000).unwrap();
+    let before = p.phase(RADIANCE_ESTIMATE);
+    let b = knn::estimate(&mut p, &map, &q, &tiled, 10_000).unwrap();
+    let after = p.phase(RADIANCE_ESTIMATE);
+    assert!(a.finished && b.finished);
+    assert_eq!(a.states, b.states, "the same estimate");
+    assert_eq!(a.passes, b.passes, "as many passes: the slowest tile sets both");
+    let used: Vec<i32> = a.states.iter().map(|s| s.used).collect();
+    // the emulator's lane-iterations are exactly what the per-pixel lookup counts predict
+    assert_eq!(a.lane_iterations, knn::predicted_lane_iterations(&used, 32, 32, 8, None));
+    assert_eq!(b.lane_iterations, knn::predicted_lane_iterations(&used, 32, 32, 8, Some(16)));
+    assert!(b.lane_iterations < a.lane_iterations, "{} vs {}", b.lane_iterations, a.lane_iterations);
+    // and the tiled passes ran fewer thread instructions
+    let tiled_inst = after.thread_instructions - before.thread_instructions;
+    assert!(tiled_inst < before.thread_instructions);
+}

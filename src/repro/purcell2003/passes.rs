@@ -101,6 +101,8 @@ pub struct Passes {
     knn: Module,
     /// Counters per phase name, summed over its launches.
     pub phases: BTreeMap<String, PhaseCounts>,
+    /// Counters per kernel name, summed over its launches.
+    pub kernels: BTreeMap<String, PhaseCounts>,
 }
 
 impl Passes {
@@ -115,7 +117,7 @@ impl Passes {
         let photons = dev.load_ptx(PHOTONS_PTX, "kernels/purcell2003/photons.ptx")?;
         let grid = dev.load_ptx(GRID_PTX, "kernels/purcell2003/grid.ptx")?;
         let knn = dev.load_ptx(KNN_PTX, "kernels/purcell2003/knn.ptx")?;
-        Ok(Passes { dev, photons, grid, knn, phases: BTreeMap::new() })
+        Ok(Passes { dev, photons, grid, knn, phases: BTreeMap::new(), kernels: BTreeMap::new() })
     }
 
     /// The module of `k`.
@@ -143,6 +145,7 @@ impl Passes {
         };
         let s = self.dev.launch(m, kernel, cfg, args)?;
         self.phases.entry(phase.to_string()).or_default().add(m, &s);
+        self.kernels.entry(kernel.to_string()).or_default().add(m, &s);
         Ok(s)
     }
 
@@ -162,6 +165,16 @@ impl Passes {
     /// The counters of `phase` (zero if it has not run).
     pub fn phase(&self, phase: &str) -> PhaseCounts {
         self.phases.get(phase).cloned().unwrap_or_default()
+    }
+
+    /// The counters of `phase`, taken out (a later launch of it starts from zero).
+    pub fn take_phase(&mut self, phase: &str) -> PhaseCounts {
+        self.phases.remove(phase).unwrap_or_default()
+    }
+
+    /// The counters of every launch of `kernel` (zero if it has not run).
+    pub fn kernel(&self, kernel: &str) -> PhaseCounts {
+        self.kernels.get(kernel).cloned().unwrap_or_default()
     }
 
     /// A buffer holding `data`.
