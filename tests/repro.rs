@@ -30,7 +30,8 @@ fn list_shows_every_thesis_and_the_status_of_chapter_4() {
         ("fabianowski:4.5", "reproduced"),
         ("fabianowski:4.10", "modelled"),
         ("fabianowski:5.1", "missing"),
-        ("purcell:1", "missing"),
+        ("purcell:1", "partly"),
+        ("lin:1", "missing"),
     ] {
         let line =
             out.lines().find(|l| l.trim_start().starts_with(&format!("{addr} "))).unwrap_or_else(|| panic!("{addr}"));
@@ -42,8 +43,8 @@ fn list_shows_every_thesis_and_the_status_of_chapter_4() {
 #[test]
 fn addresses_and_their_errors() {
     // a table that exists but is not reproduced, a thesis that does not exist, a table id nobody has
-    let (ok, _, err) = warplight(&["tables", "purcell:2"]);
-    assert!(!ok && err.contains("purcell:2 is not reproduced (missing)"), "{err}");
+    let (ok, _, err) = warplight(&["tables", "lin:2"]);
+    assert!(!ok && err.contains("lin:2 is not reproduced (missing)"), "{err}");
     let (ok, _, err) = warplight(&["tables", "nobody:1"]);
     assert!(!ok && err.contains("no thesis \"nobody\"; theses: fabianowski, engelhardt"), "{err}");
     let (ok, _, err) = warplight(&["tables", "4.11"]);
