@@ -213,8 +213,8 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     t.notes.push(
         "TEX follows from the data layout: map A reads first[c], first[c+1], the sorted element and the photon's position, \
          power and direction per lookup; map B its cell's stored count and redistribution factor and the slot's position, \
-         power and direction. Our routing pass reads its photon from memory (1 load) where the 2003 vertex program received \
-         it as a vertex attribute after the read-back (0 TEX)."
+         power and direction. Our routing pass reads its photon from memory (its flag, then a valid photon's position: \
+         1 or 2 loads) where the 2003 vertex program received it as a vertex attribute after the read-back (0 TEX)."
             .into(),
     );
     vec![t]
