@@ -1,0 +1,142 @@
+//! Photon tracing with photon differentials (thesis 000 §5.1): the emulated
+//! kernel stores exactly the photons of the native reference, and the
+//! differentials behave as the equations say on hand-made geometry.
+
+use std::path::Path;
+
+use glam::Vec3;
+use warplight::host::kdtree::{BuildParams, Heuristic, build};
+use warplight::host::scene_file;
+use warplight::repro::fabianowski2011::photons::{
+    self, Differentials, Emission, PhotonError, azimuth, emit, propagate, reemit, reflect, rng,
+};
+use warplight::sim::Device;
+
+fn v(a: [f32; 3]) -> Vec3 {
+    Vec3::from(a)
+}
+
+#[test]
+fn kernel_stores_the_reference_photons_bit_for_bit() {
+    let scene = scene_file::load(Path::new("scenes/cornell-box.toml")).unwrap();
+    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+    let e = Emission::of(&scene, 384).unwrap();
+    let native = photons::reference(&scene, &tree, &e);
+    let mut dev = Device::new();
+    let module = photons::load(&mut dev).unwrap();
+    let k = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap();
+    assert_eq!(k.photons.len(), native.len());
+    // the same float operations in the same order (no contraction on either side,
+    // correctly rounded sqrt and division): every stored bit agrees
+    for (i, (a, b)) in k.photons.iter().zip(&native).enumerate() {
+        for s in 0..2 {
+            assert_eq!(a[s].map(|p| p.bits()), b[s].map(|p| p.bits()), "photon {i} slot {s}");
+        }
+    }
+    let second = native.iter().filter(|p| p[0].is_some()).count();
+    let third = native.iter().filter(|p| p[1].is_some()).count();
+    // the test means something: both slots are populated, roulette terminated some
+    assert!(second > 50 && third > 20 && third < second, "stored {second} second, {third} third interactions");
+    for p in native.iter().flatten().flatten() {
+        assert!(p.bits()[..21].iter().all(|b| f32::from_bits(*b).is_finite()), "{p:?}");
+        assert!(v(p.dz[0]).length() > 0.0 && v(p.dz[1]).length() > 0.0);
+        // propagated position differentials lie in the surface's plane
+        for d in p.dz {
+            assert!(v(d).dot(v(p.normal)).abs() <= 1e-4 * v(d).length(), "{p:?}");
+        }
+    }
+}
+
+#[test]
+fn a_scene_without_a_point_light_is_an_error() {
+    let mut scene = scene_file::load(Path::new("scenes/cornell-box.toml")).unwrap();
+    scene.lights.retain(|l| !matches!(l, warplight::host::scene::Light::Point { .. }));
+    assert!(matches!(Emission::of(&scene, 16), Err(PhotonError::NoPointLight(_))));
+}
+
+#[test]
+fn the_generator_is_uniform_and_the_azimuth_is_exact_to_1e7() {
+    let n = 20_000u32;
+    let mean = (0..n).map(|i| rng(i, 3) as f64).sum::<f64>() / n as f64;
+    assert!((mean - 0.5).abs() < 0.01, "mean {mean}");
+    assert_eq!(rng(7, 2), rng(7, 2));
+    assert_ne!(rng(7, 2), rng(7, 3));
+    for i in 0..1000 {
+        let y = i as f32 / 1000.0;
+        let (c, s) = azimuth(y);
+        let a = 2.0 * std::f64::consts::PI * y as f64;
+        assert!((c as f64 - a.cos()).abs() < 3e-7 && (s as f64 - a.sin()).abs() < 3e-7, "y {y}: {c} {s}");
+    }
+}
+
+/// A photon from a point light toward +z, hitting the plane z = d head on.
+fn straight(d: f32) -> Differentials {
+    let mut p = emit([0.0; 3], 1.0, (1.0, 0.0));
+    propagate(&mut p, d, [0.0, 0.0, -1.0]);
+    p
+}
+
+#[test]
+fn the_footprint_grows_linearly_with_distance_from_a_point_light() {
+    // eq. 3.7 with dz = 0 at the light: dz/dp = t dw/dp on a plane facing the light
+    let base = straight(1.0);
+    for d in [0.5f32, 2.0, 3.0, 8.0] {
+        let p = straight(d);
+        for i in 0..2 {
+            assert!((v(p.dz[i]) - v(base.dz[i]) * d).length() <= 1e-6 * d, "d {d}: {:?}", p.dz);
+        }
+    }
+    // at p1 = 0 (cos p1 = 1): dw/dp1 = (1, 0, 0), dw/dp2 = (0, 1, 0)
+    assert_eq!(base.dz, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    // on a plane tilted by 60 degrees the footprint stretches by 1/cos along the tilt (eq. 3.9)
+    let n = [0.0, -(60f32.to_radians().sin()), -(60f32.to_radians().cos())];
+    let mut p = emit([0.0; 3], 1.0, (1.0, 0.0));
+    propagate(&mut p, 2.0, n);
+    assert!((v(p.dz[1]).length() - 2.0 / 60f32.to_radians().cos()).abs() < 1e-5, "{:?}", p.dz);
+    assert!((v(p.dz[0]).length() - 2.0).abs() < 1e-6);
+    assert!(v(p.dz[1]).dot(v(n)).abs() < 1e-6, "it lies in the plane");
+}
+
+#[test]
+fn a_mirror_reflects_the_differentials() {
+    // a photon leaving the origin at 45 degrees in the x-z plane meets the mirror
+    // z = 1 after t = sqrt 2, reflects, and travels on another sqrt 2 to x = 2:
+    // the footprint is the mirror image (z -> 2 - z) of the straight one at distance 2 sqrt 2
+    let c = std::f32::consts::FRAC_1_SQRT_2;
+    let mut p = emit([0.0; 3], c, (1.0, 0.0));
+    let mut q = p;
+    let r = std::f32::consts::SQRT_2;
+    propagate(&mut p, r, [0.0, 0.0, -1.0]);
+    reflect(&mut p, [0.0, 0.0, -1.0]);
+    assert!((v(p.w) - Vec3::new(c, 0.0, -c)).length() < 1e-6);
+    // the reflected direction differential mirrors the incoming one in z
+    let dw = q.dw;
+    for i in 0..2 {
+        assert!((v(p.dw[i]) - Vec3::new(dw[i][0], dw[i][1], -dw[i][2])).length() < 1e-6);
+    }
+    propagate(&mut p, r, [-1.0, 0.0, 0.0]);
+    propagate(&mut q, 2.0 * r, [-1.0, 0.0, 0.0]);
+    assert!((v(p.z) - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5, "{:?}", p.z);
+    for i in 0..2 {
+        let m = Vec3::new(q.dz[i][0], q.dz[i][1], -q.dz[i][2]);
+        assert!((v(p.dz[i]) - m).length() < 1e-5, "{i}: {:?} vs {m:?}", p.dz[i]);
+    }
+}
+
+#[test]
+fn re_emission_keeps_the_footprint_scale_through_the_virtual_offset() {
+    // eq. 5.30: t_v^2 = 2 |dz1 x dz2|; at normal re-emission (y1 = 0, cos p'1 = 1) the new
+    // position differentials are t_v dw', |dw'| = 1/2 each and orthogonal, so the new
+    // footprint area |dz1' x dz2'| = t_v^2 / 4 = |dz1 x dz2| / 2
+    let mut p = straight(3.0);
+    let before = v(p.dz[0]).cross(v(p.dz[1])).length();
+    reemit(&mut p, [0.0, 0.0, -1.0], 0.0, (1.0, 0.0));
+    assert!((v(p.w) - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+    let after = v(p.dz[0]).cross(v(p.dz[1])).length();
+    assert!((after - before / 2.0).abs() < 1e-5 * before, "{before} -> {after}");
+    for i in 0..2 {
+        assert!((v(p.dw[i]).length() - 0.5).abs() < 1e-6);
+        assert!(v(p.dw[i]).dot(v(p.w)).abs() < 1e-6);
+    }
+}
