@@ -34,7 +34,7 @@ pub fn reference_pass(input: &[(u32, u32)], offset: usize, stepno: usize) -> Vec
     (0..input.len())
         .map(|e| {
             let csign: i64 = if e % stage < offset { 1 } else { -1 };
-            let cdir: i64 = if (e / stepno) % 2 == 0 { 1 } else { -1 };
+            let cdir: i64 = if (e / stepno).is_multiple_of(2) { 1 } else { -1 };
             let v0 = input[e];
             let v1 = input[(e as i64 + csign * offset as i64) as usize];
             let cmin = if v0.0 < v1.0 { v0 } else { v1 };
