@@ -289,9 +289,12 @@ fn every_count_tag_has_its_instruction_in_the_ptx() {
     let m = rt_kernels::load(&mut dev).unwrap();
     let file = m.prog.files.iter().position(|f| f.ends_with("fabianowski2011/raytrace.cu")).unwrap() as u32;
     for t in &tags {
-        let found = m.prog.functions.iter().flat_map(|f| &f.info).any(|i| {
-            i.src.is_some_and(|s| s.file == file && s.line == t.line) && i.opcode == t.opcode
-        });
+        let found = m
+            .prog
+            .functions
+            .iter()
+            .flat_map(|f| &f.info)
+            .any(|i| i.src.is_some_and(|s| s.file == file && s.line == t.line) && i.opcode == t.opcode);
         assert!(found, "raytrace.cu:{}: no {} for @count {}", t.line, t.opcode, t.name);
     }
 }
