@@ -377,6 +377,9 @@ impl Ctx<'_> {
 /// the host-memory budget ([`crate::limits::memory_budget`]) may allow less.
 pub const MAX_BUFFER_BYTES: u64 = 8 << 30;
 
+/// The largest PTX file a spec may name.
+pub const MAX_PTX_BYTES: u64 = 256 << 20;
+
 /// The most dynamic shared memory a launch may ask for: the simulated
 /// device's shared memory per CTA (`SimConfig::max_shared_per_cta`).
 pub const MAX_DYNAMIC_SHARED: u32 = 228 * 1024;
@@ -686,8 +689,13 @@ pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
         crate::compile::compile(&spec.ptx, crate::compile::Dialect::Clang)
             .map_err(|e| SpecError::Io { file: spec.file.display().to_string(), msg: format!("ptx: {e}") })?
     } else {
-        std::fs::read_to_string(&spec.ptx)
-            .map_err(|e| SpecError::Io { file: spec.ptx.display().to_string(), msg: e.to_string() })?
+        let io = |msg: String| SpecError::Io { file: spec.ptx.display().to_string(), msg };
+        // only a regular file of bounded size: never /dev/zero or a FIFO
+        let meta = std::fs::metadata(&spec.ptx).map_err(|e| io(e.to_string()))?;
+        if !meta.is_file() || meta.len() > MAX_PTX_BYTES {
+            return Err(io(format!("not a regular file of at most {} MiB", MAX_PTX_BYTES >> 20)));
+        }
+        std::fs::read_to_string(&spec.ptx).map_err(|e| io(e.to_string()))?
     };
     let prog = crate::ptx::load(&src, &spec.ptx.display().to_string()).map_err(SimError::from)?;
     check_resources(spec, &prog, dev.config())?;

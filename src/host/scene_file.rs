@@ -330,6 +330,9 @@ fn load_obj(
     materials: &mut Vec<Material>,
 ) -> Result<Vec<Triangle>, SceneError> {
     let opts = tobj::LoadOptions { triangulate: true, single_index: false, ..Default::default() };
+    if path.exists() && !path.is_file() {
+        return cx.err("obj", format!("{} is not a regular file", path.display()));
+    }
     if !path.exists() {
         return cx.err(
             "obj",
