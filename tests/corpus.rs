@@ -188,7 +188,6 @@ fn mutate(text: &str, rng: &mut Rng) -> String {
 /// buffers allocated under a small budget; scenes: the kd-tree built)
 /// without a panic.
 #[test]
-#[ignore = "killed on the development machine while a mutated path (/dev/zero) is read; being fixed"]
 fn mutated_specs_and_scenes_never_panic() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let specs: Vec<(PathBuf, String)> =
