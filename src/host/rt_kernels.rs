@@ -232,7 +232,7 @@ impl MemObserver for CacheObserver {
                 continue;
             }
             let a = ev.addrs[lane];
-            if a >= base && a < base + 8 * self.inner.len() as u64 && (a - base) % 8 == 0 {
+            if a >= base && a < base + 8 * self.inner.len() as u64 && (a - base).is_multiple_of(8) {
                 self.served += self.inner[((a - base) / 8) as usize] as u64;
             }
         }
