@@ -283,7 +283,8 @@ pub fn trace_one(caster: &Caster, e: &Emission, i: u32) -> [Option<Photon>; 2] {
         }
         let col = m.color;
         let rho = (col[0] + col[1] + col[2]) / 3.0;
-        if !(rng(i, 4 * k - 2) < rho) {
+        // survive only if y < rho (as the kernel's `!(y < rho)` test; a NaN rho terminates)
+        if rng(i, 4 * k - 2).partial_cmp(&rho) != Some(std::cmp::Ordering::Less) {
             break;
         }
         flux = [flux[0] * (col[0] / rho), flux[1] * (col[1] / rho), flux[2] * (col[2] / rho)];
