@@ -111,9 +111,8 @@ fn a_mirror_reflects_the_differentials() {
     reflect(&mut p, [0.0, 0.0, -1.0]);
     assert!((v(p.w) - Vec3::new(c, 0.0, -c)).length() < 1e-6);
     // the reflected direction differential mirrors the incoming one in z
-    let dw = q.dw;
-    for i in 0..2 {
-        assert!((v(p.dw[i]) - Vec3::new(dw[i][0], dw[i][1], -dw[i][2])).length() < 1e-6);
+    for (r, d) in p.dw.iter().zip(q.dw) {
+        assert!((v(*r) - Vec3::new(d[0], d[1], -d[2])).length() < 1e-6);
     }
     propagate(&mut p, r, [-1.0, 0.0, 0.0]);
     propagate(&mut q, 2.0 * r, [-1.0, 0.0, 0.0]);
