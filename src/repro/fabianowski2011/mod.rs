@@ -453,12 +453,11 @@ pub fn flight_table(
         &scenes,
         "SIROH trees, 30 persistent CTAs x 256 threads, 32-pixel job blocks, clang-16 PTX, gt200 profile",
     ));
-    t
     t.notes.push(COUNTING.into());
     t.notes.push(MATERIALS.into());
+    t
 }
 
-/// A frame-rate table through the GTX 280 timing model ([`timing`]; no
 /// How the flight tables' counts are made.
 pub const COUNTING: &str = "Counts by the emulator: the kernels run without in-kernel tallies; rays, inner-node steps, \
      leaf visits, triangle tests and local-memory stack pushes and pops are the executions of the instructions on the \
@@ -472,6 +471,7 @@ pub const MATERIALS: &str = "Materials: none of Sponza, Sibenik and Conference h
      so these scenes trace no reflection rays and the texture cache sees kd-tree, reference and triangle fetches only, \
      none of the thesis' texture-map traffic (Table A.1: 64 MB Sponza, 16 MB Sibenik).";
 
+/// A frame-rate table through the GTX 280 timing model ([`timing`]; no
 /// parameter from the thesis): every column predicted, the absolute one
 /// compared within ±15 %, the relative ones within the ratio tolerance.
 pub fn timing_table(
