@@ -32,6 +32,7 @@ use std::collections::HashMap;
 
 use super::cfg::Cfg;
 use super::counters::LaunchStats;
+use super::decode::Code;
 use super::exec::Ctx;
 use super::fault::Fault;
 use super::grid::{GridRun, Schedule};
@@ -268,6 +269,8 @@ pub struct Module {
     pub prog: Program,
     /// CFG of each function.
     pub cfgs: Vec<Cfg>,
+    /// The decoded, executable form.
+    pub code: Code,
     globals: Vec<u64>,
 }
 
@@ -395,7 +398,8 @@ impl Device {
             }
             globals.push(p.0);
         }
-        Module { prog, cfgs, globals }
+        let code = Code::decode(&prog);
+        Module { prog, cfgs, code, globals }
     }
 
     fn prepare(
@@ -469,6 +473,7 @@ impl Device {
     ) -> Ctx<'a> {
         Ctx {
             prog: &m.prog,
+            code: &m.code,
             cfgs: &m.cfgs,
             mem: &self.mem,
             kparams: kp,

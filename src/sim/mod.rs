@@ -9,6 +9,7 @@ pub mod alu;
 pub mod cfg;
 pub mod counters;
 pub mod cta;
+pub mod decode;
 pub mod device;
 pub mod exec;
 pub mod fault;
