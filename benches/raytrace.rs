@@ -71,6 +71,15 @@ fn report() {
 }
 
 fn bench(c: &mut Criterion) {
+    // `RAYTRACE_ONCE=1`: one emulated frame on one host thread and nothing
+    // else, for profiling (`perf record`).
+    if std::env::var_os("RAYTRACE_ONCE").is_some() {
+        let (s, tree, cam) = setup();
+        let t0 = Instant::now();
+        emulated(&s, &tree, &cam, 1);
+        eprintln!("one emulated frame, 1 thread: {:.3} s", t0.elapsed().as_secs_f64());
+        return;
+    }
     report();
     let (s, tree, cam) = setup();
     let mut g = c.benchmark_group("sponza_512");

@@ -174,10 +174,15 @@ pub struct CtaModel {
     /// the lines of each half-warp lookup end at the next `tex_ends` entry.
     tex_pending: Vec<u64>,
     tex_ends: Vec<usize>,
+    /// Scratch space reused by every event, so that counting allocates nothing.
+    lines: Vec<u64>,
+    pairs: Vec<(u64, u64)>,
 }
 
 impl CtaModel {
-    fn new(profile: Profile, shape: &[usize]) -> Self {
+    /// A CTA's model of `profile`, with per-instruction counts shaped as `shape`
+    /// (instructions per function).
+    pub fn new(profile: Profile, shape: &[usize]) -> Self {
         let p = profile.params();
         CtaModel {
             profile,
@@ -188,6 +193,8 @@ impl CtaModel {
                 .then(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways)),
             tex_pending: Vec::new(),
             tex_ends: Vec::new(),
+            lines: Vec::with_capacity(64),
+            pairs: Vec::with_capacity(64),
         }
     }
 
@@ -210,16 +217,19 @@ impl CtaModel {
         let physical = |l: usize| if local { sectors::local_physical(key, l, ev.addrs[l]) } else { ev.addrs[l] };
         if self.profile == Profile::Gt200 {
             if kind == Kind::Texture {
-                // The texture path does not coalesce: one lookup per distinct 32-byte line per half-warp.
+                // The texture path does not coalesce: one request per half-warp
+                // with active lanes, one lookup per distinct 32-byte line in it.
+                let mut lines = std::mem::take(&mut self.lines);
                 for h in 0..2 {
                     let m = ev.mask & (0xFFFF << (16 * h));
-                    let lines = sectors::sectors(m, ev.bytes, |l| ev.addrs[l]);
+                    sectors::sectors_into(m, ev.bytes, |l| ev.addrs[l], &mut lines);
                     c.requests += (!lines.is_empty()) as u64;
+                    im.requests += (!lines.is_empty()) as u64;
                     c.sectors += lines.len() as u64;
                     im.sectors += lines.len() as u64;
                     match self.tex.as_mut() {
                         Some(cache) => {
-                            for s in lines {
+                            for &s in &lines {
                                 if cache.access(s) {
                                     c.hits += 1;
                                 } else {
@@ -235,7 +245,7 @@ impl CtaModel {
                         None => {}
                     }
                 }
-                im.requests = 1;
+                self.lines = lines;
                 return im;
             }
             // Local memory is interleaved per thread, so give the coalescer word addresses.
@@ -260,11 +270,12 @@ impl CtaModel {
             im.sectors = t.count();
             return im;
         }
-        let secs = if local {
-            sectors::local_sectors(key, ev.mask, ev.bytes, |l| ev.addrs[l])
+        let mut secs = std::mem::take(&mut self.lines);
+        if local {
+            sectors::local_sectors_into(key, ev.mask, ev.bytes, |l| ev.addrs[l], &mut secs);
         } else {
-            sectors::sectors(ev.mask, ev.bytes, physical)
-        };
+            sectors::sectors_into(ev.mask, ev.bytes, physical, &mut secs);
+        }
         c.requests += 1;
         c.sectors += secs.len() as u64;
         im.requests = 1;
@@ -275,7 +286,7 @@ impl CtaModel {
             _ => None,
         };
         if let Some(cache) = cache {
-            for s in secs {
+            for &s in &secs {
                 if cache.access(s) {
                     c.hits += 1;
                 } else {
@@ -286,18 +297,19 @@ impl CtaModel {
             && let Some(l1) = self.l1.as_mut()
         {
             // write-through: stores keep cached sectors valid
-            for s in secs {
+            for &s in &secs {
                 l1.access(s);
             }
         }
+        self.lines = secs;
         im
     }
 
     fn banked(&mut self, ev: &MemEvent, which: Bank) -> InstMem {
         let cost = if self.profile == Profile::Gt200 {
-            banks::cost16(ev.mask, ev.bytes, |l| ev.addrs[l])
+            banks::cost16_with(ev.mask, ev.bytes, |l| ev.addrs[l], &mut self.pairs)
         } else {
-            banks::cost32(ev.mask, ev.bytes, |l| ev.addrs[l])
+            banks::cost32_with(ev.mask, ev.bytes, |l| ev.addrs[l], &mut self.pairs)
         };
         let c = match which {
             Bank::Load => &mut self.counters.shared_ld,
@@ -317,8 +329,10 @@ impl CtaModel {
         // The constant cache serves one address per pass (per half-warp on GT200).
         let groups: &[u32] = if self.profile == Profile::Gt200 { &[0xFFFF, 0xFFFF_0000] } else { &[u32::MAX] };
         let mut passes = 0;
+        let a = &mut self.lines;
         for g in groups {
-            let mut a: Vec<u64> = (0..32).filter(|l| (ev.mask & g) >> l & 1 != 0).map(|l| ev.addrs[l]).collect();
+            a.clear();
+            a.extend((0..32).filter(|l| (ev.mask & g) >> l & 1 != 0).map(|l| ev.addrs[l]));
             a.sort_unstable();
             a.dedup();
             passes += a.len() as u64;
@@ -353,9 +367,12 @@ enum Bank {
     Atom,
 }
 
-impl MemObserver for CtaModel {
-    fn access(&mut self, ev: &MemEvent) {
-        let im = match (ev.space, ev.op) {
+impl CtaModel {
+    /// Counts one warp-level access into the CTA's counters and returns what it
+    /// cost that instruction. The one implementation of the profile's rules:
+    /// the counters and the teaching views ([`explain`]) both take it from here.
+    pub fn count(&mut self, ev: &MemEvent) -> InstMem {
+        match (ev.space, ev.op) {
             (MemSpace::Global, MemOp::Load) if ev.nc && self.profile != Profile::Hopper => {
                 self.global(ev, Kind::Texture)
             }
@@ -373,7 +390,18 @@ impl MemObserver for CtaModel {
                 self.counters.param += 1;
                 InstMem::default()
             }
-        };
+        }
+    }
+
+    /// The counters so far.
+    pub fn counters(&self) -> &MemCounters {
+        &self.counters
+    }
+}
+
+impl MemObserver for CtaModel {
+    fn access(&mut self, ev: &MemEvent) {
+        let im = self.count(ev);
         let slot = &mut self.per_inst[ev.func as usize][ev.pc as usize];
         slot.requests += im.requests;
         slot.sectors += im.sectors;

@@ -152,11 +152,17 @@ pub(super) fn set(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, kind: &Kind, exec: u32)
 /// `selp`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn selp(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, d: Dst, a: Src, b: Src, p: PredSrc, exec: u32) {
-    let r: Lanes = {
+    let mut r = [0u64; 32];
+    {
         let (va, vb) = (operand(ctx, w, cta, a), operand(ctx, w, cta, b));
         let pv = pred_bits(w.frame(), p);
-        std::array::from_fn(|l| if pv >> l & 1 != 0 { va[l] } else { vb[l] })
-    };
+        for l in 0..32 {
+            // branch-free: the predicate bit as an all-ones or all-zeros mask
+            let m = ((pv >> l) & 1) as u64;
+            let m = m.wrapping_neg();
+            r[l] = (va[l] & m) | (vb[l] & !m);
+        }
+    }
     write(w.frames.last_mut().expect("frame"), d, &r, exec);
 }
 

@@ -40,7 +40,7 @@ pub(super) fn atomic(
     b: Src,
     c: Src,
     exec: u32,
-) -> Result<Effect, ExecFault> {
+) -> Result<Effect, Box<ExecFault>> {
     let addrs = addresses(ctx, w, cta, addr);
     let (vb, vc) = (read(ctx, w, cta, b), read(ctx, w, cta, c));
     let size = ty.bytes();

@@ -18,7 +18,7 @@ pub(super) fn call(
     callee: u32,
     args: &[(u32, u32, u32)],
     exec: u32,
-) -> Result<Effect, ExecFault> {
+) -> Result<Effect, Box<ExecFault>> {
     if exec == 0 {
         return Ok(Effect::Continue);
     }

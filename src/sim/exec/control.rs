@@ -42,7 +42,7 @@ pub(super) fn bar(
     id: Src,
     count: Option<Src>,
     exec: u32,
-) -> Result<Effect, ExecFault> {
+) -> Result<Effect, Box<ExecFault>> {
     if exec != w.live {
         return Err(fault(FaultKind::DivergentBarrier { active: exec, live: w.live }, None));
     }

@@ -112,7 +112,7 @@ pub(super) fn access(
     size: u32,
     align: u32,
     store: Option<u64>,
-) -> Result<u64, ExecFault> {
+) -> Result<u64, Box<ExecFault>> {
     let a = r.addr();
     let oob = || fault(FaultKind::OutOfBounds { space: r.space(), addr: a, size }, Some(lane));
     if !a.is_multiple_of(align as u64) {
@@ -260,7 +260,7 @@ fn vector_access(
     vals: &mut [Lanes],
     store: bool,
     touched: &mut Touched,
-) -> Result<Option<Resolved>, ExecFault> {
+) -> Result<Option<Resolved>, Box<ExecFault>> {
     let size = ty.bytes();
     let n = vals.len() as u32;
     let mut first = None;
@@ -314,7 +314,7 @@ fn vector_access(
 }
 
 /// Vector accesses must be aligned to their whole size.
-fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), ExecFault> {
+fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), Box<ExecFault>> {
     if !r.addr().is_multiple_of(total as u64) {
         return Err(fault(FaultKind::Misaligned { space: r.space(), addr: r.addr(), size: total }, Some(lane)));
     }
@@ -355,7 +355,7 @@ pub(super) fn load(
     addr: &Address,
     nc: bool,
     exec: u32,
-) -> Result<(), ExecFault> {
+) -> Result<(), Box<ExecFault>> {
     let addrs = addresses(ctx, w, cta, addr);
     let mut touched = Touched::new();
     // a scalar load needs one lane array, not four
@@ -391,7 +391,7 @@ pub(super) fn store(
     srcs: &[Src],
     addr: &Address,
     exec: u32,
-) -> Result<(), ExecFault> {
+) -> Result<(), Box<ExecFault>> {
     let addrs = addresses(ctx, w, cta, addr);
     let mut vs = [[0u64; 32]; 4];
     for (k, v) in srcs.iter().enumerate() {

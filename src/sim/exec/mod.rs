@@ -81,8 +81,10 @@ pub struct ExecFault {
     pub lane: Option<u32>,
 }
 
-fn fault(kind: FaultKind, lane: Option<usize>) -> ExecFault {
-    ExecFault { kind, lane: lane.map(|l| l as u32) }
+/// A fault, boxed: instructions return it rarely, and a small `Result` keeps
+/// the common path cheap.
+fn fault(kind: FaultKind, lane: Option<usize>) -> Box<ExecFault> {
+    Box::new(ExecFault { kind, lane: lane.map(|l| l as u32) })
 }
 
 /// What the executed instruction did to the warp's schedulability.
@@ -227,7 +229,7 @@ fn special(ctx: &Ctx, w: &Warp, cta: &CtaMut, sr: SpecialReg) -> Lanes {
 
 /// Executes the next instruction of warp `w`. Returns its function and PC (for
 /// fault reports and stepping) and its effect.
-pub fn step(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut) -> (u32, u32, Result<Effect, ExecFault>) {
+pub fn step(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut) -> (u32, u32, Result<Effect, Box<ExecFault>>) {
     let base = w.frame().stack_base;
     cta.counters.reconvergences += w.stack.reconverge(base) as u64;
     let top = *w.stack.top().expect("running warp has a path");
@@ -249,7 +251,7 @@ fn advance(w: &mut Warp, pc: u32) {
     w.stack.top_mut().expect("top").pc = pc + 1;
 }
 
-fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, ExecFault> {
+fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, Box<ExecFault>> {
     let f = &ctx.prog.functions[func as usize];
     let pc = top.pc;
     let (Some(inst), Some(op)) = (f.insts.get(pc as usize), ctx.code.funcs[func as usize].ops.get(pc as usize)) else {
