@@ -27,11 +27,12 @@ pub mod validation;
 
 use std::any::Any;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::ptx::Program;
 use crate::ptx::ir::MemSpace;
 use crate::sim::counters::Counters;
-use crate::sim::{MemEvent, MemObserver, MemOp, ObserverFactory};
+use crate::sim::{Fidelity, MemEvent, MemObserver, MemOp, ObserverFactory};
 pub use occupancy::{Occupancy, occupancy};
 pub use profile::Profile;
 
@@ -177,24 +178,32 @@ pub struct CtaModel {
     /// Scratch space reused by every event, so that counting allocates nothing.
     lines: Vec<u64>,
     pairs: Vec<(u64, u64)>,
+    /// Simulates caches (fidelity `caches`); without, hits and misses stay 0.
+    caches: bool,
 }
 
 impl CtaModel {
     /// A CTA's model of `profile`, with per-instruction counts shaped as `shape`
     /// (instructions per function).
     pub fn new(profile: Profile, shape: &[usize]) -> Self {
+        Self::with_caches(profile, shape, true)
+    }
+
+    /// As [`CtaModel::new`]; without `caches` no cache is simulated.
+    pub fn with_caches(profile: Profile, shape: &[usize], caches: bool) -> Self {
         let p = profile.params();
         CtaModel {
             profile,
             counters: MemCounters::default(),
             per_inst: shape.iter().map(|&n| vec![InstMem::default(); n]).collect(),
-            l1: (p.l1_bytes > 0).then(|| cache::SectorCache::new(p.l1_bytes, 128, 4)),
-            tex: (p.tex_bytes > 0 && p.tex_shared_sms == 1)
+            l1: (caches && p.l1_bytes > 0).then(|| cache::SectorCache::new(p.l1_bytes, 128, 4)),
+            tex: (caches && p.tex_bytes > 0 && p.tex_shared_sms == 1)
                 .then(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways)),
             tex_pending: Vec::new(),
             tex_ends: Vec::new(),
             lines: Vec::with_capacity(64),
             pairs: Vec::with_capacity(64),
+            caches,
         }
     }
 
@@ -238,7 +247,7 @@ impl CtaModel {
                             }
                         }
                         // a cache shared by the TPC: looked up at the round's end
-                        None if !lines.is_empty() => {
+                        None if self.caches && !lines.is_empty() => {
                             self.tex_pending.extend_from_slice(&lines);
                             self.tex_ends.push(self.tex_pending.len());
                         }
@@ -427,6 +436,8 @@ pub struct Model {
     /// Texture caches shared by the SMs of a texture processor cluster (GT200),
     /// by cluster; created on first use.
     shared_tex: Mutex<Vec<Option<cache::SectorCache>>>,
+    /// Simulates caches (set by the launch's fidelity; on by default).
+    caches: AtomicBool,
 }
 
 /// What a model counted.
@@ -451,6 +462,7 @@ impl Model {
             shape,
             acc: Mutex::new(ModelStats { profile, counters: MemCounters::default(), per_inst }),
             shared_tex: Mutex::new(Vec::new()),
+            caches: AtomicBool::new(true),
         }
     }
 
@@ -462,7 +474,11 @@ impl Model {
 
 impl ObserverFactory for Model {
     fn create(&self, _cta: u32) -> Box<dyn MemObserver> {
-        Box::new(CtaModel::new(self.profile, &self.shape))
+        Box::new(CtaModel::with_caches(self.profile, &self.shape, self.caches.load(Ordering::Relaxed)))
+    }
+
+    fn set_fidelity(&self, level: Fidelity) {
+        self.caches.store(level >= Fidelity::Caches, Ordering::Relaxed);
     }
 
     /// Replays the round's texture lookups of the CTAs that share a texture

@@ -2,7 +2,8 @@
 //! ([`warp`]), instruction semantics ([`exec`], [`alu`]), CTAs and their warp
 //! scheduler ([`cta`]), the grid scheduler ([`grid`]), device memory
 //! ([`memory`]), faults ([`fault`]), counters ([`counters`]), stepping
-//! ([`stepper`]) and the public [`Device`] API ([`device`]).
+//! ([`stepper`]), fidelity levels ([`fidelity`]), the decoded executable form
+//! ([`decode`]) and the public [`Device`] API ([`device`]).
 
 pub mod access_log;
 pub mod alu;
@@ -13,6 +14,7 @@ pub mod decode;
 pub mod device;
 pub mod exec;
 pub mod fault;
+pub mod fidelity;
 pub mod grid;
 pub mod memory;
 pub mod observer;
@@ -23,6 +25,7 @@ pub mod warp;
 pub use counters::{Counters, LaunchStats};
 pub use device::{Arg, Device, DevicePtr, Element, LaunchConfig, Module, SimConfig, SimError};
 pub use fault::{Fault, FaultKind};
+pub use fidelity::Fidelity;
 pub use grid::Schedule;
 pub use observer::{MemEvent, MemObserver, MemOp, ObserverFactory};
 pub use stepper::{StepEvent, Stepper, WarpView};

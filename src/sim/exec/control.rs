@@ -14,7 +14,9 @@ pub(super) fn branch(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, pc: u
     let rpc = ctx.cfgs[func as usize].reconv[pc as usize];
     if w.stack.branch(exec, target, pc + 1, rpc) == BranchOutcome::Diverged {
         cta.counters.divergent_branches += 1;
-        cta.profile.per_fn[func as usize][pc as usize].divergent += 1;
+        if ctx.per_inst {
+            cta.profile.per_fn[func as usize][pc as usize].divergent += 1;
+        }
     }
     Effect::Continue
 }

@@ -52,6 +52,8 @@ pub struct Ctx<'a> {
     pub max_call_depth: u32,
     /// Makes the per-CTA memory observers (counter models), if any.
     pub observers: Option<&'a dyn ObserverFactory>,
+    /// Count per instruction (fidelity `instructions` and up).
+    pub per_inst: bool,
 }
 
 /// The CTA-owned state an instruction may change besides its warp.
@@ -268,10 +270,12 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
     c.thread_instructions += mask.count_ones() as u64;
     c.thread_instructions_pred_on += exec.count_ones() as u64;
     c.by_class.add(op.class);
-    let ic = &mut cta.profile.per_fn[func as usize][pc as usize];
-    ic.warp += 1;
-    ic.thread += mask.count_ones() as u64;
-    ic.pred_on += exec.count_ones() as u64;
+    if ctx.per_inst {
+        let ic = &mut cta.profile.per_fn[func as usize][pc as usize];
+        ic.warp += 1;
+        ic.thread += mask.count_ones() as u64;
+        ic.pred_on += exec.count_ones() as u64;
+    }
 
     // Control transfers move the stack themselves (and run with no lane active too).
     match &inst.kind {
