@@ -321,6 +321,7 @@ fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), Box<Ex
     Ok(())
 }
 
+/// Counts a memory instruction under the space its first lane resolved to.
 pub(super) fn count_space(c: &mut crate::sim::counters::SpaceCounts, r: Resolved) {
     match r {
         Resolved::Global(_) => c.global += 1,
@@ -331,6 +332,7 @@ pub(super) fn count_space(c: &mut crate::sim::counters::SpaceCounts, r: Resolved
     }
 }
 
+/// Every lane's address: base operand plus offset (32-bit bases wrap, then zero-extend).
 pub(super) fn addresses(ctx: &Ctx, w: &Warp, cta: &CtaMut, a: &Address) -> Lanes {
     let base = operand(ctx, w, cta, a.base);
     if a.wide {
@@ -339,8 +341,6 @@ pub(super) fn addresses(ctx: &Ctx, w: &Warp, cta: &CtaMut, a: &Address) -> Lanes
         map1(&base, |b| (b as u32).wrapping_add(a.offset as u32) as u64)
     }
 }
-
-/// Executes the next instruction of warp `w`. Returns its function and PC (for
 
 /// `ld`: `ds.len()` elements per lane.
 #[allow(clippy::too_many_arguments)]
