@@ -27,6 +27,8 @@ pub mod validation;
 
 use std::any::Any;
 use std::sync::Mutex;
+
+use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::ptx::Program;
@@ -440,6 +442,35 @@ pub struct Model {
     caches: AtomicBool,
 }
 
+/// Replays one texture-processor cluster's lookups of a round into its cache:
+/// the cluster's CTAs take turns one half-warp lookup at a time, in CTA order.
+fn replay_cluster(cache: &mut cache::SectorCache, group: &mut [(u32, &mut CtaModel)]) {
+    let mut next = vec![0usize; group.len()];
+    loop {
+        let mut any = false;
+        for (j, (_, m)) in group.iter_mut().enumerate() {
+            let Some(&end) = m.tex_ends.get(next[j]) else { continue };
+            let start = if next[j] == 0 { 0 } else { m.tex_ends[next[j] - 1] };
+            for i in start..end {
+                if cache.access(m.tex_pending[i]) {
+                    m.counters.texture.hits += 1;
+                } else {
+                    m.counters.texture.misses += 1;
+                }
+            }
+            next[j] += 1;
+            any = true;
+        }
+        if !any {
+            break;
+        }
+    }
+    for (_, m) in group.iter_mut() {
+        m.tex_pending.clear();
+        m.tex_ends.clear();
+    }
+}
+
 /// What a model counted.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct ModelStats {
@@ -504,36 +535,23 @@ impl ObserverFactory for Model {
         }
         ctas.sort_by_key(|c| c.0); // stable: CTA order within a cluster
         let mut caches = self.shared_tex.lock().expect("model lock");
-        for group in ctas.chunk_by_mut(|a, b| a.0 == b.0) {
-            let k = group[0].0 as usize;
-            if caches.len() <= k {
-                caches.resize(k + 1, None);
-            }
-            let cache = caches[k].get_or_insert_with(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways));
-            let mut next = vec![0usize; group.len()];
-            loop {
-                let mut any = false;
-                for (j, (_, m)) in group.iter_mut().enumerate() {
-                    let Some(&end) = m.tex_ends.get(next[j]) else { continue };
-                    let start = if next[j] == 0 { 0 } else { m.tex_ends[next[j] - 1] };
-                    for i in start..end {
-                        if cache.access(m.tex_pending[i]) {
-                            m.counters.texture.hits += 1;
-                        } else {
-                            m.counters.texture.misses += 1;
-                        }
-                    }
-                    next[j] += 1;
-                    any = true;
+        // Each cluster's cache is its own: replay the clusters in parallel
+        // (on the launch's host threads), each in its fixed order.
+        let mut work: Vec<(usize, cache::SectorCache, &mut [(u32, &mut CtaModel)])> = ctas
+            .chunk_by_mut(|a, b| a.0 == b.0)
+            .map(|group| {
+                let k = group[0].0 as usize;
+                if caches.len() <= k {
+                    caches.resize(k + 1, None);
                 }
-                if !any {
-                    break;
-                }
-            }
-            for (_, m) in group.iter_mut() {
-                m.tex_pending.clear();
-                m.tex_ends.clear();
-            }
+                let cache =
+                    caches[k].take().unwrap_or_else(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways));
+                (k, cache, group)
+            })
+            .collect();
+        work.par_iter_mut().for_each(|(_, cache, group)| replay_cluster(cache, group));
+        for (k, cache, _) in work {
+            caches[k] = Some(cache);
         }
     }
 
