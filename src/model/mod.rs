@@ -442,9 +442,12 @@ pub struct Model {
     caches: AtomicBool,
 }
 
+/// One texture-processor cluster's CTA models of a round, with their cluster index.
+type Cluster<'a, 'b> = &'a mut [(u32, &'b mut CtaModel)];
+
 /// Replays one texture-processor cluster's lookups of a round into its cache:
 /// the cluster's CTAs take turns one half-warp lookup at a time, in CTA order.
-fn replay_cluster(cache: &mut cache::SectorCache, group: &mut [(u32, &mut CtaModel)]) {
+fn replay_cluster(cache: &mut cache::SectorCache, group: Cluster) {
     let mut next = vec![0usize; group.len()];
     loop {
         let mut any = false;
@@ -537,7 +540,7 @@ impl ObserverFactory for Model {
         let mut caches = self.shared_tex.lock().expect("model lock");
         // Each cluster's cache is its own: replay the clusters in parallel
         // (on the launch's host threads), each in its fixed order.
-        let mut work: Vec<(usize, cache::SectorCache, &mut [(u32, &mut CtaModel)])> = ctas
+        let mut work: Vec<(usize, cache::SectorCache, Cluster)> = ctas
             .chunk_by_mut(|a, b| a.0 == b.0)
             .map(|group| {
                 let k = group[0].0 as usize;
