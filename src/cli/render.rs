@@ -33,6 +33,10 @@ pub struct RenderArgs {
     /// Device profile of the emulated kernels' memory counters: gt200, maxwell, hopper.
     #[arg(long, default_value = "gt200")]
     pub device: String,
+    /// What the emulated kernels model beyond the image: functional, instructions,
+    /// memory or caches (the full model). The image is the same at every level.
+    #[arg(long, default_value_t = crate::sim::Fidelity::Caches)]
+    pub fidelity: crate::sim::Fidelity,
     /// kd-tree heuristic: sah or siroh.
     #[arg(long, default_value = "sah")]
     pub heuristic: String,
@@ -130,7 +134,9 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             (fb, st, None)
         }
         Some(v) => {
-            let mut dev = Device::with_config(rt_kernels::sim_config(&cam));
+            let mut config = rt_kernels::sim_config(&cam);
+            config.fidelity = a.fidelity;
+            let mut dev = Device::with_config(config);
             let module = rt_kernels::load(&mut dev)?;
             let pb = std::io::stderr().is_terminal().then(|| {
                 let pb = indicatif::ProgressBar::new_spinner();
