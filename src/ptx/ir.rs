@@ -4,6 +4,7 @@
 //! type, labels to instruction indices, parameters and variables to offsets in
 //! their state space. Nothing here knows how instructions execute.
 
+use super::error::PtxError;
 use super::types::Ty;
 
 /// Index of a data register in a function's register file.
@@ -411,6 +412,11 @@ pub struct Function {
     pub declared_reg_words: u32,
     /// Offsets of the shared variables the function names itself (callees not included).
     pub shared_refs: Vec<u32>,
+    /// Why the function cannot run, when it (or a function it calls) holds an
+    /// instruction warplight does not execute: the module still loads, and only
+    /// a launch of this kernel fails, with this error. The body is then a single
+    /// `trap` at the unsupported instruction.
+    pub unsupported: Option<PtxError>,
 }
 
 /// A module-scope `.global` variable.

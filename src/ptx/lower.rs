@@ -446,6 +446,7 @@ impl<'a> FnLower<'a> {
             labels: Vec::new(),
             declared_reg_words: 0,
             shared_refs: Vec::new(),
+            unsupported: None,
         };
         FnLower {
             f,

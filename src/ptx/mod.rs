@@ -11,6 +11,7 @@
 pub mod ast;
 pub mod error;
 pub mod ir;
+pub mod ir_text;
 pub mod lexer;
 pub mod lower;
 pub mod parser;
