@@ -414,8 +414,8 @@ pub struct Function {
     pub shared_refs: Vec<u32>,
     /// Why the function cannot run, when it (or a function it calls) holds an
     /// instruction warplight does not execute: the module still loads, and only
-    /// a launch of this kernel fails, with this error. The body is then a single
-    /// `trap` at the unsupported instruction.
+    /// a launch of this kernel fails, with this error (file, line, instruction).
+    /// In the body a `trap` stands in place of each unsupported instruction.
     pub unsupported: Option<PtxError>,
 }
 
@@ -516,6 +516,12 @@ impl Program {
             size = size.div_ceil(v.align) * v.align + v.size;
         }
         size
+    }
+
+    /// Why kernel (or function) `k` cannot run, when it needs an instruction
+    /// warplight does not execute; `None` when it can.
+    pub fn kernel_error(&self, k: u32) -> Option<&super::error::PtxError> {
+        self.functions.get(k as usize).and_then(|f| f.unsupported.as_ref())
     }
 
     /// Names of all kernels (as in the PTX; C++ kernels mangled).
