@@ -77,53 +77,44 @@ fn every_instruction_form_lowers_as_recorded() {
     );
 }
 
+/// Changes an instruction in place; false when it does not apply to it.
+type Mutation = fn(&mut Kind) -> bool;
+
 /// The comparison above can fail: a changed operation, destination width,
 /// address width, rounding mode or guard each changes the rendered text.
 #[test]
 fn a_changed_lowering_fails_the_snapshot() {
     let (prog, text) = render(&Path::new(DIR).join("arith.ptx"));
     let f = prog.functions.iter().position(|f| f.name == "arith").unwrap();
-    let mutations: Vec<(&str, Box<dyn Fn(&mut Kind) -> bool>)> = vec![
-        (
-            "operation",
-            Box::new(|k| match k {
-                Kind::Arith { op, .. } if *op == ArithOp::Add => {
-                    *op = ArithOp::Sub;
-                    true
-                }
-                _ => false,
-            }),
-        ),
-        (
-            "destination width",
-            Box::new(|k| match k {
-                Kind::Arith { d, .. } => {
-                    d.mask >>= 1;
-                    true
-                }
-                _ => false,
-            }),
-        ),
-        (
-            "rounding",
-            Box::new(|k| match k {
-                Kind::Arith { mode, .. } if mode.rnd.is_some() => {
-                    mode.rnd = None;
-                    true
-                }
-                _ => false,
-            }),
-        ),
-        (
-            "approximation",
-            Box::new(|k| match k {
-                Kind::Arith { mode, .. } => {
-                    mode.approx = !mode.approx;
-                    true
-                }
-                _ => false,
-            }),
-        ),
+    let mutations: [(&str, Mutation); 4] = [
+        ("operation", |k| match k {
+            Kind::Arith { op, .. } if *op == ArithOp::Add => {
+                *op = ArithOp::Sub;
+                true
+            }
+            _ => false,
+        }),
+        ("destination width", |k| match k {
+            Kind::Arith { d, .. } => {
+                d.mask >>= 1;
+                true
+            }
+            _ => false,
+        }),
+        ("rounding", |k| match k {
+            Kind::Arith { mode, .. } if mode.rnd.is_some() => {
+                mode.rnd = None;
+                true
+            }
+            _ => false,
+        }),
+        ("approximation", |k| match k {
+            Kind::Arith { mode, .. } => {
+                mode.approx = !mode.approx;
+                true
+            }
+            _ => false,
+        }),
     ];
     for (what, m) in mutations {
         let mut changed = prog.clone();

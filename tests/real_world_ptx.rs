@@ -299,3 +299,16 @@ fn the_command_line_names_unusable_kernels() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `%globaltimer` (and its low half) reads a deterministic count like
+/// `%clock64`: increasing within a run, equal between runs.
+#[test]
+fn globaltimer_is_deterministic_and_increasing() {
+    let body = ".reg .b32 %r<2>;\n.reg .b64 %rd<4>;\nld.param.u64 %rd1, [out];\nmov.u64 %rd2, %globaltimer;\n\
+                mov.u32 %r1, %globaltimer_lo;\nmov.u64 %rd3, %globaltimer;\nst.global.u64 [%rd1], %rd2;\n\
+                st.global.u32 [%rd1+8], %r1;\nst.global.u64 [%rd1+16], %rd3;\nret;";
+    let a = run(body, 6);
+    let (t0, t1, t2) = (a[0] as u64 | (a[1] as u64) << 32, a[2] as u64, a[4] as u64 | (a[5] as u64) << 32);
+    assert!(t0 < t1 && t1 < t2, "{t0} {t1} {t2}");
+    assert_eq!(run(body, 6), a, "the same in a second run");
+}

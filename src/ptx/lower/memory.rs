@@ -32,7 +32,7 @@ impl FnLower<'_> {
     /// Lowers a validated `atom` or `red` (`red` has no destination).
     pub(super) fn lower_atom(&self, i: &ast::Instruction, d: &Decoded) -> LResult<Kind> {
         let (pos, ops, m) = (i.pos, &i.operands, &d.mods);
-        let op = m.words.iter().filter_map(|w| atom_op_of(w)).last().expect("validated: an operation");
+        let op = m.words.iter().rev().find_map(|w| atom_op_of(w)).expect("validated: an operation");
         let t = one_type(d, i)?;
         let k = usize::from(d.op == Opcode::Atom);
         let (addr, sym_space) = self.address(&ops[k], pos)?;

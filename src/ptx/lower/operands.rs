@@ -55,6 +55,8 @@ fn special_reg(name: &str) -> Option<SpecialReg> {
         "%lanemask_gt" => SpecialReg::LaneMaskGt,
         "%clock" => SpecialReg::Clock,
         "%clock64" => SpecialReg::Clock64,
+        // deterministic, as %clock64 (docs/ptx-support.md); a 32-bit read keeps the low half
+        "%globaltimer" | "%globaltimer_lo" => SpecialReg::Clock64,
         _ => return None,
     })
 }
