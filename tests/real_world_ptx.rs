@@ -312,3 +312,16 @@ fn globaltimer_is_deterministic_and_increasing() {
     assert!(t0 < t1 && t1 < t2, "{t0} {t1} {t2}");
     assert_eq!(run(body, 6), a, "the same in a second run");
 }
+
+/// `popc`, `clz` and `brev` on 64-bit values (counts into 32-bit registers).
+#[test]
+fn bit_counts_of_64_bit_values() {
+    let out = run(
+        ".reg .b32 %r<4>;\n.reg .b64 %rd<5>;\nld.param.u64 %rd1, [out];\nmov.u64 %rd2, 0xF000000000000001;\n\
+         popc.b64 %r1, %rd2;\nclz.b64 %r2, %rd2;\nmov.u64 %rd3, 1;\nclz.b64 %r3, %rd3;\nbrev.b64 %rd4, %rd3;\n\
+         st.global.u32 [%rd1], %r1;\nst.global.u32 [%rd1+4], %r2;\nst.global.u32 [%rd1+8], %r3;\n\
+         st.global.u64 [%rd1+16], %rd4;\nret;",
+        6,
+    );
+    assert_eq!(out, [5, 0, 63, 0, 0, 0x8000_0000]);
+}
