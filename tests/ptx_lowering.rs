@@ -155,3 +155,51 @@ fn the_snapshots_cover_every_supported_opcode() {
     let missing: Vec<&&str> = ptx::parser::KNOWN_OPCODES.iter().filter(|o| !seen.contains(**o)).collect();
     assert!(missing.is_empty(), "opcodes with no snapshot: {missing:?}");
 }
+
+/// Validation refuses malformed forms with an `invalid` error and valid PTX
+/// that warplight does not execute with an `unsupported` one, each at the
+/// instruction's line.
+#[test]
+fn validation_names_what_is_wrong() {
+    let cases = [
+        ("add.s32 %r1, %r2;", "invalid: `add.s32` takes 3 operands, found 2"),
+        ("add %r1, %r2, %r3;", "invalid: `add` needs a type"),
+        ("add.s32.u32 %r1, %r2, %r3;", "invalid: `add.s32.u32` has more than one type"),
+        ("add.cc.u32 %r1, %r2, %r3;", "unsupported instruction `add.cc.u32 (carry chains)`"),
+        ("add.f16 %h1, %h1, %h1;", "unsupported instruction `add.f16 (.f16)`"),
+        ("mul.wide.f32 %f1, %f1, %f1;", "invalid: `mul.wide.f32`: .hi/.wide apply to integers"),
+        ("min.xorsign.abs.f32 %f1, %f1, %f1;", "unsupported instruction `min.xorsign.abs.f32 (modifier .xorsign)`"),
+        ("prmt.b32.f4e %r1, %r2, %r3, %r4;", "unsupported instruction `prmt.b32.f4e (modifier .f4e)`"),
+        ("setp.s32 %p1, %r1, %r2;", "invalid: `setp.s32` needs a comparison"),
+        ("setp.lt.and.s32 %p1, %r1, %r2;", "invalid: `setp.lt.and.s32` takes 4 operands, found 3"),
+        ("set.lt.s32 %r1, %r2, %r3;", "invalid: `set` needs a destination and a source type"),
+        ("cvt.f32 %f1, %r1;", "invalid: `cvt` needs a destination and a source type"),
+        ("cvt.f32.f16 %f1, %h1;", "unsupported instruction `cvt.f32.f16 (.f16)`"),
+        ("cvt.rzi.f32.s32 %f1, %r1;", "integer rounding modifier on an int-to-float conversion"),
+        ("cvta.u64 %rd1, %rd1;", "invalid: `cvta` needs a state space"),
+        ("ld.global.v2.u32 %r1, [%rd1];", "invalid: `ld.global.v2.u32` moves 2 value(s), found 1"),
+        ("ld.global.foo.u32 %r1, [%rd1];", "unsupported instruction `ld.global.foo.u32 (modifier .foo)`"),
+        ("atom.global.u32 %r1, [%rd1], 1;", "invalid: `atom.global.u32` needs an operation"),
+        (
+            "atom.global.add.u16 %h1, [%rd1], 1;",
+            "unsupported instruction `atom.global.add.u16 (types narrower than 32 bits)`",
+        ),
+        ("atom.global.cas.b32 %r1, [%rd1], 1;", "invalid: `atom.global.cas.b32` takes 4 operands, found 3"),
+        ("bra 5;", "invalid: `bra` needs a label"),
+        ("bar.sync;", "takes a barrier id and an optional thread count"),
+        ("vote.sync.b32 %r1, %p1, -1;", "invalid: `vote` needs a mode"),
+        ("shfl.sync.b32 %r1, %r2, 1, 31, -1;", "invalid: `shfl` needs a mode"),
+        ("mov.b64 %rd1, {%r1, %r2, %r3};", "vector move parts must be 8, 16 or 32 bits"),
+        ("redux.sync.add.u32 %r1, %r2, -1;", "unsupported instruction `redux.sync.add.u32`"),
+        ("bfind.u32 %r1, %r2;", "unsupported instruction `bfind.u32`"),
+    ];
+    for (inst, expected) in cases {
+        let src = format!(
+            ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{{\n\
+             .reg .pred %p<2>;\n.reg .b16 %h<2>;\n.reg .b32 %r<5>;\n.reg .f32 %f<2>;\n.reg .b64 %rd<2>;\n\
+             {inst}\nret;\n}}\n"
+        );
+        let e = ptx::load(&src, "v.ptx").map(|_| ()).unwrap_err().to_string();
+        assert!(e.starts_with("v.ptx:11:1: ") && e.contains(expected), "{inst}: {e}");
+    }
+}
