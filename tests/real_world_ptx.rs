@@ -262,7 +262,9 @@ fn the_command_line_names_unusable_kernels() {
         err.contains("kernel `bad`: ") && err.contains("mixed.ptx:32:2: unsupported instruction `redux.sync.add.u32`"),
         "{err}"
     );
-    assert!(err.contains("kernel `calls_bad`: ") && err.contains("kernel `texture`: "), "{err}");
+    let calls = err.lines().find(|l| l.starts_with("kernel `calls_bad`")).unwrap_or_default();
+    assert!(calls.contains("(through `sum`, which it calls): ") && calls.contains("mixed.ptx:9:2: "), "{err}");
+    assert!(err.contains("kernel `texture`: "), "{err}");
     assert!(!err.contains("kernel `good`"), "{err}");
 
     let (ok, out, err) = warplight(&["kernels", p]);

@@ -10,7 +10,7 @@ pub fn kernels(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
         let params: Vec<String> = f.params.iter().map(|p| format!(".{} {}", p.ty, p.name)).collect();
         println!("  {}({})", f.name, params.join(", "));
         if let Some(e) = &f.unsupported {
-            println!("    unusable: {e}");
+            println!("    unusable{}: {e}", through(&prog, k as u32));
             continue;
         }
         println!(
@@ -36,8 +36,11 @@ pub fn check(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let unusable: Vec<String> = prog
         .functions
         .iter()
-        .filter(|f| f.is_entry)
-        .filter_map(|f| f.unsupported.as_ref().map(|e| format!("kernel `{}`: {e}", f.name)))
+        .enumerate()
+        .filter(|(_, f)| f.is_entry)
+        .filter_map(|(k, f)| {
+            f.unsupported.as_ref().map(|e| format!("kernel `{}`{}: {e}", f.name, through(&prog, k as u32)))
+        })
         .collect();
     if !unusable.is_empty() {
         return Err(format!(
@@ -57,4 +60,13 @@ pub fn check(path: &Path) -> Result<(), Box<dyn std::error::Error>> {
         prog.functions.len()
     );
     Ok(())
+}
+
+/// ` (through `f`, which it calls)` when kernel `k` cannot run because of a
+/// function it calls; empty otherwise.
+fn through(prog: &crate::ptx::Program, k: u32) -> String {
+    match prog.unsupported_in(k) {
+        Some(f) if f != prog.functions[k as usize].name => format!(" (through `{f}`, which it calls)"),
+        _ => String::new(),
+    }
 }

@@ -524,6 +524,18 @@ impl Program {
         self.functions.get(k as usize).and_then(|f| f.unsupported.as_ref())
     }
 
+    /// The function that holds the instruction kernel `k` cannot run (`k`
+    /// itself, or a function it calls), when there is one.
+    pub fn unsupported_in(&self, k: u32) -> Option<&str> {
+        let e = self.kernel_error(k)?;
+        let holds = |f: &&Function| {
+            f.unsupported.as_ref() == Some(e)
+                && f.insts.iter().zip(&f.info).any(|(i, inf)| i.kind == Kind::Trap && inf.ptx_line == e.pos.line)
+        };
+        let own = self.functions.get(k as usize).filter(holds);
+        own.or_else(|| self.functions.iter().find(holds)).map(|f| f.name.as_str())
+    }
+
     /// Names of all kernels (as in the PTX; C++ kernels mangled).
     pub fn kernel_names(&self) -> Vec<&str> {
         self.functions.iter().filter(|f| f.is_entry).map(|f| f.name.as_str()).collect()
