@@ -1,6 +1,6 @@
 //! Syntax tree → validated IR, along the lines of naga's and ZLUDA's front
-//! ends: this file lays out the module (variables, parameters, signatures) and
-//! walks each function body; every instruction is decoded once into a typed
+//! ends: this file places the module's variables (with [`layout`], which also
+//! lays out signatures) and walks each function body; every instruction is decoded once into a typed
 //! opcode and modifiers ([`opcode`]), its shape checked ([`validate`]), and it
 //! is lowered into a [`Kind`] by the file of its family ([`data`], [`arith`],
 //! [`compare`], [`convert`], [`memory`], [`control`], [`warp`]), resolving its
@@ -24,14 +24,15 @@ pub mod compare;
 pub mod control;
 pub mod convert;
 pub mod data;
+pub mod layout;
 pub mod memory;
 pub mod opcode;
 pub mod operands;
 pub mod validate;
 pub mod warp;
 
+use layout::{Signature, align_up, collect_shared, init_bytes, signature};
 use opcode::{Decoded, Family, Opcode};
-use operands::lit_bits;
 
 /// A lowering result: errors carry the position; the file is added by [`super::load`].
 pub type LResult<T> = Result<T, (Pos, PtxErrorKind)>;
@@ -46,11 +47,6 @@ fn unsupported<T>(pos: Pos, what: impl Into<String>) -> LResult<T> {
     Err((pos, PtxErrorKind::Unsupported(what.into())))
 }
 
-fn align_up(v: u64, a: u64) -> u64 {
-    let a = a.max(1);
-    v.div_ceil(a) * a
-}
-
 #[derive(Debug, Clone, Copy)]
 enum Sym {
     Reg(RegId),
@@ -62,6 +58,30 @@ enum Sym {
     Const(u32),
     Global(u32),
     Func(u32),
+}
+
+/// Marks every function that calls an unusable one (directly or through
+/// others) unusable, with the callee's error.
+fn mark_callers_unusable(prog: &mut Program) {
+    loop {
+        let mut changed = false;
+        for k in 0..prog.functions.len() {
+            if prog.functions[k].unsupported.is_some() {
+                continue;
+            }
+            let inherited = prog.functions[k].insts.iter().find_map(|i| match i.kind {
+                Kind::Call { func, .. } => prog.functions[func as usize].unsupported.clone(),
+                _ => None,
+            });
+            if inherited.is_some() {
+                prog.functions[k].unsupported = inherited;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
 }
 
 /// Lowers a parsed module.
@@ -220,99 +240,13 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
     for (f, e) in prog.functions.iter_mut().zip(&own_errors) {
         f.unsupported = e.as_ref().map(wrap);
     }
-    // a function that calls an unusable one is unusable, with the callee's error
-    loop {
-        let mut changed = false;
-        for k in 0..prog.functions.len() {
-            if prog.functions[k].unsupported.is_some() {
-                continue;
-            }
-            let inherited = prog.functions[k].insts.iter().find_map(|i| match i.kind {
-                Kind::Call { func, .. } => prog.functions[func as usize].unsupported.clone(),
-                _ => None,
-            });
-            if inherited.is_some() {
-                prog.functions[k].unsupported = inherited;
-                changed = true;
-            }
-        }
-        if !changed {
-            break;
-        }
-    }
+    mark_callers_unusable(&mut prog);
     // nothing in the module can run: fail as a whole, with the first error
     let usable = prog.functions.iter().any(|f| f.is_entry && f.unsupported.is_none());
     if !usable && let Some(first) = own_errors.into_iter().flatten().next() {
         return Err(first);
     }
     Ok(prog)
-}
-
-fn collect_shared<'a>(body: &'a [Stmt], out: &mut Vec<&'a ast::VarDecl>) {
-    for s in body {
-        match s {
-            Stmt::Decl(d) if d.space == Space::Shared => out.push(d),
-            Stmt::Block(b) => collect_shared(b, out),
-            _ => {}
-        }
-    }
-}
-
-fn init_bytes(v: &ast::VarDecl) -> LResult<Vec<u8>> {
-    let size = v.size_bytes() as usize;
-    let mut out = Vec::with_capacity(size);
-    if let Some(init) = &v.init {
-        let eb = v.ty.bytes() as usize;
-        for l in init {
-            let bits = lit_bits(*l, v.ty, v.pos)?;
-            out.extend_from_slice(&bits.to_le_bytes()[..eb]);
-        }
-        if out.len() > size && size > 0 {
-            return invalid(v.pos, format!("initializer of `{}` has more elements than the array", v.name));
-        }
-    }
-    out.resize(size, 0);
-    Ok(out)
-}
-
-#[derive(Debug, Clone)]
-struct Signature {
-    is_entry: bool,
-    has_body: bool,
-    name: String,
-    params: Vec<Param>,
-    returns: Vec<Param>,
-    param_area: u32,
-}
-
-fn signature(f: &ast::Function) -> LResult<Signature> {
-    let is_entry = f.kind == ast::FunctionKind::Entry;
-    let mut off: u64 = 0;
-    let mut place = |v: &ast::VarDecl| -> LResult<Param> {
-        if v.space != Space::Param && v.space != Space::Reg {
-            return unsupported(v.pos, format!(".{} parameter", v.space));
-        }
-        if v.space == Space::Reg {
-            return unsupported(v.pos, ".reg parameters (use .param)");
-        }
-        let size = v.size_bytes().max(v.ty.bytes() as u64 * v.vector.unwrap_or(1) as u64);
-        let size = if v.dims.is_empty() { v.ty.bytes() as u64 * v.vector.unwrap_or(1) as u64 } else { size };
-        let align = v.align.map(|a| a as u64).unwrap_or(v.ty.bytes() as u64);
-        off = align_up(off, align);
-        let p = Param { name: v.name.clone(), ty: v.ty, offset: off as u32, size: size as u32 };
-        off += size;
-        Ok(p)
-    };
-    let returns = f.returns.iter().map(&mut place).collect::<LResult<Vec<_>>>()?;
-    let params = f.params.iter().map(&mut place).collect::<LResult<Vec<_>>>()?;
-    Ok(Signature {
-        is_entry,
-        has_body: f.body.is_some(),
-        name: f.name.clone(),
-        params,
-        returns,
-        param_area: off as u32,
-    })
 }
 
 struct FnLower<'a> {
