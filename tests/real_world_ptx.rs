@@ -299,6 +299,16 @@ fn the_command_line_names_unusable_kernels() {
             );
         }
     }
+    // stepping and tracing it fail the same way
+    let bad = dir.join("bad.toml");
+    let html = dir.join("t.html");
+    for args in [
+        vec!["step", bad.to_str().unwrap(), "--log"],
+        vec!["trace", bad.to_str().unwrap(), "-o", html.to_str().unwrap()],
+    ] {
+        let (ok, _, err) = warplight(&args);
+        assert!(!ok && err.contains(":32:2: unsupported instruction `redux.sync.add.u32`"), "{args:?}: {err}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 
