@@ -452,9 +452,9 @@ pub fn flight_table(
         &scenes,
         "SIROH trees, 30 persistent CTAs x 256 threads, 32-pixel job blocks, clang-16 PTX, gt200 profile",
     ));
-    t
     t.notes.push(COUNTING.into());
     t.notes.push(MATERIALS.into());
+    t
 }
 
 /// A frame-rate table through the GTX 280 timing model ([`timing`]; no
