@@ -225,9 +225,11 @@ fn an_unsupported_instruction_fails_only_its_kernels() {
     let tex = error("texture").expect("`texture` is unusable");
     assert!(tex.starts_with("mixed.ptx:58:2: unsupported instruction `tex.2d.v4.f32.f32`"), "{tex}");
 
-    // launched anyway through the library, the kernel stops at the instruction's place
-    let e = dev.launch(&m, "bad", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err();
-    assert!(e.to_string().contains("trap"), "{e}");
+    // launched anyway through the library, the launch is refused with the same error
+    let e = dev.launch(&m, "bad", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err().to_string();
+    assert!(e.contains("mixed.ptx:32:2: unsupported instruction `redux.sync.add.u32`"), "{e}");
+    let e = dev.launch(&m, "calls_bad", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err().to_string();
+    assert!(e.contains("mixed.ptx:9:2: unsupported instruction `redux.sync.add.u32`"), "{e}");
 }
 
 /// A module none of whose kernels can run still fails to load, with the first error.

@@ -418,6 +418,10 @@ impl Device {
             file: m.prog.source_name.clone(),
             available: m.prog.kernel_names().join(", "),
         })?;
+        if let Some(e) = m.prog.kernel_error(k) {
+            // the module loaded, but this kernel (or a function it calls) needs an unsupported instruction
+            return Err(SimError::Ptx(e.clone()));
+        }
         let f = &m.prog.functions[k as usize];
         if f.insts.is_empty() {
             // Only declared (`.entry k(...);`): a body, even an empty one, has an exit.

@@ -76,6 +76,6 @@ pub trait ObserverFactory: Sync {
     fn end_round(&self, _observers: &mut [(u32, &mut dyn MemObserver)]) {}
     /// Called before a launch with its [`Fidelity`](super::Fidelity) (`memory`
     /// or `caches`): a model with caches leaves them out below `caches`.
-    /// Default: nothing.
-    fn set_fidelity(&self, _level: super::Fidelity) {}
+    /// Required, so that a factory wrapping another one cannot forget to pass it on.
+    fn set_fidelity(&self, level: super::Fidelity);
 }
