@@ -16,7 +16,7 @@ use warplight::host::rt_kernels::{self, Variant};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::model::Profile;
-use warplight::sim::Device;
+use warplight::sim::{Device, Fidelity};
 
 fn setup() -> (Scene, KdTree, Camera) {
     let s = scene_file::load(Path::new("scenes/sponza.toml")).expect("scene");
@@ -33,14 +33,54 @@ fn native(s: &Scene, tree: &KdTree, cam: &Camera) -> u64 {
 }
 
 fn emulated(s: &Scene, tree: &KdTree, cam: &Camera, threads: usize) -> u64 {
+    emulated_at(s, tree, cam, threads, Fidelity::Caches).trace.rays
+}
+
+fn emulated_at(s: &Scene, tree: &KdTree, cam: &Camera, threads: usize, level: Fidelity) -> rt_kernels::KernelRender {
     let mut cfg = rt_kernels::sim_config(cam);
     cfg.threads = threads;
+    cfg.fidelity = level;
     let mut dev = Device::with_config(cfg);
     let module = rt_kernels::load(&mut dev).expect("kernels");
-    let k =
-        rt_kernels::render(&mut dev, &module, s, tree, cam, s.flight.light_offset(0), Variant::Stack, Profile::Gt200)
-            .expect("render");
-    k.trace.rays
+    rt_kernels::render(&mut dev, &module, s, tree, cam, s.flight.light_offset(0), Variant::Stack, Profile::Gt200)
+        .expect("render")
+}
+
+/// Speed against counter accuracy per fidelity level (`RAYTRACE_FIDELITY=out.json`):
+/// the frame at 256 x 256 on one host thread; x: million warp instructions per
+/// second, y: mean relative error (%) of the GT200 profiler counters against
+/// the full model. Written as `warplight chart scatter` JSON.
+fn fidelity_chart(out: &str) {
+    let (s, tree, mut cam) = setup();
+    cam.resolution = [256, 256];
+    let full = emulated_at(&s, &tree, &cam, 1, Fidelity::Caches);
+    let reference = full.memory.profiler_names(&full.launch.totals);
+    let mut series = Vec::new();
+    for level in Fidelity::ALL {
+        let t = best(2, || {
+            std::hint::black_box(emulated_at(&s, &tree, &cam, 1, level));
+            0
+        });
+        let r = emulated_at(&s, &tree, &cam, 1, level);
+        let got = r.memory.profiler_names(&r.launch.totals);
+        let errs: Vec<f64> = reference
+            .iter()
+            .zip(&got)
+            .filter(|(a, _)| a.1 > 0)
+            .map(|(a, b)| (a.1 as f64 - b.1 as f64).abs() / a.1 as f64)
+            .collect();
+        let err = 100.0 * errs.iter().sum::<f64>() / errs.len().max(1) as f64;
+        let speed = r.launch.totals.warp_instructions as f64 / t / 1e6;
+        eprintln!("  {level:<12} {t:>7.3} s  {speed:>6.2} M warp-inst/s  counter error {err:>5.1} %");
+        series.push(serde_json::json!({"name": level.name(), "points": [[speed, err]]}));
+    }
+    let chart = serde_json::json!({
+        "title": "Emulated trace_stack, Sponza 256x256, 1 host thread: speed against GT200 counter error per fidelity level",
+        "x_label": "million warp instructions per second",
+        "y_label": "mean relative error of the GT200 profiler counters vs the full model (%)",
+        "series": series,
+    });
+    std::fs::write(out, serde_json::to_string_pretty(&chart).expect("json")).expect("write chart data");
 }
 
 /// Best of `n` timings of `f`.
@@ -71,6 +111,19 @@ fn report() {
 }
 
 fn bench(c: &mut Criterion) {
+    // `RAYTRACE_ONCE=1`: one emulated frame on one host thread and nothing
+    // else, for profiling (`perf record`).
+    if let Some(out) = std::env::var_os("RAYTRACE_FIDELITY") {
+        fidelity_chart(&out.to_string_lossy());
+        return;
+    }
+    if std::env::var_os("RAYTRACE_ONCE").is_some() {
+        let (s, tree, cam) = setup();
+        let t0 = Instant::now();
+        emulated(&s, &tree, &cam, 1);
+        eprintln!("one emulated frame, 1 thread: {:.3} s", t0.elapsed().as_secs_f64());
+        return;
+    }
     report();
     let (s, tree, cam) = setup();
     let mut g = c.benchmark_group("sponza_512");

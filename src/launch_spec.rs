@@ -802,7 +802,11 @@ pub fn check_resources(spec: &Spec, prog: &crate::ptx::Program, config: &SimConf
 pub fn arguments(spec: &Spec, p: &Prepared, l: &LaunchSpec) -> Result<Vec<Arg>, SpecError> {
     let file = spec.file.display().to_string();
     let f = match p.module.prog.kernel(&l.kernel) {
-        Some(k) => &p.module.prog.functions[k as usize],
+        Some(k) => match p.module.prog.kernel_error(k) {
+            // a kernel that needs an instruction warplight does not execute
+            Some(e) => return Err(SpecError::Sim(SimError::Ptx(e.clone()))),
+            None => &p.module.prog.functions[k as usize],
+        },
         None => {
             return Err(SpecError::Sim(SimError::UnknownKernel {
                 name: l.kernel.clone(),

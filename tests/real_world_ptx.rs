@@ -1,6 +1,8 @@
 //! PTX forms that nvcc emits for ordinary kernels (issue 20): the predefined
-//! constant `WARP_SZ`, and 32-bit register addresses that wrap at 2^32 before
-//! the offset is added (`[%r4+68]` with %r4 = 0xFFFFFFC0 is offset 4).
+//! constant `WARP_SZ`, 32-bit register addresses that wrap at 2^32 before
+//! the offset is added (`[%r4+68]` with %r4 = 0xFFFFFFC0 is offset 4), and
+//! modules where one kernel needs an instruction warplight does not execute
+//! (only that kernel fails).
 
 use warplight::sim::{Arg, Device, LaunchConfig};
 
@@ -120,4 +122,220 @@ fn a_spec_initialises_constant_memory() {
     let e = String::from_utf8_lossy(&launch(&f).stderr).into_owned();
     assert!(e.contains("20 bytes do not fit `taps` (16 bytes)"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A module with a kernel that needs `redux.sync` (not executed yet), a kernel
+/// that reaches it through a device function, one that samples a texture,
+/// and two ordinary kernels.
+const MIXED: &str = "\
+.version 7.8
+.target sm_90
+.address_size 64
+
+.func (.param .b32 r) sum(.param .b32 a)
+{
+	.reg .b32 %r<3>;
+	ld.param.b32 %r1, [a];
+	redux.sync.add.u32 %r2, %r1, -1;
+	st.param.b32 [r], %r2;
+	ret;
+}
+
+.visible .entry good(.param .u64 out)
+{
+	.reg .b32 %r<2>;
+	.reg .b64 %rd<4>;
+	ld.param.u64 %rd1, [out];
+	mov.u32 %r1, %tid.x;
+	mul.wide.u32 %rd2, %r1, 4;
+	add.s64 %rd3, %rd1, %rd2;
+	st.global.u32 [%rd3], %r1;
+	ret;
+}
+
+.visible .entry bad(.param .u64 out)
+{
+	.reg .b32 %r<3>;
+	.reg .b64 %rd<2>;
+	ld.param.u64 %rd1, [out];
+	mov.u32 %r1, %tid.x;
+	redux.sync.add.u32 %r2, %r1, -1;
+	st.global.u32 [%rd1], %r2;
+	ret;
+}
+
+.visible .entry calls_bad(.param .u64 out)
+{
+	.reg .b32 %r<3>;
+	.reg .b64 %rd<2>;
+	ld.param.u64 %rd1, [out];
+	{
+		.param .b32 a;
+		st.param.b32 [a], 1;
+		.param .b32 r;
+		call.uni (r), sum, (a);
+		ld.param.b32 %r2, [r];
+	}
+	st.global.u32 [%rd1], %r2;
+	ret;
+}
+
+.visible .entry texture(.param .u64 t, .param .u64 out)
+{
+	.reg .f32 %f<5>;
+	.reg .b64 %rd<3>;
+	ld.param.u64 %rd1, [t];
+	tex.2d.v4.f32.f32 {%f1, %f2, %f3, %f4}, [%rd1, {%f1, %f1}];
+	ret;
+}
+
+.visible .entry also_good(.param .u64 out)
+{
+	.reg .b32 %r<2>;
+	.reg .b64 %rd<2>;
+	ld.param.u64 %rd1, [out];
+	mov.u32 %r1, 7;
+	st.global.u32 [%rd1], %r1;
+	ret;
+}
+";
+
+/// One unsupported instruction fails only the kernels that need it (issue 20
+/// item 1): the module loads, the other kernels run, and the unusable ones
+/// carry the error naming file, line and instruction.
+#[test]
+fn an_unsupported_instruction_fails_only_its_kernels() {
+    let mut dev = Device::new();
+    let m = dev.load_ptx(MIXED, "mixed.ptx").unwrap_or_else(|e| panic!("the module must load: {e}"));
+    let out = dev.alloc_zeroed::<u32>(32);
+    dev.launch(&m, "good", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(dev.read::<u32>(out, 32), (0..32).collect::<Vec<u32>>());
+    dev.launch(&m, "also_good", LaunchConfig::linear(1, 1), &[Arg::Ptr(out)]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(dev.read::<u32>(out, 1), [7]);
+
+    let error = |k: &str| m.prog.kernel_error(m.prog.kernel(k).unwrap()).map(|e| e.to_string());
+    assert_eq!(error("good"), None);
+    assert_eq!(error("also_good"), None);
+    let bad = error("bad").expect("`bad` is unusable");
+    assert!(bad.starts_with("mixed.ptx:32:2: unsupported instruction `redux.sync.add.u32`"), "{bad}");
+    assert!(bad.contains("| redux.sync.add.u32 %r2, %r1, -1;"), "quotes the line: {bad}");
+    // through the device function: the callee's instruction is named
+    let calls = error("calls_bad").expect("`calls_bad` is unusable");
+    assert!(calls.starts_with("mixed.ptx:9:2: unsupported instruction `redux.sync.add.u32`"), "{calls}");
+    let tex = error("texture").expect("`texture` is unusable");
+    assert!(tex.starts_with("mixed.ptx:58:2: unsupported instruction `tex.2d.v4.f32.f32`"), "{tex}");
+
+    // launched anyway through the library, the launch is refused with the same error
+    let e = dev.launch(&m, "bad", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err().to_string();
+    assert!(e.contains("mixed.ptx:32:2: unsupported instruction `redux.sync.add.u32`"), "{e}");
+    let e = dev.launch(&m, "calls_bad", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err().to_string();
+    assert!(e.contains("mixed.ptx:9:2: unsupported instruction `redux.sync.add.u32`"), "{e}");
+}
+
+/// A module none of whose kernels can run still fails to load, with the first error.
+#[test]
+fn a_module_with_no_usable_kernel_fails_to_load() {
+    let only_bad =
+        MIXED.replace(".visible .entry good(", ".func good(").replace(".visible .entry also_good(", ".func also_good(");
+    let e = warplight::ptx::load(&only_bad, "bad.ptx").unwrap_err().to_string();
+    assert!(e.starts_with("bad.ptx:9:2: unsupported instruction `redux.sync.add.u32`"), "{e}");
+}
+
+/// `check` reports every unusable kernel and fails, `kernels` marks them, and
+/// `launch` runs the good kernel and refuses the bad one with the error.
+#[test]
+fn the_command_line_names_unusable_kernels() {
+    let dir = std::env::temp_dir().join(format!("warplight-unusable-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ptx = dir.join("mixed.ptx");
+    std::fs::write(&ptx, MIXED).unwrap();
+    let warplight = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
+        (
+            o.status.success(),
+            String::from_utf8_lossy(&o.stdout).into_owned(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let p = ptx.to_str().unwrap();
+    let (ok, _, err) = warplight(&["check", p]);
+    assert!(!ok && err.contains("3 of 5 kernels cannot run"), "{err}");
+    assert!(
+        err.contains("kernel `bad`: ") && err.contains("mixed.ptx:32:2: unsupported instruction `redux.sync.add.u32`"),
+        "{err}"
+    );
+    let calls = err.lines().find(|l| l.starts_with("kernel `calls_bad`")).unwrap_or_default();
+    assert!(calls.contains("(through `sum`, which it calls): ") && calls.contains("mixed.ptx:9:2: "), "{err}");
+    assert!(err.contains("kernel `texture`: "), "{err}");
+    assert!(!err.contains("kernel `good`"), "{err}");
+
+    let (ok, out, err) = warplight(&["kernels", p]);
+    assert!(ok, "{err}");
+    // the line after a kernel's signature
+    let next = |k: &str| {
+        let lines: Vec<&str> = out.lines().collect();
+        let i = lines.iter().position(|l| l.starts_with(&format!("  {k}("))).unwrap_or_else(|| panic!("{out}"));
+        lines[i + 1].to_string()
+    };
+    assert!(
+        next("bad").contains("unusable: ")
+            && next("bad").contains(":32:2: unsupported instruction `redux.sync.add.u32`"),
+        "{out}"
+    );
+    assert!(next("good").contains("instructions") && next("also_good").contains("instructions"), "{out}");
+
+    let spec = |k: &str| {
+        format!(
+            "ptx = \"mixed.ptx\"\nkernel = \"{k}\"\ngrid = 1\nblock = 32\nargs = [\"out\"]\n[[buffer]]\nname = \"out\"\ntype = \"u32\"\nlen = 32\n"
+        )
+    };
+    for (k, runs) in [("good", true), ("bad", false), ("calls_bad", false)] {
+        let f = dir.join(format!("{k}.toml"));
+        std::fs::write(&f, spec(k)).unwrap();
+        let (ok, _, err) = warplight(&["launch", f.to_str().unwrap()]);
+        assert_eq!(ok, runs, "{k}: {err}");
+        if !runs {
+            assert!(
+                err.contains("unsupported instruction `redux.sync.add.u32`") && err.contains("mixed.ptx:"),
+                "{k}: {err}"
+            );
+        }
+    }
+    // stepping and tracing it fail the same way
+    let bad = dir.join("bad.toml");
+    let html = dir.join("t.html");
+    for args in [
+        vec!["step", bad.to_str().unwrap(), "--log"],
+        vec!["trace", bad.to_str().unwrap(), "-o", html.to_str().unwrap()],
+    ] {
+        let (ok, _, err) = warplight(&args);
+        assert!(!ok && err.contains(":32:2: unsupported instruction `redux.sync.add.u32`"), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `%globaltimer` (and its low half) reads a deterministic count like
+/// `%clock64`: increasing within a run, equal between runs.
+#[test]
+fn globaltimer_is_deterministic_and_increasing() {
+    let body = ".reg .b32 %r<2>;\n.reg .b64 %rd<4>;\nld.param.u64 %rd1, [out];\nmov.u64 %rd2, %globaltimer;\n\
+                mov.u32 %r1, %globaltimer_lo;\nmov.u64 %rd3, %globaltimer;\nst.global.u64 [%rd1], %rd2;\n\
+                st.global.u32 [%rd1+8], %r1;\nst.global.u64 [%rd1+16], %rd3;\nret;";
+    let a = run(body, 6);
+    let (t0, t1, t2) = (a[0] as u64 | (a[1] as u64) << 32, a[2] as u64, a[4] as u64 | (a[5] as u64) << 32);
+    assert!(t0 < t1 && t1 < t2, "{t0} {t1} {t2}");
+    assert_eq!(run(body, 6), a, "the same in a second run");
+}
+
+/// `popc`, `clz` and `brev` on 64-bit values (counts into 32-bit registers).
+#[test]
+fn bit_counts_of_64_bit_values() {
+    let out = run(
+        ".reg .b32 %r<4>;\n.reg .b64 %rd<5>;\nld.param.u64 %rd1, [out];\nmov.u64 %rd2, 0xF000000000000001;\n\
+         popc.b64 %r1, %rd2;\nclz.b64 %r2, %rd2;\nmov.u64 %rd3, 1;\nclz.b64 %r3, %rd3;\nbrev.b64 %rd4, %rd3;\n\
+         st.global.u32 [%rd1], %r1;\nst.global.u32 [%rd1+4], %r2;\nst.global.u32 [%rd1+8], %r3;\n\
+         st.global.u64 [%rd1+16], %rd4;\nret;",
+        6,
+    );
+    assert_eq!(out, [5, 0, 63, 0, 0, 0x8000_0000]);
 }

@@ -67,6 +67,10 @@ pub struct LaunchOptions {
     /// List the counter names of the spec's device by section, without running.
     #[arg(long)]
     pub list_metrics: bool,
+    /// What to model beyond the results: functional, instructions, memory or
+    /// caches (the full model). Results are the same at every level; see docs/performance.md.
+    #[arg(long, default_value_t = crate::sim::Fidelity::Caches)]
+    pub fidelity: crate::sim::Fidelity,
 }
 
 type Res = Result<(), Box<dyn std::error::Error>>;
@@ -100,7 +104,9 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     if let Some(why) = capped {
         eprintln!("warning: --threads {}: {why}", a.threads);
     }
-    let mut dev = Device::with_config(spec.sim_config(threads, a.max_instructions));
+    let mut config = spec.sim_config(threads, a.max_instructions);
+    config.fidelity = a.fidelity;
+    let mut dev = Device::with_config(config);
     let prepared = launch_spec::prepare(&spec, &mut dev)?;
     let prog = &prepared.module.prog;
     // metric names are known before anything runs: list them, or check --metrics

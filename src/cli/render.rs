@@ -33,6 +33,10 @@ pub struct RenderArgs {
     /// Device profile of the emulated kernels' memory counters: gt200, maxwell, hopper.
     #[arg(long, default_value = "gt200")]
     pub device: String,
+    /// What the emulated kernels model beyond the image: functional, instructions,
+    /// memory or caches (the full model). The image is the same at every level.
+    #[arg(long, default_value_t = crate::sim::Fidelity::Caches)]
+    pub fidelity: crate::sim::Fidelity,
     /// kd-tree heuristic: sah or siroh.
     #[arg(long, default_value = "sah")]
     pub heuristic: String,
@@ -130,7 +134,9 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             (fb, st, None)
         }
         Some(v) => {
-            let mut dev = Device::with_config(rt_kernels::sim_config(&cam));
+            let mut config = rt_kernels::sim_config(&cam);
+            config.fidelity = a.fidelity;
+            let mut dev = Device::with_config(config);
             let module = rt_kernels::load(&mut dev)?;
             let pb = std::io::stderr().is_terminal().then(|| {
                 let pb = indicatif::ProgressBar::new_spinner();
@@ -196,22 +202,35 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         format!("primary {}, reflection {}, shadow {}", st.primary, st.reflection, st.shadow)
     };
-    println!("  rays {} ({kinds})  in {:.3} s: {:.2} M rays/s", st.rays, render_s, st.rays as f64 / render_s / 1e6);
-    println!(
-        "  per ray: {:.2} inner nodes, {:.2} leaves, {:.2} plane tests, {:.2} barycentric tests",
-        st.inner_nodes as f64 / st.rays.max(1) as f64,
-        st.leaves as f64 / st.rays.max(1) as f64,
-        st.plane_tests as f64 / st.rays.max(1) as f64,
-        st.barycentric_tests as f64 / st.rays.max(1) as f64
-    );
+    // the functional level keeps no per-line counters: the kernels' work is then unknown, not zero
+    let counted = emulated.as_ref().is_none_or(|k| k.counted);
+    if !counted {
+        println!("  rays and per-ray work not counted at --fidelity functional (they need the instructions level)  in {render_s:.3} s");
+    } else {
+        println!("  rays {} ({kinds})  in {:.3} s: {:.2} M rays/s", st.rays, render_s, st.rays as f64 / render_s / 1e6);
+        println!(
+            "  per ray: {:.2} inner nodes, {:.2} leaves, {:.2} plane tests, {:.2} barycentric tests",
+            st.inner_nodes as f64 / st.rays.max(1) as f64,
+            st.leaves as f64 / st.rays.max(1) as f64,
+            st.plane_tests as f64 / st.rays.max(1) as f64,
+            st.barycentric_tests as f64 / st.rays.max(1) as f64
+        );
+    }
     if let Some(k) = &emulated {
         let c = &k.launch.totals;
         println!(
-            "  emulated {}: {} warp instructions, {} thread instructions ({:.0} instructions per ray by the thesis' rule: warp instructions x 32 / rays)",
+            "  emulated {}: {} warp instructions, {} thread instructions{}",
             k.launch.kernel,
             c.warp_instructions,
             c.thread_instructions,
-            c.warp_instructions as f64 * 32.0 / st.rays.max(1) as f64
+            if counted {
+                format!(
+                    " ({:.0} instructions per ray by the thesis' rule: warp instructions x 32 / rays)",
+                    c.warp_instructions as f64 * 32.0 / st.rays.max(1) as f64
+                )
+            } else {
+                String::new()
+            }
         );
         println!(
             "  branches {} (divergent {}), global atomics {}, {} profile: {} global load transactions, {} texture lookups ({} hits)",
@@ -228,7 +247,7 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(j) = &a.json {
         let v = serde_json::json!({
             "scene": scene.name, "frame": a.frame, "variant": a.variant, "heuristic": h,
-            "resolution": cam.resolution, "tree": ts, "counters": counters_json(&st, emulated.is_some()), "render_seconds": render_s,
+            "resolution": cam.resolution, "tree": ts, "counters": if counted { counters_json(&st, emulated.is_some()) } else { serde_json::Value::Null }, "render_seconds": render_s,
             "emulator": emulated.as_ref().map(|k| serde_json::json!({
                 "totals": k.launch.totals, "memory": k.memory.metrics(&k.launch.totals).into_iter().collect::<std::collections::BTreeMap<_, _>>(),
             })),

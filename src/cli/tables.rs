@@ -74,6 +74,10 @@ pub struct TablesArgs {
     /// Print what would run and the time estimate, and stop.
     #[arg(long)]
     pub plan: bool,
+    /// Fidelity of the emulated runs: functional, instructions, memory or caches
+    /// (default: the lowest level the named tables need; see docs/performance.md).
+    #[arg(long)]
+    pub fidelity: Option<crate::sim::Fidelity>,
 }
 
 /// Runs the command.
@@ -251,6 +255,8 @@ fn plan(a: &TablesArgs) -> Result<Planned, Box<dyn std::error::Error>> {
 }
 
 fn measure(a: &TablesArgs) -> Result<Results, Box<dyn std::error::Error>> {
+    let needed = registry::resolve(&a.tables)?.iter().map(registry::lowest_fidelity).max();
+    crate::sim::fidelity::set_default_level(a.fidelity.or(needed).unwrap_or_default());
     let (plan, scenes, unavailable) = plan(a)?;
     let threads = rayon::current_num_threads();
     eprint!("{}", plan.describe(&scenes, &unavailable, threads));

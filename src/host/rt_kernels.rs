@@ -291,6 +291,10 @@ impl ObserverFactory for NodeCacheFetches<'_> {
             .collect();
         self.model.end_round(&mut inner);
     }
+
+    fn set_fidelity(&self, level: crate::sim::Fidelity) {
+        self.model.set_fidelity(level);
+    }
 }
 
 /// CTAs of the persistent-threads launch (one per GTX 280 SM).
@@ -320,8 +324,12 @@ pub struct KernelRender {
     pub image: FrameBuffer,
     /// Triangle hit by each pixel's primary ray (-1: none).
     pub hit_tri: Vec<i32>,
-    /// Work counted by the kernel, summed over pixels.
+    /// Work counted by the emulator (per-line counters of the kernel's tagged
+    /// lines), summed over pixels; all zero when `counted` is false.
     pub trace: TraceStats,
+    /// Whether `trace` was counted: the `functional` fidelity level keeps no
+    /// per-line counters, so a plain build's work counts are then unknown.
+    pub counted: bool,
     /// The emulator's counters.
     pub launch: LaunchStats,
     /// The device profile's memory counters.
@@ -451,6 +459,7 @@ pub fn render_build(
         image.pixels[i] = [px[0], px[1], px[2]];
     }
     let mut trace = TraceStats::default();
+    let counted = build == Build::Instrumented || dev.config().fidelity >= crate::sim::Fidelity::Instructions;
     match build {
         Build::Instrumented => {
             let st = dev.read::<u32>(stats, 8 * npix);
@@ -464,6 +473,7 @@ pub fn render_build(
                 trace.local_stack_accesses += s[6] as u64;
             }
         }
+        Build::Plain if !counted => {}
         Build::Plain => {
             let c = line_counts(&module.prog, &launch, &count_tags(SOURCE));
             let get = |n: &str| c.get(n).copied().unwrap_or(0);
@@ -477,7 +487,7 @@ pub fn render_build(
         }
     }
     trace.primary = npix as u64;
-    Ok(KernelRender { image, hit_tri: dev.read::<i32>(hit, npix), trace, launch, memory: model.finish() })
+    Ok(KernelRender { image, hit_tri: dev.read::<i32>(hit, npix), trace, counted, launch, memory: model.finish() })
 }
 
 /// Loads the kernels' PTX (the plain build) on `dev`.

@@ -40,10 +40,15 @@ fn degree(pairs: &mut Vec<(u64, u64)>) -> u64 {
 
 /// 32 banks × 4 bytes, Volta and later (Hopper) and Maxwell.
 pub fn cost32(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> BankCost {
+    cost32_with(mask, bytes, addr, &mut Vec::with_capacity(64))
+}
+
+/// [`cost32`] with a caller's scratch buffer, so that a caller reusing it allocates nothing.
+pub fn cost32_with(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64, pairs: &mut Vec<(u64, u64)>) -> BankCost {
     let group = (128 / bytes.clamp(4, 16)) as usize;
     let mut c = BankCost::default();
     for g in (0..32).step_by(group) {
-        let mut pairs = Vec::with_capacity(64);
+        pairs.clear();
         for l in g..g + group {
             if mask >> l & 1 == 0 {
                 continue;
@@ -58,7 +63,7 @@ pub fn cost32(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> BankCost {
         if pairs.is_empty() {
             continue;
         }
-        let d = degree(&mut pairs);
+        let d = degree(pairs);
         c.wavefronts += d;
         c.conflicts += d - 1;
     }
@@ -67,12 +72,17 @@ pub fn cost32(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> BankCost {
 
 /// 16 banks × 4 bytes per half-warp, compute capability 1.x (GT200).
 pub fn cost16(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> BankCost {
+    cost16_with(mask, bytes, addr, &mut Vec::with_capacity(16))
+}
+
+/// [`cost16`] with a caller's scratch buffer.
+pub fn cost16_with(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64, pairs: &mut Vec<(u64, u64)>) -> BankCost {
     let mut c = BankCost::default();
     for h in 0..2 {
         // A 64-bit (or 128-bit) access is served as consecutive 32-bit passes.
         let passes = bytes.div_ceil(4).max(1) as u64;
         for p in 0..passes {
-            let mut pairs = Vec::with_capacity(16);
+            pairs.clear();
             for l in h * 16..h * 16 + 16 {
                 if mask >> l & 1 == 0 {
                     continue;
@@ -84,7 +94,7 @@ pub fn cost16(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> BankCost {
             if pairs.is_empty() {
                 continue;
             }
-            let d = degree(&mut pairs);
+            let d = degree(pairs);
             c.wavefronts += d;
             c.conflicts += d - 1;
         }

@@ -1,14 +1,15 @@
 //! What one warp-level memory access costs under a device profile, spelled
 //! out lane by lane for the teaching views (`warplight step`, `warplight
 //! trace`): the transactions or sectors the lanes' addresses form, or the
-//! banks they fall in. It uses the same functions as the counter model, so the
-//! totals it shows are the counts the model adds for that instruction
-//! (cache hits aside).
+//! banks they fall in. The numbers come from the counter model itself
+//! ([`CtaModel::count`], the one implementation of the rules), so they are
+//! the counts the model adds for that instruction (cache hits aside); the
+//! units listed are formed by the same functions the model uses.
 
-use crate::model::{Profile, banks, coalesce_gt200, sectors};
+use crate::model::{CtaModel, InstMem, Profile, coalesce_gt200, sectors};
 use crate::ptx::ir::MemSpace;
 use crate::sim::access_log::Access;
-use crate::sim::observer::MemOp;
+use crate::sim::observer::{MemEvent, MemOp};
 
 /// A group of lanes served together: a transaction, a sector, or a bank.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
@@ -29,6 +30,31 @@ pub struct Explanation {
     pub units: Vec<Unit>,
     /// For each lane, the index of the first unit serving it (None: inactive).
     pub lane_unit: Vec<Option<usize>>,
+    /// What the counter model counts for this access.
+    pub cost: InstMem,
+}
+
+/// What the counter model of `profile` counts for `a` (a fresh model: no cache state).
+pub fn cost(profile: Profile, a: &Access) -> InstMem {
+    let ev = MemEvent {
+        func: a.func,
+        pc: a.pc,
+        op: a.op,
+        space: a.space,
+        nc: a.nc,
+        bytes: a.bytes,
+        elem_bytes: a.elem_bytes,
+        mask: a.mask,
+        addrs: &a.addrs,
+        cta: a.cta,
+        warp: a.warp,
+    };
+    CtaModel::new(profile, &[]).count(&ev)
+}
+
+/// Whether `profile` sends `a` through GT200's texture path (per half-warp lines).
+fn gt200_texture(profile: Profile, a: &Access) -> bool {
+    profile == Profile::Gt200 && a.nc && a.space == MemSpace::Global && a.op == MemOp::Load
 }
 
 /// The name of an access, e.g. `global load` or `shared atomic`.
@@ -56,19 +82,20 @@ pub fn access_name(a: &Access) -> String {
 pub fn explain(profile: Profile, a: &Access) -> Explanation {
     let lanes = a.mask.count_ones();
     let head = format!("{} {}B x{lanes}", access_name(a), a.bytes);
+    let cost = cost(profile, a);
     let (summary, units) = match a.space {
-        MemSpace::Shared => shared(profile, a, head),
-        MemSpace::Global | MemSpace::Local => {
-            if profile == Profile::Gt200 && !(a.nc && a.space == MemSpace::Global) {
-                segments(a, head)
-            } else {
-                sector_units(profile, a, head)
-            }
+        MemSpace::Shared => shared(profile, a, head, &cost),
+        MemSpace::Global | MemSpace::Local if gt200_texture(profile, a) => texture_lines(a, head, &cost),
+        MemSpace::Global | MemSpace::Local if profile == Profile::Gt200 => segments(a, head, &cost),
+        MemSpace::Global | MemSpace::Local => sector_units(profile, a, head, &cost),
+        MemSpace::Const => {
+            let p = cost.wavefronts;
+            (format!("{head}: {} constant-cache pass{}", p, if p == 1 { "" } else { "es" }), Vec::new())
         }
-        _ => (format!("{head}: not modelled (uniform parameter/constant space)"), Vec::new()),
+        _ => (format!("{head}: not modelled (uniform parameter space)"), Vec::new()),
     };
     let lane_unit = (0..32).map(|l| units.iter().position(|u| u.lanes >> l & 1 != 0)).collect();
-    Explanation { summary, units, lane_unit }
+    Explanation { summary, units, lane_unit, cost }
 }
 
 /// The key of the warp's private local-memory region (as the counter model forms it).
@@ -77,7 +104,7 @@ fn local_key(a: &Access) -> u64 {
 }
 
 /// GT200 half-warp segments (global and local).
-fn segments(a: &Access, head: String) -> (String, Vec<Unit>) {
+fn segments(a: &Access, head: String, cost: &InstMem) -> (String, Vec<Unit>) {
     let segs = if a.space == MemSpace::Local {
         // interleaved per thread: each 4-byte word is its own coalescing pass
         let key = local_key(a);
@@ -97,16 +124,36 @@ fn segments(a: &Access, head: String) -> (String, Vec<Unit>) {
         .iter()
         .map(|s| Unit { label: format!("half-warp {}: {} B at {:#x}", s.half, s.size, s.base), lanes: s.lanes })
         .collect::<Vec<_>>();
+    let n = cost.sectors;
+    let summary =
+        format!("{head}: gt200 {n} transaction{}, {moved} B moved for {useful} B used", if n == 1 { "" } else { "s" });
+    (summary, units)
+}
+
+/// GT200's texture path: no coalescing; each half-warp is a request for the
+/// distinct 32-byte lines its lanes read.
+fn texture_lines(a: &Access, head: String, cost: &InstMem) -> (String, Vec<Unit>) {
+    let mut units = Vec::new();
+    for h in 0..2u32 {
+        let m = a.mask & (0xFFFF << (16 * h));
+        for s in sectors::sectors(m, a.bytes, |l| a.addrs[l]) {
+            let lanes = (0..32)
+                .filter(|&l| m >> l & 1 != 0 && sectors::sectors(1 << l, a.bytes, |_| a.addrs[l]).contains(&s))
+                .fold(0u32, |acc, l| acc | 1 << l);
+            units.push(Unit { label: format!("half-warp {h}: line {:#x}", s * sectors::SECTOR), lanes });
+        }
+    }
+    let (r, n) = (cost.requests, cost.sectors);
     let summary = format!(
-        "{head}: gt200 {} transaction{}, {moved} B moved for {useful} B used",
-        units.len(),
-        if units.len() == 1 { "" } else { "s" }
+        "{head}: gt200 texture path, {r} request{} (one per half-warp), {n} line{} of 32 B",
+        if r == 1 { "" } else { "s" },
+        if n == 1 { "" } else { "s" }
     );
     (summary, units)
 }
 
 /// 32-byte sectors (Maxwell, Hopper; GT200's texture path by 32-byte lines).
-fn sector_units(profile: Profile, a: &Access, head: String) -> (String, Vec<Unit>) {
+fn sector_units(profile: Profile, a: &Access, head: String, cost: &InstMem) -> (String, Vec<Unit>) {
     let key = local_key(a);
     let local = a.space == MemSpace::Local;
     let secs = if local {
@@ -135,18 +182,19 @@ fn sector_units(profile: Profile, a: &Access, head: String) -> (String, Vec<Unit
             Unit { label: format!("sector {:#x}", s * sectors::SECTOR), lanes }
         })
         .collect::<Vec<_>>();
-    let what = if profile == Profile::Gt200 { "texture lines of 32 B" } else { "sectors" };
-    let summary = format!("{head}: {} 1 request, {} {what}", profile.params().name, units.len());
+    let (r, n) = (cost.requests, cost.sectors);
+    let summary = format!(
+        "{head}: {} {r} request{}, {n} sector{}",
+        profile.params().name,
+        if r == 1 { "" } else { "s" },
+        if n == 1 { "" } else { "s" }
+    );
     (summary, units)
 }
 
 /// Shared-memory banks.
-fn shared(profile: Profile, a: &Access, head: String) -> (String, Vec<Unit>) {
-    let (nbanks, cost) = if profile == Profile::Gt200 {
-        (16u64, banks::cost16(a.mask, a.bytes, |l| a.addrs[l]))
-    } else {
-        (32u64, banks::cost32(a.mask, a.bytes, |l| a.addrs[l]))
-    };
+fn shared(profile: Profile, a: &Access, head: String, cost: &InstMem) -> (String, Vec<Unit>) {
+    let nbanks = if profile == Profile::Gt200 { 16u64 } else { 32u64 };
     // one unit per bank, empty ones included, so that a lane's unit is its bank
     let mut units = Vec::new();
     for b in 0..nbanks {
@@ -168,8 +216,8 @@ fn shared(profile: Profile, a: &Access, head: String) -> (String, Vec<Unit>) {
         profile.params().name,
         cost.wavefronts,
         if cost.wavefronts == 1 { "" } else { "s" },
-        cost.conflicts,
-        if cost.conflicts == 1 { "" } else { "s" }
+        cost.bank_conflicts,
+        if cost.bank_conflicts == 1 { "" } else { "s" }
     );
     (summary, units)
 }
@@ -225,6 +273,38 @@ mod tests {
         assert_eq!(p.lane_unit[1], Some(1));
         assert_eq!(p.lane_unit[31], Some(31));
         assert!(p.summary.contains("1 wavefront, 0 conflicts"), "{}", p.summary);
+    }
+
+    /// Issue 19 item 4: GT200 `ld.global.nc`, lanes 0 and 16 read one 32-byte
+    /// line. The texture path serves each half-warp separately: two requests,
+    /// two lookups, as the counters say.
+    #[test]
+    fn gt200_texture_counts_per_half_warp_as_the_counters_do() {
+        let mut a = access(MemSpace::Global, 4, |_| 0x1000);
+        a.nc = true;
+        a.mask = 1 | 1 << 16;
+        let e = explain(Profile::Gt200, &a);
+        assert_eq!((e.cost.requests, e.cost.sectors), (2, 2));
+        assert_eq!(e.units.len(), 2, "{e:?}");
+        assert_eq!((e.units[0].lanes, e.units[1].lanes), (1, 1 << 16));
+        assert!(e.summary.contains("2 requests (one per half-warp), 2 lines"), "{}", e.summary);
+        // and the counters of a model that saw it
+        let mut m = CtaModel::new(Profile::Gt200, &[]);
+        let ev = MemEvent {
+            func: 0,
+            pc: 0,
+            op: MemOp::Load,
+            space: MemSpace::Global,
+            nc: true,
+            bytes: 4,
+            elem_bytes: 4,
+            mask: a.mask,
+            addrs: &a.addrs,
+            cta: 0,
+            warp: 0,
+        };
+        m.count(&ev);
+        assert_eq!((m.counters().texture.requests, m.counters().texture.sectors), (2, 2));
     }
 
     #[test]

@@ -28,10 +28,13 @@ pub mod validation;
 use std::any::Any;
 use std::sync::Mutex;
 
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::ptx::Program;
 use crate::ptx::ir::MemSpace;
 use crate::sim::counters::Counters;
-use crate::sim::{MemEvent, MemObserver, MemOp, ObserverFactory};
+use crate::sim::{Fidelity, MemEvent, MemObserver, MemOp, ObserverFactory};
 pub use occupancy::{Occupancy, occupancy};
 pub use profile::Profile;
 
@@ -174,20 +177,35 @@ pub struct CtaModel {
     /// the lines of each half-warp lookup end at the next `tex_ends` entry.
     tex_pending: Vec<u64>,
     tex_ends: Vec<usize>,
+    /// Scratch space reused by every event, so that counting allocates nothing.
+    lines: Vec<u64>,
+    pairs: Vec<(u64, u64)>,
+    /// Simulates caches (fidelity `caches`); without, hits and misses stay 0.
+    caches: bool,
 }
 
 impl CtaModel {
-    fn new(profile: Profile, shape: &[usize]) -> Self {
+    /// A CTA's model of `profile`, with per-instruction counts shaped as `shape`
+    /// (instructions per function).
+    pub fn new(profile: Profile, shape: &[usize]) -> Self {
+        Self::with_caches(profile, shape, true)
+    }
+
+    /// As [`CtaModel::new`]; without `caches` no cache is simulated.
+    pub fn with_caches(profile: Profile, shape: &[usize], caches: bool) -> Self {
         let p = profile.params();
         CtaModel {
             profile,
             counters: MemCounters::default(),
             per_inst: shape.iter().map(|&n| vec![InstMem::default(); n]).collect(),
-            l1: (p.l1_bytes > 0).then(|| cache::SectorCache::new(p.l1_bytes, 128, 4)),
-            tex: (p.tex_bytes > 0 && p.tex_shared_sms == 1)
+            l1: (caches && p.l1_bytes > 0).then(|| cache::SectorCache::new(p.l1_bytes, 128, 4)),
+            tex: (caches && p.tex_bytes > 0 && p.tex_shared_sms == 1)
                 .then(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways)),
             tex_pending: Vec::new(),
             tex_ends: Vec::new(),
+            lines: Vec::with_capacity(64),
+            pairs: Vec::with_capacity(64),
+            caches,
         }
     }
 
@@ -210,16 +228,19 @@ impl CtaModel {
         let physical = |l: usize| if local { sectors::local_physical(key, l, ev.addrs[l]) } else { ev.addrs[l] };
         if self.profile == Profile::Gt200 {
             if kind == Kind::Texture {
-                // The texture path does not coalesce: one lookup per distinct 32-byte line per half-warp.
+                // The texture path does not coalesce: one request per half-warp
+                // with active lanes, one lookup per distinct 32-byte line in it.
+                let mut lines = std::mem::take(&mut self.lines);
                 for h in 0..2 {
                     let m = ev.mask & (0xFFFF << (16 * h));
-                    let lines = sectors::sectors(m, ev.bytes, |l| ev.addrs[l]);
+                    sectors::sectors_into(m, ev.bytes, |l| ev.addrs[l], &mut lines);
                     c.requests += (!lines.is_empty()) as u64;
+                    im.requests += (!lines.is_empty()) as u64;
                     c.sectors += lines.len() as u64;
                     im.sectors += lines.len() as u64;
                     match self.tex.as_mut() {
                         Some(cache) => {
-                            for s in lines {
+                            for &s in &lines {
                                 if cache.access(s) {
                                     c.hits += 1;
                                 } else {
@@ -228,14 +249,14 @@ impl CtaModel {
                             }
                         }
                         // a cache shared by the TPC: looked up at the round's end
-                        None if !lines.is_empty() => {
+                        None if self.caches && !lines.is_empty() => {
                             self.tex_pending.extend_from_slice(&lines);
                             self.tex_ends.push(self.tex_pending.len());
                         }
                         None => {}
                     }
                 }
-                im.requests = 1;
+                self.lines = lines;
                 return im;
             }
             // Local memory is interleaved per thread, so give the coalescer word addresses.
@@ -260,11 +281,12 @@ impl CtaModel {
             im.sectors = t.count();
             return im;
         }
-        let secs = if local {
-            sectors::local_sectors(key, ev.mask, ev.bytes, |l| ev.addrs[l])
+        let mut secs = std::mem::take(&mut self.lines);
+        if local {
+            sectors::local_sectors_into(key, ev.mask, ev.bytes, |l| ev.addrs[l], &mut secs);
         } else {
-            sectors::sectors(ev.mask, ev.bytes, physical)
-        };
+            sectors::sectors_into(ev.mask, ev.bytes, physical, &mut secs);
+        }
         c.requests += 1;
         c.sectors += secs.len() as u64;
         im.requests = 1;
@@ -275,7 +297,7 @@ impl CtaModel {
             _ => None,
         };
         if let Some(cache) = cache {
-            for s in secs {
+            for &s in &secs {
                 if cache.access(s) {
                     c.hits += 1;
                 } else {
@@ -286,18 +308,19 @@ impl CtaModel {
             && let Some(l1) = self.l1.as_mut()
         {
             // write-through: stores keep cached sectors valid
-            for s in secs {
+            for &s in &secs {
                 l1.access(s);
             }
         }
+        self.lines = secs;
         im
     }
 
     fn banked(&mut self, ev: &MemEvent, which: Bank) -> InstMem {
         let cost = if self.profile == Profile::Gt200 {
-            banks::cost16(ev.mask, ev.bytes, |l| ev.addrs[l])
+            banks::cost16_with(ev.mask, ev.bytes, |l| ev.addrs[l], &mut self.pairs)
         } else {
-            banks::cost32(ev.mask, ev.bytes, |l| ev.addrs[l])
+            banks::cost32_with(ev.mask, ev.bytes, |l| ev.addrs[l], &mut self.pairs)
         };
         let c = match which {
             Bank::Load => &mut self.counters.shared_ld,
@@ -317,8 +340,10 @@ impl CtaModel {
         // The constant cache serves one address per pass (per half-warp on GT200).
         let groups: &[u32] = if self.profile == Profile::Gt200 { &[0xFFFF, 0xFFFF_0000] } else { &[u32::MAX] };
         let mut passes = 0;
+        let a = &mut self.lines;
         for g in groups {
-            let mut a: Vec<u64> = (0..32).filter(|l| (ev.mask & g) >> l & 1 != 0).map(|l| ev.addrs[l]).collect();
+            a.clear();
+            a.extend((0..32).filter(|l| (ev.mask & g) >> l & 1 != 0).map(|l| ev.addrs[l]));
             a.sort_unstable();
             a.dedup();
             passes += a.len() as u64;
@@ -353,9 +378,12 @@ enum Bank {
     Atom,
 }
 
-impl MemObserver for CtaModel {
-    fn access(&mut self, ev: &MemEvent) {
-        let im = match (ev.space, ev.op) {
+impl CtaModel {
+    /// Counts one warp-level access into the CTA's counters and returns what it
+    /// cost that instruction. The one implementation of the profile's rules:
+    /// the counters and the teaching views ([`explain`]) both take it from here.
+    pub fn count(&mut self, ev: &MemEvent) -> InstMem {
+        match (ev.space, ev.op) {
             (MemSpace::Global, MemOp::Load) if ev.nc && self.profile != Profile::Hopper => {
                 self.global(ev, Kind::Texture)
             }
@@ -373,7 +401,18 @@ impl MemObserver for CtaModel {
                 self.counters.param += 1;
                 InstMem::default()
             }
-        };
+        }
+    }
+
+    /// The counters so far.
+    pub fn counters(&self) -> &MemCounters {
+        &self.counters
+    }
+}
+
+impl MemObserver for CtaModel {
+    fn access(&mut self, ev: &MemEvent) {
+        let im = self.count(ev);
         let slot = &mut self.per_inst[ev.func as usize][ev.pc as usize];
         slot.requests += im.requests;
         slot.sectors += im.sectors;
@@ -399,6 +438,40 @@ pub struct Model {
     /// Texture caches shared by the SMs of a texture processor cluster (GT200),
     /// by cluster; created on first use.
     shared_tex: Mutex<Vec<Option<cache::SectorCache>>>,
+    /// Simulates caches (set by the launch's fidelity; on by default).
+    caches: AtomicBool,
+}
+
+/// One texture-processor cluster's CTA models of a round, with their cluster index.
+type Cluster<'a, 'b> = &'a mut [(u32, &'b mut CtaModel)];
+
+/// Replays one texture-processor cluster's lookups of a round into its cache:
+/// the cluster's CTAs take turns one half-warp lookup at a time, in CTA order.
+fn replay_cluster(cache: &mut cache::SectorCache, group: Cluster) {
+    let mut next = vec![0usize; group.len()];
+    loop {
+        let mut any = false;
+        for (j, (_, m)) in group.iter_mut().enumerate() {
+            let Some(&end) = m.tex_ends.get(next[j]) else { continue };
+            let start = if next[j] == 0 { 0 } else { m.tex_ends[next[j] - 1] };
+            for i in start..end {
+                if cache.access(m.tex_pending[i]) {
+                    m.counters.texture.hits += 1;
+                } else {
+                    m.counters.texture.misses += 1;
+                }
+            }
+            next[j] += 1;
+            any = true;
+        }
+        if !any {
+            break;
+        }
+    }
+    for (_, m) in group.iter_mut() {
+        m.tex_pending.clear();
+        m.tex_ends.clear();
+    }
 }
 
 /// What a model counted.
@@ -423,6 +496,7 @@ impl Model {
             shape,
             acc: Mutex::new(ModelStats { profile, counters: MemCounters::default(), per_inst }),
             shared_tex: Mutex::new(Vec::new()),
+            caches: AtomicBool::new(true),
         }
     }
 
@@ -434,7 +508,11 @@ impl Model {
 
 impl ObserverFactory for Model {
     fn create(&self, _cta: u32) -> Box<dyn MemObserver> {
-        Box::new(CtaModel::new(self.profile, &self.shape))
+        Box::new(CtaModel::with_caches(self.profile, &self.shape, self.caches.load(Ordering::Relaxed)))
+    }
+
+    fn set_fidelity(&self, level: Fidelity) {
+        self.caches.store(level >= Fidelity::Caches, Ordering::Relaxed);
     }
 
     /// Replays the round's texture lookups of the CTAs that share a texture
@@ -460,36 +538,23 @@ impl ObserverFactory for Model {
         }
         ctas.sort_by_key(|c| c.0); // stable: CTA order within a cluster
         let mut caches = self.shared_tex.lock().expect("model lock");
-        for group in ctas.chunk_by_mut(|a, b| a.0 == b.0) {
-            let k = group[0].0 as usize;
-            if caches.len() <= k {
-                caches.resize(k + 1, None);
-            }
-            let cache = caches[k].get_or_insert_with(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways));
-            let mut next = vec![0usize; group.len()];
-            loop {
-                let mut any = false;
-                for (j, (_, m)) in group.iter_mut().enumerate() {
-                    let Some(&end) = m.tex_ends.get(next[j]) else { continue };
-                    let start = if next[j] == 0 { 0 } else { m.tex_ends[next[j] - 1] };
-                    for i in start..end {
-                        if cache.access(m.tex_pending[i]) {
-                            m.counters.texture.hits += 1;
-                        } else {
-                            m.counters.texture.misses += 1;
-                        }
-                    }
-                    next[j] += 1;
-                    any = true;
+        // Each cluster's cache is its own: replay the clusters in parallel
+        // (on the launch's host threads), each in its fixed order.
+        let mut work: Vec<(usize, cache::SectorCache, Cluster)> = ctas
+            .chunk_by_mut(|a, b| a.0 == b.0)
+            .map(|group| {
+                let k = group[0].0 as usize;
+                if caches.len() <= k {
+                    caches.resize(k + 1, None);
                 }
-                if !any {
-                    break;
-                }
-            }
-            for (_, m) in group.iter_mut() {
-                m.tex_pending.clear();
-                m.tex_ends.clear();
-            }
+                let cache =
+                    caches[k].take().unwrap_or_else(|| cache::SectorCache::new(p.tex_bytes, p.tex_line, p.tex_ways));
+                (k, cache, group)
+            })
+            .collect();
+        work.par_iter_mut().for_each(|(_, cache, group)| replay_cluster(cache, group));
+        for (k, cache, _) in work {
+            caches[k] = Some(cache);
         }
     }
 

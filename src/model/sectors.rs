@@ -16,6 +16,13 @@ pub fn local_physical(warp_key: u64, lane: usize, off: u64) -> u64 {
 /// bytes at `addr(lane)`. Sorted, without duplicates.
 pub fn sectors(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<u64> {
     let mut v = Vec::with_capacity(32);
+    sectors_into(mask, bytes, addr, &mut v);
+    v
+}
+
+/// [`sectors`] into `v` (cleared first), so that a caller reusing `v` allocates nothing.
+pub fn sectors_into(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64, v: &mut Vec<u64>) {
+    v.clear();
     for l in 0..32 {
         if mask >> l & 1 == 0 {
             continue;
@@ -28,12 +35,18 @@ pub fn sectors(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<u64> {
     }
     v.sort_unstable();
     v.dedup();
-    v
 }
 
 /// Sectors of a local-memory access (interleaved layout, see [`local_physical`]).
 pub fn local_sectors(warp_key: u64, mask: u32, bytes: u32, off: impl Fn(usize) -> u64) -> Vec<u64> {
     let mut v = Vec::with_capacity(32);
+    local_sectors_into(warp_key, mask, bytes, off, &mut v);
+    v
+}
+
+/// [`local_sectors`] into `v` (cleared first).
+pub fn local_sectors_into(warp_key: u64, mask: u32, bytes: u32, off: impl Fn(usize) -> u64, v: &mut Vec<u64>) {
+    v.clear();
     for l in 0..32 {
         if mask >> l & 1 == 0 {
             continue;
@@ -48,7 +61,6 @@ pub fn local_sectors(warp_key: u64, mask: u32, bytes: u32, off: impl Fn(usize) -
     }
     v.sort_unstable();
     v.dedup();
-    v
 }
 
 #[cfg(test)]

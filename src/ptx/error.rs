@@ -54,6 +54,30 @@ pub struct PtxError {
     pub kind: PtxErrorKind,
 }
 
+/// Most characters of a source line an error message quotes.
+const QUOTED_LINE_CHARS: usize = 160;
+
+/// `line`, cut to [`QUOTED_LINE_CHARS`] characters with `…` when longer.
+fn shorten(line: &str) -> String {
+    match line.char_indices().nth(QUOTED_LINE_CHARS) {
+        Some((cut, _)) => format!("{}…", &line[..cut]),
+        None => line.to_string(),
+    }
+}
+
+impl PtxError {
+    /// The error `kind` at `pos` of the file `file` whose text is `src`
+    /// (the line is quoted from it).
+    pub fn at(file: &str, src: &str, pos: Pos, kind: PtxErrorKind) -> PtxError {
+        PtxError {
+            file: file.to_string(),
+            pos,
+            line_text: src.lines().nth(pos.line.saturating_sub(1) as usize).map(|l| shorten(l.trim())),
+            kind,
+        }
+    }
+}
+
 impl fmt::Display for PtxError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}:{}: {}", self.file, self.pos, self.kind)?;

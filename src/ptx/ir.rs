@@ -4,6 +4,7 @@
 //! type, labels to instruction indices, parameters and variables to offsets in
 //! their state space. Nothing here knows how instructions execute.
 
+use super::error::PtxError;
 use super::types::Ty;
 
 /// Index of a data register in a function's register file.
@@ -411,6 +412,11 @@ pub struct Function {
     pub declared_reg_words: u32,
     /// Offsets of the shared variables the function names itself (callees not included).
     pub shared_refs: Vec<u32>,
+    /// Why the function cannot run, when it (or a function it calls) holds an
+    /// instruction warplight does not execute: the module still loads, and only
+    /// a launch of this kernel fails, with this error (file, line, instruction).
+    /// In the body a `trap` stands in place of each unsupported instruction.
+    pub unsupported: Option<PtxError>,
 }
 
 /// A module-scope `.global` variable.
@@ -510,6 +516,24 @@ impl Program {
             size = size.div_ceil(v.align) * v.align + v.size;
         }
         size
+    }
+
+    /// Why kernel (or function) `k` cannot run, when it needs an instruction
+    /// warplight does not execute; `None` when it can.
+    pub fn kernel_error(&self, k: u32) -> Option<&super::error::PtxError> {
+        self.functions.get(k as usize).and_then(|f| f.unsupported.as_ref())
+    }
+
+    /// The function that holds the instruction kernel `k` cannot run (`k`
+    /// itself, or a function it calls), when there is one.
+    pub fn unsupported_in(&self, k: u32) -> Option<&str> {
+        let e = self.kernel_error(k)?;
+        let holds = |f: &&Function| {
+            f.unsupported.as_ref() == Some(e)
+                && f.insts.iter().zip(&f.info).any(|(i, inf)| i.kind == Kind::Trap && inf.ptx_line == e.pos.line)
+        };
+        let own = self.functions.get(k as usize).filter(holds);
+        own.or_else(|| self.functions.iter().find(holds)).map(|f| f.name.as_str())
     }
 
     /// Names of all kernels (as in the PTX; C++ kernels mangled).

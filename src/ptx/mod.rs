@@ -11,6 +11,7 @@
 pub mod ast;
 pub mod error;
 pub mod ir;
+pub mod ir_text;
 pub mod lexer;
 pub mod lower;
 pub mod parser;
@@ -20,27 +21,16 @@ pub use error::{Pos, PtxError, PtxErrorKind, PtxResult};
 pub use ir::Program;
 
 /// Parses and validates PTX source text. `name` is used in error messages.
+///
+/// A kernel that needs an instruction warplight does not execute (or calls a
+/// function that does) does not stop the module from loading: it is marked
+/// ([`ir::Function::unsupported`], [`Program::kernel_error`]) and fails when
+/// launched. A module none of whose kernels can run is an error.
 pub fn load(src: &str, name: &str) -> PtxResult<Program> {
-    let wrap = |(pos, kind): (Pos, PtxErrorKind)| PtxError {
-        file: name.to_string(),
-        pos,
-        line_text: src.lines().nth(pos.line.saturating_sub(1) as usize).map(|l| shorten(l.trim())),
-        kind,
-    };
+    let wrap = |(pos, kind): (Pos, PtxErrorKind)| PtxError::at(name, src, pos, kind);
     let toks = lexer::lex(src).map_err(wrap)?;
     let module = parser::parse(&toks).map_err(wrap)?;
     lower::lower(&module, name, src).map_err(wrap)
-}
-
-/// Most characters of a source line an error message quotes.
-const QUOTED_LINE_CHARS: usize = 160;
-
-/// `line`, cut to [`QUOTED_LINE_CHARS`] characters with `…` when longer.
-fn shorten(line: &str) -> String {
-    match line.char_indices().nth(QUOTED_LINE_CHARS) {
-        Some((cut, _)) => format!("{}…", &line[..cut]),
-        None => line.to_string(),
-    }
 }
 
 /// Reads a PTX file and loads it.

@@ -511,21 +511,49 @@ impl<'a> Parser<'a> {
             mods.push(m.clone());
             self.i += 1;
         }
+        let start = self.i;
         let operands = match self.operand_list() {
             Ok(o) => o,
             // Operand syntax of instructions warplight does not know (textures, tensor
-            // ops...) is not parsed: name the instruction instead.
+            // ops...) is not parsed: the instruction is kept without operands (the
+            // lowering reports it unsupported, failing only its function) when its
+            // `;` is found before the block ends, else it is named as the error.
             Err(_) if !KNOWN_OPCODES.contains(&opcode.as_str()) => {
-                let mut full = opcode.clone();
-                for m in &mods {
-                    full.push('.');
-                    full.push_str(m);
+                self.i = start;
+                if self.skip_statement() {
+                    Vec::new()
+                } else {
+                    let mut full = opcode.clone();
+                    for m in &mods {
+                        full.push('.');
+                        full.push_str(m);
+                    }
+                    return Err((pos, PtxErrorKind::Unsupported(full)));
                 }
-                return Err((pos, PtxErrorKind::Unsupported(full)));
             }
             Err(e) => return Err(e),
         };
         Ok(Instruction { guard, opcode, mods, operands, pos })
+    }
+
+    /// Skips tokens through the next `;` outside braces; false (and nothing
+    /// skipped) when a `}` closing the enclosing block or the end of the file
+    /// comes first.
+    fn skip_statement(&mut self) -> bool {
+        let start = self.i;
+        let mut depth = 0usize;
+        while let Some(t) = self.peek() {
+            self.i += 1;
+            match t {
+                Tok::Punct(';') if depth == 0 => return true,
+                Tok::Punct('{') => depth += 1,
+                Tok::Punct('}') if depth == 0 => break,
+                Tok::Punct('}') => depth -= 1,
+                _ => {}
+            }
+        }
+        self.i = start;
+        false
     }
 
     fn operand_list(&mut self) -> PResult<Vec<Operand>> {

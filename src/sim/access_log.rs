@@ -87,4 +87,7 @@ impl ObserverFactory for AccessLog {
     }
 
     fn retire(&self, _obs: Box<dyn MemObserver>) {}
+
+    /// A log records every access at every level that observes memory.
+    fn set_fidelity(&self, _level: super::Fidelity) {}
 }

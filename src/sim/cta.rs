@@ -195,7 +195,7 @@ impl Cta {
 
     /// Issues one warp instruction. `Ok(None)` means the CTA cannot issue now
     /// (see [`Cta::stall`]).
-    pub fn step(&mut self, ctx: &Ctx) -> Result<Option<Issued>, CtaFault> {
+    pub fn step(&mut self, ctx: &Ctx) -> Result<Option<Issued>, Box<CtaFault>> {
         let w = match self.pick() {
             Ok(Some(w)) => w,
             Ok(None) => {
@@ -215,7 +215,7 @@ impl Cta {
                     .unwrap_or((0, 0, 0));
                 let f = CtaFault { kind: FaultKind::BarrierDeadlock { waiting }, warp: wi, func, pc, lane: None };
                 self.fault = Some(f.clone());
-                return Err(f);
+                return Err(Box::new(f));
             }
             Err(_) => return Ok(None),
         };
@@ -243,7 +243,7 @@ impl Cta {
             Err(e) => {
                 let f = CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane };
                 self.fault = Some(f.clone());
-                return Err(f);
+                return Err(Box::new(f));
             }
         }
         Ok(Some(Issued { warp: w as u32, func, pc, mask }))
@@ -255,7 +255,7 @@ impl Cta {
     }
 
     /// Issues up to `quantum` warp instructions, stopping early when blocked.
-    pub fn run_round(&mut self, ctx: &Ctx, quantum: u64) -> Result<u64, CtaFault> {
+    pub fn run_round(&mut self, ctx: &Ctx, quantum: u64) -> Result<u64, Box<CtaFault>> {
         let mut n = 0;
         while n < quantum {
             match self.step(ctx)? {

@@ -32,8 +32,10 @@ use std::collections::HashMap;
 
 use super::cfg::Cfg;
 use super::counters::LaunchStats;
+use super::decode::Code;
 use super::exec::Ctx;
 use super::fault::Fault;
+use super::fidelity::Fidelity;
 use super::grid::{GridRun, Schedule};
 use super::memory::DeviceMemory;
 use super::observer::ObserverFactory;
@@ -208,6 +210,8 @@ pub struct SimConfig {
     pub max_threads_per_cta: u32,
     /// Largest shared memory per CTA.
     pub max_shared_per_cta: u32,
+    /// How much beyond the results a launch models ([`Fidelity`]); never changes results.
+    pub fidelity: Fidelity,
 }
 
 /// The default watchdog: warp instructions per launch (2^32, a few minutes of
@@ -257,6 +261,7 @@ impl Default for SimConfig {
             max_call_depth: DEFAULT_MAX_CALL_DEPTH,
             max_threads_per_cta: 1024,
             max_shared_per_cta: 228 * 1024,
+            fidelity: super::fidelity::default_level(),
         }
     }
 }
@@ -268,6 +273,8 @@ pub struct Module {
     pub prog: Program,
     /// CFG of each function.
     pub cfgs: Vec<Cfg>,
+    /// The decoded, executable form.
+    pub code: Code,
     globals: Vec<u64>,
 }
 
@@ -395,7 +402,8 @@ impl Device {
             }
             globals.push(p.0);
         }
-        Module { prog, cfgs, globals }
+        let code = Code::decode(&prog);
+        Module { prog, cfgs, code, globals }
     }
 
     fn prepare(
@@ -410,6 +418,10 @@ impl Device {
             file: m.prog.source_name.clone(),
             available: m.prog.kernel_names().join(", "),
         })?;
+        if let Some(e) = m.prog.kernel_error(k) {
+            // the module loaded, but this kernel (or a function it calls) needs an unsupported instruction
+            return Err(SimError::Ptx(e.clone()));
+        }
         let f = &m.prog.functions[k as usize];
         if f.insts.is_empty() {
             // Only declared (`.entry k(...);`): a body, even an empty one, has an exit.
@@ -469,6 +481,7 @@ impl Device {
     ) -> Ctx<'a> {
         Ctx {
             prog: &m.prog,
+            code: &m.code,
             cfgs: &m.cfgs,
             mem: &self.mem,
             kparams: kp,
@@ -479,6 +492,7 @@ impl Device {
             local_limit: self.config.local_limit,
             max_call_depth: self.config.max_call_depth,
             observers,
+            per_inst: self.config.fidelity >= Fidelity::Instructions,
         }
     }
 
@@ -504,38 +518,32 @@ impl Device {
         observers: Option<&dyn ObserverFactory>,
     ) -> Result<LaunchStats, SimError> {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
+        // Below `memory` nobody listens; the listener learns whether to simulate caches.
+        let fidelity = self.config.fidelity;
+        let observers = observers.filter(|_| fidelity >= Fidelity::Memory);
+        if let Some(o) = observers {
+            o.set_fidelity(fidelity);
+        }
         let ctx = self.ctx(m, kp, &cfg, observers);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
         run.run(self.pool.as_ref()).map_err(SimError::Fault)
     }
 
-    /// Starts a launch for stepping one warp instruction at a time.
-    pub fn stepper<'a>(
+    /// Checks a launch and makes its runner (for [`super::stepper`], which
+    /// adds the stepping entry points to `Device`).
+    pub(crate) fn prepare_run<'a>(
         &'a self,
         m: &'a Module,
         kernel: &str,
         cfg: LaunchConfig,
         args: &[Arg],
-    ) -> Result<super::stepper::Stepper<'a>, SimError> {
+        observers: Option<&'a dyn ObserverFactory>,
+    ) -> Result<GridRun<'a>, SimError> {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
-        Ok(super::stepper::Stepper::new(self, m, k, kp, shared, cfg, None))
+        Ok(self.make_run(m, k, kp, shared, &cfg, observers))
     }
 
-    /// Like [`Device::stepper`], and every step's memory accesses are recorded
-    /// in `log` and handed out with its [`StepEvent`](super::stepper::StepEvent).
-    pub fn stepper_logged<'a>(
-        &'a self,
-        m: &'a Module,
-        kernel: &str,
-        cfg: LaunchConfig,
-        args: &[Arg],
-        log: &'a super::access_log::AccessLog,
-    ) -> Result<super::stepper::Stepper<'a>, SimError> {
-        let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
-        Ok(super::stepper::Stepper::new(self, m, k, kp, shared, cfg, Some(log)))
-    }
-
-    pub(crate) fn make_run<'a>(
+    fn make_run<'a>(
         &'a self,
         m: &'a Module,
         k: u32,

@@ -116,7 +116,12 @@ impl<'a> GridRun<'a> {
             Some(p) if self.resident.len() > 1 => p.install(|| self.resident.par_iter_mut().for_each(run)),
             _ => self.resident.iter_mut().for_each(run),
         }
-        self.commit()
+        // The between-rounds phase runs on the launch's threads too (observers
+        // may settle independent parts in parallel, `ObserverFactory::end_round`).
+        match pool {
+            Some(p) => p.install(|| self.commit()),
+            None => self.commit(),
+        }
     }
 
     /// The between-rounds phase: faults, atomics, retirement, admission, budget.

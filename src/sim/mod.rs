@@ -2,16 +2,19 @@
 //! ([`warp`]), instruction semantics ([`exec`], [`alu`]), CTAs and their warp
 //! scheduler ([`cta`]), the grid scheduler ([`grid`]), device memory
 //! ([`memory`]), faults ([`fault`]), counters ([`counters`]), stepping
-//! ([`stepper`]) and the public [`Device`] API ([`device`]).
+//! ([`stepper`]), fidelity levels ([`fidelity`]), the decoded executable form
+//! ([`decode`]) and the public [`Device`] API ([`device`]).
 
 pub mod access_log;
 pub mod alu;
 pub mod cfg;
 pub mod counters;
 pub mod cta;
+pub mod decode;
 pub mod device;
 pub mod exec;
 pub mod fault;
+pub mod fidelity;
 pub mod grid;
 pub mod memory;
 pub mod observer;
@@ -22,6 +25,7 @@ pub mod warp;
 pub use counters::{Counters, LaunchStats};
 pub use device::{Arg, Device, DevicePtr, Element, LaunchConfig, Module, SimConfig, SimError};
 pub use fault::{Fault, FaultKind};
+pub use fidelity::Fidelity;
 pub use grid::Schedule;
 pub use observer::{MemEvent, MemObserver, MemOp, ObserverFactory};
 pub use stepper::{StepEvent, Stepper, WarpView};

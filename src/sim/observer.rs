@@ -74,4 +74,8 @@ pub trait ObserverFactory: Sync {
     /// texture processor cluster) replays the round's accesses here in a fixed
     /// order, so that its results do not depend on host threads. Default: nothing.
     fn end_round(&self, _observers: &mut [(u32, &mut dyn MemObserver)]) {}
+    /// Called before a launch with its [`Fidelity`](super::Fidelity) (`memory`
+    /// or `caches`): a model with caches leaves them out below `caches`.
+    /// Required, so that a factory wrapping another one cannot forget to pass it on.
+    fn set_fidelity(&self, level: super::Fidelity);
 }

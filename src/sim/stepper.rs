@@ -4,7 +4,7 @@
 
 use super::access_log::{Access, AccessLog};
 use super::counters::Counters;
-use super::device::{Device, LaunchConfig, Module};
+use super::device::{Arg, Device, LaunchConfig, Module, SimError};
 use super::fault::Fault;
 use super::grid::GridRun;
 use super::simt_stack::SimtEntry;
@@ -69,20 +69,37 @@ pub struct Stepper<'a> {
     log: Option<&'a AccessLog>,
 }
 
-impl<'a> Stepper<'a> {
-    pub(crate) fn new(
-        dev: &'a Device,
+/// The stepping entry points of a [`Device`] (here, so that the device does
+/// not depend on the stepper).
+impl Device {
+    /// Starts a launch for stepping one warp instruction at a time.
+    pub fn stepper<'a>(
+        &'a self,
         m: &'a Module,
-        k: u32,
-        kp: Vec<u8>,
-        shared: usize,
+        kernel: &str,
         cfg: LaunchConfig,
-        log: Option<&'a AccessLog>,
-    ) -> Self {
-        let obs = log.map(|l| l as &dyn super::observer::ObserverFactory);
-        Stepper { run: dev.make_run(m, k, kp, shared, &cfg, obs), module: m, finished: false, log }
+        args: &[Arg],
+    ) -> Result<Stepper<'a>, SimError> {
+        let run = self.prepare_run(m, kernel, cfg, args, None)?;
+        Ok(Stepper { run, module: m, finished: false, log: None })
     }
 
+    /// Like [`Device::stepper`], and every step's memory accesses are recorded
+    /// in `log` and handed out with its [`StepEvent`].
+    pub fn stepper_logged<'a>(
+        &'a self,
+        m: &'a Module,
+        kernel: &str,
+        cfg: LaunchConfig,
+        args: &[Arg],
+        log: &'a AccessLog,
+    ) -> Result<Stepper<'a>, SimError> {
+        let run = self.prepare_run(m, kernel, cfg, args, Some(log as &dyn super::observer::ObserverFactory))?;
+        Ok(Stepper { run, module: m, finished: false, log: Some(log) })
+    }
+}
+
+impl<'a> Stepper<'a> {
     /// The module being run.
     pub fn module(&self) -> &'a Module {
         self.module

@@ -1,0 +1,107 @@
+//! Control: branches (resolved once all labels are known), calls of device
+//! functions through `.param` variables, `ret`/`exit`/`trap`, barriers, fences
+//! and the instructions without effect in the model.
+
+use super::opcode::{Decoded, Opcode};
+use super::{FnLower, LResult, Sym, invalid, unsupported};
+use crate::ptx::ast::{self, Operand};
+use crate::ptx::ir::*;
+use crate::ptx::types::Ty;
+
+impl FnLower<'_> {
+    /// Lowers a validated control instruction.
+    pub(super) fn lower_control(&mut self, i: &ast::Instruction, d: &Decoded) -> LResult<Kind> {
+        use Opcode::*;
+        let (pos, ops, m) = (i.pos, &i.operands, &d.mods);
+        Ok(match d.op {
+            Bra => {
+                let Operand::Name(l) = &ops[0] else { unreachable!("validated: a label") };
+                self.fixups.push((self.out.insts.len(), l.clone(), pos));
+                Kind::Bra { target: u32::MAX, uni: m.has("uni") }
+            }
+            Call => self.call(i)?,
+            Ret if self.sigs[self.me].is_entry => Kind::Exit,
+            Ret => Kind::Ret,
+            Exit => Kind::Exit,
+            Trap => Kind::Trap,
+            Bar | Barrier if m.has("warp") => Kind::Nop, // bar.warp.sync: the warp executes in lockstep here
+            Bar | Barrier => {
+                let id = self.src(&ops[0], Ty::U32, pos)?;
+                let count = if ops.len() == 2 { Some(self.src(&ops[1], Ty::U32, pos)?) } else { None };
+                Kind::Bar { id, count }
+            }
+            Membar | Fence => Kind::Membar,
+            Prefetch | Prefetchu | Pmevent | Nanosleep | Brkpt | Nop => Kind::Nop,
+            other => unreachable!("{other:?} is not a control opcode"),
+        })
+    }
+
+    /// A direct call: arguments and return values are `.param` variables,
+    /// copied into and out of the callee's frame.
+    fn call(&mut self, i: &ast::Instruction) -> LResult<Kind> {
+        let pos = i.pos;
+        let ops = &i.operands;
+        let mut k = 0;
+        let mut rets: &[Operand] = &[];
+        if let Some(Operand::List(r)) = ops.first() {
+            rets = r;
+            k = 1;
+        }
+        let Some(Operand::Name(fname)) = ops.get(k) else {
+            return invalid(pos, "`call` needs a function name");
+        };
+        let args: &[Operand] = match ops.get(k + 1) {
+            Some(Operand::List(a)) => a,
+            None => &[],
+            Some(_) => return unsupported(pos, "indirect call with a prototype"),
+        };
+        if ops.len() > k + 2 {
+            return unsupported(pos, "indirect call with a prototype");
+        }
+        let fidx = match self.lookup(fname) {
+            Some(Sym::Func(f)) => f as usize,
+            Some(Sym::Reg(_)) => return unsupported(pos, "indirect call through a register"),
+            _ => return invalid(pos, format!("call of undeclared function `{fname}`")),
+        };
+        let callee = &self.sigs[fidx];
+        if callee.is_entry {
+            return invalid(pos, format!("`{fname}` is a kernel and cannot be called"));
+        }
+        if !callee.has_body {
+            return unsupported(pos, format!("call of `{fname}`, which has no body in this module"));
+        }
+        if args.len() != callee.params.len() || rets.len() != callee.returns.len() {
+            return invalid(
+                pos,
+                format!(
+                    "`{}` takes {} argument(s) and {} return value(s); the call passes {} and {}",
+                    callee.name,
+                    callee.params.len(),
+                    callee.returns.len(),
+                    args.len(),
+                    rets.len()
+                ),
+            );
+        }
+        let param_var = |o: &Operand| -> LResult<(u32, u32)> {
+            match o {
+                Operand::Name(n) => match self.lookup(n) {
+                    Some(Sym::FrameParam(off, size)) => Ok((off, size)),
+                    _ => unsupported(pos, format!("call argument `{n}` that is not a .param variable")),
+                },
+                _ => unsupported(pos, "call argument that is not a .param variable"),
+            }
+        };
+        let mut a = Vec::new();
+        for (o, p) in args.iter().zip(&callee.params) {
+            let (off, size) = param_var(o)?;
+            a.push((off, p.offset, size.min(p.size)));
+        }
+        let mut r = Vec::new();
+        for (o, p) in rets.iter().zip(&callee.returns) {
+            let (off, size) = param_var(o)?;
+            r.push((p.offset, off, size.min(p.size)));
+        }
+        Ok(Kind::Call { func: fidx as u32, args: a, rets: r })
+    }
+}

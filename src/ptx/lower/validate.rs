@@ -1,0 +1,271 @@
+//! Validation of an instruction's shape before it is lowered: the modifiers
+//! its opcode accepts, its types, its operand count and operand forms. What
+//! passes here is lowered by the family files without re-checking; what is
+//! refused is an error at the instruction — `unsupported` for valid PTX that
+//! warplight does not execute, `invalid` for PTX that breaks a rule.
+
+use super::opcode::{Decoded, Opcode, atom_op_of, bool_of, cmp_of};
+use super::{LResult, invalid, unsupported};
+use crate::ptx::ast::{self, Operand};
+use crate::ptx::ir::Rounding;
+use crate::ptx::types::Ty;
+
+/// Rounding-mode words.
+pub const ROUNDINGS: &[&str] = &["rn", "rz", "rm", "rp", "rni", "rzi", "rmi", "rpi"];
+
+/// Qualifiers `ld` and `st` accept (caching, ordering and scope have no effect on results).
+const LD_ST_WORDS: &[&str] = &[
+    "v2",
+    "v4",
+    "nc",
+    "volatile",
+    "weak",
+    "relaxed",
+    "acquire",
+    "release",
+    "ca",
+    "cg",
+    "cs",
+    "lu",
+    "cv",
+    "wb",
+    "wt",
+    "cta",
+    "gpu",
+    "sys",
+    "L1::evict_normal",
+    "L1::evict_unchanged",
+    "L1::evict_first",
+    "L1::evict_last",
+    "L1::no_allocate",
+    "L2::64B",
+    "L2::128B",
+    "L2::256B",
+    "L2::evict_first",
+    "L2::evict_last",
+    "L2::evict_normal",
+];
+
+/// Ordering, scope and `.noftz` words of atomics (no effect in the model).
+const ATOM_IGNORED: &[&str] = &["relaxed", "acquire", "release", "acq_rel", "cta", "gpu", "sys", "noftz"];
+
+/// Fails when a modifier word of `d` is not in `allowed`.
+fn only(d: &Decoded, allowed: &[&str], i: &ast::Instruction) -> LResult<()> {
+    for w in &d.mods.words {
+        if !allowed.contains(&w.as_str()) {
+            return unsupported(i.pos, format!("{} (modifier .{w})", d.full));
+        }
+    }
+    Ok(())
+}
+
+/// Fails unless `i` has `n` operands.
+pub fn operands(i: &ast::Instruction, n: usize) -> LResult<()> {
+    if i.operands.len() != n {
+        return invalid(i.pos, format!("`{}` takes {n} operands, found {}", i.full_opcode(), i.operands.len()));
+    }
+    Ok(())
+}
+
+/// The single type of `d`.
+pub fn one_type(d: &Decoded, i: &ast::Instruction) -> LResult<Ty> {
+    match d.mods.types.as_slice() {
+        [t] => Ok(*t),
+        [] => invalid(i.pos, format!("`{}` needs a type", d.full)),
+        _ => invalid(i.pos, format!("`{}` has more than one type", d.full)),
+    }
+}
+
+/// The source operand count and extra modifier words of an arithmetic opcode.
+pub fn arith_shape(op: Opcode) -> (usize, &'static [&'static str]) {
+    use Opcode::*;
+    match op {
+        Mul => (2, &["lo", "hi", "wide"]),
+        Mad | Fma => (3, &["lo", "hi", "wide"]),
+        Mul24 => (2, &["lo", "hi"]),
+        Mad24 => (3, &["lo", "hi"]),
+        Shf => (3, &["l", "r", "wrap", "clamp"]),
+        Bfe | Prmt => (3, &[]),
+        Abs | Neg | Not | Cnot | Popc | Clz | Brev | Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 => (1, &[]),
+        _ => (2, &[]),
+    }
+}
+
+/// Width of each part of a `mov` vector operand of `parts` parts of a `bits`-wide type.
+pub fn part_bits(bits: u32, parts: usize, i: &ast::Instruction) -> LResult<u32> {
+    let b = if parts == 0 { 0 } else { bits / parts as u32 };
+    if !matches!(b, 8 | 16 | 32) {
+        return invalid(i.pos, "vector move parts must be 8, 16 or 32 bits");
+    }
+    Ok(b)
+}
+
+/// Checks the shape of `i` (decoded as `d`).
+pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
+    use Opcode::*;
+    let pos = i.pos;
+    let m = &d.mods;
+    let n_ops = i.operands.len();
+    match d.op {
+        Mov => {
+            operands(i, 2)?;
+            only(d, &[], i)?;
+            let t = one_type(d, i)?;
+            if t != Ty::Pred {
+                match (&i.operands[0], &i.operands[1]) {
+                    (_, Operand::Vector(p)) | (Operand::Vector(p), _) => {
+                        part_bits(t.bits(), p.len(), i)?;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        And | Or | Xor | Not | Cnot if m.types.first() == Some(&Ty::Pred) => {
+            operands(i, if matches!(d.op, Not | Cnot) { 2 } else { 3 })?;
+        }
+        Bfi => {
+            operands(i, 5)?;
+            only(d, &[], i)?;
+            one_type(d, i)?;
+        }
+        Setp | Set => {
+            let mut cmp = None;
+            let mut comb = false;
+            for w in &m.words {
+                if let Some(c) = cmp_of(w).filter(|_| cmp.is_none()) {
+                    cmp = Some(c);
+                } else if bool_of(w).is_some() {
+                    comb = true;
+                } else if w != "ftz" {
+                    return unsupported(pos, format!("{} (modifier .{w})", d.full));
+                }
+            }
+            if cmp.is_none() {
+                return invalid(pos, format!("`{}` needs a comparison", d.full));
+            }
+            operands(i, if comb { 4 } else { 3 })?;
+            if d.op == Setp {
+                one_type(d, i)?;
+            } else if m.types.len() != 2 {
+                return invalid(pos, "`set` needs a destination and a source type");
+            }
+        }
+        Selp => {
+            operands(i, 4)?;
+            only(d, &[], i)?;
+            one_type(d, i)?;
+        }
+        Cvt => {
+            operands(i, 2)?;
+            let mut allowed = ROUNDINGS.to_vec();
+            allowed.extend(["ftz", "sat"]);
+            only(d, &allowed, i)?;
+            let [dty, sty] = m.types.as_slice() else {
+                return invalid(pos, "`cvt` needs a destination and a source type");
+            };
+            if *dty == Ty::F16 || *sty == Ty::F16 {
+                return unsupported(pos, format!("{} (.f16)", d.full));
+            }
+            if dty.is_float()
+                && sty.is_int()
+                && matches!(m.rounding(), Some(Rounding::Rni | Rounding::Rzi | Rounding::Rmi | Rounding::Rpi))
+            {
+                return invalid(pos, "integer rounding modifier on an int-to-float conversion");
+            }
+        }
+        Cvta => {
+            operands(i, 2)?;
+            only(d, &["to"], i)?;
+            one_type(d, i)?;
+            if m.space.is_none() {
+                return invalid(pos, "`cvta` needs a state space");
+            }
+        }
+        Ld | St => {
+            operands(i, 2)?;
+            only(d, LD_ST_WORDS, i)?;
+            one_type(d, i)?;
+            let vals = if d.op == Ld { &i.operands[0] } else { &i.operands[1] };
+            let n = match vals {
+                Operand::Vector(v) => v.len(),
+                _ => 1,
+            };
+            if n != m.vec() as usize {
+                return invalid(pos, format!("`{}` moves {} value(s), found {n}", d.full, m.vec()));
+            }
+        }
+        Atom | Red => {
+            let mut op = None;
+            for w in &m.words {
+                match atom_op_of(w) {
+                    Some(o) => op = Some(o),
+                    None if ATOM_IGNORED.contains(&w.as_str()) => {}
+                    None => return unsupported(pos, format!("{} (modifier .{w})", d.full)),
+                }
+            }
+            let Some(op) = op else {
+                return invalid(pos, format!("`{}` needs an operation", d.full));
+            };
+            let t = one_type(d, i)?;
+            if t.bits() < 32 || t == Ty::F16 {
+                return unsupported(pos, format!("{} (types narrower than 32 bits)", d.full));
+            }
+            let has_d = d.op == Atom;
+            operands(i, usize::from(has_d) + 2 + usize::from(op == crate::ptx::ir::AtomOp::Cas))?;
+        }
+        Bra => {
+            operands(i, 1)?;
+            only(d, &["uni"], i)?;
+            if !matches!(i.operands[0], Operand::Name(_)) {
+                return invalid(pos, "`bra` needs a label");
+            }
+        }
+        Call | Ret => only(d, &["uni"], i)?,
+        Bar | Barrier if m.has("warp") => {} // bar.warp.sync
+        Bar | Barrier => {
+            only(d, &["sync", "aligned"], i)?;
+            if !m.has("sync") && d.op == Bar && !m.words.is_empty() {
+                return unsupported(pos, d.full.clone());
+            }
+            if n_ops == 0 || n_ops > 2 {
+                return invalid(pos, format!("`{}` takes a barrier id and an optional thread count", d.full));
+            }
+        }
+        Vote => {
+            only(d, &["sync", "all", "any", "uni", "ballot"], i)?;
+            if m.vote_mode().is_none() {
+                return invalid(pos, "`vote` needs a mode");
+            }
+            operands(i, if m.has("sync") { 3 } else { 2 })?;
+        }
+        Activemask => operands(i, 1)?,
+        Shfl => {
+            only(d, &["sync", "up", "down", "bfly", "idx"], i)?;
+            if m.shfl_mode().is_none() {
+                return invalid(pos, "`shfl` needs a mode");
+            }
+            operands(i, if m.has("sync") { 5 } else { 4 })?;
+        }
+        Exit | Trap | Membar | Fence | Prefetch | Prefetchu | Pmevent | Nanosleep | Brkpt | Nop => {}
+        // the arithmetic opcodes
+        _ => {
+            let t = one_type(d, i)?;
+            if m.has("cc") {
+                return unsupported(pos, format!("{} (carry chains)", d.full));
+            }
+            let (nsrc, extra) = arith_shape(d.op);
+            let mut allowed: Vec<&str> = vec!["ftz", "sat", "approx", "full"];
+            allowed.extend(ROUNDINGS);
+            allowed.extend(extra);
+            only(d, &allowed, i)?;
+            operands(i, nsrc + 1)?;
+            if t.is_float() && t != Ty::F32 && t != Ty::F64 {
+                return unsupported(pos, format!("{} (.{t})", d.full));
+            }
+            if t.is_float() && matches!(d.op, Mul | Mad | Fma) && (m.has("hi") || m.has("wide")) {
+                return invalid(pos, format!("`{}`: .hi/.wide apply to integers", d.full));
+            }
+        }
+    }
+    Ok(())
+}

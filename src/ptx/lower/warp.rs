@@ -1,0 +1,56 @@
+//! Warp-level instructions: `vote` (all, any, uni, ballot), `activemask`
+//! (a ballot of `true`) and `shfl` (idx, up, down, bfly).
+
+use super::opcode::Decoded;
+use super::{FnLower, LResult};
+use crate::ptx::ast::{self, Operand};
+use crate::ptx::ir::*;
+use crate::ptx::types::Ty;
+
+/// The member mask of a warp instruction without `.sync`: the whole warp.
+const WHOLE_WARP: Src = Src::Imm(u32::MAX as u64);
+
+impl FnLower<'_> {
+    /// Lowers a validated `vote`.
+    pub(super) fn lower_vote(&self, i: &ast::Instruction, d: &Decoded) -> LResult<Kind> {
+        let (pos, ops, m) = (i.pos, &i.operands, &d.mods);
+        let mode = m.vote_mode().expect("validated: a mode");
+        let membermask = if m.has("sync") { self.src(&ops[2], Ty::U32, pos)? } else { WHOLE_WARP };
+        let a = self.pred_src(&ops[1], pos)?;
+        Ok(if mode == VoteMode::Ballot {
+            Kind::Vote { mode, d: Some(self.dst(&ops[0], pos)?), p: PRED_FALSE, a, membermask }
+        } else {
+            Kind::Vote { mode, d: None, p: self.pred_dst(&ops[0], pos)?, a, membermask }
+        })
+    }
+
+    /// Lowers `activemask d`: a ballot of `true` over the whole warp.
+    pub(super) fn lower_activemask(&self, i: &ast::Instruction) -> LResult<Kind> {
+        Ok(Kind::Vote {
+            mode: VoteMode::Ballot,
+            d: Some(self.dst(&i.operands[0], i.pos)?),
+            p: PRED_FALSE,
+            a: PredSrc { reg: PRED_TRUE, neg: false },
+            membermask: WHOLE_WARP,
+        })
+    }
+
+    /// Lowers a validated `shfl`.
+    pub(super) fn lower_shfl(&self, i: &ast::Instruction, d: &Decoded) -> LResult<Kind> {
+        let (pos, ops, m) = (i.pos, &i.operands, &d.mods);
+        let mode = m.shfl_mode().expect("validated: a mode");
+        let (dst, p) = match &ops[0] {
+            Operand::Pair(d, p) => (self.dst(&Operand::Name(d.clone()), pos)?, Some(self.pred_named(p, pos)?)),
+            o => (self.dst(o, pos)?, None),
+        };
+        Ok(Kind::Shfl {
+            mode,
+            d: dst,
+            p,
+            a: self.src(&ops[1], Ty::B32, pos)?,
+            b: self.src(&ops[2], Ty::U32, pos)?,
+            c: self.src(&ops[3], Ty::U32, pos)?,
+            membermask: if m.has("sync") { self.src(&ops[4], Ty::U32, pos)? } else { WHOLE_WARP },
+        })
+    }
+}

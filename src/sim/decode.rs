@@ -1,0 +1,317 @@
+//! The executable form of a module, decoded once when it is loaded: for every
+//! instruction, what the executor would otherwise work out on every issue —
+//! its counter class and, for arithmetic, the 32-lane function that the
+//! `(operation, type, rounding)` triple selects. The executor looks the
+//! instruction's [`Op`] up by PC and dispatches on it; the validated IR
+//! (`crate::ptx::ir`) stays the source of operands and of the rare forms.
+
+use crate::ptx::ir::{ArithOp, FloatMode, InstClass, Kind, Program, Rounding};
+use crate::ptx::types::Ty;
+
+use super::alu;
+
+/// 32 lanes of register bits.
+pub type Lanes = [u64; 32];
+
+/// An arithmetic operation over 32 lanes with its type and modifiers resolved:
+/// `f(a, b, c, out)` writes every lane of `out`.
+pub type LaneFn = fn(&Lanes, &Lanes, &Lanes, &mut Lanes);
+
+/// One decoded instruction (16 bytes: guarded by a test).
+#[derive(Debug, Clone, Copy)]
+pub struct Op {
+    /// For arithmetic: the resolved 32-lane function; `None`: interpreted
+    /// from the IR instruction.
+    pub lanes: Option<LaneFn>,
+    /// Whether `lanes` reads operand `c`.
+    pub reads_c: bool,
+    /// Its class, for the class counters.
+    pub class: InstClass,
+}
+
+/// A function's decoded instructions, parallel to its IR instructions.
+#[derive(Debug, Clone, Default)]
+pub struct FnCode {
+    /// One per instruction.
+    pub ops: Vec<Op>,
+}
+
+/// A decoded module.
+#[derive(Debug, Clone, Default)]
+pub struct Code {
+    /// One per function of the program.
+    pub funcs: Vec<FnCode>,
+}
+
+impl Code {
+    /// Decodes every function of `prog`.
+    pub fn decode(prog: &Program) -> Code {
+        let funcs = prog
+            .functions
+            .iter()
+            .map(|f| FnCode {
+                ops: f
+                    .insts
+                    .iter()
+                    .zip(&f.info)
+                    .map(|(i, info)| {
+                        let r = match i.kind {
+                            Kind::Arith { op, ty, mode, .. } => resolve_arith(op, ty, mode),
+                            _ => None,
+                        };
+                        Op { lanes: r.map(|r| r.0), reads_c: r.is_some_and(|r| r.1), class: info.class }
+                    })
+                    .collect(),
+            })
+            .collect();
+        Code { funcs }
+    }
+}
+
+#[inline(always)]
+fn map2(a: &Lanes, b: &Lanes, out: &mut Lanes, f: impl Fn(u64, u64) -> u64) {
+    for l in 0..32 {
+        out[l] = f(a[l], b[l]);
+    }
+}
+
+#[inline(always)]
+fn map3(a: &Lanes, b: &Lanes, c: &Lanes, out: &mut Lanes, f: impl Fn(u64, u64, u64) -> u64) {
+    for l in 0..32 {
+        out[l] = f(a[l], b[l], c[l]);
+    }
+}
+
+#[inline(always)]
+fn f32of(x: u64) -> f32 {
+    f32::from_bits(x as u32)
+}
+
+/// An f32 result's bits, NaN made canonical (as `alu` does).
+#[inline(always)]
+pub fn canon32(x: f32) -> u64 {
+    if x.is_nan() { alu::NAN32 as u64 } else { x.to_bits() as u64 }
+}
+
+/// `min`/`max` of f32 as `alu::arith` defines them (NaN operands ignored,
+/// -0 below +0).
+#[inline(always)]
+fn minmax32(a: u64, b: u64, max: bool) -> u64 {
+    let (x, y) = (f32of(a), f32of(b));
+    let r = match (x.is_nan(), y.is_nan()) {
+        (true, true) => f32::NAN,
+        (true, false) => y,
+        (false, true) => x,
+        _ if x == y => {
+            if (x.is_sign_negative() && !max) || (x.is_sign_positive() && max) {
+                x
+            } else {
+                y
+            }
+        }
+        _ if (x < y) != max => x,
+        _ => y,
+    };
+    canon32(r)
+}
+
+macro_rules! lanefn2 {
+    ($name:ident, |$x:ident, $y:ident| $e:expr) => {
+        fn $name(a: &Lanes, b: &Lanes, _c: &Lanes, out: &mut Lanes) {
+            map2(a, b, out, |$x, $y| $e)
+        }
+    };
+}
+
+macro_rules! lanefn3 {
+    ($name:ident, |$x:ident, $y:ident, $z:ident| $e:expr) => {
+        fn $name(a: &Lanes, b: &Lanes, c: &Lanes, out: &mut Lanes) {
+            map3(a, b, c, out, |$x, $y, $z| $e)
+        }
+    };
+}
+
+lanefn2!(add32, |x, y| (x as u32).wrapping_add(y as u32) as u64);
+lanefn2!(add64, |x, y| x.wrapping_add(y));
+lanefn2!(sub32, |x, y| (x as u32).wrapping_sub(y as u32) as u64);
+lanefn2!(sub64, |x, y| x.wrapping_sub(y));
+lanefn2!(mul32, |x, y| (x as u32).wrapping_mul(y as u32) as u64);
+lanefn2!(mul64, |x, y| x.wrapping_mul(y));
+lanefn2!(and32, |x, y| x & y & 0xFFFF_FFFF);
+lanefn2!(or32, |x, y| (x | y) & 0xFFFF_FFFF);
+lanefn2!(xor32, |x, y| (x ^ y) & 0xFFFF_FFFF);
+lanefn2!(and64, |x, y| x & y);
+lanefn2!(or64, |x, y| x | y);
+lanefn2!(xor64, |x, y| x ^ y);
+lanefn2!(shl32, |x, s| if (s as u32) >= 32 { 0 } else { ((x as u32) << s) as u64 });
+lanefn2!(shl64, |x, s| if (s as u32) >= 64 { 0 } else { x << s });
+lanefn2!(shr_u32, |x, s| if (s as u32) >= 32 { 0 } else { ((x as u32) >> s) as u64 });
+lanefn2!(shr_u64, |x, s| if (s as u32) >= 64 { 0 } else { x >> s });
+lanefn2!(shr_s32, |x, s| ((x as i32) >> (s as u32).min(31)) as u32 as u64);
+lanefn2!(mul_wide_s32, |x, y| ((x as i32 as i64) * (y as i32 as i64)) as u64);
+lanefn2!(mul_wide_u32, |x, y| (x & 0xFFFF_FFFF) * (y & 0xFFFF_FFFF));
+lanefn2!(min_s32, |x, y| (x as i32).min(y as i32) as u32 as u64);
+lanefn2!(max_s32, |x, y| (x as i32).max(y as i32) as u32 as u64);
+lanefn2!(min_u32, |x, y| (x as u32).min(y as u32) as u64);
+lanefn2!(max_u32, |x, y| (x as u32).max(y as u32) as u64);
+lanefn3!(mad32, |x, y, z| (x as u32).wrapping_mul(y as u32).wrapping_add(z as u32) as u64);
+lanefn2!(fadd, |x, y| canon32(f32of(x) + f32of(y)));
+lanefn2!(fsub, |x, y| canon32(f32of(x) - f32of(y)));
+lanefn2!(fmul, |x, y| canon32(f32of(x) * f32of(y)));
+lanefn2!(fdiv, |x, y| canon32(f32of(x) / f32of(y)));
+lanefn2!(fmin, |x, y| minmax32(x, y, false));
+lanefn2!(fmax, |x, y| minmax32(x, y, true));
+lanefn2!(fneg, |x, _y| canon32(-f32of(x)));
+lanefn2!(fabs, |x, _y| canon32(f32of(x).abs()));
+lanefn2!(frcp, |x, _y| canon32(1.0 / f32of(x)));
+lanefn2!(fsqrt, |x, _y| canon32(f32of(x).sqrt()));
+lanefn3!(ffma, |x, y, z| canon32(f32of(x).mul_add(f32of(y), f32of(z))));
+
+/// The 32-lane function of an arithmetic instruction whose semantics
+/// (`alu::arith`) reduce to a plain operation, and whether it reads `c`;
+/// `None` for the other forms, which the executor evaluates lane by lane.
+pub fn resolve_arith(op: ArithOp, ty: Ty, mode: FloatMode) -> Option<(LaneFn, bool)> {
+    use ArithOp as A;
+    use Ty as T;
+    // Round-to-nearest is IEEE's default, so `.rn` and no rounding agree.
+    let nearest = matches!(mode.rnd, None | Some(Rounding::Rn)) && !mode.ftz && !mode.sat;
+    let int = !mode.sat;
+    let f: LaneFn = match (op, ty) {
+        (A::Add, T::S32 | T::U32 | T::B32) if int => add32,
+        (A::Add, T::S64 | T::U64 | T::B64) if int => add64,
+        (A::Sub, T::S32 | T::U32 | T::B32) if int => sub32,
+        (A::Sub, T::S64 | T::U64 | T::B64) if int => sub64,
+        (A::Mul, T::S32 | T::U32 | T::B32) => mul32,
+        (A::Mul, T::S64 | T::U64 | T::B64) => mul64,
+        (A::And, T::B32 | T::U32 | T::S32) => and32,
+        (A::Or, T::B32 | T::U32 | T::S32) => or32,
+        (A::Xor, T::B32 | T::U32 | T::S32) => xor32,
+        (A::And, T::B64 | T::U64 | T::S64) => and64,
+        (A::Or, T::B64 | T::U64 | T::S64) => or64,
+        (A::Xor, T::B64 | T::U64 | T::S64) => xor64,
+        (A::Shl, T::B32 | T::U32 | T::S32) => shl32,
+        (A::Shl, T::B64 | T::U64 | T::S64) => shl64,
+        (A::Shr, T::B32 | T::U32) => shr_u32,
+        (A::Shr, T::B64 | T::U64) => shr_u64,
+        (A::Shr, T::S32) => shr_s32,
+        (A::MulWide, T::S32) => mul_wide_s32,
+        (A::MulWide, T::U32) => mul_wide_u32,
+        (A::Min, T::S32) => min_s32,
+        (A::Max, T::S32) => max_s32,
+        (A::Min, T::U32) => min_u32,
+        (A::Max, T::U32) => max_u32,
+        (A::Mad, T::S32 | T::U32 | T::B32) => return Some((mad32, true)),
+        (A::Add, T::F32) if nearest => fadd,
+        (A::Sub, T::F32) if nearest => fsub,
+        (A::Mul, T::F32) if nearest => fmul,
+        (A::Div, T::F32) if nearest => fdiv,
+        (A::Rcp, T::F32) if nearest => frcp,
+        (A::Sqrt, T::F32) if nearest && !mode.approx => fsqrt,
+        (A::Min, T::F32) if !mode.ftz && !mode.sat => fmin,
+        (A::Max, T::F32) if !mode.ftz && !mode.sat => fmax,
+        (A::Neg, T::F32) if !mode.ftz && !mode.sat => fneg,
+        (A::Abs, T::F32) if !mode.ftz && !mode.sat => fabs,
+        (A::Mad, T::F32) if nearest => return Some((ffma, true)),
+        _ => return None,
+    };
+    Some((f, false))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_decoded_instruction_is_16_bytes() {
+        assert_eq!(std::mem::size_of::<Op>(), 16);
+    }
+
+    /// Every resolved function computes what `alu::arith` computes, on
+    /// operands chosen to hit the edge cases (NaN, signed zeros, infinities,
+    /// subnormals, shifts past the width, sign bits).
+    #[test]
+    fn resolved_functions_agree_with_the_lane_semantics() {
+        let f = |x: f32| x.to_bits() as u64;
+        let vals: Vec<u64> = vec![
+            0,
+            1,
+            2,
+            31,
+            32,
+            33,
+            63,
+            64,
+            0xFFFF_FFFF,
+            0x8000_0000,
+            0x7FFF_FFFF,
+            u64::MAX,
+            0x1234_5678_9ABC_DEF0,
+            f(1.5),
+            f(-2.25),
+            f(0.0),
+            f(-0.0),
+            f(f32::NAN),
+            f(-f32::NAN),
+            f(f32::INFINITY),
+            f(f32::NEG_INFINITY),
+            f(1e-40),
+            f(-1e-40),
+            f(3.0e38),
+            f(1.0 / 3.0),
+        ];
+        let modes = [
+            FloatMode::default(),
+            FloatMode { rnd: Some(Rounding::Rn), ..FloatMode::default() },
+            FloatMode { rnd: Some(Rounding::Rz), ..FloatMode::default() },
+            FloatMode { ftz: true, ..FloatMode::default() },
+            FloatMode { sat: true, ..FloatMode::default() },
+            FloatMode { approx: true, ..FloatMode::default() },
+        ];
+        let ops = [
+            ArithOp::Add,
+            ArithOp::Sub,
+            ArithOp::Mul,
+            ArithOp::MulWide,
+            ArithOp::Mad,
+            ArithOp::Div,
+            ArithOp::Rcp,
+            ArithOp::Sqrt,
+            ArithOp::Min,
+            ArithOp::Max,
+            ArithOp::Neg,
+            ArithOp::Abs,
+            ArithOp::And,
+            ArithOp::Or,
+            ArithOp::Xor,
+            ArithOp::Shl,
+            ArithOp::Shr,
+        ];
+        let tys = [Ty::S32, Ty::U32, Ty::B32, Ty::S64, Ty::U64, Ty::B64, Ty::F32];
+        let mut resolved = 0;
+        for op in ops {
+            for ty in tys {
+                for mode in modes {
+                    let Some((func, _)) = resolve_arith(op, ty, mode) else { continue };
+                    resolved += 1;
+                    for (i, &x) in vals.iter().enumerate() {
+                        // 32 lanes: x against every value, c rotating
+                        let a: Lanes = [x; 32];
+                        let b: Lanes = std::array::from_fn(|l| vals[l % vals.len()]);
+                        let c: Lanes = std::array::from_fn(|l| vals[(l + i) % vals.len()]);
+                        let mut out = [0; 32];
+                        func(&a, &b, &c, &mut out);
+                        for l in 0..32 {
+                            let want = alu::arith(op, ty, mode, a[l], b[l], c[l]);
+                            assert_eq!(
+                                out[l], want,
+                                "{op:?}.{ty:?} {mode:?} a={:#x} b={:#x} c={:#x}",
+                                a[l], b[l], c[l]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(resolved > 40, "only {resolved} forms resolved");
+    }
+}

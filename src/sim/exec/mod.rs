@@ -1,0 +1,346 @@
+//! Executes one warp instruction: fetch from the SIMT stack's top path,
+//! evaluate the guard, count, apply the instruction to the active lanes
+//! (registers as 32-lane arrays), and move the PC or the stack.
+//!
+//! This file holds the launch context ([`Ctx`], [`CtaMut`]), operand access
+//! and the dispatch; the instruction families live in [`arith`] (data and
+//! lane exchange), [`memory`] (loads, stores, address spaces, observer
+//! events), [`atomic`], [`control`] (branches, exit, barriers) and [`call`].
+
+mod arith;
+mod atomic;
+mod call;
+mod control;
+mod memory;
+
+pub use atomic::{PendingAtomic, apply_pending};
+pub use call::call_chain;
+
+use super::cfg::Cfg;
+use super::counters::{Counters, InstProfile};
+use super::decode::Code;
+use super::fault::FaultKind;
+use super::memory::DeviceMemory;
+use super::observer::{MemObserver, ObserverFactory};
+use super::simt_stack::SimtEntry;
+use super::warp::{Frame, Warp};
+use crate::ptx::ir::*;
+
+/// Everything an instruction may read that is shared by all CTAs of a launch.
+pub struct Ctx<'a> {
+    /// The program.
+    pub prog: &'a Program,
+    /// Its decoded form.
+    pub code: &'a Code,
+    /// CFG (reconvergence points) of each function.
+    pub cfgs: &'a [Cfg],
+    /// Device memory.
+    pub mem: &'a DeviceMemory,
+    /// Kernel parameter bytes.
+    pub kparams: Vec<u8>,
+    /// Addresses of the module's `.global` variables.
+    pub global_addrs: &'a [u64],
+    /// Grid size in CTAs.
+    pub grid: [u32; 3],
+    /// CTA size in threads.
+    pub block: [u32; 3],
+    /// Simulated SM count (for `%smid`, `%nsmid`).
+    pub num_sms: u32,
+    /// Per-thread local memory limit in bytes.
+    pub local_limit: u32,
+    /// Most device-function frames on a warp's call stack.
+    pub max_call_depth: u32,
+    /// Makes the per-CTA memory observers (counter models), if any.
+    pub observers: Option<&'a dyn ObserverFactory>,
+    /// Count per instruction (fidelity `instructions` and up).
+    pub per_inst: bool,
+}
+
+/// The CTA-owned state an instruction may change besides its warp.
+pub struct CtaMut<'a> {
+    /// CTA index.
+    pub cta_id: [u32; 3],
+    /// Linear CTA index.
+    pub cta_linear: u32,
+    /// Shared memory.
+    pub shared: &'a mut Vec<u8>,
+    /// Counters.
+    pub counters: &'a mut Counters,
+    /// Per-instruction counts.
+    pub profile: &'a mut InstProfile,
+    /// Global atomics waiting for the round's end.
+    pub pending: &'a mut Vec<PendingAtomic>,
+    /// The CTA's memory observer.
+    pub observer: Option<&'a mut Box<dyn MemObserver>>,
+}
+
+/// A fault raised by an instruction (the caller adds where).
+#[derive(Debug, Clone)]
+pub struct ExecFault {
+    /// What happened.
+    pub kind: FaultKind,
+    /// The first faulting lane, if per lane.
+    pub lane: Option<u32>,
+}
+
+/// A fault, boxed: instructions return it rarely, and a small `Result` keeps
+/// the common path cheap.
+fn fault(kind: FaultKind, lane: Option<usize>) -> Box<ExecFault> {
+    Box::new(ExecFault { kind, lane: lane.map(|l| l as u32) })
+}
+
+/// What the executed instruction did to the warp's schedulability.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Effect {
+    /// The warp can continue.
+    Continue,
+    /// The warp blocked (barrier, atomic) or finished.
+    Blocked,
+}
+
+/// 32 lanes of register bits.
+pub(crate) type Lanes = [u64; 32];
+
+#[inline(always)]
+fn map1(a: &Lanes, f: impl Fn(u64) -> u64) -> Lanes {
+    std::array::from_fn(|l| f(a[l]))
+}
+
+#[inline(always)]
+fn map3(a: &Lanes, b: &Lanes, c: &Lanes, f: impl Fn(u64, u64, u64) -> u64) -> Lanes {
+    std::array::from_fn(|l| f(a[l], b[l], c[l]))
+}
+
+#[inline(always)]
+fn write(frame: &mut Frame, d: Dst, v: &Lanes, mask: u32) {
+    if d.reg == Dst::SINK {
+        return;
+    }
+    let r = &mut frame.regs[d.reg as usize];
+    if mask == u32::MAX {
+        for l in 0..32 {
+            r[l] = v[l] & d.mask;
+        }
+    } else {
+        for l in 0..32 {
+            if mask >> l & 1 != 0 {
+                r[l] = v[l] & d.mask;
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn pred_bits(frame: &Frame, p: PredSrc) -> u32 {
+    let v = frame.preds[p.reg as usize];
+    if p.neg { !v } else { v }
+}
+
+#[inline(always)]
+fn set_pred(frame: &mut Frame, p: PredId, value: u32, mask: u32) {
+    if p > PRED_TRUE {
+        let r = &mut frame.preds[p as usize];
+        *r = (*r & !mask) | (value & mask);
+    }
+}
+
+fn combine(op: BoolOp, a: u32, b: u32) -> u32 {
+    match op {
+        BoolOp::And => a & b,
+        BoolOp::Or => a | b,
+        BoolOp::Xor => a ^ b,
+    }
+}
+
+fn lane_of_mask(m: u32) -> Option<usize> {
+    (m != 0).then(|| m.trailing_zeros() as usize)
+}
+
+/// Reads a source operand for all lanes.
+#[inline]
+fn read(ctx: &Ctx, w: &Warp, cta: &CtaMut, s: Src) -> Lanes {
+    let f = w.frame();
+    match s {
+        Src::Reg(r) => f.regs[r as usize],
+        Src::Imm(v) => [v; 32],
+        Src::LocalAddr(o) => [(f.local_base + o) as u64; 32],
+        Src::GlobalAddr(g, o) => [ctx.global_addrs[g as usize] + o as u64; 32],
+        Src::Special(sr) => special(ctx, w, cta, sr),
+    }
+}
+
+/// An operand's lanes: a register borrowed from the frame, or a value built
+/// for any other source. Saves copying 256 bytes per register operand.
+// Boxing the value would allocate per operand; the enum lives on the stack
+// for one instruction.
+#[allow(clippy::large_enum_variant)]
+enum Operand<'a> {
+    Reg(&'a Lanes),
+    Value(Lanes),
+}
+
+impl std::ops::Deref for Operand<'_> {
+    type Target = Lanes;
+    #[inline]
+    fn deref(&self) -> &Lanes {
+        match self {
+            Operand::Reg(r) => r,
+            Operand::Value(v) => v,
+        }
+    }
+}
+
+#[inline]
+fn operand<'a>(ctx: &Ctx, w: &'a Warp, cta: &CtaMut, s: Src) -> Operand<'a> {
+    match s {
+        Src::Reg(r) => Operand::Reg(&w.frame().regs[r as usize]),
+        other => Operand::Value(read(ctx, w, cta, other)),
+    }
+}
+
+fn special(ctx: &Ctx, w: &Warp, cta: &CtaMut, sr: SpecialReg) -> Lanes {
+    let [bx, by, _] = ctx.block;
+    let tid = |l: usize, d: u8| -> u64 {
+        let lin = w.id * 32 + l as u32;
+        (match d {
+            0 => lin % bx,
+            1 => (lin / bx) % by,
+            _ => lin / (bx * by),
+        }) as u64
+    };
+    match sr {
+        SpecialReg::Tid(d) => std::array::from_fn(|l| tid(l, d)),
+        SpecialReg::Ntid(d) => [ctx.block[d as usize] as u64; 32],
+        SpecialReg::Ctaid(d) => [cta.cta_id[d as usize] as u64; 32],
+        SpecialReg::Nctaid(d) => [ctx.grid[d as usize] as u64; 32],
+        SpecialReg::LaneId => std::array::from_fn(|l| l as u64),
+        SpecialReg::WarpId => [w.id as u64; 32],
+        SpecialReg::NWarpId => [(bx * ctx.block[1] * ctx.block[2]).div_ceil(32) as u64; 32],
+        SpecialReg::SmId => [(cta.cta_linear % ctx.num_sms) as u64; 32],
+        SpecialReg::NSmId => [ctx.num_sms as u64; 32],
+        SpecialReg::GridId => [0; 32],
+        SpecialReg::LaneMaskEq => std::array::from_fn(|l| 1u64 << l),
+        SpecialReg::LaneMaskLe => std::array::from_fn(|l| ((1u64 << (l + 1)) - 1) & 0xFFFF_FFFF),
+        SpecialReg::LaneMaskLt => std::array::from_fn(|l| (1u64 << l) - 1),
+        SpecialReg::LaneMaskGe => std::array::from_fn(|l| (0xFFFF_FFFFu64 << l) & 0xFFFF_FFFF),
+        SpecialReg::LaneMaskGt => std::array::from_fn(|l| (0xFFFF_FFFFu64 << (l + 1)) & 0xFFFF_FFFF),
+        // A deterministic clock: the CTA's issued warp instructions.
+        SpecialReg::Clock | SpecialReg::Clock64 => [cta.counters.warp_instructions; 32],
+    }
+}
+
+/// Executes the next instruction of warp `w`. Returns its function and PC (for
+/// fault reports and stepping) and its effect.
+pub fn step(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut) -> (u32, u32, Result<Effect, Box<ExecFault>>) {
+    let base = w.frame().stack_base;
+    cta.counters.reconvergences += w.stack.reconverge(base) as u64;
+    let top = *w.stack.top().expect("running warp has a path");
+    let func = w.frame().func;
+    let pc = top.pc;
+    let r = exec(ctx, w, cta, func, top);
+    // Pop paths that reached their reconvergence point now, so that the stack
+    // seen between instructions is the one the next instruction runs on.
+    if !w.stack.entries.is_empty() {
+        let base = w.frame().stack_base;
+        cta.counters.reconvergences += w.stack.reconverge(base) as u64;
+    }
+    (func, pc, r)
+}
+
+/// Moves the running path to the next instruction.
+#[inline(always)]
+fn advance(w: &mut Warp, pc: u32) {
+    w.stack.top_mut().expect("top").pc = pc + 1;
+}
+
+fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, Box<ExecFault>> {
+    let f = &ctx.prog.functions[func as usize];
+    let pc = top.pc;
+    let (Some(inst), Some(op)) = (f.insts.get(pc as usize), ctx.code.funcs[func as usize].ops.get(pc as usize)) else {
+        return Err(fault(FaultKind::Unsupported(format!("execution ran past the end of `{}`", f.name)), None));
+    };
+    let mask = top.mask;
+    let exec = match inst.guard {
+        None => mask,
+        Some(p) => mask & pred_bits(w.frame(), p),
+    };
+    // counting
+    let c = &mut *cta.counters;
+    c.warp_instructions += 1;
+    c.thread_instructions += mask.count_ones() as u64;
+    c.thread_instructions_pred_on += exec.count_ones() as u64;
+    c.by_class.add(op.class);
+    if ctx.per_inst {
+        let ic = &mut cta.profile.per_fn[func as usize][pc as usize];
+        ic.warp += 1;
+        ic.thread += mask.count_ones() as u64;
+        ic.pred_on += exec.count_ones() as u64;
+    }
+
+    // Control transfers move the stack themselves (and run with no lane active too).
+    match &inst.kind {
+        Kind::Bra { target, .. } => return Ok(control::branch(ctx, w, cta, func, pc, *target, exec)),
+        // `ret` in the kernel's own frame (no caller to return to) ends the
+        // thread, as `exit` does; the front end already lowers a kernel's
+        // `ret` to `exit`, this covers hand-built programs.
+        Kind::Exit | Kind::Ret if matches!(inst.kind, Kind::Exit) || w.frames.len() == 1 => {
+            advance(w, pc);
+            return Ok(control::exit(ctx, w, exec));
+        }
+        Kind::Ret => {
+            advance(w, pc);
+            return Ok(call::ret(ctx, w, exec));
+        }
+        Kind::Call { func: callee, args, .. } => {
+            advance(w, pc);
+            return call::call(ctx, w, cta, pc, *callee, args, exec);
+        }
+        _ => {}
+    }
+
+    advance(w, pc);
+    if exec == 0 {
+        // Predicated off for every lane: issued, no effect.
+        return Ok(Effect::Continue);
+    }
+
+    if let (Some(lanes), Kind::Arith { d, a, b, c, .. }) = (op.lanes, &inst.kind) {
+        arith::resolved(ctx, w, cta, lanes, op.reads_c, *d, *a, *b, *c, exec);
+        return Ok(Effect::Continue);
+    }
+
+    match &inst.kind {
+        Kind::Mov { d, a } => arith::mov(ctx, w, cta, *d, *a, exec),
+        Kind::Pack { d, parts, part_bits } => arith::pack(ctx, w, cta, *d, parts, *part_bits, exec),
+        Kind::Unpack { ds, a, part_bits } => arith::unpack(ctx, w, cta, ds, *a, *part_bits, exec),
+        Kind::Arith { op, ty, mode, d, a, b, c } => {
+            arith::arith(ctx, w, cta, (*op, *ty, *mode), *d, [*a, *b, *c], exec)
+        }
+        Kind::Bfi { ty, d, a, b, c, e } => arith::bfi(ctx, w, cta, *ty, *d, [*a, *b, *c, *e], exec),
+        Kind::Setp { .. } => arith::setp(ctx, w, cta, &inst.kind, exec),
+        Kind::Set { .. } => arith::set(ctx, w, cta, &inst.kind, exec),
+        Kind::Selp { d, a, b, p } => arith::selp(ctx, w, cta, *d, *a, *b, *p, exec),
+        Kind::PredLogic { op, d, a, b } => arith::pred_logic(w, *op, *d, *a, *b, exec),
+        Kind::Cvt { dty, sty, mode, d, a } => arith::cvt(ctx, w, cta, (*dty, *sty, *mode), *d, *a, exec),
+        Kind::Cvta { to_generic, space, d, a } => memory::cvta(ctx, w, cta, *to_generic, *space, *d, *a, exec),
+        Kind::Ld { space, ty, ds, addr, nc, .. } => {
+            memory::load(ctx, w, cta, (func, pc), *space, *ty, ds, addr, *nc, exec)?
+        }
+        Kind::St { space, ty, vals, addr, .. } => {
+            memory::store(ctx, w, cta, (func, pc), *space, *ty, vals, addr, exec)?
+        }
+        Kind::Atom { space, op, ty, d, addr, b, c } => {
+            return atomic::atomic(ctx, w, cta, (func, pc), *space, *op, *ty, *d, addr, *b, *c, exec);
+        }
+        Kind::Bar { id, count } => return control::bar(ctx, w, cta, *id, *count, exec),
+        Kind::Vote { mode, d, p, a, .. } => arith::vote(w, *mode, *d, *p, *a, exec),
+        Kind::Shfl { mode, d, p, a, b, c, .. } => arith::shfl(ctx, w, cta, *mode, *d, *p, [*a, *b, *c], exec),
+        Kind::Membar => return Ok(control::membar(w, cta)),
+        Kind::Nop => {}
+        Kind::Trap => return Err(fault(FaultKind::Trap, lane_of_mask(exec))),
+        Kind::Bra { .. } | Kind::Exit | Kind::Ret | Kind::Call { .. } => {
+            unreachable!("handled above")
+        }
+    }
+    Ok(Effect::Continue)
+}
