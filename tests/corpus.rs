@@ -96,7 +96,7 @@ fn every_corpus_input_gives_its_exit_code_and_a_clear_message() {
 }
 
 /// Issue 18: from a folder outside the checkout, scene names, the validation
-/// fixtures and `--scenes DIR` resolve, and a file error names the file.
+/// fixtures and `--scene-dir DIR` resolve, and a file error names the file.
 #[test]
 fn the_binary_works_from_any_directory() {
     let dir = tempdir("anywhere");
@@ -106,9 +106,9 @@ fn the_binary_works_from_any_directory() {
     let (code, out) = warplight_in(&dir, &["scene", "info", "no-such-scene"]);
     assert_eq!(code, Some(1), "{out}");
     assert!(out.contains("scenes/no-such-scene.toml: No such file or directory"), "{out}");
-    assert!(out.contains("no such scene in") && out.contains("--scenes DIR"), "{out}");
+    assert!(out.contains("no such scene in") && out.contains("--scene-dir DIR"), "{out}");
     assert!(!out.contains(": -:"), "{out}");
-    let (code, out) = warplight_in(&dir, &["scene", "info", "disc", "--scenes", corpus().to_str().unwrap()]);
+    let (code, out) = warplight_in(&dir, &["scene", "info", "disc", "--scene-dir", corpus().to_str().unwrap()]);
     assert_eq!(code, Some(0), "{out}");
     assert!(out.contains("1998"), "{out}");
     let (code, out) = warplight_in(&dir, &["launch", "missing.toml"]);

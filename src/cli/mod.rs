@@ -37,8 +37,9 @@ pub struct Cli {
     pub memory_budget: Option<u64>,
     /// A folder of scene files searched first for scene names (before scenes/,
     /// $WARPLIGHT_HOME/scenes and the checkout's scenes/).
-    #[arg(long, global = true, value_name = "DIR")]
-    pub scenes: Option<std::path::PathBuf>,
+    /// (Named --scene-dir: `tables --scenes` lists scene names.)
+    #[arg(long = "scene-dir", global = true, value_name = "DIR")]
+    pub scene_dir: Option<std::path::PathBuf>,
 }
 
 /// Subcommands.
@@ -120,7 +121,7 @@ pub fn main() -> i32 {
     if let Some(b) = cli.memory_budget {
         crate::limits::set_memory_budget(b);
     }
-    if let Some(d) = cli.scenes {
+    if let Some(d) = cli.scene_dir {
         crate::host::scene_file::set_scene_dir(d);
     }
     let r = match cli.command {

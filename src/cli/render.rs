@@ -205,7 +205,9 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     // the functional level keeps no per-line counters: the kernels' work is then unknown, not zero
     let counted = emulated.as_ref().is_none_or(|k| k.counted);
     if !counted {
-        println!("  rays and per-ray work not counted at --fidelity functional (they need the instructions level)  in {render_s:.3} s");
+        println!(
+            "  rays and per-ray work not counted at --fidelity functional (they need the instructions level)  in {render_s:.3} s"
+        );
     } else {
         println!("  rays {} ({kinds})  in {:.3} s: {:.2} M rays/s", st.rays, render_s, st.rays as f64 / render_s / 1e6);
         println!(

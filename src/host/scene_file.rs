@@ -24,13 +24,13 @@ pub struct SceneError {
 
 static SCENES_FLAG: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
 
-/// Sets the folder of `--scenes DIR`, searched before every other (once, before any work).
+/// Sets the folder of `--scene-dir DIR`, searched before every other (once, before any work).
 pub fn set_scene_dir(dir: PathBuf) {
     let _ = SCENES_FLAG.set(dir);
 }
 
 /// The folders a scene name (`sponza`) is looked up in, in order: the
-/// `--scenes DIR` folder, `scenes/` in the current directory,
+/// `--scene-dir DIR` folder, `scenes/` in the current directory,
 /// `$WARPLIGHT_HOME/scenes`, and the `scenes/` of the checkout warplight was
 /// built from (so that `cargo install --path .` gives a binary that finds
 /// them from anywhere while the checkout exists).
@@ -170,7 +170,8 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let mut msg = e.to_string();
         if e.kind() == std::io::ErrorKind::NotFound && path.starts_with("scenes") {
             let dirs: Vec<String> = scene_dirs().iter().map(|d| d.display().to_string()).collect();
-            msg = format!("{msg} (no such scene in {}; give a path, --scenes DIR or WARPLIGHT_HOME)", dirs.join(", "));
+            msg =
+                format!("{msg} (no such scene in {}; give a path, --scene-dir DIR or WARPLIGHT_HOME)", dirs.join(", "));
         }
         SceneError { file: file.clone(), key: "-".into(), msg }
     })?;
