@@ -430,13 +430,7 @@ pub fn render_build(
         ]);
     }
     let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
-    let up = |dev: &mut Device, bytes: &[u8], name: &str| -> Result<crate::sim::DevicePtr, SimError> {
-        let p = dev.alloc_bytes(bytes.len().max(4) as u64, name);
-        if !bytes.is_empty() {
-            dev.write(p, bytes)?;
-        }
-        Ok(p)
-    };
+    let up = upload;
     let pp = up(dev, &params, "params")?;
     let nodes = up(dev, &lay.nodes, "nodes")?;
     let refs = up(dev, &lay.tri_refs, "tri_refs")?;
@@ -488,6 +482,16 @@ pub fn render_build(
     }
     trace.primary = npix as u64;
     Ok(KernelRender { image, hit_tri: dev.read::<i32>(hit, npix), trace, counted, launch, memory: model.finish() })
+}
+
+/// Allocates a buffer named `name` holding `bytes` (at least 4 bytes, so that
+/// an empty table still has an address) on `dev`.
+pub fn upload(dev: &mut Device, bytes: &[u8], name: &str) -> Result<crate::sim::DevicePtr, SimError> {
+    let p = dev.alloc_bytes(bytes.len().max(4) as u64, name);
+    if !bytes.is_empty() {
+        dev.write(p, bytes)?;
+    }
+    Ok(p)
 }
 
 /// Loads the kernels' PTX (the plain build) on `dev`.

@@ -374,13 +374,7 @@ pub fn trace_kernel(
         mats.extend_from_slice(&[m.emission[0], m.emission[1], m.emission[2], 0.0]);
     }
     let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
-    let up = |dev: &mut Device, bytes: &[u8], name: &str| -> Result<crate::sim::DevicePtr, SimError> {
-        let p = dev.alloc_bytes(bytes.len().max(4) as u64, name);
-        if !bytes.is_empty() {
-            dev.write(p, bytes)?;
-        }
-        Ok(p)
-    };
+    let up = crate::host::rt_kernels::upload;
     let pp = up(dev, &params, "params")?;
     let nodes = up(dev, &lay.nodes, "nodes")?;
     let refs = up(dev, &lay.tri_refs, "tri_refs")?;
