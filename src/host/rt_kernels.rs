@@ -336,8 +336,21 @@ pub struct KernelRender {
     pub memory: ModelStats,
 }
 
-fn f32s(v: &[f32]) -> Vec<u8> {
-    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+/// The scene's materials as the kernels read them: per material
+/// `color.rgb, kind` then `emission.rgb, 0`, kind 0 diffuse, 1 mirror (glass
+/// too), 2 emitter.
+pub fn material_table(scene: &Scene) -> Vec<f32> {
+    let mut mats = Vec::with_capacity(8 * scene.materials.len());
+    for m in &scene.materials {
+        let kind = match m.kind {
+            MaterialKind::Diffuse => 0.0,
+            MaterialKind::Mirror | MaterialKind::Glass { .. } => 1.0,
+            MaterialKind::Emitter => 2.0,
+        };
+        mats.extend_from_slice(&[m.color[0], m.color[1], m.color[2], kind]);
+        mats.extend_from_slice(&[m.emission[0], m.emission[1], m.emission[2], 0.0]);
+    }
+    mats
 }
 
 /// Renders `camera`'s view with kernel `variant` under device profile `profile`.
@@ -379,7 +392,7 @@ pub fn render_build(
     });
     let (lp, li) = light.unwrap_or((Vec3::ZERO, [0.0; 3]));
     let eps = tree.bounds.size().length().max(1e-3) * EPS_REL;
-    let mut params = f32s(&[
+    let mut params = to_bytes(&[
         camera.position[0],
         camera.position[1],
         camera.position[2],
@@ -411,24 +424,7 @@ pub fn render_build(
     for v in [w as i32, h as i32, npix as i32, light.is_some() as i32] {
         params.extend_from_slice(&v.to_le_bytes());
     }
-    let mut mats = Vec::new();
-    for m in &scene.materials {
-        let kind = match m.kind {
-            MaterialKind::Diffuse => 0.0,
-            MaterialKind::Mirror | MaterialKind::Glass { .. } => 1.0,
-            MaterialKind::Emitter => 2.0,
-        };
-        mats.extend_from_slice(&[
-            m.color[0],
-            m.color[1],
-            m.color[2],
-            kind,
-            m.emission[0],
-            m.emission[1],
-            m.emission[2],
-            0.0,
-        ]);
-    }
+    let mats = material_table(scene);
     let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
     let up = upload;
     let pp = up(dev, &params, "params")?;
@@ -436,7 +432,7 @@ pub fn render_build(
     let refs = up(dev, &lay.tri_refs, "tri_refs")?;
     let tb = up(dev, &lay.triangles, "triangles")?;
     let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
-    let mb = up(dev, &f32s(&mats), "materials")?;
+    let mb = up(dev, &to_bytes(&mats), "materials")?;
     let ab = up(dev, &lay.aabbs, "aabbs")?;
     let next = dev.alloc_zeroed::<u32>(1);
     let color = dev.alloc_zeroed::<f32>(4 * npix);

@@ -315,10 +315,6 @@ pub struct KernelPhotons {
     pub launch: LaunchStats,
 }
 
-fn f32s(v: &[f32]) -> Vec<u8> {
-    v.iter().flat_map(|x| x.to_le_bytes()).collect()
-}
-
 fn slot(s: &[f32]) -> Option<Photon> {
     if s[23] != 1.0 {
         return None;
@@ -352,7 +348,7 @@ pub fn trace_kernel(
     let lay = layout(tree, &tris, 0);
     let eps = tree.bounds.size().length().max(1e-3) * EPS_REL;
     let (lo, hi) = (tree.bounds.lo, tree.bounds.hi);
-    let mut params = f32s(&[
+    let mut params = to_bytes(&[
         e.position[0],
         e.position[1],
         e.position[2],
@@ -368,11 +364,7 @@ pub fn trace_kernel(
         eps,
     ]);
     params.extend_from_slice(&(e.n as i32).to_le_bytes());
-    let mut mats = Vec::new();
-    for m in &scene.materials {
-        mats.extend_from_slice(&[m.color[0], m.color[1], m.color[2], kind_code(m.kind)]);
-        mats.extend_from_slice(&[m.emission[0], m.emission[1], m.emission[2], 0.0]);
-    }
+    let mats = crate::host::rt_kernels::material_table(scene);
     let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
     let up = crate::host::rt_kernels::upload;
     let pp = up(dev, &params, "params")?;
@@ -380,7 +372,7 @@ pub fn trace_kernel(
     let refs = up(dev, &lay.tri_refs, "tri_refs")?;
     let tb = up(dev, &lay.triangles, "triangles")?;
     let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
-    let mb = up(dev, &f32s(&mats), "materials")?;
+    let mb = up(dev, &to_bytes(&mats), "materials")?;
     let out = dev.alloc_zeroed::<f32>(2 * SLOT * e.n.max(1));
     let ctas = (e.n.div_ceil(THREADS as usize) as u32).clamp(1, MAX_CTAS);
     let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, out].into_iter().map(Arg::Ptr).collect();
