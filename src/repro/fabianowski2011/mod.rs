@@ -19,6 +19,7 @@ pub mod table_4_3;
 pub mod table_4_4;
 pub mod timing;
 pub mod traversal;
+pub mod vkde;
 
 use flight::{SceneRun, Totals};
 

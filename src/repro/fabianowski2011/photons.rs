@@ -131,19 +131,24 @@ pub fn azimuth(y: f32) -> (f32, f32) {
     }
 }
 
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+/// a · b, summed left to right (as the kernels do).
+pub(crate) fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
-fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+/// a + b.
+pub(crate) fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
-fn scale(a: [f32; 3], s: f32) -> [f32; 3] {
+/// a · s.
+pub(crate) fn scale(a: [f32; 3], s: f32) -> [f32; 3] {
     [a[0] * s, a[1] * s, a[2] * s]
 }
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+/// a × b.
+pub(crate) fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
-fn len(a: [f32; 3]) -> f32 {
+/// ‖a‖ = √(a · a).
+pub(crate) fn len(a: [f32; 3]) -> f32 {
     dot(a, a).sqrt()
 }
 
