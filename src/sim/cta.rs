@@ -75,6 +75,8 @@ pub struct Cta {
     cur: usize,
     slice_left: u32,
     slice: u32,
+    /// The random schedule's generator state (`--schedule random`), when on.
+    rng: Option<u64>,
 }
 
 impl Cta {
@@ -119,7 +121,27 @@ impl Cta {
             cur: 0,
             slice_left: slice,
             slice: slice.max(1),
+            rng: None,
         }
+    }
+
+    /// Switches this CTA to the random warp schedule (once; later calls keep
+    /// the generator): every instruction comes from a ready warp drawn from a
+    /// generator seeded with `seed` and the CTA's index, so a seed gives one
+    /// interleaving whatever the host threads.
+    pub fn randomize(&mut self, seed: u64) {
+        if self.rng.is_none() {
+            self.rng = Some(seed ^ (self.linear as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        }
+    }
+
+    /// The next draw of the random schedule (SplitMix64).
+    fn draw(state: &mut u64) -> u64 {
+        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
     }
 
     /// True when every warp finished.
@@ -130,10 +152,27 @@ impl Cta {
     /// Picks the warp to issue from next, releasing barriers when possible.
     fn pick(&mut self) -> Result<Option<usize>, Stall> {
         let n = self.warps.len();
-        if self.slice_left > 0 && self.warps[self.cur].state == WarpState::Ready {
+        if let Some(mut state) = self.rng {
+            for attempt in 0..2 {
+                let ready = self.warps.iter().filter(|w| w.state == WarpState::Ready).count();
+                if ready > 0 {
+                    let k = (Self::draw(&mut state) % ready as u64) as usize;
+                    self.rng = Some(state);
+                    let i = (0..n).filter(|&i| self.warps[i].state == WarpState::Ready).nth(k).expect("ready warp");
+                    self.cur = i;
+                    return Ok(Some(i));
+                }
+                if attempt == 0 && !self.try_release() {
+                    break;
+                }
+            }
+        } else if self.slice_left > 0 && self.warps[self.cur].state == WarpState::Ready {
             return Ok(Some(self.cur));
         }
         for attempt in 0..2 {
+            if self.rng.is_some() {
+                break;
+            }
             for k in 1..=n {
                 let i = (self.cur + k) % n;
                 if self.warps[i].state == WarpState::Ready {
@@ -183,6 +222,10 @@ impl Cta {
                 None => waiting.len() == alive,
             };
             if done {
+                if let Some(o) = self.observer.as_mut() {
+                    let warps: Vec<u32> = waiting.iter().map(|&i| i as u32).collect();
+                    o.barrier_release(id, &warps);
+                }
                 for i in waiting {
                     self.warps[i].state = WarpState::Ready;
                 }
@@ -236,6 +279,9 @@ impl Cta {
             Ok(Effect::Continue) => {}
             Ok(Effect::Blocked) => {
                 self.slice_left = 0;
+                if let (WarpState::Barrier { id, .. }, Some(o)) = (warp.state, self.observer.as_mut()) {
+                    o.barrier_arrive(w as u32, func, pc, id);
+                }
                 if matches!(warp.state, WarpState::Barrier { .. } | WarpState::Done) {
                     self.try_release();
                 }

@@ -255,6 +255,7 @@ impl Default for SimConfig {
                 round_quantum: 20_000,
                 max_resident_ctas: 240,
                 max_warp_instructions: DEFAULT_MAX_WARP_INSTRUCTIONS,
+                random_seed: None,
             },
             num_sms: 30,
             local_limit: 64 * 1024,

@@ -32,6 +32,10 @@ pub struct Schedule {
     pub max_resident_ctas: u32,
     /// Launch-wide warp-instruction budget (runaway detection).
     pub max_warp_instructions: u64,
+    /// The random warp schedule (`--schedule random --seed N`): inside each
+    /// CTA, every instruction comes from a ready warp drawn with this seed.
+    /// `None`: loose round robin.
+    pub random_seed: Option<u64>,
 }
 
 /// An executing grid.
@@ -75,8 +79,17 @@ impl<'a> GridRun<'a> {
             step_cta: 0,
             step_issued: 0,
         };
-        g.admit();
+        g.admit_scheduled();
         g
+    }
+
+    /// Makes CTAs resident ([`GridRun::admit`]) and puts new ones on the
+    /// random schedule when it is on.
+    fn admit_scheduled(&mut self) {
+        self.admit();
+        if let Some(seed) = self.sched.random_seed {
+            self.resident.iter_mut().for_each(|c| c.randomize(seed));
+        }
     }
 
     fn admit(&mut self) {
@@ -155,7 +168,7 @@ impl<'a> GridRun<'a> {
                 i += 1;
             }
         }
-        self.admit();
+        self.admit_scheduled();
         let issued: u64 =
             self.retired_instructions + self.resident.iter().map(|c| c.counters.warp_instructions).sum::<u64>();
         if issued > self.sched.max_warp_instructions
