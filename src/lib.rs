@@ -21,6 +21,7 @@
 #![warn(missing_docs)]
 
 pub mod chart;
+pub mod check;
 pub mod cli;
 pub mod compile;
 pub mod host;

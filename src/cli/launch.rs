@@ -71,6 +71,9 @@ pub struct LaunchOptions {
     /// caches (the full model). Results are the same at every level; see docs/performance.md.
     #[arg(long, default_value_t = crate::sim::Fidelity::Caches)]
     pub fidelity: crate::sim::Fidelity,
+    /// Checking (`--check`, `--uninit`) and the warp schedule (`--schedule`, `--seed`).
+    #[command(flatten)]
+    pub checks: crate::check::cli::CheckArgs,
 }
 
 type Res = Result<(), Box<dyn std::error::Error>>;
@@ -106,6 +109,7 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     }
     let mut config = spec.sim_config(threads, a.max_instructions);
     config.fidelity = a.fidelity;
+    a.checks.configure(&mut config)?;
     let mut dev = Device::with_config(config);
     let prepared = launch_spec::prepare(&spec, &mut dev)?;
     let prog = &prepared.module.prog;
@@ -126,9 +130,18 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
         pb.enable_steady_tick(std::time::Duration::from_millis(100));
         pb
     });
-    let result = launch_spec::run(&spec, &mut dev, &prepared, profile);
+    let tools = a.checks.tools()?;
+    let (result, checked) = if tools.any() {
+        let r = crate::check::spec::run(&spec, &mut dev, &prepared, profile, &a.checks.options(&prepared)?);
+        (r.error.map_or(Ok(r.results), Err), Some(r.reports))
+    } else {
+        (launch_spec::run(&spec, &mut dev, &prepared, profile), None)
+    };
     if let Some(pb) = spinner {
         pb.finish_and_clear();
+    }
+    if let Some(reports) = checked.as_ref().filter(|_| !a.json || result.is_err()) {
+        crate::check::cli::print_reports(reports, spec.launches.len(), tools, a.csv || a.json);
     }
     let stats = result?;
     // Outputs only after every launch succeeded: no partial files.
@@ -168,6 +181,9 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
         let mut out = serde_json::json!({
             "spec": spec.file, "ptx": spec.ptx, "device": profile.params(), "launches": launches,
         });
+        if let Some(reports) = &checked {
+            out["check"] = crate::check::cli::json(reports);
+        }
         if !printed.is_empty() {
             let bufs: serde_json::Map<String, serde_json::Value> = printed
                 .iter()
