@@ -375,7 +375,7 @@ impl Ctx<'_> {
 
 /// The largest buffer a spec may declare (the host must hold it, and a copy);
 /// the host-memory budget ([`crate::limits::memory_budget`]) may allow less.
-pub const MAX_BUFFER_BYTES: u64 = 8 << 30;
+pub const MAX_BUFFER_BYTES: u64 = crate::limits::MAX_ALLOCATION_BYTES;
 
 /// The largest PTX file a spec may name.
 pub const MAX_PTX_BYTES: u64 = 256 << 20;

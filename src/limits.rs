@@ -20,6 +20,26 @@ pub const MAX_GRID_DIM: [u32; 3] = [(1 << 31) - 1, 65535, 65535];
 /// CUDA's most threads per block (all dimensions together).
 pub const MAX_THREADS_PER_BLOCK: u64 = 1024;
 
+/// The largest single allocation: a launch spec's buffer or a module's
+/// `.global` variable (8 GiB).
+pub const MAX_ALLOCATION_BYTES: u64 = 8 << 30;
+
+/// CUDA's constant bank: the `.const` variables of a module (64 KiB).
+pub const MAX_CONST_BANK_BYTES: u64 = 64 << 10;
+
+/// The most static `.shared` memory a module may declare: the largest shared
+/// memory per CTA of the simulated devices (228 KiB; a launch checks its
+/// device's own, `SimConfig::max_shared_per_cta`).
+pub const MAX_STATIC_SHARED_BYTES: u64 = 228 << 10;
+
+/// The most `.local` memory a function may declare per thread (2 GiB; a
+/// launch checks its device's own, `SimConfig::local_limit`, 64 KiB by default).
+pub const MAX_LOCAL_BYTES: u64 = 2 << 30;
+
+/// CUDA's largest parameter area (32 764 bytes since CUDA 12.1 on Volta and
+/// later), for kernels and device functions alike.
+pub const MAX_PARAM_BYTES: u64 = 32764;
+
 /// The largest image `render` makes, in pixels (16384 × 16384).
 pub const MAX_PIXELS: u64 = 16384 * 16384;
 

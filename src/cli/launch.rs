@@ -228,6 +228,9 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
                 "    limited by {}; {} registers/thread (PTX), {} B shared/CTA",
                 o.limiter, o.registers_per_thread, o.shared_per_cta
             );
+            if let Some(n) = &o.notice {
+                println!("    note: {n}");
+            }
             if hidden > 0 {
                 println!("  ({hidden} zero counters and profiler names not shown: --all shows them)");
             }

@@ -6,7 +6,7 @@
 //! instructions, or until it blocks (barrier, global atomic, fence) or
 //! finishes, then moves to the next ready warp in index order. A barrier
 //! completes when every warp that has not finished waits at it (or, with a
-//! thread count, when that many threads wait).
+//! thread count, when that many threads wait, counted in whole warps).
 
 use super::cfg::EXIT_PC;
 use super::counters::{Counters, InstProfile};
@@ -81,12 +81,19 @@ pub struct Cta {
 
 impl Cta {
     /// Creates CTA `linear` of the launch, with every warp at the kernel's first instruction.
-    pub fn new(ctx: &Ctx, kernel: u32, linear: u32, shared_size: usize, slice: u32) -> Cta {
+    /// A kernel whose `.local` frame is larger than the device's local memory
+    /// per thread (`ctx.local_limit`) is a [`FaultKind::LocalStackOverflow`]
+    /// at its first instruction, before anything is allocated for it.
+    pub fn new(ctx: &Ctx, kernel: u32, linear: u32, shared_size: usize, slice: u32) -> Result<Cta, CtaFault> {
         let [gx, gy, _] = ctx.grid;
         let id = [linear % gx, (linear / gx) % gy, linear / (gx * gy)];
         let threads = ctx.block[0] * ctx.block[1] * ctx.block[2];
         let nwarps = threads.div_ceil(32);
         let f = &ctx.prog.functions[kernel as usize];
+        if f.local_size > ctx.local_limit {
+            let kind = FaultKind::LocalStackOverflow { needed: f.local_size as u64, limit: ctx.local_limit as u64 };
+            return Err(CtaFault { kind, warp: 0, func: kernel, pc: 0, lane: None });
+        }
         let warps = (0..nwarps)
             .map(|w| {
                 let n = (threads - w * 32).min(32);
@@ -108,7 +115,7 @@ impl Cta {
             .collect();
         let mut counters = Counters { ctas: 1, warps: nwarps as u64, ..Default::default() };
         counters.rounds = 0;
-        Cta {
+        Ok(Cta {
             id,
             linear,
             warps,
@@ -122,7 +129,7 @@ impl Cta {
             slice_left: slice,
             slice: slice.max(1),
             rng: None,
-        }
+        })
     }
 
     /// Switches this CTA to the random warp schedule (once; later calls keep
@@ -216,7 +223,8 @@ impl Cta {
                 WarpState::Barrier { count, .. } => count,
                 _ => None,
             });
-            let threads: u32 = waiting.iter().map(|&i| self.warps[i].lanes.count_ones()).sum();
+            // warps arrive whole (PTX): a partial last warp counts as 32 threads
+            let threads = waiting.len() as u32 * 32;
             let done = match count {
                 Some(c) => threads >= c,
                 None => waiting.len() == alive,

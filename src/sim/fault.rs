@@ -38,6 +38,28 @@ pub enum FaultKind {
         /// Lanes alive in the warp.
         live: u32,
     },
+    /// `bar.sync`/`barrier` with a barrier id past 15, or a thread count that
+    /// is not a positive multiple of the warp size within the CTA's warps
+    /// (undefined on the GPU; `docs/limits.md`).
+    BadBarrier {
+        /// The barrier id (0 to 15 are valid).
+        id: u32,
+        /// The thread count operand, when given.
+        count: Option<u32>,
+        /// The CTA's threads in whole warps (the most a count may be).
+        cta_threads: u32,
+    },
+    /// A `shfl.sync`/`vote.sync` whose member mask leaves out a lane that
+    /// executes it, or names live lanes of the warp that do not execute it
+    /// with it (on another path, or predicated off): undefined on the GPU.
+    MemberMask {
+        /// The member mask (of the first lane in error).
+        mask: u32,
+        /// Lanes that execute the instruction.
+        active: u32,
+        /// Lanes alive in the warp (not exited).
+        live: u32,
+    },
     /// Every warp of a CTA is waiting at barriers that can never complete.
     BarrierDeadlock {
         /// (warp, barrier id) of each waiting warp.
@@ -86,6 +108,37 @@ impl fmt::Display for FaultKind {
             FaultKind::ReadOnly { space } => write!(f, "store to read-only {space:?} space"),
             FaultKind::DivergentBarrier { active, live } => {
                 write!(f, "barrier reached by part of a warp: active lanes {active:#010x}, live lanes {live:#010x}")
+            }
+            FaultKind::BadBarrier { id, count, cta_threads } => {
+                if *id > 15 {
+                    write!(f, "barrier id {id} is out of range (a CTA has barriers 0 to 15)")
+                } else {
+                    write!(
+                        f,
+                        "barrier {id} with a thread count of {}: it must be a positive multiple of 32 \
+                         and at most the CTA's {cta_threads} threads in whole warps",
+                        count.unwrap_or(0)
+                    )
+                }
+            }
+            FaultKind::MemberMask { mask, active, live } => {
+                let missing = active & !mask;
+                if missing != 0 {
+                    write!(
+                        f,
+                        "member mask {mask:#010x} leaves out lane {} that executes the instruction \
+                         (active lanes {active:#010x}; undefined on the GPU)",
+                        missing.trailing_zeros()
+                    )
+                } else {
+                    write!(
+                        f,
+                        "member mask {mask:#010x} names lane {} that does not execute the instruction with the others \
+                         (active lanes {active:#010x}, live lanes {live:#010x}; the GPU would wait for it or is undefined: \
+                         use __activemask() or converge first)",
+                        (mask & live & !active).trailing_zeros()
+                    )
+                }
             }
             FaultKind::BarrierDeadlock { waiting } => {
                 write!(f, "barrier deadlock: warps wait at barriers that cannot complete (warp, barrier): {waiting:?}")

@@ -56,6 +56,8 @@ pub struct GridRun<'a> {
     /// Stepping position: index into `resident` and instructions issued by it this round.
     step_cta: usize,
     step_issued: u64,
+    /// A CTA that could not be made resident ([`Cta::new`]'s error).
+    refused: Option<Box<Fault>>,
 }
 
 impl<'a> GridRun<'a> {
@@ -78,6 +80,7 @@ impl<'a> GridRun<'a> {
             retired_instructions: 0,
             step_cta: 0,
             step_issued: 0,
+            refused: None,
         };
         g.admit_scheduled();
         g
@@ -94,8 +97,17 @@ impl<'a> GridRun<'a> {
 
     fn admit(&mut self) {
         while (self.resident.len() as u32) < self.sched.max_resident_ctas.max(1) && self.next_cta < self.total_ctas {
-            let c = Cta::new(&self.ctx, self.kernel, self.next_cta, self.shared_size, self.sched.warp_slice);
-            self.resident.push(c);
+            match Cta::new(&self.ctx, self.kernel, self.next_cta, self.shared_size, self.sched.warp_slice) {
+                Ok(c) => self.resident.push(c),
+                Err(f) => {
+                    // reported by the next `commit` (every CTA of the kernel would refuse)
+                    let [gx, gy, _] = self.ctx.grid;
+                    let n = self.next_cta;
+                    let id = [n % gx, (n / gx) % gy, n / (gx * gy)];
+                    self.refused = Some(Box::new(make_fault(self.ctx.prog, &self.kernel_name, id, &f)));
+                    return;
+                }
+            }
             self.next_cta += 1;
         }
     }
@@ -140,6 +152,9 @@ impl<'a> GridRun<'a> {
     /// The between-rounds phase: faults, atomics, retirement, admission, budget.
     fn commit(&mut self) -> Result<(), Box<Fault>> {
         self.totals.rounds += 1;
+        if let Some(f) = self.refused.take() {
+            return Err(f);
+        }
         if let Some(c) = self.resident.iter().find(|c| c.fault.is_some()) {
             let f = c.fault.clone().expect("fault");
             return Err(self.locate(c, &f));

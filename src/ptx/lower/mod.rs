@@ -31,7 +31,7 @@ pub mod operands;
 pub mod validate;
 pub mod warp;
 
-use layout::{Signature, align_up, collect_shared, init_bytes, signature};
+use layout::{Signature, align_up, check_var_size, collect_shared, init_bytes, signature, var_size};
 use opcode::{Decoded, Family, Opcode};
 
 /// A lowering result: errors carry the position; the file is added by [`super::load`].
@@ -113,20 +113,20 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
             return Ok(u32::MAX);
         }
         let align = v.align.unwrap_or(v.ty.bytes()) as u64;
+        let size = var_size(v)?;
         shared_off = align_up(shared_off, align);
         let off = shared_off;
-        shared_off += v.size_bytes();
-        if shared_off > u32::MAX as u64 {
-            return invalid(v.pos, "shared memory too large");
-        }
+        shared_off = off.saturating_add(size);
+        check_var_size(v, size, shared_off)?;
         prog.shared_vars.push(SharedVar {
             name: v.name.clone(),
             offset: off as u32,
-            size: v.size_bytes() as u32,
+            size: size as u32,
             align: align as u32,
         });
         Ok(off as u32)
     };
+    let mut global_bytes: u64 = 0;
     for v in &m.vars {
         match v.space {
             Space::Shared => {
@@ -136,6 +136,8 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
             Space::Const => {
                 let align = v.align.unwrap_or(v.ty.bytes()) as u64;
                 let off = align_up(prog.const_bank.len() as u64, align);
+                let size = var_size(v)?;
+                check_var_size(v, size, off.saturating_add(size))?;
                 let bytes = init_bytes(v)?;
                 prog.const_bank.resize(off as usize, 0);
                 prog.const_bank.extend_from_slice(&bytes);
@@ -146,11 +148,14 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
                 if v.is_extern {
                     return unsupported(v.pos, format!(".extern .global {}", v.name));
                 }
+                let size = var_size(v)?;
+                global_bytes = global_bytes.saturating_add(size);
+                check_var_size(v, size, global_bytes)?;
                 let bytes = init_bytes(v)?;
                 let idx = prog.globals.len() as u32;
                 prog.globals.push(GlobalVar {
                     name: v.name.clone(),
-                    size: v.size_bytes(),
+                    size,
                     align: v.align.unwrap_or(v.ty.bytes()),
                     init: bytes,
                 });
@@ -468,9 +473,12 @@ impl<'a> FnLower<'a> {
             }
             Space::Local => {
                 let align = d.align.unwrap_or(d.ty.bytes()) as u64;
+                let size = var_size(d)?;
                 self.local = align_up(self.local, align);
                 let off = self.local;
-                self.local += d.size_bytes();
+                self.local = off.saturating_add(size);
+                // bounded so that the frame size (and each offset) fits its u32
+                check_var_size(d, size, align_up(self.local, 16))?;
                 self.out.local_align = self.out.local_align.max(align as u32);
                 self.declare(d.name.clone(), Sym::Local(off as u32));
             }
@@ -478,9 +486,9 @@ impl<'a> FnLower<'a> {
                 let align = d.align.unwrap_or(d.ty.bytes()) as u64;
                 self.frame_param = align_up(self.frame_param, align);
                 let off = self.frame_param;
-                let size =
-                    if d.dims.is_empty() { d.ty.bytes() as u64 * d.vector.unwrap_or(1) as u64 } else { d.size_bytes() };
-                self.frame_param += size;
+                let size = if d.dims.is_empty() { d.ty.bytes() as u64 * d.vector.unwrap_or(1) as u64 } else { var_size(d)? };
+                self.frame_param = off.saturating_add(size);
+                check_var_size(d, size, self.frame_param)?;
                 self.declare(d.name.clone(), Sym::FrameParam(off as u32, size as u32));
             }
             Space::Shared => {} // placed with the module

@@ -7,15 +7,17 @@ use crate::ptx::ast::{self, Operand};
 use crate::ptx::ir::*;
 use crate::ptx::types::Ty;
 
-/// The member mask of a warp instruction without `.sync`: the whole warp.
-const WHOLE_WARP: Src = Src::Imm(u32::MAX as u64);
+/// The member mask of a warp instruction without `.sync` (and of
+/// `activemask`): the lanes that execute it. No 32-bit operand has this
+/// value, so the simulator tells it from a `.sync` form's mask.
+pub const NO_MEMBER_MASK: Src = Src::Imm(1 << 32);
 
 impl FnLower<'_> {
     /// Lowers a validated `vote`.
     pub(super) fn lower_vote(&self, i: &ast::Instruction, d: &Decoded) -> LResult<Kind> {
         let (pos, ops, m) = (i.pos, &i.operands, &d.mods);
         let mode = m.vote_mode().expect("validated: a mode");
-        let membermask = if m.has("sync") { self.src(&ops[2], Ty::U32, pos)? } else { WHOLE_WARP };
+        let membermask = if m.has("sync") { self.src(&ops[2], Ty::U32, pos)? } else { NO_MEMBER_MASK };
         let a = self.pred_src(&ops[1], pos)?;
         Ok(if mode == VoteMode::Ballot {
             Kind::Vote { mode, d: Some(self.dst(&ops[0], pos)?), p: PRED_FALSE, a, membermask }
@@ -31,7 +33,7 @@ impl FnLower<'_> {
             d: Some(self.dst(&i.operands[0], i.pos)?),
             p: PRED_FALSE,
             a: PredSrc { reg: PRED_TRUE, neg: false },
-            membermask: WHOLE_WARP,
+            membermask: NO_MEMBER_MASK,
         })
     }
 
@@ -50,7 +52,7 @@ impl FnLower<'_> {
             a: self.src(&ops[1], Ty::B32, pos)?,
             b: self.src(&ops[2], Ty::U32, pos)?,
             c: self.src(&ops[3], Ty::U32, pos)?,
-            membermask: if m.has("sync") { self.src(&ops[4], Ty::U32, pos)? } else { WHOLE_WARP },
+            membermask: if m.has("sync") { self.src(&ops[4], Ty::U32, pos)? } else { NO_MEMBER_MASK },
         })
     }
 }

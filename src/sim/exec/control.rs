@@ -50,9 +50,40 @@ pub(super) fn bar(
     }
     let idv = read(ctx, w, cta, id)[lane_of_mask(exec).unwrap_or(0)] as u32;
     let cnt = count.map(|c| read(ctx, w, cta, c)[lane_of_mask(exec).unwrap_or(0)] as u32);
+    // PTX: ids 0..15; a count is a multiple of the warp size (warps arrive
+    // whole); more threads than the CTA's warps hold could never arrive.
+    let cta_threads = (ctx.block[0] * ctx.block[1] * ctx.block[2]).div_ceil(32) * 32;
+    if idv > 15 || cnt.is_some_and(|c| c == 0 || c % 32 != 0 || c > cta_threads) {
+        return Err(fault(FaultKind::BadBarrier { id: idv, count: cnt, cta_threads }, None));
+    }
     cta.counters.barrier_warp_arrivals += 1;
     w.state = WarpState::Barrier { id: idv, count: cnt };
     Ok(Effect::Blocked)
+}
+
+/// The member mask of `shfl.sync`/`vote.sync`: each executing lane must be
+/// in its mask, and the mask may name no live lane that does not execute the
+/// instruction (on another path of a divergent warp, or predicated off) —
+/// the GPU leaves both undefined (before Volta) or waits for the named lanes
+/// (Volta on), which a warp on a SIMT stack cannot. Lanes the mask names
+/// that have exited or do not exist (a partial last warp under
+/// `0xffffffff`) are ignored, as the GPU does. The forms without `.sync`
+/// have no mask to check.
+pub(super) fn member_mask(ctx: &Ctx, w: &Warp, cta: &CtaMut, mask: Src, exec: u32) -> Result<(), Box<ExecFault>> {
+    if mask == crate::ptx::lower::warp::NO_MEMBER_MASK {
+        return Ok(());
+    }
+    let m = read(ctx, w, cta, mask);
+    let mut bits = exec;
+    while bits != 0 {
+        let l = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let ml = m[l] as u32;
+        if ml & (1 << l) == 0 || ml & w.live & !exec != 0 {
+            return Err(fault(FaultKind::MemberMask { mask: ml, active: exec, live: w.live }, Some(l)));
+        }
+    }
+    Ok(())
 }
 
 /// `membar`/`fence`: waits for this CTA's outstanding global atomics.

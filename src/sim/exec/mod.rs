@@ -333,8 +333,14 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             return atomic::atomic(ctx, w, cta, (func, pc), *space, *op, *ty, *d, addr, *b, *c, exec);
         }
         Kind::Bar { id, count } => return control::bar(ctx, w, cta, *id, *count, exec),
-        Kind::Vote { mode, d, p, a, .. } => arith::vote(w, *mode, *d, *p, *a, exec),
-        Kind::Shfl { mode, d, p, a, b, c, .. } => arith::shfl(ctx, w, cta, *mode, *d, *p, [*a, *b, *c], exec),
+        Kind::Vote { mode, d, p, a, membermask } => {
+            control::member_mask(ctx, w, cta, *membermask, exec)?;
+            arith::vote(w, *mode, *d, *p, *a, exec)
+        }
+        Kind::Shfl { mode, d, p, a, b, c, membermask } => {
+            control::member_mask(ctx, w, cta, *membermask, exec)?;
+            arith::shfl(ctx, w, cta, *mode, *d, *p, [*a, *b, *c], exec)
+        }
         Kind::Membar => return Ok(control::membar(w, cta)),
         Kind::Nop => {}
         Kind::Trap => return Err(fault(FaultKind::Trap, lane_of_mask(exec))),

@@ -1,0 +1,210 @@
+//! Operands of the synchronising instructions that the GPU leaves undefined
+//! are faults naming the kernel and PTX line, never hangs or silent wrong
+//! results (issue 17, item 11): `bar.sync` ids past 15 and thread counts that
+//! are not multiples of the warp size or exceed the CTA, `shfl.sync`/`vote.sync`
+//! member masks that leave out executing lanes or name lanes on another path;
+//! and a kernel whose `.local` frame exceeds the device's local memory
+//! through the Rust API.
+
+use warplight::sim::{Arg, Device, Fault, FaultKind, LaunchConfig, LaunchStats, SimConfig, SimError};
+
+const HEAD: &str = ".version 7.8\n.target sm_90\n.address_size 64\n";
+
+/// Barriers: the id and count come from parameters; threads at or past
+/// `skip_from` leave before the barrier.
+const BARRIERS: &str = "
+.visible .entry bar_param(.param .u32 id, .param .u32 count, .param .u32 skip_from)
+{
+.reg .pred %p<2>;
+.reg .b32 %r<5>;
+ld.param.u32 %r1, [id];
+ld.param.u32 %r2, [count];
+ld.param.u32 %r3, [skip_from];
+mov.u32 %r4, %tid.x;
+setp.ge.u32 %p1, %r4, %r3;
+@%p1 bra END;
+bar.sync %r1, %r2;
+END:
+ret;
+}
+.visible .entry bar_16()
+{
+bar.sync 16;
+ret;
+}
+.visible .entry bar_1_33()
+{
+bar.sync 1, 33;
+ret;
+}
+";
+
+/// Shuffles and votes: lanes below `split` branch away; the others shuffle
+/// down by one under `mask` and store the result, or take a ballot of the
+/// executing lanes (`__activemask()`), or a vote without `.sync`.
+const WARP_OPS: &str = "
+.visible .entry shfl_split(.param .u64 out, .param .u32 split, .param .u32 mask)
+{
+.reg .pred %p<2>;
+.reg .b32 %r<6>;
+.reg .b64 %rd<4>;
+ld.param.u64 %rd1, [out];
+ld.param.u32 %r3, [split];
+ld.param.u32 %r4, [mask];
+mov.u32 %r1, %tid.x;
+setp.lt.u32 %p1, %r1, %r3;
+@%p1 bra DONE;
+shfl.sync.down.b32 %r2, %r1, 1, 31, %r4;
+mul.wide.u32 %rd2, %r1, 4;
+add.s64 %rd3, %rd1, %rd2;
+st.global.u32 [%rd3], %r2;
+DONE:
+ret;
+}
+.visible .entry ballot_split(.param .u64 out, .param .u32 split)
+{
+.reg .pred %p<3>;
+.reg .b32 %r<6>;
+.reg .b64 %rd<4>;
+ld.param.u64 %rd1, [out];
+ld.param.u32 %r3, [split];
+mov.u32 %r1, %tid.x;
+setp.lt.u32 %p1, %r1, %r3;
+@%p1 bra DONE;
+activemask.b32 %r4;
+and.b32 %r5, %r1, 1;
+setp.eq.u32 %p2, %r5, 1;
+vote.sync.ballot.b32 %r2, %p2, %r4;
+vote.any.pred %p2, %p2;
+mul.wide.u32 %rd2, %r1, 4;
+add.s64 %rd3, %rd1, %rd2;
+st.global.u32 [%rd3], %r2;
+DONE:
+ret;
+}
+";
+
+fn device() -> Device {
+    Device::with_config(SimConfig { threads: 1, ..SimConfig::default() })
+}
+
+fn fault_of(r: Result<LaunchStats, SimError>) -> Box<Fault> {
+    match r {
+        Err(SimError::Fault(f)) => f,
+        other => panic!("expected a fault, got {other:?}"),
+    }
+}
+
+fn bar_launch(block: u32, id: u32, count: u32, skip_from: u32) -> Result<LaunchStats, SimError> {
+    let mut dev = device();
+    let m = dev.load_ptx(&format!("{HEAD}{BARRIERS}"), "bar.ptx").unwrap();
+    let args = [Arg::U32(id), Arg::U32(count), Arg::U32(skip_from)];
+    dev.launch(&m, "bar_param", LaunchConfig::linear(1, block), &args)
+}
+
+#[test]
+fn barrier_ids_past_15_are_faults() {
+    let f = fault_of(bar_launch(64, 16, 64, 64));
+    assert_eq!(f.kind, FaultKind::BadBarrier { id: 16, count: Some(64), cta_threads: 64 });
+    assert_eq!(f.ptx_line, 15, "{f}");
+    let msg = f.to_string();
+    assert!(msg.contains("barrier id 16 is out of range (a CTA has barriers 0 to 15)"), "{msg}");
+    assert!(msg.contains("bar_param") && msg.contains("bar.ptx:15"), "{msg}");
+    let mut dev = device();
+    let m = dev.load_ptx(&format!("{HEAD}{BARRIERS}"), "bar.ptx").unwrap();
+    let f = fault_of(dev.launch(&m, "bar_16", LaunchConfig::linear(1, 32), &[]));
+    assert!(matches!(f.kind, FaultKind::BadBarrier { id: 16, count: None, .. }), "{f}");
+    assert_eq!(f.ptx_line, 21);
+    // 15 is the last valid id
+    bar_launch(64, 15, 64, 64).unwrap();
+}
+
+#[test]
+fn barrier_counts_are_whole_warps_within_the_cta() {
+    let mut dev = device();
+    let m = dev.load_ptx(&format!("{HEAD}{BARRIERS}"), "bar.ptx").unwrap();
+    let f = fault_of(dev.launch(&m, "bar_1_33", LaunchConfig::linear(1, 64), &[]));
+    assert_eq!(f.kind, FaultKind::BadBarrier { id: 1, count: Some(33), cta_threads: 64 });
+    assert!(f.to_string().contains("thread count of 33: it must be a positive multiple of 32"), "{f}");
+    for count in [0, 48, 96] {
+        let f = fault_of(bar_launch(64, 1, count, 64));
+        assert_eq!(f.kind, FaultKind::BadBarrier { id: 1, count: Some(count), cta_threads: 64 }, "{count}");
+    }
+    // Two of four warps meet at barrier 1 with a count of 64; the others leave.
+    bar_launch(128, 1, 64, 64).unwrap();
+    // A partial last warp arrives as a whole warp: 48 threads are two warps, 64 threads.
+    bar_launch(48, 1, 64, 48).unwrap();
+    // A count the arriving warps never reach is a deadlock, not a hang.
+    let f = fault_of(bar_launch(128, 1, 128, 64));
+    assert!(matches!(f.kind, FaultKind::BarrierDeadlock { .. }), "{f}");
+}
+
+fn shfl(block: u32, split: u32, mask: u32) -> (Result<LaunchStats, SimError>, Vec<u32>) {
+    let mut dev = device();
+    let m = dev.load_ptx(&format!("{HEAD}{WARP_OPS}"), "warp.ptx").unwrap();
+    let out = dev.alloc_zeroed::<u32>(block as usize);
+    let r =
+        dev.launch(&m, "shfl_split", LaunchConfig::linear(1, block), &[Arg::Ptr(out), Arg::U32(split), Arg::U32(mask)]);
+    (r, dev.read::<u32>(out, block as usize))
+}
+
+#[test]
+fn a_member_mask_naming_lanes_on_another_path_is_a_fault() {
+    // lanes 0-15 branch away; 16-31 shuffle naming the whole warp
+    let (r, _) = shfl(32, 16, u32::MAX);
+    let f = fault_of(r);
+    assert_eq!(f.kind, FaultKind::MemberMask { mask: u32::MAX, active: 0xFFFF_0000, live: u32::MAX });
+    assert_eq!((f.lane, f.ptx_line), (Some(16), 16), "{f}");
+    let msg = f.to_string();
+    assert!(msg.contains("names lane 0 that does not execute the instruction"), "{msg}");
+    assert!(msg.contains("shfl_split") && msg.contains("warp.ptx:16"), "{msg}");
+    // the mask of the lanes that run it: a correct shuffle
+    let (r, out) = shfl(32, 16, 0xFFFF_0000);
+    r.unwrap();
+    let want: Vec<u32> = (0..32).map(|l| if l < 16 { 0 } else { (l + 1).min(31) }).collect();
+    assert_eq!(out, want);
+}
+
+#[test]
+fn a_member_mask_leaving_out_an_executing_lane_is_a_fault() {
+    let (r, _) = shfl(32, 0, 0x0000_FFFF);
+    let f = fault_of(r);
+    assert!(matches!(f.kind, FaultKind::MemberMask { mask: 0xFFFF, active: u32::MAX, .. }), "{f}");
+    assert_eq!(f.lane, Some(16));
+    assert!(f.to_string().contains("leaves out lane 16 that executes the instruction"), "{f}");
+}
+
+#[test]
+fn lanes_that_do_not_exist_or_exited_may_be_named() {
+    // 48 threads: the second warp has 16 lanes and shuffles under 0xffffffff
+    let (r, out) = shfl(48, 0, u32::MAX);
+    r.unwrap();
+    for t in (0..31).chain(32..47) {
+        assert_eq!(out[t], t as u32 + 1, "thread {t}");
+    }
+}
+
+#[test]
+fn activemask_ballots_and_votes_without_sync_run_in_divergent_code() {
+    let mut dev = device();
+    let m = dev.load_ptx(&format!("{HEAD}{WARP_OPS}"), "warp.ptx").unwrap();
+    let out = dev.alloc_zeroed::<u32>(32);
+    dev.launch(&m, "ballot_split", LaunchConfig::linear(1, 32), &[Arg::Ptr(out), Arg::U32(8)]).unwrap();
+    // lanes 8-31 run it; the odd ones among them vote true
+    let want: Vec<u32> = (0..32).map(|l| if l < 8 { 0 } else { 0xAAAA_AA00 }).collect();
+    assert_eq!(dev.read::<u32>(out, 32), want);
+}
+
+#[test]
+fn a_local_frame_over_the_device_limit_is_a_typed_error_through_the_api() {
+    let src = format!("{HEAD}.visible .entry k()\n{{\n.local .align 4 .b8 a[4096];\nret;\n}}\n");
+    let mut dev = Device::with_config(SimConfig { threads: 1, local_limit: 1024, ..SimConfig::default() });
+    let m = dev.load_ptx(&src, "local.ptx").unwrap();
+    let f = fault_of(dev.launch(&m, "k", LaunchConfig::linear(2, 32), &[]));
+    assert_eq!(f.kind, FaultKind::LocalStackOverflow { needed: 4096, limit: 1024 });
+    assert_eq!(f.kernel, "k");
+    // within the limit it runs
+    let mut dev = Device::with_config(SimConfig { threads: 1, local_limit: 4096, ..SimConfig::default() });
+    let m = dev.load_ptx(&src, "local.ptx").unwrap();
+    dev.launch(&m, "k", LaunchConfig::linear(2, 32), &[]).unwrap();
+}
