@@ -42,6 +42,12 @@ const CASES: &[(&str, i32, &str)] = &[
     ("check regs_range.ptx", 1, "more registers than a function can have"),
     ("launch local_1gb.toml", 1, "kernel `k` has 1 GiB of .local memory per thread; the simulated device has 64 KiB"),
     ("launch len_1e12.toml", 1, "`buffer[0].len`: 1000000000000 elements of 1 bytes is more than a buffer may hold"),
+    ("launch global_4tb.toml", 1, "global_4tb.ptx:4:1: over a limit: .global variable `g` is 3.6 TiB; one allocation"),
+    ("check local_4gb.ptx", 1, "local_4gb.ptx:7:1: over a limit: .local variable `b` is 2 GiB (4 GiB with"),
+    ("check shared_40gb.ptx", 1, "shared_40gb.ptx:6:1: over a limit: .shared variable `s` is 37.3 GiB; a CTA's"),
+    ("check const_40gb.ptx", 1, "const_40gb.ptx:4:1: over a limit: .const variable `c` is 37.3 GiB; the constant"),
+    ("check dims_overflow.ptx", 1, "dims_overflow.ptx:4:1: over a limit: `h`: its dimensions multiply past 2^64 bytes"),
+    ("check param_100k.ptx", 1, "param_100k.ptx:4:19: over a limit: .param variable `p` is 97.7 KiB"),
     ("launch regs_60000.toml", 1, "needs 109.9 GiB of host memory; the budget is 2 GiB (WARPLIGHT_MEMORY_BUDGET)"),
     ("render --scene disc.toml --resolution 100000x100000 -o o.png", 1, "10000000000 pixels is more than 268435456"),
     ("render --scene disc.toml --resolution 16384x16384 -o o.png", 1, "a render of 16384 x 16384 pixels needs 8 GiB"),
@@ -235,4 +241,164 @@ fn mutated_specs_and_scenes_never_panic() {
         assert!(r.is_ok(), "scene {} mutated to:\n{m}", path.display());
     }
     assert!(runs >= 20, "only {runs} runs");
+}
+
+/// Numbers that have broken sizes, ids and counts in PTX before.
+const HOSTILE_NUMBERS: &[&str] = &[
+    "0",
+    "-1",
+    "15",
+    "16",
+    "33",
+    "65535",
+    "2147483648",
+    "4294967295",
+    "4294967296",
+    "4000000000000",
+    "18446744073709551615",
+];
+
+/// Lines that have broken the front end or the simulator before.
+const HOSTILE_LINES: &[&str] = &[
+    "bar.sync 16;",
+    "bar.sync 1, 33;",
+    "bar.sync 0, 4096;",
+    "shfl.sync.down.b32 %r1, %r1, 1, 31, -1;",
+    "vote.sync.ballot.b32 %r1, %p1, 65535;",
+    ".local .align 4 .b8 __fuzz_l[4294967296];",
+    ".shared .align 4 .b8 __fuzz_s[40000000000];",
+    ".global .align 4 .b8 __fuzz_g[4000000000000];",
+    ".const .align 4 .b8 __fuzz_c[100000];",
+    ".reg .b32 %fuzz<4294967295>;",
+    "ret;",
+    "exit;",
+    "trap;",
+    "{",
+    "}",
+    "$L__fuzz: bra $L__fuzz;",
+];
+
+/// One mutation of PTX text: a number replaced by a hostile one, a line
+/// dropped, duplicated or swapped, a hostile line inserted, or a byte changed.
+fn mutate_ptx(text: &str, rng: &mut Rng) -> String {
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    for _ in 0..1 + rng.below(3) {
+        if lines.is_empty() {
+            break;
+        }
+        let i = rng.below(lines.len());
+        match rng.below(7) {
+            0 => {
+                lines.remove(i);
+            }
+            1 => {
+                let l = lines[i].clone();
+                lines.insert(i, l);
+            }
+            2 => {
+                let j = rng.below(lines.len());
+                lines.swap(i, j);
+            }
+            3 => lines.insert(i, HOSTILE_LINES[rng.below(HOSTILE_LINES.len())].to_string()),
+            4 => {
+                let mut b = std::mem::take(&mut lines[i]).into_bytes();
+                if !b.is_empty() {
+                    let p = rng.below(b.len());
+                    b[p] = b"{}[]();,.%@!-0123456789 x"[rng.below(25)];
+                }
+                lines[i] = String::from_utf8_lossy(&b).into_owned();
+            }
+            _ => {
+                // a run of digits (in a size, an id, an immediate) becomes a hostile number
+                let l = &lines[i];
+                let starts: Vec<usize> = l
+                    .char_indices()
+                    .filter(|&(k, c)| c.is_ascii_digit() && (k == 0 || !l.as_bytes()[k - 1].is_ascii_alphanumeric()))
+                    .map(|(k, _)| k)
+                    .collect();
+                if !starts.is_empty() {
+                    let s = starts[rng.below(starts.len())];
+                    let e = l[s..].find(|c: char| !c.is_ascii_digit()).map_or(l.len(), |n| s + n);
+                    lines[i] = format!("{}{}{}", &l[..s], HOSTILE_NUMBERS[rng.below(HOSTILE_NUMBERS.len())], &l[e..]);
+                }
+            }
+        }
+    }
+    lines.join("\n")
+}
+
+/// Issue 17's bounded PTX fuzz: the committed PTX (test kernels, lessons and
+/// this corpus) mutated with a fixed seed, loaded and, when it loads, every
+/// kernel launched on small buffers under a small watchdog — for a few seconds.
+/// A panic fails the test; an abort (allocation failure) or hang would end
+/// the test binary, which fails the run as well.
+#[test]
+fn mutated_ptx_loads_and_runs_without_panic() {
+    use warplight::sim::{Arg, Device, LaunchConfig, SimConfig};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files: Vec<(String, String)> = Vec::new();
+    for dir in ["kernels/tests", "kernels/lessons", "tests/corpus"] {
+        let mut names: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "ptx"))
+            .collect();
+        names.sort();
+        for p in names {
+            let text = std::fs::read_to_string(&p).unwrap();
+            if text.len() < 64 * 1024 {
+                files.push((p.file_name().unwrap().to_string_lossy().into_owned(), text));
+            }
+        }
+    }
+    assert!(files.len() >= 20, "{} PTX files", files.len());
+    warplight::limits::set_memory_budget(256 << 20);
+    let mut cfg = SimConfig { threads: 1, max_call_depth: 8, ..SimConfig::default() };
+    cfg.schedule.max_warp_instructions = 20_000;
+    cfg.schedule.round_quantum = 2_000;
+    let mut rng = Rng(0x5DEE_CE66_D1CE_5EED);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(6);
+    let (mut runs, mut loaded, mut launched) = (0, 0, 0);
+    while std::time::Instant::now() < deadline && runs < 5000 {
+        runs += 1;
+        let (name, text) = &files[rng.below(files.len())];
+        let m = mutate_ptx(text, &mut rng);
+        let ctas = 1 + rng.below(2) as u32;
+        let threads = [32, 48, 64][rng.below(3)];
+        let r = std::panic::catch_unwind(|| {
+            let mut dev = Device::with_config(cfg.clone());
+            let module = match dev.load_ptx(&m, name) {
+                Ok(module) => module,
+                Err(e) => {
+                    assert!(e.to_string().contains(name.as_str()), "{e}");
+                    return (0, 0);
+                }
+            };
+            let mut n = 0;
+            for k in module.prog.kernel_names() {
+                let f = &module.prog.functions[module.prog.kernel(k).unwrap() as usize];
+                let args: Vec<Arg> = f
+                    .params
+                    .iter()
+                    .map(|p| match p.size {
+                        8 => Arg::Ptr(dev.alloc_zeroed::<u8>(64 << 10)),
+                        4 => Arg::U32(1),
+                        s => Arg::Bytes(vec![0; s as usize]),
+                    })
+                    .collect();
+                // faults and errors are expected; panics are not
+                let _ = dev.launch(&module, k, LaunchConfig::linear(ctas, threads), &args);
+                n += 1;
+            }
+            (1, n)
+        });
+        match r {
+            Ok((l, n)) => {
+                loaded += l;
+                launched += n;
+            }
+            Err(_) => panic!("{name} mutated to:\n{m}"),
+        }
+    }
+    assert!(runs >= 50 && loaded >= 10 && launched >= 10, "{runs} runs, {loaded} loaded, {launched} launches");
 }

@@ -120,14 +120,25 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
         return Ok(());
     }
     report::check_metrics(&a.metrics, &known)?;
+    // on a terminal: CTAs retired of the launch's grid, with an ETA (the simulator's progress hook)
     let spinner = std::io::stderr().is_terminal().then(|| {
-        let pb = indicatif::ProgressBar::new_spinner();
-        pb.set_style(indicatif::ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("template"));
+        let pb = indicatif::ProgressBar::new(0);
+        let style = "{msg} [{bar:30}] {pos}/{len} CTAs [{elapsed}, eta {eta}]";
+        pb.set_style(indicatif::ProgressStyle::with_template(style).expect("template"));
         pb.set_message(format!(
             "running {}",
             spec.launches.iter().map(|l| l.kernel.as_str()).collect::<Vec<_>>().join(", ")
         ));
-        pb.enable_steady_tick(std::time::Duration::from_millis(100));
+        pb.enable_steady_tick(std::time::Duration::from_millis(200));
+        let bar = pb.clone();
+        dev.set_progress(Some(std::sync::Arc::new(move |p: &crate::sim::grid::Progress| {
+            if p.ctas_retired < bar.position() || p.ctas != bar.length().unwrap_or(0) {
+                // the next launch of the spec
+                bar.reset();
+                bar.set_length(p.ctas);
+            }
+            bar.set_position(p.ctas_retired);
+        })));
         pb
     });
     let tools = a.checks.tools()?;

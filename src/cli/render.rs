@@ -14,7 +14,7 @@ use crate::model::Profile;
 use crate::sim::Device;
 
 /// Options of `warplight render`.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct RenderArgs {
     /// Scene name (in scenes/) or path to a scene .toml.
     #[arg(long, default_value = "cornell-box")]
@@ -22,6 +22,10 @@ pub struct RenderArgs {
     /// Frame of the camera flight (0 = the start pose).
     #[arg(long, default_value_t = 0)]
     pub frame: u32,
+    /// Frames A to B-1 of the flight (`A..B`), one image each: `-o out.png`
+    /// writes out-0000.png, out-0001.png, ... (the frame number, 4 digits).
+    #[arg(long, value_name = "A..B", conflicts_with = "frame")]
+    pub frames: Option<String>,
     /// Image size WIDTHxHEIGHT (default: the scene's camera).
     #[arg(long)]
     pub resolution: Option<String>,
@@ -73,8 +77,64 @@ fn bytes_per_pixel(emulated: bool) -> u64 {
     if emulated { 128 } else { 32 }
 }
 
-/// Runs the command.
+/// `out.png` for frame 5: `out-0005.png`.
+fn frame_output(output: &std::path::Path, frame: u32) -> PathBuf {
+    let stem = output.file_stem().and_then(|s| s.to_str()).unwrap_or("render");
+    let ext = output.extension().and_then(|s| s.to_str()).unwrap_or("png");
+    output.with_file_name(format!("{stem}-{frame:04}.{ext}"))
+}
+
+/// Runs the command: one frame, or each frame of `--frames A..B` with the
+/// range's progress and ETA on stderr.
 pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let Some(frames) = &a.frames else { return run_frame(a) };
+    let range = crate::repro::protocol::FrameRange::parse(frames)?;
+    // the whole range is checked before the first frame
+    let flight = scene_file::load(&scene_path(&a.scene))?.flight.frames;
+    if range.end > flight {
+        return Err(format!("--frames {frames}: the flight has {flight} frames (0..{flight})").into());
+    }
+    let t0 = Instant::now();
+    for (i, f) in (range.start..range.end).enumerate() {
+        let b = RenderArgs { frames: None, frame: f, output: frame_output(&a.output, f), ..a.clone() };
+        run_frame(b)?;
+        let done = i as u32 + 1;
+        let left = range.len() - done;
+        let eta = t0.elapsed().as_secs_f64() / done as f64 * left as f64;
+        eprintln!(
+            "frames {done}/{} done in {:.1} s{}",
+            range.len(),
+            t0.elapsed().as_secs_f64(),
+            if left > 0 { format!(", eta {eta:.0} s") } else { String::new() }
+        );
+    }
+    Ok(())
+}
+
+/// A bar of the image's pixels, moved by the kernels' job queue (the
+/// simulator's progress hook), with an ETA; on a terminal only.
+fn pixel_progress(dev: &mut Device, kernel: &str, pixels: u64) -> Option<indicatif::ProgressBar> {
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let pb = indicatif::ProgressBar::new(pixels);
+    let style = "{msg} [{bar:30}] {pos}/{len} pixels [{elapsed}, eta {eta}]";
+    pb.set_style(indicatif::ProgressStyle::with_template(style).ok()?);
+    pb.set_message(format!("emulating {kernel}"));
+    pb.enable_steady_tick(std::time::Duration::from_millis(200));
+    let bar = pb.clone();
+    dev.set_progress(Some(std::sync::Arc::new(move |p: &crate::sim::grid::Progress| {
+        let queue = p.memory.allocations().iter().find(|a| a.name == rt_kernels::JOB_QUEUE);
+        if let Some(q) = queue {
+            // pixels claimed by the warps (in blocks of 32); those of the last blocks are still running
+            bar.set_position(q.load(0, 4).min(pixels));
+        }
+    })));
+    Some(pb)
+}
+
+/// Renders one frame.
+fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let kernel_variant = match a.variant.as_str() {
         "native" => None,
         v => Some(Variant::parse(v).ok_or_else(|| {
@@ -138,17 +198,7 @@ pub fn run(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
             config.fidelity = a.fidelity;
             let mut dev = Device::with_config(config);
             let module = rt_kernels::load(&mut dev)?;
-            let pb = std::io::stderr().is_terminal().then(|| {
-                let pb = indicatif::ProgressBar::new_spinner();
-                pb.set_message(format!(
-                    "emulating {} ({} x {} pixels)",
-                    v.kernel(),
-                    cam.resolution[0],
-                    cam.resolution[1]
-                ));
-                pb.enable_steady_tick(std::time::Duration::from_millis(100));
-                pb
-            });
+            let pb = pixel_progress(&mut dev, v.kernel(), width as u64 * height as u64);
             let k = rt_kernels::render(
                 &mut dev,
                 &module,

@@ -434,7 +434,7 @@ pub fn render_build(
     let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
     let mb = up(dev, &to_bytes(&mats), "materials")?;
     let ab = up(dev, &lay.aabbs, "aabbs")?;
-    let next = dev.alloc_zeroed::<u32>(1);
+    let next = up(dev, &[0; 4], JOB_QUEUE)?;
     let color = dev.alloc_zeroed::<f32>(4 * npix);
     let hit = dev.alloc_zeroed::<i32>(npix);
     let stats = dev.alloc_zeroed::<u32>(8 * npix);
@@ -489,6 +489,10 @@ pub fn upload(dev: &mut Device, bytes: &[u8], name: &str) -> Result<crate::sim::
     }
     Ok(p)
 }
+
+/// The name of the kernels' job queue (a u32: the next pixel to claim, in
+/// blocks of 32), which `render` reads for its progress.
+pub const JOB_QUEUE: &str = "job_queue";
 
 /// Loads the kernels' PTX (the plain build) on `dev`.
 pub fn load(dev: &mut Device) -> Result<Module, SimError> {

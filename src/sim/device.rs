@@ -305,6 +305,7 @@ pub struct Device {
     config: SimConfig,
     pool: Option<rayon::ThreadPool>,
     sizes: HashMap<u64, u64>,
+    progress: Option<super::grid::ProgressHook>,
 }
 
 impl Default for Device {
@@ -323,7 +324,14 @@ impl Device {
     pub fn with_config(config: SimConfig) -> Self {
         let (threads, _) = cap_host_threads(config.threads);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().ok();
-        Device { mem: DeviceMemory::new(), config, pool, sizes: HashMap::new() }
+        Device { mem: DeviceMemory::new(), config, pool, sizes: HashMap::new(), progress: None }
+    }
+
+    /// Sets (or clears) the hook that [`Device::launch`] tells where a launch
+    /// stands between scheduling rounds: CTAs retired of the grid's, for
+    /// progress bars and ETAs (`render`, `launch`, `tables`).
+    pub fn set_progress(&mut self, hook: Option<super::grid::ProgressHook>) {
+        self.progress = hook;
     }
 
     /// The configuration.
@@ -527,7 +535,7 @@ impl Device {
         }
         let ctx = self.ctx(m, kp, &cfg, observers);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
-        run.run(self.pool.as_ref()).map_err(SimError::Fault)
+        run.run_with_progress(self.pool.as_ref(), self.progress.as_ref()).map_err(SimError::Fault)
     }
 
     /// Checks a launch and makes its runner (for [`super::stepper`], which

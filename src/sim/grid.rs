@@ -38,6 +38,23 @@ pub struct Schedule {
     pub random_seed: Option<u64>,
 }
 
+/// Where a launch stands, told to a [`ProgressHook`] between scheduling rounds.
+pub struct Progress<'a> {
+    /// CTAs that finished.
+    pub ctas_retired: u64,
+    /// CTAs of the grid.
+    pub ctas: u64,
+    /// Warp instructions issued so far (all CTAs).
+    pub warp_instructions: u64,
+    /// Device memory (for kernels whose progress is a counter they keep,
+    /// such as a persistent-threads job queue).
+    pub memory: &'a super::memory::DeviceMemory,
+}
+
+/// Called between scheduling rounds of a launch ([`super::Device::set_progress`]);
+/// nothing is counted or called when none is set.
+pub type ProgressHook = std::sync::Arc<dyn Fn(&Progress) + Send + Sync>;
+
 /// An executing grid.
 pub struct GridRun<'a> {
     /// Launch context.
@@ -255,9 +272,27 @@ impl<'a> GridRun<'a> {
     }
 
     /// Runs the whole grid.
-    pub fn run(mut self, pool: Option<&rayon::ThreadPool>) -> Result<LaunchStats, Box<Fault>> {
+    pub fn run(self, pool: Option<&rayon::ThreadPool>) -> Result<LaunchStats, Box<Fault>> {
+        self.run_with_progress(pool, None)
+    }
+
+    /// Runs the whole grid, telling `progress` where it stands after each round.
+    pub fn run_with_progress(
+        mut self,
+        pool: Option<&rayon::ThreadPool>,
+        progress: Option<&ProgressHook>,
+    ) -> Result<LaunchStats, Box<Fault>> {
         while !self.done() {
             self.round(pool)?;
+            if let Some(p) = progress {
+                p(&Progress {
+                    ctas_retired: (self.next_cta as usize - self.resident.len()) as u64,
+                    ctas: self.total_ctas as u64,
+                    warp_instructions: self.retired_instructions
+                        + self.resident.iter().map(|c| c.counters.warp_instructions).sum::<u64>(),
+                    memory: self.ctx.mem,
+                });
+            }
         }
         Ok(self.finish())
     }
