@@ -65,6 +65,8 @@ const CASES: &[(&str, i32, &str)] = &[
     ("render --scene disc.toml --resolution 8x8 -o o.png", 0, "1998 triangles"),
     // 7. the output format is checked first
     ("render --scene disc.toml -o o.jpg", 1, "-o o.jpg: expected a .png or .exr file"),
+    ("render --scene disc.toml --frames 2..1 -o o.png", 1, "--frames 2..1: the range is empty"),
+    ("render --scene disc.toml --frames 0..2000000 -o o.png", 1, "--frames 0..2000000: the flight has"),
     // 8. nesting
     ("check nesting.ptx", 1, "nested more than 256 deep"),
     // 10. host threads
