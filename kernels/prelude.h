@@ -129,3 +129,14 @@ WL_DEV double sqrt(double x) { return __nvvm_sqrt_rn_d(x); }
 // ---- warplight helpers, for both compilers ----
 // Global thread index of a 1-D launch.
 #define WL_TID (blockIdx.x * blockDim.x + threadIdx.x)
+
+#if !defined(__NVCC__)
+// printf: clang lowers a call to `vprintf(format, args)` with the arguments
+// in a local buffer, as nvcc does; warplight prints per lane (docs/prelude.md).
+extern "C" __device__ int printf(const char *, ...);
+#endif
+
+// CUDA's math library (kernels/cuda_math.h), when `warplight compile` found libdevice.
+#if defined(WL_CUDA_MATH) && !defined(__NVCC__)
+#include "cuda_math.h"
+#endif

@@ -2,12 +2,94 @@
 //! kernels are built with (`kernels/build.sh`) and warplight's prelude
 //! (`kernels/prelude.h`, compiled into the binary), so that `warplight
 //! compile kernel.cu` works from any directory without the CUDA SDK.
+//!
+//! CUDA's math library (`expf`, `sinf`, `powf`, `min`, ...; `docs/prelude.md`)
+//! comes from libdevice, NVIDIA's bitcode library, which clang links into the
+//! kernel when [`find_libdevice`] finds it (`kernels/cuda_math.h` declares the
+//! functions). A few instructions of libdevice's that warplight does not
+//! execute are rewritten into equivalent ones ([`rewrite_for_warplight`]).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The prelude: CUDA keywords and intrinsics for clang without the SDK.
 pub const PRELUDE: &str = include_str!("../kernels/prelude.h");
+
+/// CUDA's math library declarations for clang (included by the prelude when
+/// `WL_CUDA_MATH` is defined, which [`compile`] does when libdevice is found).
+pub const CUDA_MATH: &str = include_str!("../kernels/cuda_math.h");
+
+/// The environment variable naming libdevice (`libdevice.10.bc`).
+pub const LIBDEVICE_ENV: &str = "WARPLIGHT_LIBDEVICE";
+
+/// How to get libdevice when it is missing.
+pub const LIBDEVICE_HINT: &str = "install it with `pip install nvidia-cuda-nvcc` (no GPU needed; warplight finds it \
+through `python3`), or name the file with --libdevice PATH or WARPLIGHT_LIBDEVICE=PATH \
+(CUDA toolkits have it at nvvm/libdevice/libdevice.10.bc)";
+
+/// CUDA math functions a student is likely to call: when clang reports one of
+/// them undeclared and libdevice is missing, the error says how to get it.
+const MATH_NAMES: &[&str] = &[
+    "min",
+    "max",
+    "abs",
+    "expf",
+    "exp",
+    "exp10f",
+    "expm1f",
+    "logf",
+    "log",
+    "log2f",
+    "log10f",
+    "log1pf",
+    "sinf",
+    "sin",
+    "cosf",
+    "cos",
+    "tanf",
+    "tan",
+    "sincosf",
+    "asinf",
+    "acosf",
+    "atanf",
+    "atan2f",
+    "sinhf",
+    "coshf",
+    "tanhf",
+    "powf",
+    "pow",
+    "cbrtf",
+    "floorf",
+    "floor",
+    "ceilf",
+    "ceil",
+    "roundf",
+    "round",
+    "truncf",
+    "fmodf",
+    "hypotf",
+    "erff",
+    "lgammaf",
+    "tgammaf",
+    "__expf",
+    "__logf",
+    "__powf",
+    "__fdividef",
+    "__sincosf",
+    "__tanf",
+    "fmin",
+    "fmax",
+    "fabs",
+    "isnan",
+    "isinf",
+    "copysignf",
+    "umin",
+    "umax",
+    "llmin",
+    "llmax",
+    "llabs",
+    "printf",
+];
 
 /// Which compiler makes the PTX.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +133,28 @@ pub enum CompileError {
         /// What went wrong.
         msg: String,
     },
+    /// The source calls a CUDA math function and libdevice was not found.
+    #[error("{file}: `{function}` is in CUDA's math library (libdevice), which was not found; {hint}\n{stderr}")]
+    NoLibdevice {
+        /// The source.
+        file: String,
+        /// The undeclared function.
+        function: String,
+        /// How to install libdevice.
+        hint: &'static str,
+        /// The compiler's messages.
+        stderr: String,
+    },
+    /// `--libdevice` or `WARPLIGHT_LIBDEVICE` names no file.
+    #[error("{file}: libdevice not found there ({from}); {hint}")]
+    LibdeviceMissing {
+        /// The path given.
+        file: String,
+        /// Where it was given (the option or the variable).
+        from: &'static str,
+        /// How to install libdevice.
+        hint: &'static str,
+    },
     /// The compiler rejected the source.
     #[error("{file}: {program} failed:\n{stderr}")]
     Failed {
@@ -86,19 +190,202 @@ pub fn compiler(d: Dialect) -> Result<PathBuf, CompileError> {
     which(&program).ok_or(CompileError::NotInstalled { program, hint })
 }
 
-/// Compiles `src` to PTX (sm_90, PTX 7.8 for clang) with the prelude
-/// included first, line tables on, and returns the PTX text.
+/// How to compile a CUDA source.
+#[derive(Debug, Clone, Default)]
+pub struct CompileOptions {
+    /// The compiler.
+    pub dialect: Dialect,
+    /// libdevice as named by `--libdevice`; `None` looks for it ([`find_libdevice`]).
+    pub libdevice: Option<PathBuf>,
+}
+
+impl Default for Dialect {
+    fn default() -> Self {
+        Dialect::Clang
+    }
+}
+
+/// The libdevice file under a CUDA installation or pip package root.
+fn libdevice_under(root: &Path) -> Option<PathBuf> {
+    ["nvvm/libdevice/libdevice.10.bc", "libdevice/libdevice.10.bc"].iter().map(|r| root.join(r)).find(|p| p.is_file())
+}
+
+/// The roots of the pip packages `nvidia-cuda-nvcc` (`nvidia/cu13`, CUDA 13)
+/// and `nvidia-cuda-nvcc-cu12` (`nvidia/cuda_nvcc`), as `python3` sees them.
+fn pip_roots() -> Vec<PathBuf> {
+    let python = std::env::var("PYTHON").ok().filter(|p| !p.is_empty()).unwrap_or_else(|| "python3".into());
+    let Ok(o) = Command::new(python)
+        .args(["-c", "import nvidia\nfor p in nvidia.__path__: print(p)"])
+        .stderr(std::process::Stdio::null())
+        .output()
+    else {
+        return Vec::new();
+    };
+    let mut roots = Vec::new();
+    for dir in String::from_utf8_lossy(&o.stdout).lines().map(PathBuf::from) {
+        let mut subs: Vec<PathBuf> =
+            std::fs::read_dir(&dir).map(|d| d.flatten().map(|e| e.path()).collect()).unwrap_or_default();
+        subs.sort();
+        roots.extend(subs);
+    }
+    roots
+}
+
+/// libdevice (`libdevice.10.bc`, CUDA's math library as LLVM bitcode).
+///
+/// In order: `explicit` (`--libdevice`), `$WARPLIGHT_LIBDEVICE` (`none`
+/// compiles without the math library), `$CUDA_HOME`, `$CUDA_PATH`, beside
+/// `$NVCC` or the `nvcc` on `PATH`, `/usr/local/cuda`, Debian's
+/// `nvidia-cuda-toolkit`, and the pip package `nvidia-cuda-nvcc` as
+/// `python3` finds it. `Ok(None)` when none has it; an error when the file
+/// named explicitly does not exist.
+pub fn find_libdevice(explicit: Option<&Path>) -> Result<Option<PathBuf>, CompileError> {
+    let named = |p: &Path, from: &'static str| {
+        if p.is_file() {
+            Ok(Some(p.to_path_buf()))
+        } else {
+            Err(CompileError::LibdeviceMissing { file: p.display().to_string(), from, hint: LIBDEVICE_HINT })
+        }
+    };
+    if let Some(p) = explicit {
+        return named(p, "--libdevice");
+    }
+    if let Some(v) = std::env::var_os(LIBDEVICE_ENV).filter(|v| !v.is_empty()) {
+        if v == "none" {
+            return Ok(None);
+        }
+        return named(Path::new(&v), LIBDEVICE_ENV);
+    }
+    let mut roots: Vec<PathBuf> = ["CUDA_HOME", "CUDA_PATH"]
+        .iter()
+        .filter_map(std::env::var_os)
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .collect();
+    if let Ok(nvcc) = compiler(Dialect::Nvcc)
+        && let Some(root) = std::fs::canonicalize(&nvcc).ok().and_then(|p| Some(p.parent()?.parent()?.to_path_buf()))
+    {
+        roots.push(root);
+    }
+    roots.extend(["/usr/local/cuda", "/usr/lib/cuda", "/usr/lib/nvidia-cuda-toolkit"].map(PathBuf::from));
+    if let Some(p) = roots.iter().find_map(|r| libdevice_under(r)) {
+        return Ok(Some(p));
+    }
+    Ok(pip_roots().iter().find_map(|r| libdevice_under(r)))
+}
+
+/// Rewrites what libdevice brings that warplight does not execute into
+/// equivalent PTX, each on the line of the original so that line numbers
+/// stay: `min/max.NaN.f32` ([`nan_min_max`]), register lists
+/// ([`split_reg_list`]) and this carry chain.
+///
+/// libdevice implements 64-bit products with inline assembly, a carry chain
+/// `mad.lo.cc.u32 lo, a, b, c; madc.hi.u32 hi, a, b, 0;` (that is,
+/// `{hi, lo} = a * b + c` in 64 bits), which warplight does not execute.
+/// Rewrites each such pair into the same computation without the carry flag,
+/// `mad.wide.u32` of `c` widened, on the first line (the second becomes a
+/// comment), so line numbers stay. Other carry chains are left alone.
+pub fn rewrite_for_warplight(ptx: &str) -> String {
+    let lines: Vec<&str> = ptx.lines().collect();
+    let operands = |l: &str, op: &str| -> Option<Vec<String>> {
+        let rest = l.trim().strip_prefix(op)?.trim().strip_suffix(';')?;
+        Some(rest.split(',').map(|o| o.trim().to_string()).collect())
+    };
+    let mut out = String::with_capacity(ptx.len() + 256);
+    let mut i = 0;
+    while i < lines.len() {
+        let pair = operands(lines[i], "mad.lo.cc.u32").zip(lines.get(i + 1).and_then(|l| operands(l, "madc.hi.u32")));
+        if let Some((lo, hi)) = pair
+            && lo.len() == 4
+            && hi.len() == 4
+            && lo[1] == hi[1]
+            && lo[2] == hi[2]
+            && hi[3] == "0"
+        {
+            let (d_lo, a, b, c, d_hi) = (&lo[0], &lo[1], &lo[2], &lo[3], &hi[0]);
+            let widen =
+                if c.starts_with('%') { format!("cvt.u64.u32 %wl_c, {c};") } else { format!("mov.u64 %wl_c, {c};") };
+            out.push_str(&format!(
+                "\t{{ .reg .b64 %wl_c; .reg .b64 %wl_m; {widen} mad.wide.u32 %wl_m, {a}, {b}, %wl_c; \
+                 mov.b64 {{{d_lo}, {d_hi}}}, %wl_m; }} // warplight: mad.lo.cc.u32 + madc.hi.u32 without the carry flag\n"
+            ));
+            out.push_str(&format!("\t// madc.hi.u32 {d_hi}, {a}, {b}, 0 (in the line above)\n"));
+            i += 2;
+            continue;
+        }
+        out.push_str(&nan_min_max(&split_reg_list(lines[i])));
+        out.push('\n');
+        i += 1;
+    }
+    out
+}
+
+/// `min.NaN.f32 d, a, b` (and `max`; libdevice's `sinhf` uses it): the
+/// result is NaN when an operand is, else `min`. Written with `setp.nan`,
+/// `min` and `selp` on the same line.
+fn nan_min_max(line: &str) -> std::borrow::Cow<'_, str> {
+    let t = line.trim();
+    let Some((op, rest)) =
+        t.strip_prefix("min.NaN.f32").map(|r| ("min", r)).or_else(|| t.strip_prefix("max.NaN.f32").map(|r| ("max", r)))
+    else {
+        return line.into();
+    };
+    let ops: Vec<&str> = rest.trim().trim_end_matches(';').split(',').map(str::trim).collect();
+    let [d, a, b] = ops.as_slice() else {
+        return line.into();
+    };
+    format!(
+        "\t{{ .reg .pred %wl_p; .reg .f32 %wl_t; setp.nan.f32 %wl_p, {a}, {b}; {op}.f32 %wl_t, {a}, {b}; \
+         selp.f32 {d}, 0f7FFFFFFF, %wl_t, %wl_p; }} // warplight: {op}.NaN.f32"
+    )
+    .into()
+}
+
+/// `.reg .u32 r0, r1;` (libdevice's inline assembly names several registers
+/// without `<N>`) as one declaration each, on the same line.
+fn split_reg_list(line: &str) -> std::borrow::Cow<'_, str> {
+    let t = line.trim();
+    let Some(rest) = t.strip_prefix(".reg ").and_then(|r| r.strip_suffix(';')) else {
+        return line.into();
+    };
+    let Some((ty, names)) = rest.trim().split_once(char::is_whitespace) else {
+        return line.into();
+    };
+    if !names.contains(',') || names.contains('<') {
+        return line.into();
+    }
+    let decls: Vec<String> = names.split(',').map(|n| format!(".reg {ty} {};", n.trim())).collect();
+    format!("\t{}", decls.join(" ")).into()
+}
+
+/// Compiles `src` to PTX with clang-16 or nvcc, libdevice looked for
+/// ([`compile_with`] with default options but the dialect).
 pub fn compile(src: &Path, d: Dialect) -> Result<String, CompileError> {
+    compile_with(src, &CompileOptions { dialect: d, libdevice: None })
+}
+
+/// Compiles `src` to PTX (sm_90, PTX 7.8 for clang) with the prelude
+/// included first, line tables on, and returns the PTX text. With clang and
+/// libdevice found, CUDA's math library is declared (`WL_CUDA_MATH`) and
+/// libdevice linked in.
+pub fn compile_with(src: &Path, opts: &CompileOptions) -> Result<String, CompileError> {
+    let d = opts.dialect;
     let file = src.display().to_string();
     if !src.is_file() {
         return Err(CompileError::Io { file, msg: "no such file".into() });
     }
     let cc = compiler(d)?;
+    let libdevice = match d {
+        Dialect::Clang => find_libdevice(opts.libdevice.as_deref())?,
+        Dialect::Nvcc => None, // nvcc brings its own math library
+    };
     let dir = std::env::temp_dir().join(format!("warplight-compile-{}", std::process::id()));
     let io = |f: &Path, e: std::io::Error| CompileError::Io { file: f.display().to_string(), msg: e.to_string() };
     std::fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
     let prelude = dir.join("prelude.h");
     std::fs::write(&prelude, PRELUDE).map_err(|e| io(&prelude, e))?;
+    let math = dir.join("cuda_math.h");
+    std::fs::write(&math, CUDA_MATH).map_err(|e| io(&math, e))?;
     let out = dir.join("out.ptx");
     let mut cmd = Command::new(&cc);
     match d {
@@ -106,6 +393,10 @@ pub fn compile(src: &Path, d: Dialect) -> Result<String, CompileError> {
             cmd.args(["-x", "cuda", "--cuda-device-only", "-nocudainc", "-nocudalib", "--cuda-gpu-arch=sm_90"])
                 .args(["-Xclang", "-target-feature", "-Xclang", "+ptx78", "-O3", "-ffp-contract=on"])
                 .args(["-gline-tables-only", "-fdebug-compilation-dir=.", "-S"]);
+            if let Some(lib) = &libdevice {
+                // nvcc's defaults: no flush to zero, precise transcendentals
+                cmd.arg("-DWL_CUDA_MATH").args(["-Xclang", "-mlink-builtin-bitcode", "-Xclang"]).arg(lib);
+            }
         }
         Dialect::Nvcc => {
             cmd.args(["-arch=sm_90", "-O3", "-ptx", "-lineinfo"]);
@@ -119,16 +410,28 @@ pub fn compile(src: &Path, d: Dialect) -> Result<String, CompileError> {
     cmd.arg(format!("-I{}", dir.display())).arg("-o").arg(&out).arg(src);
     let o = cmd.output().map_err(|e| io(&cc, e))?;
     let result = if o.status.success() {
-        std::fs::read_to_string(&out).map_err(|e| io(&out, e))
-    } else {
-        Err(CompileError::Failed {
-            file,
-            program: cc.display().to_string(),
-            stderr: String::from_utf8_lossy(&o.stderr).trim_end().to_string(),
+        std::fs::read_to_string(&out).map_err(|e| io(&out, e)).map(|p| match d {
+            Dialect::Clang => rewrite_for_warplight(&p),
+            Dialect::Nvcc => p,
         })
+    } else {
+        let stderr = String::from_utf8_lossy(&o.stderr).trim_end().to_string();
+        match undeclared_math(&stderr).filter(|_| d == Dialect::Clang && libdevice.is_none()) {
+            Some(function) => Err(CompileError::NoLibdevice { file, function, hint: LIBDEVICE_HINT, stderr }),
+            None => Err(CompileError::Failed { file, program: cc.display().to_string(), stderr }),
+        }
     };
     let _ = std::fs::remove_dir_all(&dir);
     result
+}
+
+/// The first CUDA math function clang reports undeclared, if any.
+fn undeclared_math(stderr: &str) -> Option<String> {
+    stderr.lines().find_map(|l| {
+        let rest = l.split("use of undeclared identifier '").nth(1)?;
+        let name = rest.split('\'').next()?;
+        MATH_NAMES.contains(&name).then(|| name.to_string())
+    })
 }
 
 pub use crate::ptx::ir::demangle;

@@ -154,6 +154,11 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     if let Some(reports) = checked.as_ref().filter(|_| !a.json || result.is_err()) {
         crate::check::cli::print_reports(reports, spec.launches.len(), tools, a.csv || a.json);
     }
+    // the kernels' printf output comes first, also when a launch faulted (it shows how far it got)
+    let printf = dev.take_printf();
+    if !a.json || result.is_err() {
+        show_printf(&printf, a.csv || a.json);
+    }
     let stats = result?;
     // Outputs only after every launch succeeded: no partial files.
     for (name, file) in &dumps {
@@ -194,6 +199,13 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
         });
         if let Some(reports) = &checked {
             out["check"] = crate::check::cli::json(reports);
+        }
+        if !printf.is_empty() {
+            let recs: Vec<serde_json::Value> = printf
+                .iter()
+                .map(|r| serde_json::json!({ "cta": r.cta, "warp": r.warp, "lane": r.lane, "text": r.text }))
+                .collect();
+            out["printf"] = recs.into();
         }
         if !printed.is_empty() {
             let bufs: serde_json::Map<String, serde_json::Value> = printed
@@ -271,6 +283,24 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
         }
     }
     Ok(())
+}
+
+/// Prints the kernels' `printf` output (in the order of `crate::sim::printf`:
+/// CTA, warp, call, lane) to stdout, or to stderr when stdout carries CSV or
+/// JSON, followed by a blank line that separates it from the report.
+pub fn show_printf(recs: &[crate::sim::printf::PrintfRecord], to_stderr: bool) {
+    if recs.is_empty() {
+        return;
+    }
+    let mut text = crate::sim::printf::text(recs);
+    if !text.ends_with('\n') {
+        text.push('\n');
+    }
+    if to_stderr {
+        eprint!("{text}");
+    } else {
+        println!("{text}");
+    }
 }
 
 /// `p` without `dir/..` pairs (`examples/lessons/../../kernels/x.ptx` is

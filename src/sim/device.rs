@@ -305,6 +305,7 @@ pub struct Device {
     config: SimConfig,
     pool: Option<rayon::ThreadPool>,
     sizes: HashMap<u64, u64>,
+    printf: super::printf::PrintfSink,
     progress: Option<super::grid::ProgressHook>,
 }
 
@@ -324,7 +325,14 @@ impl Device {
     pub fn with_config(config: SimConfig) -> Self {
         let (threads, _) = cap_host_threads(config.threads);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().ok();
-        Device { mem: DeviceMemory::new(), config, pool, sizes: HashMap::new(), progress: None }
+        Device {
+            mem: DeviceMemory::new(),
+            config,
+            pool,
+            sizes: HashMap::new(),
+            printf: Default::default(),
+            progress: None,
+        }
     }
 
     /// Sets (or clears) the hook that [`Device::launch`] tells where a launch
@@ -502,7 +510,14 @@ impl Device {
             max_call_depth: self.config.max_call_depth,
             observers,
             per_inst: self.config.fidelity >= Fidelity::Instructions,
+            printf: super::printf::PrintfTarget { sink: &self.printf, launch: self.printf.begin_launch() },
         }
+    }
+
+    /// The `printf` output of the kernels run since the last call, in a
+    /// deterministic order (launch, CTA, warp, call, lane; [`super::printf`]).
+    pub fn take_printf(&self) -> Vec<super::printf::PrintfRecord> {
+        self.printf.take()
     }
 
     /// Runs a kernel to completion. On a fault, memory keeps what the kernel wrote

@@ -3,7 +3,8 @@
 //! scheduler ([`cta`]), the grid scheduler ([`grid`]), device memory
 //! ([`memory`]), faults ([`fault`]), counters ([`counters`]), stepping
 //! ([`stepper`]), fidelity levels ([`fidelity`]), the decoded executable form
-//! ([`decode`]) and the public [`Device`] API ([`device`]).
+//! ([`decode`]), device-side `printf` ([`printf`]) and the public [`Device`]
+//! API ([`device`]).
 
 pub mod access_log;
 pub mod alu;
@@ -18,6 +19,7 @@ pub mod fidelity;
 pub mod grid;
 pub mod memory;
 pub mod observer;
+pub mod printf;
 pub mod simt_stack;
 pub mod stepper;
 pub mod warp;

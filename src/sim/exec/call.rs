@@ -1,13 +1,16 @@
 //! Device-function calls: the callee's frame (registers, parameters, local
 //! area) on call, copying return values back when all its paths returned, and
-//! popping frames whose lanes exited.
+//! popping frames whose lanes exited. `vprintf` (device `printf`), declared
+//! without a body, is executed here ([`vprintf`], `crate::sim::printf`).
 
 use super::super::cfg::EXIT_PC;
 use super::super::simt_stack::SimtEntry;
 use super::super::warp::{Warp, WarpState};
+use super::memory::{access, resolve};
 use super::{CtaMut, Ctx, Effect, ExecFault, fault, lane_of_mask};
-use crate::ptx::ir::Kind;
+use crate::ptx::ir::{Kind, MemSpace};
 use crate::sim::fault::FaultKind;
+use crate::sim::printf::{self, PrintfRecord};
 
 /// `call`: pushes the callee's frame and a path for the calling lanes.
 pub(super) fn call(
@@ -24,6 +27,9 @@ pub(super) fn call(
     }
     cta.counters.calls += 1;
     let cf = &ctx.prog.functions[callee as usize];
+    if cf.insts.is_empty() && cf.name == printf::VPRINTF {
+        return vprintf(ctx, w, cta, pc, args, exec);
+    }
     // Device-function frames on the stack after this call (the kernel's is not one).
     let depth = w.frames.len() as u64;
     if depth > ctx.max_call_depth as u64 {
@@ -59,6 +65,87 @@ pub(super) fn call(
     w.local_top = need as u32;
     w.stack.push(SimtEntry { pc: 0, rpc: EXIT_PC, mask: exec });
     w.frames.push(nf);
+    Ok(Effect::Continue)
+}
+
+/// One lane's view of memory for `printf`: generic addresses resolved as
+/// loads resolve them.
+struct LaneMemory<'a, 'c, 'm> {
+    ctx: &'a Ctx<'c>,
+    w: &'a mut Warp,
+    shared: &'a mut [u8],
+    lane: usize,
+    _m: std::marker::PhantomData<&'m ()>,
+}
+
+impl printf::Memory for LaneMemory<'_, '_, '_> {
+    fn byte(&mut self, addr: u64) -> Option<u8> {
+        let r = resolve(MemSpace::Generic, addr);
+        access(self.ctx, self.w, self.shared, r, self.lane, 1, 1, None).ok().map(|v| v as u8)
+    }
+}
+
+/// `call vprintf, (format, args)`: formats each active lane's call
+/// ([`printf::format`]) into the launch's sink, and returns the number of
+/// arguments used (negative when memory was unreadable, as CUDA's -1).
+fn vprintf(
+    ctx: &Ctx,
+    w: &mut Warp,
+    cta: &mut CtaMut,
+    pc: u32,
+    args: &[(u32, u32, u32)],
+    exec: u32,
+) -> Result<Effect, Box<ExecFault>> {
+    let [(fmt_off, _, 8), (args_off, _, 8)] = args else {
+        return Err(fault(
+            FaultKind::Unsupported("`vprintf` called with other than two 64-bit arguments".into()),
+            lane_of_mask(exec),
+        ));
+    };
+    let seq = ctx.printf.sink.next_seq();
+    let ps = w.frame().param_size as usize;
+    let word = |w: &Warp, l: usize, off: u32| {
+        let o = l * ps + off as usize;
+        u64::from_le_bytes(w.frame().params[o..o + 8].try_into().expect("8 bytes"))
+    };
+    let mut recs = Vec::new();
+    let mut results = [0i32; 32];
+    for l in (0..32).filter(|l| exec >> l & 1 != 0) {
+        let (fmt, buf) = (word(w, l, *fmt_off), word(w, l, *args_off));
+        let mut mem = LaneMemory { ctx, w, shared: cta.shared, lane: l, _m: std::marker::PhantomData };
+        let text = match printf::format(&mut mem, fmt, buf) {
+            Ok((text, n)) => {
+                results[l] = n as i32;
+                text
+            }
+            Err(e) => {
+                results[l] = -1;
+                format!("[{e}]\n")
+            }
+        };
+        recs.push(PrintfRecord {
+            launch: ctx.printf.launch,
+            cta_linear: cta.cta_linear,
+            cta: cta.cta_id,
+            warp: w.id,
+            seq,
+            lane: l as u32,
+            text,
+        });
+    }
+    ctx.printf.sink.push(recs);
+    // the return value, when the call takes it (`call (retval0), vprintf, ...`)
+    let f = w.frame().func as usize;
+    if let Kind::Call { rets, .. } = &ctx.prog.functions[f].insts[pc as usize].kind
+        && let [(_, dst, size @ 1..=8)] = rets.as_slice()
+    {
+        let (dst, size) = (*dst as usize, *size as usize);
+        let frame = w.frames.last_mut().expect("caller frame");
+        for l in (0..32).filter(|l| exec >> l & 1 != 0) {
+            let o = l * ps + dst;
+            frame.params[o..o + size].copy_from_slice(&(results[l] as i64).to_le_bytes()[..size]);
+        }
+    }
     Ok(Effect::Continue)
 }
 

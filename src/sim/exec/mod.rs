@@ -54,6 +54,8 @@ pub struct Ctx<'a> {
     pub observers: Option<&'a dyn ObserverFactory>,
     /// Count per instruction (fidelity `instructions` and up).
     pub per_inst: bool,
+    /// Where `printf` output goes.
+    pub printf: super::printf::PrintfTarget<'a>,
 }
 
 /// The CTA-owned state an instruction may change besides its warp.
