@@ -109,3 +109,33 @@ pub fn json(reports: &[(usize, super::Report)]) -> serde_json::Value {
         .collect::<Vec<_>>()
         .into()
 }
+
+/// `--check` and `--schedule` for `step` and `trace`: runs the spec's
+/// launches up to and including `launch` (index) checked, under the schedule
+/// asked for, and prints the stepped launch's reports to stderr before the
+/// view opens. The stepped launch itself runs under the default schedule.
+pub fn check_before_stepping(
+    spec: &crate::launch_spec::Spec,
+    launch: usize,
+    a: &CheckArgs,
+    max_instructions: Option<u64>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let tools = a.tools()?;
+    if a.schedule == ScheduleKind::Random && !tools.any() {
+        return Err("--schedule random with step and trace applies to the --check run; give --check too".into());
+    }
+    if !tools.any() {
+        return Ok(());
+    }
+    let mut spec = spec.clone();
+    spec.launches.truncate(launch + 1);
+    let mut config = spec.sim_config(0, max_instructions);
+    a.configure(&mut config)?;
+    let mut dev = crate::sim::Device::with_config(config);
+    let p = crate::launch_spec::prepare(&spec, &mut dev)?;
+    let profile = crate::model::Profile::Hopper;
+    let r = super::spec::run(&spec, &mut dev, &p, profile, &a.options(&p)?);
+    let reports: Vec<(usize, super::Report)> = r.reports.into_iter().filter(|(i, _)| *i == launch).collect();
+    print_reports(&reports, 1, tools, true);
+    Ok(())
+}

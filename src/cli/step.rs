@@ -59,6 +59,10 @@ pub struct StepArgs {
     /// gt200, maxwell or hopper (default: the spec's `device`, else hopper).
     #[arg(long)]
     pub device: Option<String>,
+    /// Checking (`--check`, `--uninit`; the reports come before the view) and
+    /// the schedule of that checked run (`--schedule random --seed N`).
+    #[command(flatten)]
+    pub checks: crate::check::cli::CheckArgs,
 }
 
 /// Parses `SLOT:WARP`.
@@ -82,6 +86,7 @@ pub fn profile(session: &Session, device: Option<&str>) -> Result<Profile, Box<d
 pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut session = Session::load_launch(&a.spec, a.launch)?;
     session.max_instructions = a.max_instructions;
+    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
     let only = a.warp.as_deref().map(parse_warp).transpose()?;
     let profile = profile(&session, a.device.as_deref())?;
     let breaks = session.with_stepper(|st| Ok(Breakpoints::new(&st.module().prog, &a.breaks, &a.src_breaks)?))?;

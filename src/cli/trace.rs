@@ -46,6 +46,10 @@ pub struct TraceArgs {
     /// (default: the spec's `device`, else hopper).
     #[arg(long)]
     pub device: Option<String>,
+    /// Checking (`--check`, `--uninit`; the reports go to stderr) and the
+    /// schedule of that checked run (`--schedule random --seed N`).
+    #[command(flatten)]
+    pub checks: crate::check::cli::CheckArgs,
 }
 
 /// Runs the command.
@@ -56,6 +60,7 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut session = Session::load_launch(&a.spec, a.launch)?;
     let profile = crate::cli::step::profile(&session, a.device.as_deref())?;
     session.max_instructions = a.max_instructions;
+    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
     let spinner = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new_spinner();
