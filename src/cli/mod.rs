@@ -40,6 +40,11 @@ pub struct Cli {
     /// (Named --scene-dir: `tables --scenes` lists scene names.)
     #[arg(long = "scene-dir", global = true, value_name = "DIR")]
     pub scene_dir: Option<std::path::PathBuf>,
+    /// Count shared accesses as the PTX writes them, not as ptxas merges
+    /// (LDS.64/128, STS.64/128) and drops repeated loads, and global atomics
+    /// with an unused result as atomics, not reductions (maxwell, hopper). See docs/devices.md.
+    #[arg(long = "no-ptxas-vectorize", global = true)]
+    pub no_ptxas_vectorize: bool,
 }
 
 /// Subcommands.
@@ -123,6 +128,9 @@ pub fn main() -> i32 {
     }
     if let Some(d) = cli.scene_dir {
         crate::host::scene_file::set_scene_dir(d);
+    }
+    if cli.no_ptxas_vectorize {
+        crate::model::vectorize::set_default(false);
     }
     let r = match cli.command {
         Command::Launch(a) => launch::run(a),

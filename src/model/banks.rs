@@ -7,6 +7,18 @@
 //!   lanes reading the same word share it. Bank conflicts are the wavefronts
 //!   beyond one per group — the minimum for the access width — as Nsight
 //!   Compute's `l1tex__data_bank_conflicts_pipe_lsu_mem_shared_*` counts them.
+//! - Hopper loads of 8 and 16 bytes where lanes pair up (lanes `n` and
+//!   `n^1`, or `n` and `n^2`, read the same address wherever both are
+//!   active) are served in groups twice as large (the whole warp for 8 bytes,
+//!   half-warps for 16): the shared memory returns 128 bytes a wavefront, and
+//!   paired lanes share their data, so each wavefront packs twice the lanes.
+//!   An NVIDIA engineer's rule for compute capability 7.x
+//!   (forums.developer.nvidia.com, "Unexpected shared memory bank conflict",
+//!   2019), measured on the H200 by the single-warp probes of
+//!   `kernels/validation/suite.cu` (`docs/validation.md`): a 16-byte load
+//!   where each half-warp reads one element takes 2 wavefronts, not 4; all
+//!   lanes on one element: 2; lanes `l` and `l+16` sharing: still 8 (no
+//!   pairs). [`cost32_hopper_with`].
 //! - 16 banks × 4 bytes per half-warp (compute capability 1.x): each half-warp
 //!   is served separately; distinct words in one bank serialize. On 1.x,
 //!   8- and 16-bit accesses to different bytes of one word conflict too, and
@@ -45,7 +57,39 @@ pub fn cost32(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> BankCost {
 
 /// [`cost32`] with a caller's scratch buffer, so that a caller reusing it allocates nothing.
 pub fn cost32_with(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64, pairs: &mut Vec<(u64, u64)>) -> BankCost {
-    let group = (128 / bytes.clamp(4, 16)) as usize;
+    cost32_groups(mask, bytes, (128 / bytes.clamp(4, 16)) as usize, addr, pairs)
+}
+
+/// Whether lanes `n` and `n ^ x` access the same address wherever both are active.
+fn paired(mask: u32, x: usize, addr: &impl Fn(usize) -> u64) -> bool {
+    (0..32).all(|n| mask >> n & 1 == 0 || mask >> (n ^ x) & 1 == 0 || addr(n) == addr(n ^ x))
+}
+
+/// Hopper: [`cost32_with`], with loads of 8 or 16 bytes whose lanes pair up
+/// (`n` and `n^1`, or `n` and `n^2`, on one address) served in groups of twice
+/// the lanes (see the module comment). `load`: the pairing applies to loads only.
+pub fn cost32_hopper_with(
+    mask: u32,
+    bytes: u32,
+    load: bool,
+    addr: impl Fn(usize) -> u64,
+    pairs: &mut Vec<(u64, u64)>,
+) -> BankCost {
+    let mut group = (128 / bytes.clamp(4, 16)) as usize;
+    if load && group < 32 && (paired(mask, 1, &addr) || paired(mask, 2, &addr)) {
+        group *= 2;
+    }
+    cost32_groups(mask, bytes, group, addr, pairs)
+}
+
+/// 32 banks, lanes served in groups of `group`.
+fn cost32_groups(
+    mask: u32,
+    bytes: u32,
+    group: usize,
+    addr: impl Fn(usize) -> u64,
+    pairs: &mut Vec<(u64, u64)>,
+) -> BankCost {
     let mut c = BankCost::default();
     for g in (0..32).step_by(group) {
         pairs.clear();
@@ -132,6 +176,38 @@ mod tests {
     fn wide_accesses_need_more_wavefronts() {
         assert_eq!(cost32(u32::MAX, 8, |l| l as u64 * 8), BankCost { wavefronts: 2, conflicts: 0 });
         assert_eq!(cost32(u32::MAX, 16, |l| l as u64 * 16), BankCost { wavefronts: 4, conflicts: 0 });
+    }
+
+    fn hopper(mask: u32, bytes: u32, f: impl Fn(usize) -> u64) -> u64 {
+        cost32_hopper_with(mask, bytes, true, f, &mut Vec::new()).wavefronts
+    }
+
+    // The H200's single-warp probes (kernels/validation/suite.cu, probe_index):
+    // element i of a float4 (float2) array at 16 i (8 i).
+    #[test]
+    fn hopper_paired_lanes_pack_wide_loads() {
+        let modes: [fn(usize) -> u64; 7] = [
+            |l| (l as u64 >> 4) * 2,
+            |l| (l as u64 & 15) * 2,
+            |_| 5,
+            |l| l as u64 >> 1,
+            |l| (l as u64 & 1) | ((l as u64 >> 2) << 1),
+            |l| (l as u64 >> 3) * 4,
+            |l| l as u64,
+        ];
+        // measured: LDS.128 2 8 2 2 2 2 4, LDS.64 1 4 1 1 1 1 2
+        let w16: Vec<u64> = modes.iter().map(|m| hopper(u32::MAX, 16, |l| m(l) * 16)).collect();
+        assert_eq!(w16, [2, 8, 2, 2, 2, 2, 4]);
+        let w8: Vec<u64> = modes.iter().map(|m| hopper(u32::MAX, 8, |l| m(l) * 8)).collect();
+        assert_eq!(w8, [1, 4, 1, 1, 1, 1, 2]);
+        // without pairs (and on Maxwell) quarter- and half-warps stay apart
+        assert_eq!(cost32(u32::MAX, 16, |l| (l as u64 >> 4) * 32).wavefronts, 4);
+        // conflicts are the wavefronts beyond one per group
+        assert_eq!(cost32_hopper_with(u32::MAX, 16, true, |l| (l as u64 & 15) * 32, &mut Vec::new()).conflicts, 4);
+        // stores do not pack
+        assert_eq!(cost32_hopper_with(u32::MAX, 16, false, |_| 0, &mut Vec::new()).wavefronts, 4);
+        // 4-byte loads are one group already
+        assert_eq!(hopper(u32::MAX, 4, |_| 0), 1);
     }
 
     #[test]

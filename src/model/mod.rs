@@ -16,6 +16,7 @@
 //! assert_eq!(stats.counters.global_st.sectors, 8); // 2 warps x 128 contiguous bytes
 //! ```
 
+pub mod atomics;
 pub mod banks;
 pub mod cache;
 pub mod coalesce_gt200;
@@ -24,9 +25,11 @@ pub mod occupancy;
 pub mod profile;
 pub mod sectors;
 pub mod validation;
+pub mod validation_suite;
+pub mod vectorize;
 
 use std::any::Any;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -182,6 +185,8 @@ pub struct CtaModel {
     pairs: Vec<(u64, u64)>,
     /// Simulates caches (fidelity `caches`); without, hits and misses stay 0.
     caches: bool,
+    /// What ptxas makes of the accesses ([`vectorize`]); None: counted as the PTX says.
+    plan: Option<Arc<vectorize::Plan>>,
 }
 
 impl CtaModel {
@@ -206,7 +211,14 @@ impl CtaModel {
             lines: Vec::with_capacity(64),
             pairs: Vec::with_capacity(64),
             caches,
+            plan: None,
         }
+    }
+
+    /// As [`CtaModel::with_caches`], counting the accesses as ptxas's code makes
+    /// them ([`vectorize::Plan`]).
+    pub fn with_plan(profile: Profile, shape: &[usize], caches: bool, plan: Option<Arc<vectorize::Plan>>) -> Self {
+        CtaModel { plan, ..Self::with_caches(profile, shape, caches) }
     }
 
     fn global(&mut self, ev: &MemEvent, kind: Kind) -> InstMem {
@@ -281,6 +293,13 @@ impl CtaModel {
             im.sectors = t.count();
             return im;
         }
+        if self.profile == Profile::Hopper && matches!(kind, Kind::Atom | Kind::Red) {
+            // lanes on one address are served one after another (atomics.rs)
+            let n = atomics::sectors(ev.mask, ev.bytes, |l| ev.addrs[l], &mut self.lines);
+            c.requests += 1;
+            c.sectors += n;
+            return InstMem { requests: 1, sectors: n, ..InstMem::default() };
+        }
         let mut secs = std::mem::take(&mut self.lines);
         if local {
             sectors::local_sectors_into(key, ev.mask, ev.bytes, |l| ev.addrs[l], &mut secs);
@@ -319,6 +338,9 @@ impl CtaModel {
     fn banked(&mut self, ev: &MemEvent, which: Bank) -> InstMem {
         let cost = if self.profile == Profile::Gt200 {
             banks::cost16_with(ev.mask, ev.bytes, |l| ev.addrs[l], &mut self.pairs)
+        } else if self.profile == Profile::Hopper {
+            let load = matches!(which, Bank::Load);
+            banks::cost32_hopper_with(ev.mask, ev.bytes, load, |l| ev.addrs[l], &mut self.pairs)
         } else {
             banks::cost32_with(ev.mask, ev.bytes, |l| ev.addrs[l], &mut self.pairs)
         };
@@ -383,6 +405,29 @@ impl CtaModel {
     /// cost that instruction. The one implementation of the profile's rules:
     /// the counters and the teaching views ([`explain`]) both take it from here.
     pub fn count(&mut self, ev: &MemEvent) -> InstMem {
+        let action = self.plan.as_ref().map_or(vectorize::Action::Count, |p| p.action(ev.func, ev.pc));
+        match action {
+            vectorize::Action::Count => {}
+            vectorize::Action::Skip => return InstMem::default(),
+            vectorize::Action::Widen { bytes, shift } => {
+                let mut addrs = *ev.addrs;
+                for a in addrs.iter_mut() {
+                    *a = a.wrapping_add_signed(shift);
+                }
+                let wide = MemEvent { bytes, addrs: &addrs, ..*ev };
+                return self.count_as_written(&wide);
+            }
+            vectorize::Action::Red if self.profile == Profile::Hopper && ev.op == MemOp::Atomic => {
+                let red = MemEvent { op: MemOp::Reduction, ..*ev };
+                return self.count_as_written(&red);
+            }
+            vectorize::Action::Red => {}
+        }
+        self.count_as_written(ev)
+    }
+
+    /// [`CtaModel::count`] without the ptxas plan.
+    fn count_as_written(&mut self, ev: &MemEvent) -> InstMem {
         match (ev.space, ev.op) {
             (MemSpace::Global, MemOp::Load) if ev.nc && self.profile != Profile::Hopper => {
                 self.global(ev, Kind::Texture)
@@ -440,6 +485,8 @@ pub struct Model {
     shared_tex: Mutex<Vec<Option<cache::SectorCache>>>,
     /// Simulates caches (set by the launch's fidelity; on by default).
     caches: AtomicBool,
+    /// The ptxas plan of the program ([`vectorize`]), when applied.
+    plan: Option<Arc<vectorize::Plan>>,
 }
 
 /// One texture-processor cluster's CTA models of a round, with their cluster index.
@@ -487,8 +534,16 @@ pub struct ModelStats {
 }
 
 impl Model {
-    /// A model of `profile` for kernels of `prog`.
+    /// A model of `profile` for kernels of `prog`. On the maxwell and hopper
+    /// profiles the accesses are counted as ptxas's code makes them
+    /// ([`vectorize`]) unless that is switched off ([`vectorize::set_default`]).
     pub fn new(profile: Profile, prog: &Program) -> Self {
+        Self::with_vectorize(profile, prog, vectorize::default_on())
+    }
+
+    /// A model of `profile` for kernels of `prog`; `vectorize`: count the
+    /// accesses as ptxas's code makes them (maxwell and hopper only).
+    pub fn with_vectorize(profile: Profile, prog: &Program, vectorize: bool) -> Self {
         let shape: Vec<usize> = prog.functions.iter().map(|f| f.insts.len()).collect();
         let per_inst = shape.iter().map(|&n| vec![InstMem::default(); n]).collect();
         Model {
@@ -497,6 +552,7 @@ impl Model {
             acc: Mutex::new(ModelStats { profile, counters: MemCounters::default(), per_inst }),
             shared_tex: Mutex::new(Vec::new()),
             caches: AtomicBool::new(true),
+            plan: (vectorize && profile != Profile::Gt200).then(|| Arc::new(vectorize::Plan::new(prog))),
         }
     }
 
@@ -508,7 +564,7 @@ impl Model {
 
 impl ObserverFactory for Model {
     fn create(&self, _cta: u32) -> Box<dyn MemObserver> {
-        Box::new(CtaModel::with_caches(self.profile, &self.shape, self.caches.load(Ordering::Relaxed)))
+        Box::new(CtaModel::with_plan(self.profile, &self.shape, self.caches.load(Ordering::Relaxed), self.plan.clone()))
     }
 
     fn set_fidelity(&self, level: Fidelity) {
@@ -615,6 +671,9 @@ impl ModelStats {
                 ("smsp__sass_inst_executed_op_shared_st.sum", m.shared_st.instructions),
                 ("smsp__sass_inst_executed_op_local_ld.sum", m.local_ld.instructions),
                 ("smsp__sass_inst_executed_op_local_st.sum", m.local_st.instructions),
+                ("smsp__sass_inst_executed_op_shared_atom.sum", m.shared_atom.instructions),
+                ("smsp__sass_inst_executed_op_global_atom.sum", m.global_atom.instructions),
+                ("smsp__sass_inst_executed_op_global_red.sum", m.global_red.instructions),
                 ("l1tex__t_requests_pipe_lsu_mem_global_op_ld.sum", m.global_ld.requests),
                 ("l1tex__t_sectors_pipe_lsu_mem_global_op_ld.sum", m.global_ld.sectors),
                 ("l1tex__t_sectors_pipe_lsu_mem_global_op_ld_lookup_hit.sum", m.global_ld.hits),
@@ -631,6 +690,10 @@ impl ModelStats {
                 ("l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_st.sum", m.shared_st.bank_conflicts),
                 ("l1tex__t_requests_pipe_lsu_mem_global_op_atom.sum", m.global_atom.requests),
                 ("l1tex__t_requests_pipe_lsu_mem_global_op_red.sum", m.global_red.requests),
+                ("l1tex__t_sectors_pipe_lsu_mem_global_op_atom.sum", m.global_atom.sectors),
+                ("l1tex__t_sectors_pipe_lsu_mem_global_op_red.sum", m.global_red.sectors),
+                ("l1tex__data_pipe_lsu_wavefronts_mem_shared_op_atom.sum", m.shared_atom.wavefronts),
+                ("l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_atom.sum", m.shared_atom.bank_conflicts),
                 ("lts__t_sectors_op_atom.sum", m.global_atom.sectors),
                 ("lts__t_sectors_op_red.sum", m.global_red.sectors),
             ],

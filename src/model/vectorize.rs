@@ -1,0 +1,449 @@
+//! What ptxas makes of a kernel's shared-memory accesses before the GPU counts
+//! them (issue 20, items 6, 7 and 11): a static pass over each PTX function
+//! that decides, per instruction, how the Maxwell and Hopper counter models
+//! count its warp-level accesses. Values are never changed — the simulator
+//! executes the PTX as written — only the counts.
+//!
+//! - **Vectorisation.** Scalar `ld.shared`/`st.shared` of 4 or 8 bytes at
+//!   offsets `o, o+e, …` from one base register, in one straight-line run,
+//!   under one guard, with the base not redefined in between and the start
+//!   provably aligned to the merged width, become one 8- or 16-byte access
+//!   (`LDS.64`/`LDS.128`/`STS.64`/`STS.128`): counted once, at the first
+//!   member's execution, with the merged width. Loads may be separated by
+//!   loads of other spaces and bases and by non-memory instructions; a shared
+//!   or generic store, an atomic, a barrier, a fence, a call or a branch ends
+//!   the run. Stores must follow one another (non-memory instructions between
+//!   are allowed). Greedy from the lowest offset: 16 bytes where the start is
+//!   16-byte aligned, else 8 where 8-byte aligned.
+//! - **Alignment** comes from a trailing-zero analysis of the registers
+//!   (flow-insensitive, every definition of a register considered): shared
+//!   variables' offsets in warplight's layout, immediates, `shl` by a
+//!   constant, `mul`/`mad` (zeros add up), `add`/`sub`/`or` (the fewer), `and`
+//!   (the more), moves and conversions keep them; anything loaded or
+//!   special is unaligned.
+//! - **Repeated loads.** A shared load of the same base register (same
+//!   definition), offset and width as an earlier load of the same run is
+//!   dropped (ptxas reuses the register): not counted.
+//! - **Reductions.** A global `atom` whose destination register no
+//!   instruction of the function reads is executed as `RED` (add, min, max,
+//!   inc, dec, and, or, xor; not exch or cas) — counted as a reduction on the
+//!   hopper profile.
+//!
+//! The rules were read off the SASS that ptxas 13.0 makes for sm_90 of the
+//! validation suite (`kernels/validation/suite.cu`, `docs/validation.md`):
+//! the unrolled tiled matrix product's `As[ty][k..k+3]` become `LDS.128`,
+//! the sorting network's eight adjacent words two `LDS.128`/`STS.128`, and
+//! the bitonic sort's stride-1 steps (`pos = 2 * tid`) `LDS.64`/`STS.64`.
+//! Switch the pass off with `--no-ptxas-vectorize`
+//! ([`set_default`], or [`crate::model::Model::with_vectorize`]).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::ptx::Program;
+use crate::ptx::ir::{Address, ArithOp, AtomOp, Dst, Function, Kind, MemSpace, PredSrc, RegId, Src};
+
+/// How the counter model counts one instruction's accesses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Action {
+    /// As the PTX says.
+    #[default]
+    Count,
+    /// Not at all: merged into another instruction's access, or a repeated load.
+    Skip,
+    /// As one access of `bytes` per lane starting `shift` bytes from this
+    /// instruction's addresses (the first instruction of a merged group).
+    Widen {
+        /// Bytes per lane of the merged access (8 or 16).
+        bytes: u32,
+        /// Offset of the merged access's start from this instruction's address.
+        shift: i64,
+    },
+    /// A global atomic whose result is unused: a reduction.
+    Red,
+}
+
+/// The pass's decisions: `actions[function][pc]`.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Plan {
+    /// Per function, per instruction.
+    pub actions: Vec<Vec<Action>>,
+}
+
+impl Plan {
+    /// The action for instruction `pc` of function `func` ([`Action::Count`] when unknown).
+    pub fn action(&self, func: u32, pc: u32) -> Action {
+        self.actions.get(func as usize).and_then(|f| f.get(pc as usize)).copied().unwrap_or_default()
+    }
+
+    /// Plans every function of `prog`.
+    pub fn new(prog: &Program) -> Plan {
+        Plan { actions: prog.functions.iter().map(plan_function).collect() }
+    }
+}
+
+static DEFAULT_ON: AtomicBool = AtomicBool::new(true);
+
+/// Whether models made by [`crate::model::Model::new`] apply the pass (on unless
+/// switched off, e.g. by `--no-ptxas-vectorize`).
+pub fn default_on() -> bool {
+    DEFAULT_ON.load(Ordering::Relaxed)
+}
+
+/// Switches the pass on or off for models made from now on by [`crate::model::Model::new`].
+pub fn set_default(on: bool) {
+    DEFAULT_ON.store(on, Ordering::Relaxed);
+}
+
+/// What an instruction means for the pass.
+enum Effect {
+    /// Writes these data registers (and nothing the pass must stop at).
+    Writes(Vec<RegId>),
+    /// Writes predicates (guards of pending accesses may change).
+    WritesPred(Vec<RegId>),
+    /// A load or store the pass looks at.
+    Access,
+    /// Ends every run: control flow, barriers, fences, calls.
+    Boundary,
+    /// An instruction the pass does not know: the function is left as written.
+    Unknown,
+}
+
+fn dst_regs(ds: impl IntoIterator<Item = RegId>) -> Vec<RegId> {
+    ds.into_iter().filter(|&r| r != Dst::SINK).collect()
+}
+
+fn effect(k: &Kind) -> Effect {
+    match k {
+        Kind::Mov { d, .. }
+        | Kind::Pack { d, .. }
+        | Kind::Arith { d, .. }
+        | Kind::Set { d, .. }
+        | Kind::Bfi { d, .. }
+        | Kind::Selp { d, .. }
+        | Kind::Cvt { d, .. }
+        | Kind::Cvta { d, .. } => Effect::Writes(dst_regs([d.reg])),
+        Kind::Unpack { ds, .. } => Effect::Writes(dst_regs(ds.iter().map(|d| d.reg))),
+        Kind::Setp { .. } | Kind::PredLogic { .. } => Effect::WritesPred(Vec::new()),
+        Kind::Vote { d, .. } => Effect::WritesPred(dst_regs(d.iter().map(|d| d.reg))),
+        Kind::Shfl { d, .. } => Effect::WritesPred(dst_regs([d.reg])),
+        Kind::Ld { .. } | Kind::St { .. } | Kind::Atom { .. } => Effect::Access,
+        Kind::Nop => Effect::Writes(Vec::new()),
+        Kind::Bra { .. } | Kind::Call { .. } | Kind::Ret | Kind::Exit | Kind::Bar { .. } | Kind::Membar => {
+            Effect::Boundary
+        }
+        _ => Effect::Unknown,
+    }
+}
+
+/// Data registers an instruction reads (None: an instruction the pass does not know).
+fn reads(k: &Kind) -> Option<Vec<RegId>> {
+    let mut v = Vec::new();
+    let mut src = |s: &Src| {
+        if let Src::Reg(r) = s {
+            v.push(*r);
+        }
+    };
+    match k {
+        Kind::Mov { a, .. } | Kind::Cvt { a, .. } | Kind::Cvta { a, .. } | Kind::Unpack { a, .. } => src(a),
+        Kind::Pack { parts, .. } => parts.iter().for_each(src),
+        Kind::Arith { a, b, c, .. } => [a, b, c].into_iter().for_each(src),
+        Kind::Setp { a, b, .. } | Kind::Set { a, b, .. } | Kind::Selp { a, b, .. } => [a, b].into_iter().for_each(src),
+        Kind::Bfi { a, b, c, e, .. } => [a, b, c, e].into_iter().for_each(src),
+        Kind::Ld { addr, .. } => src(&addr.base),
+        Kind::St { vals, addr, .. } => {
+            vals.iter().for_each(&mut src);
+            src(&addr.base);
+        }
+        Kind::Atom { addr, b, c, .. } => [&addr.base, b, c].into_iter().for_each(src),
+        Kind::Bar { id, count } => {
+            src(id);
+            if let Some(c) = count {
+                src(c);
+            }
+        }
+        Kind::Vote { membermask, .. } => src(membermask),
+        Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(src),
+        Kind::PredLogic { .. }
+        | Kind::Bra { .. }
+        | Kind::Call { .. }
+        | Kind::Ret
+        | Kind::Exit
+        | Kind::Membar
+        | Kind::Nop => {}
+        _ => return None,
+    }
+    Some(v)
+}
+
+/// Trailing zero bits of an immediate (64 for 0).
+fn tz_imm(v: u64) -> u32 {
+    v.trailing_zeros()
+}
+
+/// Known trailing zeros of every data register of `f` (see the module comment);
+/// None when `f` holds an instruction the pass does not know.
+fn trailing_zeros(f: &Function) -> Option<Vec<u32>> {
+    let n = f.reg_masks.len();
+    let mut tz = vec![64u32; n];
+    let width = |r: RegId| f.reg_masks.get(r as usize).map_or(64, |m| m.count_ones());
+    loop {
+        let mut changed = false;
+        for inst in &f.insts {
+            let of = |s: &Src, tz: &[u32]| match s {
+                Src::Reg(r) => tz.get(*r as usize).copied().unwrap_or(0),
+                Src::Imm(v) => tz_imm(*v),
+                _ => 0,
+            };
+            let (regs, value): (Vec<RegId>, u32) = match &inst.kind {
+                Kind::Mov { d, a } => (vec![d.reg], of(a, &tz)),
+                Kind::Cvt { d, a, dty, sty, .. } if !dty.is_float() && !sty.is_float() => (vec![d.reg], of(a, &tz)),
+                Kind::Cvta { d, a, .. } => (vec![d.reg], of(a, &tz)),
+                Kind::Selp { d, a, b, .. } => (vec![d.reg], of(a, &tz).min(of(b, &tz))),
+                Kind::Arith { op, d, a, b, c, ty, .. } if !ty.is_float() => {
+                    let (a, b, c) = (of(a, &tz), of(b, &tz), of(c, &tz));
+                    let v = match op {
+                        ArithOp::Add | ArithOp::Sub | ArithOp::Or | ArithOp::Xor => a.min(b),
+                        ArithOp::And => a.max(b),
+                        ArithOp::Mul | ArithOp::MulWide => a.saturating_add(b),
+                        ArithOp::Mad | ArithOp::MadWide => a.saturating_add(b).min(c),
+                        ArithOp::Neg => a,
+                        ArithOp::Shl => match &inst.kind {
+                            Kind::Arith { b: Src::Imm(k), .. } => a.saturating_add(*k as u32),
+                            _ => 0,
+                        },
+                        _ => 0,
+                    };
+                    (vec![d.reg], v)
+                }
+                k => match effect(k) {
+                    Effect::Writes(ds) | Effect::WritesPred(ds) => (ds, 0),
+                    Effect::Access => match k {
+                        Kind::Ld { ds, .. } => (ds.iter().map(|d| d.reg).collect(), 0),
+                        Kind::Atom { d: Some(d), .. } => (vec![d.reg], 0),
+                        _ => (Vec::new(), 0),
+                    },
+                    Effect::Boundary => (Vec::new(), 0),
+                    Effect::Unknown => return None,
+                },
+            };
+            for r in regs {
+                if r == Dst::SINK || r as usize >= n {
+                    continue;
+                }
+                let v = value.min(width(r));
+                if v < tz[r as usize] {
+                    tz[r as usize] = v;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            return Some(tz);
+        }
+    }
+}
+
+/// The base of an address as the pass compares them: a register at one of its
+/// definitions, or an absolute shared offset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Base {
+    Reg(RegId, u32),
+    Abs,
+}
+
+/// A pending scalar shared access of a run.
+#[derive(Debug, Clone, Copy)]
+struct Pending {
+    pc: usize,
+    base: Base,
+    /// Byte offset from the base (absolute offset for [`Base::Abs`]).
+    off: i64,
+    /// Bytes of the access (4 or 8).
+    bytes: u32,
+    /// The guard, with the number of predicate writes before it (a guard
+    /// predicate written in between makes another guard).
+    guard: Option<(PredSrc, u32)>,
+    /// Trailing zeros known of the base.
+    tz: u32,
+}
+
+/// The scalar shared access of `k`, if it is one the pass may merge: (is a load, address, bytes).
+fn scalar_shared(k: &Kind) -> Option<(bool, Address, u32)> {
+    match k {
+        Kind::Ld { space: MemSpace::Shared, ty, ds, addr, volatile: false, .. } if ds.len() == 1 => {
+            Some((true, *addr, ty.bytes()))
+        }
+        Kind::St { space: MemSpace::Shared, ty, vals, addr, volatile: false } if vals.len() == 1 => {
+            Some((false, *addr, ty.bytes()))
+        }
+        _ => None,
+    }
+}
+
+/// Groups a run's pending accesses (all loads or all stores) into `actions`.
+fn settle(run: &mut Vec<Pending>, loads: bool, actions: &mut [Action]) {
+    // same base (definition), width and guard
+    while let Some(first) = run.first().copied() {
+        let key = (first.base, first.bytes, first.guard);
+        let mut group: Vec<Pending> = run.iter().filter(|p| (p.base, p.bytes, p.guard) == key).copied().collect();
+        run.retain(|p| (p.base, p.bytes, p.guard) != key);
+        // repeated loads: the first of each offset stays
+        if loads {
+            group.sort_by_key(|p| (p.off, p.pc));
+            let mut kept: Vec<Pending> = Vec::new();
+            for p in group {
+                if kept.last().is_some_and(|k| k.off == p.off) {
+                    actions[p.pc] = Action::Skip;
+                } else {
+                    kept.push(p);
+                }
+            }
+            group = kept;
+        } else {
+            // a store written twice at one offset is left alone
+            group.sort_by_key(|p| (p.off, p.pc));
+            group.dedup_by_key(|p| p.off);
+        }
+        let e = key.1 as i64;
+        let tz = group.first().map_or(0, |p| p.tz);
+        let aligned = |off: i64, width: i64| {
+            let k = width.trailing_zeros();
+            tz >= k && off.rem_euclid(width) == 0
+        };
+        let mut taken = vec![false; group.len()];
+        for s in 0..group.len() {
+            if taken[s] {
+                continue;
+            }
+            let start = group[s].off;
+            for width in [16i64, 8] {
+                let n = (width / e) as usize;
+                if n < 2 || !aligned(start, width) {
+                    continue;
+                }
+                let members: Option<Vec<usize>> = (0..n)
+                    .map(|j| (s..group.len()).find(|&x| !taken[x] && group[x].off == start + j as i64 * e))
+                    .collect();
+                let Some(members) = members else { continue };
+                let Some(&leader) = members.iter().min_by_key(|&&x| group[x].pc) else { continue };
+                for &m in &members {
+                    taken[m] = true;
+                    actions[group[m].pc] = Action::Skip;
+                }
+                actions[group[leader].pc] = Action::Widen { bytes: width as u32, shift: start - group[leader].off };
+                break;
+            }
+        }
+    }
+}
+
+/// Plans one function.
+fn plan_function(f: &Function) -> Vec<Action> {
+    let mut actions = vec![Action::Count; f.insts.len()];
+    let Some(tz) = trailing_zeros(f) else { return actions };
+    // registers some instruction reads (for atomics without a used result)
+    let mut read = vec![false; f.reg_masks.len()];
+    for inst in &f.insts {
+        let Some(rs) = reads(&inst.kind) else { return actions };
+        for r in rs {
+            if let Some(x) = read.get_mut(r as usize) {
+                *x = true;
+            }
+        }
+    }
+    for (pc, inst) in f.insts.iter().enumerate() {
+        if let Kind::Atom { space: MemSpace::Global | MemSpace::Generic, op, d, .. } = &inst.kind {
+            let reducible = !matches!(op, AtomOp::Exch | AtomOp::Cas);
+            let unused = d.is_none_or(|d| d.reg == Dst::SINK || !read.get(d.reg as usize).copied().unwrap_or(true));
+            if reducible && unused {
+                actions[pc] = Action::Red;
+            }
+        }
+    }
+    let mut target = vec![false; f.insts.len() + 1];
+    for (_, t) in &f.labels {
+        if let Some(x) = target.get_mut(*t as usize) {
+            *x = true;
+        }
+    }
+    // each register's definition count so far, and the predicate writes so far
+    let mut version = vec![0u32; f.reg_masks.len()];
+    let mut pred_epoch = 0u32;
+    let mut loads: Vec<Pending> = Vec::new();
+    let mut stores: Vec<Pending> = Vec::new();
+    for (pc, inst) in f.insts.iter().enumerate() {
+        if target[pc] {
+            settle(&mut loads, true, &mut actions);
+            settle(&mut stores, false, &mut actions);
+        }
+        let written: Vec<RegId> = match effect(&inst.kind) {
+            Effect::Boundary | Effect::Unknown => {
+                settle(&mut loads, true, &mut actions);
+                settle(&mut stores, false, &mut actions);
+                Vec::new()
+            }
+            Effect::WritesPred(ds) => {
+                pred_epoch += 1;
+                ds
+            }
+            Effect::Writes(ds) => ds,
+            Effect::Access => {
+                let scalar = scalar_shared(&inst.kind);
+                let (is_load, space) = match &inst.kind {
+                    Kind::Ld { space, .. } => (true, *space),
+                    Kind::St { space, .. } => (false, *space),
+                    Kind::Atom { space, .. } => (false, *space),
+                    _ => (false, MemSpace::Generic),
+                };
+                let shared_or_generic = matches!(space, MemSpace::Shared | MemSpace::Generic);
+                let based = scalar.and_then(|(load, addr, bytes)| {
+                    let (base, off, tzb) = match addr.base {
+                        Src::Reg(r) => (
+                            Base::Reg(r, version.get(r as usize).copied().unwrap_or(0)),
+                            addr.offset,
+                            tz.get(r as usize).copied().unwrap_or(0),
+                        ),
+                        Src::Imm(v) => (Base::Abs, addr.offset.wrapping_add(v as i64), 64),
+                        _ => return None,
+                    };
+                    (bytes == 4 || bytes == 8).then_some((load, base, off, bytes, tzb))
+                });
+                // a shared or generic load ends the store run; a shared or
+                // generic store or atomic ends both, except that a scalar
+                // shared store joins the store run
+                match based {
+                    Some((load, base, off, bytes, tzb)) => {
+                        let p = Pending { pc, base, off, bytes, guard: inst.guard.map(|g| (g, pred_epoch)), tz: tzb };
+                        if load {
+                            settle(&mut stores, false, &mut actions);
+                            loads.push(p);
+                        } else {
+                            settle(&mut loads, true, &mut actions);
+                            stores.push(p);
+                        }
+                    }
+                    None if shared_or_generic => {
+                        settle(&mut stores, false, &mut actions);
+                        if !is_load {
+                            settle(&mut loads, true, &mut actions);
+                        }
+                    }
+                    None => {}
+                }
+                match &inst.kind {
+                    Kind::Ld { ds, .. } => dst_regs(ds.iter().map(|d| d.reg)),
+                    Kind::Atom { d: Some(d), .. } => dst_regs([d.reg]),
+                    _ => Vec::new(),
+                }
+            }
+        };
+        for r in written {
+            if let Some(v) = version.get_mut(r as usize) {
+                *v += 1;
+            }
+        }
+    }
+    settle(&mut loads, true, &mut actions);
+    settle(&mut stores, false, &mut actions);
+    actions
+}

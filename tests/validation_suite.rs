@@ -1,0 +1,93 @@
+//! The validation suite (kernels/validation/suite.cu, clang's and nvcc's PTX)
+//! against what an H200 computed and Nsight Compute measured
+//! (tests/fixtures/validation/h200.json): every output buffer bit for bit,
+//! every metric the addresses decide exactly (listed exceptions, each with
+//! its reason, must still differ), timing-dependent shared-memory metrics at
+//! least the model's count. docs/validation.md carries the generated tables
+//! (`WARPLIGHT_PRINT_SUITE=1 cargo test --release --test validation_suite -- --nocapture`).
+
+use std::path::Path;
+use warplight::model::validation_suite::{Expect, Report, compare};
+
+/// Exact metrics known to differ: (case, dialect, metric, why). Each is
+/// explained in docs/validation.md.
+const KNOWN: &[(&str, &str, &str, &str)] = &[
+    (
+        "needleman_wunsch",
+        "clang",
+        "smsp__sass_inst_executed_op_shared_ld.sum",
+        "ptxas unrolls clang's anti-diagonal loops and executes 8 more LDS per tile",
+    ),
+    (
+        "bfs",
+        "clang",
+        "l1tex__t_sectors_pipe_lsu_mem_global_op_ld_lookup_hit.sum",
+        "L1 hits between warps of one SM depend on their timing",
+    ),
+    (
+        "bfs",
+        "nvcc",
+        "l1tex__t_sectors_pipe_lsu_mem_global_op_ld_lookup_hit.sum",
+        "L1 hits between warps of one SM depend on their timing",
+    ),
+];
+
+fn report() -> Report {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    compare(&root.join("tests/fixtures/validation/h200.json"), root).unwrap()
+}
+
+#[test]
+fn the_suite_matches_the_h200() {
+    let r = report();
+    if std::env::var_os("WARPLIGHT_PRINT_SUITE").is_some() {
+        println!("{}\n{}", r.summary_markdown(), r.differences_markdown());
+    }
+    // every case of both dialects ran, with outputs and metrics
+    assert!(r.outputs.len() >= 66, "{} cases", r.outputs.len());
+    let exact = r.rows.iter().filter(|x| x.expect == Expect::Exact).count();
+    assert!(exact >= 1700, "{exact} exact comparisons");
+    let timed = r.rows.iter().filter(|x| x.expect == Expect::TimingDependent).count();
+    assert!(timed >= 100, "{timed} timing-dependent comparisons");
+
+    let differ: Vec<String> = r
+        .outputs
+        .iter()
+        .filter(|o| !o.differ.is_empty())
+        .map(|o| format!("{} {}: {:?}", o.case, o.dialect, o.differ))
+        .collect();
+    assert!(differ.is_empty(), "outputs differ from the GPU's:\n{}", differ.join("\n"));
+
+    let known = |c: &str, d: &str, m: &str| KNOWN.iter().any(|k| (k.0, k.1, k.2) == (c, d, m));
+    let unexpected: Vec<String> = r
+        .exact_differences()
+        .iter()
+        .filter(|x| !known(&x.case, &x.dialect, &x.metric))
+        .map(|x| format!("{} {} {}: H200 {} warplight {}", x.case, x.dialect, x.metric, x.measured, x.emulated))
+        .collect();
+    assert!(unexpected.is_empty(), "{} differences:\n{}", unexpected.len(), unexpected.join("\n"));
+    for k in KNOWN {
+        assert!(
+            r.exact_differences()
+                .iter()
+                .any(|x| (x.case.as_str(), x.dialect.as_str(), x.metric.as_str()) == (k.0, k.1, k.2)),
+            "{} {} {} is equal now: remove it from KNOWN ({})",
+            k.0,
+            k.1,
+            k.2,
+            k.3
+        );
+    }
+    let below: Vec<String> = r
+        .below_the_model()
+        .iter()
+        .map(|x| format!("{} {} {}: H200 {} < warplight {}", x.case, x.dialect, x.metric, x.measured, x.emulated))
+        .collect();
+    assert!(below.is_empty(), "below the model:\n{}", below.join("\n"));
+
+    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/validation.md")).unwrap();
+    assert!(
+        doc.contains(&r.summary_markdown()) && doc.contains(&r.differences_markdown()),
+        "docs/validation.md is stale: WARPLIGHT_PRINT_SUITE=1 cargo test --release --test validation_suite -- --nocapture"
+    );
+}
