@@ -73,6 +73,14 @@ pub const KNOWN_OPCODES: &[&str] = &[
     "nanosleep",
     "brkpt",
     "nop",
+    "redux",
+    "match",
+    "bfind",
+    "dp4a",
+    "dp2a",
+    "addc",
+    "subc",
+    "madc",
 ];
 
 /// Deepest nesting of `{ }` blocks, initializer braces and operand lists the

@@ -3,11 +3,13 @@
 //! scheduler ([`cta`]), the grid scheduler ([`grid`]), device memory
 //! ([`memory`]), faults ([`fault`]), counters ([`counters`]), stepping
 //! ([`stepper`]), fidelity levels ([`fidelity`]), the decoded executable form
-//! ([`decode`]) and the public [`Device`] API ([`device`]).
+//! ([`decode`], with ptxas's FMA contraction, [`contract`], and the SFU's
+//! approximations, [`sfu`]) and the public [`Device`] API ([`device`]).
 
 pub mod access_log;
 pub mod alu;
 pub mod cfg;
+pub mod contract;
 pub mod counters;
 pub mod cta;
 pub mod decode;
@@ -16,8 +18,10 @@ pub mod exec;
 pub mod fault;
 pub mod fidelity;
 pub mod grid;
+pub mod half;
 pub mod memory;
 pub mod observer;
+pub mod sfu;
 pub mod simt_stack;
 pub mod stepper;
 pub mod warp;

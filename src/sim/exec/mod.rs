@@ -304,6 +304,14 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         return Ok(Effect::Continue);
     }
 
+    if op.fused
+        && let Kind::Arith { ty, mode, d, .. } = inst.kind
+        && let Some(fz) = ctx.code.funcs[func as usize].fused.get(&pc)
+    {
+        arith::fused(ctx, w, cta, (ty, mode), d, fz, exec);
+        return Ok(Effect::Continue);
+    }
+
     if let (Some(lanes), Kind::Arith { d, a, b, c, .. }) = (op.lanes, &inst.kind) {
         arith::resolved(ctx, w, cta, lanes, op.reads_c, *d, *a, *b, *c, exec);
         return Ok(Effect::Continue);
@@ -335,6 +343,11 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         Kind::Bar { id, count } => return control::bar(ctx, w, cta, *id, *count, exec),
         Kind::Vote { mode, d, p, a, .. } => arith::vote(w, *mode, *d, *p, *a, exec),
         Kind::Shfl { mode, d, p, a, b, c, .. } => arith::shfl(ctx, w, cta, *mode, *d, *p, [*a, *b, *c], exec),
+        Kind::Redux { op, ty, d, a, .. } => arith::redux(ctx, w, cta, *op, *ty, *d, *a, exec),
+        Kind::Match { all, ty, d, p, a, .. } => arith::match_sync(ctx, w, cta, *all, *ty, *d, *p, *a, exec),
+        Kind::Carry { op, cin, cout, ty, d, a, b, c, cc } => {
+            arith::carry(ctx, w, cta, (*op, *cin, *cout, *ty), *d, [*a, *b, *c], *cc, exec)
+        }
         Kind::Membar => return Ok(control::membar(w, cta)),
         Kind::Nop => {}
         Kind::Trap => return Err(fault(FaultKind::Trap, lane_of_mask(exec))),
