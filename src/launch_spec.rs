@@ -969,10 +969,14 @@ init = [1, 2, 3]
         assert_eq!(s.sim_config(0, None).schedule.max_warp_instructions, 1000);
         assert_eq!(s.sim_config(0, Some(7)).schedule.max_warp_instructions, 7);
         assert_eq!(s.sim_config(0, None).max_call_depth, 9);
+        assert_eq!(parse(&format!("fmad = false\n{base}")).unwrap().fmad, Some(false));
+        assert_eq!(s.fmad, None);
         for bad in ["max_instructions = 0", "max_call_depth = 4294967296", "max_call_depth = 1.5"] {
             let e = parse(&format!("{bad}\n{base}")).unwrap_err();
             assert!(e.to_string().contains("expected an integer from 1 to"), "{bad}: {e}");
         }
+        let e = parse(&format!("fmad = 1\n{base}")).unwrap_err();
+        assert!(e.to_string().contains("`fmad`: expected true or false"), "{e}");
     }
 
     #[test]

@@ -12,10 +12,6 @@ use common::*;
 use serde_json::Value;
 use warplight::sim::{Arg, LaunchConfig};
 
-/// Kernels of the fixture whose instructions warplight does not execute yet
-/// (docs/ptx-support.md lists them).
-const PENDING: &[&str] = &["sem_bar_red"];
-
 fn fixture() -> Value {
     serde_json::from_str(&std::fs::read_to_string("tests/fixtures/gpu_semantics.json").unwrap()).unwrap()
 }
@@ -50,19 +46,13 @@ fn every_semantics_kernel_matches_the_gpu() {
                 (dev.alloc_from(&a32), dev.alloc_from(&b32))
             };
             let out = dev.alloc_zeroed::<u32>(expect.len());
-            let r = dev.launch(
+            dev.launch(
                 m,
                 name,
                 LaunchConfig::linear(1, n as u32),
                 &[Arg::Ptr(out), Arg::Ptr(da), Arg::Ptr(db), Arg::I32(n as i32)],
-            );
-            if PENDING.contains(&name.as_str()) {
-                // still unsupported: the launch must say so (keeps the list honest)
-                let e = r.expect_err(name).to_string();
-                assert!(e.contains("unsupported"), "{name}: {e}");
-                continue;
-            }
-            r.unwrap_or_else(|e| panic!("{d:?} {name}: {e}"));
+            )
+            .unwrap_or_else(|e| panic!("{d:?} {name}: {e}"));
             checked += 1;
             let got = dev.read::<u32>(out, expect.len());
             let per = expect.len() / n;
@@ -77,6 +67,6 @@ fn every_semantics_kernel_matches_the_gpu() {
             }
         }
     }
-    assert_eq!(checked, 2 * (kernels.len() - PENDING.len()), "kernels run in both dialects");
+    assert_eq!(checked, 2 * kernels.len(), "kernels run in both dialects");
     assert!(mismatches.is_empty(), "{} mismatches:\n{}", mismatches.len(), mismatches.join("\n"));
 }

@@ -39,6 +39,8 @@ pub enum SpecialReg {
     LaneMaskGt,
     Clock,
     Clock64,
+    /// `%globaltimer_hi`: the upper 32 bits of the deterministic clock.
+    GlobalTimerHi,
 }
 
 /// A source operand.
@@ -245,6 +247,15 @@ pub enum ReduxOp {
     Xor,
 }
 
+/// `bar.red` reductions (`__syncthreads_count`, `_and`, `_or`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum BarRedOp {
+    Popc,
+    And,
+    Or,
+}
+
 /// Carry-chain operations: `add.cc/addc`, `sub.cc/subc`, `mad.lo.cc/madc.lo`, `mad.hi.cc/madc.hi`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)]
@@ -365,6 +376,10 @@ pub enum Kind {
     Exit,
     /// `bar.sync id[, count]` / `barrier.sync`.
     Bar { id: Src, count: Option<Src> },
+    /// `bar.red.op id[, count], a`: a barrier that also reduces predicate `a`
+    /// over the CTA's arriving threads; `.popc` writes the count to `d`,
+    /// `.and`/`.or` write predicate `p`.
+    BarRed { op: BarRedOp, d: Option<Dst>, p: PredId, id: Src, count: Option<Src>, a: PredSrc },
     /// `vote.sync.mode`: a ballot writes `d`, the others write predicate `p`.
     Vote { mode: VoteMode, d: Option<Dst>, p: PredId, a: PredSrc, membermask: Src },
     /// `shfl.sync.mode.b32 d[|p], a, b, c, membermask`.

@@ -332,6 +332,15 @@ impl Names<'_> {
                 self.src(*c),
                 self.reg(*cc)
             ),
+            Kind::BarRed { op, d, p, id, count, a } => format!(
+                "bar.red.{} {} {} <- {}{}, {}",
+                lc(op),
+                d.map(|d| self.dst(d)).unwrap_or_else(|| "-".into()),
+                self.pred(*p),
+                self.src(*id),
+                count.map(|c| format!(", {}", self.src(c))).unwrap_or_default(),
+                self.pred_src(*a)
+            ),
             Kind::Membar => "membar".into(),
             Kind::Nop => "nop".into(),
             Kind::Trap => "trap".into(),

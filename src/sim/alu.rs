@@ -1091,6 +1091,48 @@ mod tests {
         assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x0000_0080, 0, 0x8888), 0xFFFF_FFFF);
     }
 
+    /// The `prmt` modes on bytes 0x00..0x77 of {b, a}, as PTX's table lists them.
+    #[test]
+    fn prmt_modes() {
+        let (a, b) = (0x3322_1100u64, 0x7766_5544u64);
+        let p = |op, s| arith(op, Ty::B32, M, a, b, s);
+        assert_eq!(p(ArithOp::PrmtF4e, 1), 0x4433_2211);
+        assert_eq!(p(ArithOp::PrmtB4e, 0), 0x5566_7700);
+        assert_eq!(p(ArithOp::PrmtB4e, 3), 0x0011_2233);
+        assert_eq!(p(ArithOp::PrmtRc8, 2), 0x2222_2222);
+        assert_eq!(p(ArithOp::PrmtEcl, 1), 0x3322_1111);
+        assert_eq!(p(ArithOp::PrmtEcr, 2), 0x2222_1100);
+        assert_eq!(p(ArithOp::PrmtRc16, 1), 0x3322_3322);
+        assert_eq!(p(ArithOp::PrmtRc16, 6), 0x1100_1100, "only the selector's two low bits count");
+    }
+
+    #[test]
+    fn bfind_and_dot_products() {
+        assert_eq!(arith(ArithOp::Bfind, Ty::U32, M, 0x10, 0, 0), 4);
+        assert_eq!(arith(ArithOp::Bfind, Ty::U32, M, 0, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::BfindShiftamt, Ty::U32, M, 0x10, 0, 0), 27);
+        assert_eq!(arith(ArithOp::Bfind, Ty::S32, M, 0xFFFF_FFF0, 0, 0), 3, "the top bit unlike the sign");
+        assert_eq!(arith(ArithOp::Bfind, Ty::S32, M, 0xFFFF_FFFF, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Bfind, Ty::U64, M, 1 << 40, 0, 0), 40);
+        // bytes (1, 2, 3, 0xFF) . (4, 5, 6, 7) + 10: 0xFF is 255 unsigned, -1 signed
+        let (a, b) = (0xFF03_0201u64, 0x0706_0504u64);
+        assert_eq!(arith(ArithOp::Dp4aU, Ty::U32, M, a, b, 10), 10 + 4 + 10 + 18 + 255 * 7);
+        assert_eq!(arith(ArithOp::Dp4aU, Ty::S32, M, a, b, 10), 10 + 4 + 10 + 18 - 7);
+        // halves (0x0201, 0xFF03) times bytes 2, 3 of b (6, 7)
+        assert_eq!(arith(ArithOp::Dp2aHiU, Ty::S32, M, a, b, 0), (0x0201 * 6 + (0xFF03 - 0x10000) * 7) as u32 as u64);
+    }
+
+    #[test]
+    fn carry_chains() {
+        use crate::ptx::ir::CarryOp;
+        assert_eq!(carry(CarryOp::Add, Ty::U32, 0xFFFF_FFFF, 1, 0, 0), (0, 1));
+        assert_eq!(carry(CarryOp::Add, Ty::U32, 1, 1, 0, 1), (3, 0));
+        assert_eq!(carry(CarryOp::Sub, Ty::U32, 0, 0, 0, 1), (0xFFFF_FFFF, 1), "borrow in and out");
+        assert_eq!(carry(CarryOp::Sub, Ty::U64, 5, 3, 0, 0), (2, 0));
+        assert_eq!(carry(CarryOp::MadLo, Ty::U32, 0xFFFF_FFFF, 1, 0xFFFF_FFFF, 0), (0xFFFF_FFFE, 1));
+        assert_eq!(carry(CarryOp::MadHi, Ty::U32, 0xFFFF_FFFF, 1, 1, 1), (2, 0));
+    }
+
     #[test]
     fn funnel_shifts() {
         assert_eq!(arith(ArithOp::ShfLWrap, Ty::B32, M, 0x8000_0001, 0x8000_0001, 1), 0x0000_0003);

@@ -97,7 +97,7 @@ fn reads(k: &Kind) -> Vec<RegId> {
             s(&addr.base)
         }
         Kind::Atom { addr, b, c, .. } => [&addr.base, b, c].into_iter().for_each(s),
-        Kind::Bar { id, count } => {
+        Kind::Bar { id, count } | Kind::BarRed { id, count, .. } => {
             s(id);
             count.iter().for_each(s)
         }
@@ -139,7 +139,7 @@ fn writes(k: &Kind) -> Vec<RegId> {
         | Kind::Match { d: x, .. } => vec![d(x)],
         Kind::Carry { d: x, cc, .. } => vec![d(x), *cc],
         Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } => ds.iter().map(d).collect(),
-        Kind::Atom { d: x, .. } | Kind::Vote { d: x, .. } => x.iter().map(d).collect(),
+        Kind::Atom { d: x, .. } | Kind::Vote { d: x, .. } | Kind::BarRed { d: x, .. } => x.iter().map(d).collect(),
         Kind::Setp { .. }
         | Kind::PredLogic { .. }
         | Kind::St { .. }
@@ -170,7 +170,7 @@ fn preds(i: &Inst) -> (Vec<PredId>, Vec<PredId>) {
             w.push(*d);
             r.extend([a.reg, b.reg]);
         }
-        Kind::Vote { p, a, .. } => {
+        Kind::Vote { p, a, .. } | Kind::BarRed { p, a, .. } => {
             w.push(*p);
             r.push(a.reg);
         }
@@ -276,6 +276,7 @@ impl<'a> Facts<'a> {
                 Kind::St { .. }
                     | Kind::Atom { .. }
                     | Kind::Bar { .. }
+                    | Kind::BarRed { .. }
                     | Kind::Vote { .. }
                     | Kind::Shfl { .. }
                     | Kind::Redux { .. }

@@ -168,7 +168,7 @@ pub fn div_full(a: u32, b: u32, ftz: bool) -> u32 {
     let fb = f(b);
     let big = fb.abs() > BIG;
     let (mut a, mut b) = if big { (fmul(a, QUARTER, ftz), fmul(b, QUARTER, ftz)) } else { (a, b) };
-    if !ftz && !(fb.abs() >= TINY || fb.is_nan()) {
+    if !(ftz || fb.abs() >= TINY || fb.is_nan()) {
         (a, b) = (fmul(a, TWO24, false), fmul(b, TWO24, false));
     }
     fmul(mufu_rcp(b), a, ftz)

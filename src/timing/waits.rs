@@ -61,7 +61,7 @@ fn reads(k: &Kind) -> Vec<RegId> {
             addr_reg(addr, &mut v);
             [b, c].into_iter().for_each(|s| src_reg(s, &mut v));
         }
-        Kind::Bar { id, count } => {
+        Kind::Bar { id, count } | Kind::BarRed { id, count, .. } => {
             src_reg(id, &mut v);
             if let Some(c) = count {
                 src_reg(c, &mut v);

@@ -148,6 +148,9 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
                 return invalid(pos, format!("`{}` needs a comparison", d.full));
             }
             operands(i, if comb { 4 } else { 3 })?;
+            if m.types.iter().any(|t| matches!(t, Ty::F16x2 | Ty::BF16x2)) {
+                return unsupported(pos, format!("{} (packed halves)", d.full));
+            }
             if d.op == Setp {
                 one_type(d, i)?;
             } else if m.types.len() != 2 {
@@ -230,6 +233,20 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
         }
         Call | Ret => only(d, &["uni"], i)?,
         Bar | Barrier if m.has("warp") => {} // bar.warp.sync
+        Bar | Barrier if m.has("red") => {
+            only(d, &["red", "popc", "and", "or", "aligned", "sync"], i)?;
+            let t = one_type(d, i)?;
+            let ok = if m.has("popc") { t == Ty::U32 } else { (m.has("and") || m.has("or")) && t == Ty::Pred };
+            if !ok {
+                return invalid(pos, format!("`{}` needs .popc.u32, .and.pred or .or.pred", d.full));
+            }
+            if n_ops != 3 && n_ops != 4 {
+                return invalid(
+                    pos,
+                    format!("`{}` takes a destination, a barrier id, an optional count and a predicate", d.full),
+                );
+            }
+        }
         Bar | Barrier => {
             only(d, &["sync", "aligned"], i)?;
             if !m.has("sync") && d.op == Bar && !m.words.is_empty() {

@@ -236,7 +236,8 @@ pub(super) fn vote(w: &mut Warp, mode: VoteMode, d: Option<Dst>, p: PredId, a: P
     }
 }
 
-/// `redux.sync`: the operation over the executing lanes' values, given to each.
+/// `redux.sync`: the operation over the member lanes that execute it (`exec`),
+/// given to each of them.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn redux(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, op: ReduxOp, ty: Ty, d: Dst, a: Src, exec: u32) {
     let va = read(ctx, w, cta, a);
@@ -257,7 +258,7 @@ pub(super) fn redux(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, op: ReduxOp, ty: Ty, 
     write(w.frames.last_mut().expect("frame"), d, &[r; 32], exec);
 }
 
-/// `match.any.sync` / `match.all.sync` among the executing lanes.
+/// `match.any.sync` / `match.all.sync` among the member lanes that execute it (`exec`).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn match_sync(
     ctx: &Ctx,

@@ -23,7 +23,7 @@ use super::fault::FaultKind;
 use super::memory::DeviceMemory;
 use super::observer::{MemObserver, ObserverFactory};
 use super::simt_stack::SimtEntry;
-use super::warp::{Frame, Warp};
+use super::warp::{BarRedWait, Frame, Warp};
 use crate::ptx::ir::*;
 
 /// Everything an instruction may read that is shared by all CTAs of a launch.
@@ -226,6 +226,7 @@ fn special(ctx: &Ctx, w: &Warp, cta: &CtaMut, sr: SpecialReg) -> Lanes {
         SpecialReg::LaneMaskGt => std::array::from_fn(|l| (0xFFFF_FFFFu64 << (l + 1)) & 0xFFFF_FFFF),
         // A deterministic clock: the CTA's issued warp instructions.
         SpecialReg::Clock | SpecialReg::Clock64 => [cta.counters.warp_instructions; 32],
+        SpecialReg::GlobalTimerHi => [cta.counters.warp_instructions >> 32; 32],
     }
 }
 
@@ -341,10 +342,21 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             return atomic::atomic(ctx, w, cta, (func, pc), *space, *op, *ty, *d, addr, *b, *c, exec);
         }
         Kind::Bar { id, count } => return control::bar(ctx, w, cta, *id, *count, exec),
+        Kind::BarRed { op, d, p, id, count, a } => {
+            let bits = pred_bits(w.frame(), *a) & exec;
+            w.bar_red = Some(BarRedWait { op: *op, lanes: exec, bits, d: *d, p: *p });
+            return control::bar(ctx, w, cta, *id, *count, exec);
+        }
         Kind::Vote { mode, d, p, a, .. } => arith::vote(w, *mode, *d, *p, *a, exec),
         Kind::Shfl { mode, d, p, a, b, c, .. } => arith::shfl(ctx, w, cta, *mode, *d, *p, [*a, *b, *c], exec),
-        Kind::Redux { op, ty, d, a, .. } => arith::redux(ctx, w, cta, *op, *ty, *d, *a, exec),
-        Kind::Match { all, ty, d, p, a, .. } => arith::match_sync(ctx, w, cta, *all, *ty, *d, *p, *a, exec),
+        Kind::Redux { op, ty, d, a, membermask } => {
+            let members = exec & read(ctx, w, cta, *membermask)[exec.trailing_zeros() as usize] as u32;
+            arith::redux(ctx, w, cta, *op, *ty, *d, *a, members)
+        }
+        Kind::Match { all, ty, d, p, a, membermask } => {
+            let members = exec & read(ctx, w, cta, *membermask)[exec.trailing_zeros() as usize] as u32;
+            arith::match_sync(ctx, w, cta, *all, *ty, *d, *p, *a, members)
+        }
         Kind::Carry { op, cin, cout, ty, d, a, b, c, cc } => {
             arith::carry(ctx, w, cta, (*op, *cin, *cout, *ty), *d, [*a, *b, *c], *cc, exec)
         }
