@@ -10,7 +10,10 @@
 //! - Directed rounding (`.rz .rm .rp`) is exact: the round-to-nearest result is
 //!   corrected by the sign of the exact error (error-free transformations).
 //! - `.approx` transcendental functions are computed in f64 and rounded to f32
-//!   (within 1 ulp of the correctly rounded value; hardware is within 2 ulp).
+//!   (the correctly rounded value; the GPU's errors are in docs/semantics.md).
+//!   Under the hopper profile `rcp`, `rsqrt`, `sqrt` and the f32 divisions
+//!   take the H200's bits from `super::sfu` instead (chosen when decoded).
+//! - Half types (`.f16 .bf16` and pairs) are computed by `super::half`.
 //! - Integer `div` and `rem` by zero give all ones, signed or not, as an H100
 //!   does; `INT_MIN / -1` wraps to `INT_MIN` and `INT_MIN % -1` is 0.
 //! - `.sat` maps NaN and -0 to +0. With `.rm`, an exact zero sum is -0.
