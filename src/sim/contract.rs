@@ -384,3 +384,60 @@ pub fn contract(f: &Function) -> HashMap<u32, Fused> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The indices of the fused adds of kernel `k` whose body is `body`.
+    fn fused(body: &str) -> Vec<u32> {
+        let src = format!(
+            ".version 8.0\n.target sm_90\n.address_size 64\n.visible .entry k()\n{{\n\
+             .reg .pred %p<2>;\n.reg .f32 %f<8>;\n{body}\nret;\n}}\n"
+        );
+        let prog = crate::ptx::load(&src, "c.ptx").unwrap();
+        let mut v: Vec<u32> = contract(&prog.functions[0]).into_keys().collect();
+        v.sort_unstable();
+        v
+    }
+
+    #[test]
+    fn a_single_add_use_is_fused_with_the_product_sign() {
+        let f = fused("mul.f32 %f3, %f1, %f2;\nsub.f32 %f4, %f5, %f3;");
+        assert_eq!(f, vec![1]);
+        let src = ".version 8.0\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n.reg .f32 %f<8>;\n\
+                   mul.f32 %f3, %f1, %f2;\nsub.f32 %f4, %f5, %f3;\nret;\n}\n";
+        let prog = crate::ptx::load(src, "c.ptx").unwrap();
+        let fz = contract(&prog.functions[0])[&1];
+        assert_eq!((fz.mul, fz.neg_product, fz.neg_c, fz.c), (0, true, false, Src::Reg(5)));
+    }
+
+    #[test]
+    fn other_uses_rounding_and_flush_modes_block_it() {
+        assert!(fused("mul.f32 %f3, %f1, %f2;\nadd.f32 %f4, %f3, %f5;\nsetp.lt.f32 %p1, %f3, %f5;").is_empty());
+        assert!(fused("mul.rn.f32 %f3, %f1, %f2;\nadd.f32 %f4, %f3, %f5;").is_empty());
+        assert!(fused("mul.f32 %f3, %f1, %f2;\nadd.rz.f32 %f4, %f3, %f5;").is_empty());
+        assert!(fused("mul.ftz.f32 %f3, %f1, %f2;\nadd.f32 %f4, %f3, %f5;").is_empty());
+        assert!(fused("mul.f32 %f3, %f1, %f2;\nabs.f32 %f6, %f3;\nadd.f32 %f4, %f6, %f5;").is_empty());
+    }
+
+    #[test]
+    fn a_use_in_another_block_blocks_it() {
+        let body = "mul.f32 %f3, %f1, %f2;\n@%p1 bra L;\nadd.f32 %f4, %f3, %f5;\nL:\nadd.f32 %f6, %f3, %f5;";
+        assert!(fused(body).is_empty());
+    }
+
+    /// The two limits outside the measured shapes: a predicated `mul`, and a
+    /// factor register assigned between the `mul` and the add.
+    #[test]
+    fn documented_limits_are_not_fused() {
+        assert!(fused("@%p1 mul.f32 %f3, %f1, %f2;\nadd.f32 %f4, %f3, %f5;").is_empty());
+        assert!(fused("mul.f32 %f3, %f1, %f2;\nmov.f32 %f1, %f5;\nadd.f32 %f4, %f3, %f5;").is_empty());
+    }
+
+    #[test]
+    fn through_mov_and_neg_each_add_is_fused() {
+        let body = "mul.f32 %f3, %f1, %f2;\nmov.f32 %f6, %f3;\nneg.f32 %f7, %f3;\nadd.f32 %f4, %f6, %f5;\nadd.f32 %f5, %f7, %f4;";
+        assert_eq!(fused(body), vec![3, 4]);
+    }
+}
