@@ -124,6 +124,24 @@ WL_DEV float __uint_as_float(unsigned x) { return __builtin_bit_cast(float, x); 
 WL_DEV double __fma_rn(double a, double b, double c) { return __nvvm_fma_rn_d(a, b, c); }
 WL_DEV double sqrt(double x) { return __nvvm_sqrt_rn_d(x); }
 
+// ---- warp and CTA reductions, matches (sm_80+: redux.sync) ----
+WL_DEV unsigned __reduce_add_sync(unsigned m, unsigned v) { return (unsigned)__nvvm_redux_sync_add((int)v, m); }
+WL_DEV unsigned __reduce_min_sync(unsigned m, unsigned v) { return __nvvm_redux_sync_umin(v, m); }
+WL_DEV int __reduce_min_sync(unsigned m, int v) { return __nvvm_redux_sync_min(v, m); }
+WL_DEV unsigned __reduce_max_sync(unsigned m, unsigned v) { return __nvvm_redux_sync_umax(v, m); }
+WL_DEV int __reduce_max_sync(unsigned m, int v) { return __nvvm_redux_sync_max(v, m); }
+WL_DEV unsigned __reduce_and_sync(unsigned m, unsigned v) { return (unsigned)__nvvm_redux_sync_and((int)v, m); }
+WL_DEV unsigned __reduce_or_sync(unsigned m, unsigned v) { return (unsigned)__nvvm_redux_sync_or((int)v, m); }
+WL_DEV unsigned __reduce_xor_sync(unsigned m, unsigned v) { return (unsigned)__nvvm_redux_sync_xor((int)v, m); }
+WL_DEV unsigned __match_any_sync(unsigned m, unsigned v) { return __nvvm_match_any_sync_i32(m, v); }
+WL_DEV unsigned __match_all_sync(unsigned m, unsigned v, int *pred) { return __nvvm_match_all_sync_i32p(m, v, pred); }
+WL_DEV int __syncthreads_count(int p) { return __nvvm_bar0_popc(p); }
+WL_DEV int __syncthreads_and(int p) { return __nvvm_bar0_and(p); }
+WL_DEV int __syncthreads_or(int p) { return __nvvm_bar0_or(p); }
+WL_DEV int __popcll(unsigned long long x) { return __builtin_popcountll(x); }
+WL_DEV int __clzll(long long x) { return x == 0 ? 64 : __builtin_clzll((unsigned long long)x); }
+WL_DEV unsigned long long __brevll(unsigned long long x) { return __builtin_bitreverse64(x); }
+
 #endif // !__NVCC__
 
 // ---- warplight helpers, for both compilers ----

@@ -21,7 +21,9 @@
 //!
 //! Optional top-level limits hold for every launch: `max_instructions` (the
 //! watchdog, warp instructions per launch) and `max_call_depth` (nested
-//! device-function calls per warp); see `docs/limits.md`.
+//! device-function calls per warp); see `docs/limits.md`. `fmad = false` turns
+//! off ptxas's FMA contraction of unrounded `mul` + `add` pairs (on by default
+//! for the maxwell and hopper profiles; docs/semantics.md).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -271,6 +273,8 @@ pub struct Spec {
     pub max_instructions: Option<u64>,
     /// Most nested device-function calls per warp (`max_call_depth`), when given.
     pub max_call_depth: Option<u32>,
+    /// ptxas's FMA contraction (`fmad = false` turns it off), when given.
+    pub fmad: Option<bool>,
 }
 
 struct Ctx<'a> {
@@ -385,11 +389,12 @@ pub const MAX_PTX_BYTES: u64 = 256 << 20;
 pub const MAX_DYNAMIC_SHARED: u32 = 228 * 1024;
 
 /// The keys a spec knows: at the top, in `[[buffer]]` and in `[[launch]]` tables.
-const TOP_KEYS: [&str; 12] = [
+const TOP_KEYS: [&str; 13] = [
     "ptx",
     "device",
     "max_instructions",
     "max_call_depth",
+    "fmad",
     "buffer",
     "constant",
     "launch",
@@ -555,6 +560,13 @@ impl Spec {
         };
         let max_instructions = positive("max_instructions", i64::MAX as u64)?;
         let max_call_depth = positive("max_call_depth", u32::MAX as u64)?.map(|d| d as u32);
+        let fmad = match t.get("fmad") {
+            None => None,
+            Some(v) => match v.as_bool() {
+                Some(b) => Some(b),
+                None => return cx.err("fmad", "expected true or false"),
+            },
+        };
         let buffers = cx.buffers(&t, "buffer", dir)?;
         let constants = cx.buffers(&t, "constant", dir)?;
         let launches = match t.get("launch") {
@@ -605,6 +617,7 @@ impl Spec {
             launches,
             max_instructions,
             max_call_depth,
+            fmad,
         })
     }
 
@@ -956,10 +969,14 @@ init = [1, 2, 3]
         assert_eq!(s.sim_config(0, None).schedule.max_warp_instructions, 1000);
         assert_eq!(s.sim_config(0, Some(7)).schedule.max_warp_instructions, 7);
         assert_eq!(s.sim_config(0, None).max_call_depth, 9);
+        assert_eq!(parse(&format!("fmad = false\n{base}")).unwrap().fmad, Some(false));
+        assert_eq!(s.fmad, None);
         for bad in ["max_instructions = 0", "max_call_depth = 4294967296", "max_call_depth = 1.5"] {
             let e = parse(&format!("{bad}\n{base}")).unwrap_err();
             assert!(e.to_string().contains("expected an integer from 1 to"), "{bad}: {e}");
         }
+        let e = parse(&format!("fmad = 1\n{base}")).unwrap_err();
+        assert!(e.to_string().contains("`fmad`: expected true or false"), "{e}");
     }
 
     #[test]

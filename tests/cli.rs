@@ -394,3 +394,42 @@ fn step_and_trace_use_the_specs_device() {
     assert!(ok, "{err}");
     assert!(std::fs::read_to_string(&page).unwrap().contains("\"profile\":\"hopper\""), "--device wins");
 }
+
+/// `--fmad`, the spec's `fmad` and the device profile decide ptxas's FFMA
+/// contraction: `a*b + c` with c = -RN(a*b) is the product's rounding error
+/// when fused and 0 when rounded twice.
+#[test]
+fn fmad_flag_spec_key_and_profile_decide_contraction() {
+    let dir = std::env::temp_dir().join(format!("warplight-fmad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ptx = ".version 8.0\n.target sm_90\n.address_size 64\n.visible .entry k(.param .u64 p)\n{\n\
+               .reg .f32 %f<5>;\n.reg .b64 %rd<2>;\nld.param.u64 %rd1, [p];\ncvta.to.global.u64 %rd1, %rd1;\n\
+               ld.global.f32 %f1, [%rd1];\nmul.f32 %f2, %f1, %f1;\nneg.f32 %f3, %f2;\nmul.rn.f32 %f4, %f1, %f1;\n\
+               neg.f32 %f4, %f4;\nadd.f32 %f3, %f2, %f4;\nst.global.f32 [%rd1], %f3;\nret;\n}\n";
+    std::fs::write(dir.join("k.ptx"), ptx).unwrap();
+    let spec = |extra: &str| {
+        format!(
+            "{extra}ptx = \"k.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 1\nargs = [\"x\"]\n\
+             [[buffer]]\nname = \"x\"\ntype = \"f32\"\nlen = 1\ninit = [1.0000001]\n"
+        )
+    };
+    std::fs::write(dir.join("a.toml"), spec("")).unwrap();
+    std::fs::write(dir.join("b.toml"), spec("fmad = false\n")).unwrap();
+    let value = |args: &[&str]| {
+        let (ok, out, err) = warplight(args);
+        assert!(ok, "{args:?}: {err}");
+        let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+        v["print"]["x:0..1"]["values"][0].as_f64().unwrap()
+    };
+    let a = dir.join("a.toml");
+    let b = dir.join("b.toml");
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let fused = value(&["launch", a, "--json", "--print", "x"]);
+    assert!(fused != 0.0, "contracted by default on hopper: the product's rounding error");
+    assert_eq!(value(&["launch", a, "--json", "--print", "x", "--fmad=false"]), 0.0);
+    assert_eq!(value(&["launch", b, "--json", "--print", "x"]), 0.0, "the spec's fmad = false");
+    assert_eq!(value(&["launch", b, "--json", "--print", "x", "--fmad=true"]), fused, "the flag over the spec");
+    assert_eq!(value(&["launch", a, "--json", "--print", "x", "--device", "gt200"]), 0.0, "gt200 does not contract");
+    assert_eq!(value(&["launch", a, "--json", "--print", "x", "--device", "maxwell"]), fused);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -60,6 +60,11 @@ pub struct LaunchOptions {
     /// Also list zero counters and the profiler's names of the counters.
     #[arg(long)]
     pub all: bool,
+    /// ptxas's FMA contraction of unrounded mul + add/sub pairs: --fmad=false
+    /// rounds every instruction as written (default: the spec's `fmad`, else on
+    /// for maxwell and hopper, off for gt200). See docs/semantics.md.
+    #[arg(long, value_name = "BOOL")]
+    pub fmad: Option<bool>,
     /// After all launches succeed, print buffer NAME's elements (repeatable): NAME (the
     /// first 256), NAME:I, NAME:A..B (B excluded), NAME:A.. or NAME:..B.
     #[arg(long, value_name = "NAME[:RANGE]")]
@@ -110,6 +115,8 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     let mut config = spec.sim_config(threads, a.max_instructions);
     config.fidelity = a.fidelity;
     a.checks.configure(&mut config)?;
+    config.fmad = crate::sim::contract::for_profile(profile, a.fmad.or(spec.fmad));
+    config.sfu = crate::sim::sfu::SfuModel::for_profile(profile);
     let mut dev = Device::with_config(config);
     let prepared = launch_spec::prepare(&spec, &mut dev)?;
     let prog = &prepared.module.prog;

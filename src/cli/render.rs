@@ -37,6 +37,10 @@ pub struct RenderArgs {
     /// Device profile of the emulated kernels' memory counters: gt200, maxwell, hopper.
     #[arg(long, default_value = "gt200")]
     pub device: String,
+    /// ptxas's FMA contraction in the emulated kernels: --fmad=false rounds every
+    /// instruction as written (default: on for maxwell and hopper, off for gt200).
+    #[arg(long, value_name = "BOOL")]
+    pub fmad: Option<bool>,
     /// What the emulated kernels model beyond the image: functional, instructions,
     /// memory or caches (the full model). The image is the same at every level.
     #[arg(long, default_value_t = crate::sim::Fidelity::Caches)]
@@ -196,6 +200,8 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         Some(v) => {
             let mut config = rt_kernels::sim_config(&cam);
             config.fidelity = a.fidelity;
+            config.fmad = crate::sim::contract::for_profile(profile, a.fmad);
+            config.sfu = crate::sim::sfu::SfuModel::for_profile(profile);
             let mut dev = Device::with_config(config);
             let module = rt_kernels::load(&mut dev)?;
             let pb = pixel_progress(&mut dev, v.kernel(), width as u64 * height as u64);

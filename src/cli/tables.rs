@@ -78,6 +78,11 @@ pub struct TablesArgs {
     /// (default: the lowest level the named tables need; see docs/performance.md).
     #[arg(long)]
     pub fidelity: Option<crate::sim::Fidelity>,
+    /// ptxas's FMA contraction in the emulated runs of maxwell and hopper
+    /// tables (--fmad=false: every instruction rounded as written); gt200 runs
+    /// never contract. See docs/semantics.md.
+    #[arg(long, value_name = "BOOL")]
+    pub fmad: Option<bool>,
 }
 
 /// Runs the command.
@@ -257,6 +262,7 @@ fn plan(a: &TablesArgs) -> Result<Planned, Box<dyn std::error::Error>> {
 fn measure(a: &TablesArgs) -> Result<Results, Box<dyn std::error::Error>> {
     let needed = registry::resolve(&a.tables)?.iter().map(registry::lowest_fidelity).max();
     crate::sim::fidelity::set_default_level(a.fidelity.or(needed).unwrap_or_default());
+    crate::sim::contract::set_default(a.fmad.unwrap_or(true));
     let (plan, scenes, unavailable) = plan(a)?;
     let threads = rayon::current_num_threads();
     eprint!("{}", plan.describe(&scenes, &unavailable, threads));

@@ -39,6 +39,8 @@ pub enum SpecialReg {
     LaneMaskGt,
     Clock,
     Clock64,
+    /// `%globaltimer_hi`: the upper 32 bits of the deterministic clock.
+    GlobalTimerHi,
 }
 
 /// A source operand.
@@ -206,6 +208,62 @@ pub enum ArithOp {
     Ex2,
     Lg2,
     Copysign,
+    /// `bfind`: the bit position of the most significant non-sign bit (all
+    /// ones when none).
+    Bfind,
+    /// `bfind.shiftamt`: the left shift that brings that bit to the top.
+    BfindShiftamt,
+    /// `prmt.b32.f4e` (forward 4 extract), and the other `prmt` modes.
+    PrmtF4e,
+    PrmtB4e,
+    PrmtRc8,
+    PrmtEcl,
+    PrmtEcr,
+    PrmtRc16,
+    /// `dp4a.atype.u32`: four byte products summed into `c`; the instruction
+    /// type is `a`'s, `b`'s bytes are unsigned.
+    Dp4aU,
+    /// `dp4a.atype.s32`: `b`'s bytes signed.
+    Dp4aS,
+    /// `dp2a.lo.atype.u32`: two 16-bit by 8-bit products (bytes 0, 1 of `b`).
+    Dp2aLoU,
+    Dp2aLoS,
+    /// `dp2a.hi`: bytes 2, 3 of `b`.
+    Dp2aHiU,
+    Dp2aHiS,
+    /// `cvt.rn.f16x2.f32 d, a, b` (and `.bf16x2`): `a` into the upper half, `b` the lower.
+    CvtPack,
+}
+
+/// `redux.sync` operations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum ReduxOp {
+    Add,
+    Min,
+    Max,
+    And,
+    Or,
+    Xor,
+}
+
+/// `bar.red` reductions (`__syncthreads_count`, `_and`, `_or`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum BarRedOp {
+    Popc,
+    And,
+    Or,
+}
+
+/// Carry-chain operations: `add.cc/addc`, `sub.cc/subc`, `mad.lo.cc/madc.lo`, `mad.hi.cc/madc.hi`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum CarryOp {
+    Add,
+    Sub,
+    MadLo,
+    MadHi,
 }
 
 /// Floating-point and saturation modifiers of an arithmetic instruction.
@@ -219,6 +277,9 @@ pub struct FloatMode {
     pub sat: bool,
     /// `.approx` (or `.full` for `div`): an approximation, not correctly rounded.
     pub approx: bool,
+    /// `div.full` (also sets `approx`): the division that rescales huge and
+    /// tiny divisors around the approximate reciprocal.
+    pub full: bool,
 }
 
 /// Atomic operations.
@@ -315,10 +376,22 @@ pub enum Kind {
     Exit,
     /// `bar.sync id[, count]` / `barrier.sync`.
     Bar { id: Src, count: Option<Src> },
+    /// `bar.red.op id[, count], a`: a barrier that also reduces predicate `a`
+    /// over the CTA's arriving threads; `.popc` writes the count to `d`,
+    /// `.and`/`.or` write predicate `p`.
+    BarRed { op: BarRedOp, d: Option<Dst>, p: PredId, id: Src, count: Option<Src>, a: PredSrc },
     /// `vote.sync.mode`: a ballot writes `d`, the others write predicate `p`.
     Vote { mode: VoteMode, d: Option<Dst>, p: PredId, a: PredSrc, membermask: Src },
     /// `shfl.sync.mode.b32 d[|p], a, b, c, membermask`.
     Shfl { mode: ShflMode, d: Dst, p: Option<PredId>, a: Src, b: Src, c: Src, membermask: Src },
+    /// `redux.sync.op.ty d, a, membermask`: the operation over the member lanes' `a`.
+    Redux { op: ReduxOp, ty: Ty, d: Dst, a: Src, membermask: Src },
+    /// `match.any.sync.ty d, a, membermask` (the lanes holding the same
+    /// value), or `match.all` (all members or none; `p`: whether all agree).
+    Match { all: bool, ty: Ty, d: Dst, p: Option<PredId>, a: Src, membermask: Src },
+    /// A carry-chain instruction: `cin` reads the condition code `cc` (a
+    /// register the front end adds), `cout` writes it.
+    Carry { op: CarryOp, cin: bool, cout: bool, ty: Ty, d: Dst, a: Src, b: Src, c: Src, cc: RegId },
     /// `membar` / `fence`.
     Membar,
     /// An instruction with no effect in the model (`prefetch`, `pmevent`...).

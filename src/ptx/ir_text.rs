@@ -310,6 +310,37 @@ impl Names<'_> {
                 self.src(*c),
                 self.src(*membermask)
             ),
+            Kind::Redux { op, ty, d, a, membermask } => {
+                format!("redux.{}.{ty} {} <- {}, mask {}", lc(op), self.dst(*d), self.src(*a), self.src(*membermask))
+            }
+            Kind::Match { all, ty, d, p, a, membermask } => format!(
+                "match.{}.{ty} {}{} <- {}, mask {}",
+                if *all { "all" } else { "any" },
+                self.dst(*d),
+                p.map(|p| format!("|{}", self.pred(p))).unwrap_or_default(),
+                self.src(*a),
+                self.src(*membermask)
+            ),
+            Kind::Carry { op, cin, cout, ty, d, a, b, c, cc } => format!(
+                "carry.{}{}{}.{ty} {} <- {}, {}, {} ({})",
+                lc(op),
+                if *cin { ".cin" } else { "" },
+                if *cout { ".cout" } else { "" },
+                self.dst(*d),
+                self.src(*a),
+                self.src(*b),
+                self.src(*c),
+                self.reg(*cc)
+            ),
+            Kind::BarRed { op, d, p, id, count, a } => format!(
+                "bar.red.{} {} {} <- {}{}, {}",
+                lc(op),
+                d.map(|d| self.dst(d)).unwrap_or_else(|| "-".into()),
+                self.pred(*p),
+                self.src(*id),
+                count.map(|c| format!(", {}", self.src(c))).unwrap_or_default(),
+                self.pred_src(*a)
+            ),
             Kind::Membar => "membar".into(),
             Kind::Nop => "nop".into(),
             Kind::Trap => "trap".into(),
@@ -319,13 +350,13 @@ impl Names<'_> {
 
 /// `.rn.ftz.sat.approx` for the modifiers that are set.
 fn float_mode(m: FloatMode) -> String {
-    let FloatMode { rnd, ftz, sat, approx } = m;
+    let FloatMode { rnd, ftz, sat, approx, full } = m;
     let mut s = String::new();
     if let Some(r) = rnd {
         s.push('.');
         s.push_str(&lc(r));
     }
-    for (on, w) in [(ftz, ".ftz"), (sat, ".sat"), (approx, ".approx")] {
+    for (on, w) in [(ftz, ".ftz"), (sat, ".sat"), (approx && !full, ".approx"), (full, ".full")] {
         if on {
             s.push_str(w);
         }

@@ -73,6 +73,14 @@ pub const KNOWN_OPCODES: &[&str] = &[
     "nanosleep",
     "brkpt",
     "nop",
+    "redux",
+    "match",
+    "bfind",
+    "dp4a",
+    "dp2a",
+    "addc",
+    "subc",
+    "madc",
 ];
 
 /// Deepest nesting of `{ }` blocks, initializer braces and operand lists the
@@ -287,10 +295,11 @@ impl<'a> Parser<'a> {
                 Ok(())
             }
             Some(s) if Space::parse(s).is_some() => {
-                let mut v = self.var_decl()?;
-                v.is_extern = is_extern;
+                for mut v in self.var_decls()? {
+                    v.is_extern = is_extern;
+                    m.vars.push(v);
+                }
                 self.expect_punct(';')?;
-                m.vars.push(v);
                 Ok(())
             }
             Some(s) => Err((pos, PtxErrorKind::UnsupportedDirective(format!(".{s}")))),
@@ -321,6 +330,36 @@ impl<'a> Parser<'a> {
             }
         }
         let ty = ty.ok_or((pos, PtxErrorKind::Syntax("declaration without a type".into())))?;
+        self.decl_name(VarDecl {
+            space,
+            align,
+            vector,
+            ty,
+            name: String::new(),
+            range: None,
+            dims: Vec::new(),
+            init: None,
+            is_extern: false,
+            pos,
+        })
+    }
+
+    /// A declaration followed by more names of the same space and type
+    /// (`.reg .b32 %a, %b, %r<4>;`, which ptxas accepts): one [`VarDecl`] each.
+    fn var_decls(&mut self) -> PResult<Vec<VarDecl>> {
+        let first = self.var_decl()?;
+        let mut out = vec![first];
+        while self.eat_punct(',') {
+            let head = VarDecl { pos: self.pos(), ..out[0].clone() };
+            out.push(self.decl_name(head)?);
+        }
+        Ok(out)
+    }
+
+    /// The part of a declaration after its type: `name[<n>][dims] [= init]`,
+    /// filled into `head` (which carries the space, alignment and type).
+    fn decl_name(&mut self, head: VarDecl) -> PResult<VarDecl> {
+        let VarDecl { space, align, vector, ty, pos, .. } = head;
         let name = self.expect_ident()?;
         let mut range = None;
         if self.eat_punct('<') {
@@ -480,9 +519,8 @@ impl<'a> Parser<'a> {
                         self.expect_punct(';')?;
                     }
                     s if Space::parse(s).is_some() => {
-                        let v = self.var_decl()?;
+                        out.extend(self.var_decls()?.into_iter().map(Stmt::Decl));
                         self.expect_punct(';')?;
-                        out.push(Stmt::Decl(v));
                     }
                     _ => return Err((pos, PtxErrorKind::UnsupportedDirective(format!(".{d}")))),
                 },
@@ -674,6 +712,27 @@ mod tests {
         let Stmt::Inst(ld) = &body[3] else { panic!() };
         assert_eq!(ld.full_opcode(), "ld.global.nc.v2.f32");
         assert_eq!(ld.operands[1], Operand::Addr(Some("%rd1".into()), -8));
+    }
+
+    #[test]
+    fn one_declaration_may_name_several_registers() {
+        let m = parse_str(
+            ".entry k()\n{\n.reg .b32 %a, %b, %r<4>;\n.reg .f32 %f;\nret;\n}\n.global .u32 g0, g1[2] = {1, 2};\n",
+        );
+        let body = m.functions[0].body.as_ref().unwrap();
+        let names: Vec<(String, Option<u32>)> = body
+            .iter()
+            .filter_map(|s| match s {
+                Stmt::Decl(d) => Some((d.name.clone(), d.range)),
+                _ => None,
+            })
+            .collect();
+        let want = [("%a", None), ("%b", None), ("%r", Some(4)), ("%f", None)];
+        assert_eq!(names, want.map(|(n, r)| (n.to_string(), r)));
+        assert!(matches!(&body[2], Stmt::Decl(d) if d.ty == Ty::B32));
+        assert_eq!(m.vars.len(), 2);
+        assert_eq!((m.vars[1].name.as_str(), m.vars[1].dims.as_slice()), ("g1", &[Some(2)][..]));
+        assert!(m.vars[0].init.is_none());
     }
 
     #[test]

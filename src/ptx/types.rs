@@ -19,6 +19,12 @@ pub enum Ty {
     S32,
     S64,
     F16,
+    /// bfloat16.
+    BF16,
+    /// Two `.f16` in 32 bits (the first in the low half).
+    F16x2,
+    /// Two `.bf16` in 32 bits.
+    BF16x2,
     F32,
     F64,
     Pred,
@@ -41,6 +47,9 @@ impl Ty {
             "s32" => Ty::S32,
             "s64" => Ty::S64,
             "f16" => Ty::F16,
+            "bf16" => Ty::BF16,
+            "f16x2" => Ty::F16x2,
+            "bf16x2" => Ty::BF16x2,
             "f32" => Ty::F32,
             "f64" => Ty::F64,
             "pred" => Ty::Pred,
@@ -52,8 +61,8 @@ impl Ty {
     pub fn bits(self) -> u32 {
         match self {
             Ty::B8 | Ty::U8 | Ty::S8 => 8,
-            Ty::B16 | Ty::U16 | Ty::S16 | Ty::F16 => 16,
-            Ty::B32 | Ty::U32 | Ty::S32 | Ty::F32 => 32,
+            Ty::B16 | Ty::U16 | Ty::S16 | Ty::F16 | Ty::BF16 => 16,
+            Ty::B32 | Ty::U32 | Ty::S32 | Ty::F32 | Ty::F16x2 | Ty::BF16x2 => 32,
             Ty::B64 | Ty::U64 | Ty::S64 | Ty::F64 => 64,
             Ty::Pred => 1,
         }
@@ -66,7 +75,7 @@ impl Ty {
 
     /// True for `.f16`, `.f32`, `.f64`.
     pub fn is_float(self) -> bool {
-        matches!(self, Ty::F16 | Ty::F32 | Ty::F64)
+        matches!(self, Ty::F16 | Ty::BF16 | Ty::F16x2 | Ty::BF16x2 | Ty::F32 | Ty::F64)
     }
 
     /// True for the signed integer types.

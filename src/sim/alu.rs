@@ -10,7 +10,10 @@
 //! - Directed rounding (`.rz .rm .rp`) is exact: the round-to-nearest result is
 //!   corrected by the sign of the exact error (error-free transformations).
 //! - `.approx` transcendental functions are computed in f64 and rounded to f32
-//!   (within 1 ulp of the correctly rounded value; hardware is within 2 ulp).
+//!   (the correctly rounded value; the GPU's errors are in docs/semantics.md).
+//!   Under the hopper profile `rcp`, `rsqrt`, `sqrt` and the f32 divisions
+//!   take the H200's bits from `super::sfu` instead (chosen when decoded).
+//! - Half types (`.f16 .bf16` and pairs) are computed by `super::half`.
 //! - Integer `div` and `rem` by zero give all ones, signed or not, as an H100
 //!   does; `INT_MIN / -1` wraps to `INT_MIN` and `INT_MIN % -1` is 0.
 //! - `.sat` maps NaN and -0 to +0. With `.rm`, an exact zero sum is -0.
@@ -19,8 +22,9 @@
 
 use std::cmp::Ordering;
 
-use crate::ptx::ir::{ArithOp, AtomOp, Cmp, FloatMode, Rounding};
+use crate::ptx::ir::{ArithOp, AtomOp, CarryOp, Cmp, FloatMode, Rounding};
 use crate::ptx::types::Ty;
+use crate::sim::half;
 
 /// The canonical f32 NaN of NVIDIA GPUs.
 pub const NAN32: u32 = 0x7FFF_FFFF;
@@ -345,6 +349,7 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
     match ty {
         Ty::F32 => return f32op(op, m, a, b, c),
         Ty::F64 => return f64op(op, m, a, b, c),
+        t if half::is_half(t) => return half::arith(op, t, m, a, b, c),
         _ => {}
     }
     let w = ty.bits();
@@ -472,10 +477,93 @@ pub fn arith(op: ArithOp, ty: Ty, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
             }
             d
         }
+        ArithOp::PrmtF4e
+        | ArithOp::PrmtB4e
+        | ArithOp::PrmtRc8
+        | ArithOp::PrmtEcl
+        | ArithOp::PrmtEcr
+        | ArithOp::PrmtRc16 => prmt_mode(op, a, b, c),
+        ArithOp::Bfind | ArithOp::BfindShiftamt => {
+            // the most significant bit that differs from the sign (unsigned: that is set)
+            let x = if signed && sa < 0 { !ua & mask } else { ua };
+            return if x == 0 {
+                0xFFFF_FFFF
+            } else {
+                let pos = 63 - x.leading_zeros() as u64;
+                if op == ArithOp::BfindShiftamt { (w as u64 - 1) - pos } else { pos }
+            };
+        }
+        ArithOp::Dp4aU | ArithOp::Dp4aS | ArithOp::Dp2aLoU | ArithOp::Dp2aLoS | ArithOp::Dp2aHiU | ArithOp::Dp2aHiS => {
+            return dot(op, signed, a, b, c) & 0xFFFF_FFFF;
+        }
         _ => 0,
     };
     let _ = sc;
     r & mask
+}
+
+/// `prmt.b32` in one of its modes: the two low bits of `c` select the bytes of
+/// {b, a} (a the low four).
+fn prmt_mode(op: ArithOp, a: u64, b: u64, c: u64) -> u64 {
+    let bytes = ((b & 0xFFFF_FFFF) << 32) | (a & 0xFFFF_FFFF);
+    let s = c & 3;
+    let mut d = 0u64;
+    for k in 0..4u64 {
+        let sel = match op {
+            ArithOp::PrmtF4e => s + k,
+            ArithOp::PrmtB4e => (s + 8 - k) & 7,
+            ArithOp::PrmtRc8 => s,
+            ArithOp::PrmtEcl => k.max(s),
+            ArithOp::PrmtEcr => k.min(s),
+            _ => 2 * (s & 1) + (k & 1), // rc16
+        };
+        d |= ((bytes >> (8 * sel)) & 0xFF) << (8 * k);
+    }
+    d
+}
+
+/// `dp4a`/`dp2a`: `c` plus the products of `a`'s bytes (dp2a: 16-bit halves,
+/// signed when `a_signed`) with `b`'s bytes (signedness by the operation).
+fn dot(op: ArithOp, a_signed: bool, a: u64, b: u64, c: u64) -> u64 {
+    let b_signed = matches!(op, ArithOp::Dp4aS | ArithOp::Dp2aLoS | ArithOp::Dp2aHiS);
+    let part = |x: u64, k: u64, bits: u64, s: bool| -> i64 {
+        let v = (x >> (k * bits)) & ((1 << bits) - 1);
+        if s && v >> (bits - 1) != 0 { v as i64 - (1 << bits) } else { v as i64 }
+    };
+    let mut acc = c as u32 as i64;
+    match op {
+        ArithOp::Dp4aU | ArithOp::Dp4aS => {
+            for k in 0..4 {
+                acc += part(a, k, 8, a_signed) * part(b, k, 8, b_signed);
+            }
+        }
+        _ => {
+            let hi = if matches!(op, ArithOp::Dp2aHiU | ArithOp::Dp2aHiS) { 2 } else { 0 };
+            for k in 0..2 {
+                acc += part(a, k, 16, a_signed) * part(b, k + hi, 8, b_signed);
+            }
+        }
+    }
+    acc as u64
+}
+
+/// One carry-chain step on `ty` (32 or 64 bits): the result and the carry
+/// (borrow for `sub`) out. `cin` is the carry (borrow) in, 0 or 1.
+pub fn carry(op: CarryOp, ty: Ty, a: u64, b: u64, c: u64, cin: u64) -> (u64, u64) {
+    let w = ty.bits();
+    let mask = ty.mask() as u128;
+    let (a, b, c) = (a as u128 & mask, b as u128 & mask, c as u128 & mask);
+    let cin = cin as u128 & 1;
+    let wide = match op {
+        CarryOp::Add => a + b + cin,
+        CarryOp::Sub => {
+            let r = a.wrapping_sub(b).wrapping_sub(cin) & mask;
+            return (r as u64, (a < b + cin) as u64);
+        }
+        CarryOp::MadLo => ((a * b) & mask) + c + cin,
+        CarryOp::MadHi => ((a * b) >> w) + c + cin,
+    };
+    ((wide & mask) as u64, (wide >> w) as u64 & 1)
 }
 
 fn min_of(w: u32) -> i128 {
@@ -506,6 +594,9 @@ pub fn compare(cmp: Cmp, ty: Ty, ftz: bool, a: u64, b: u64) -> bool {
     if ty.is_float() {
         let (x, y) = if ty == Ty::F32 {
             (in32(a, ftz) as f64, in32(b, ftz) as f64)
+        } else if half::is_half(ty) {
+            let bf = ty == Ty::BF16;
+            (half::to_f64(a as u16, bf), half::to_f64(b as u16, bf))
         } else {
             (f64::from_bits(a), f64::from_bits(b))
         };
@@ -672,6 +763,9 @@ fn int_range(t: Ty) -> (i128, i128) {
 
 /// Evaluates `cvt.mode.dty.sty` on one lane.
 pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> u64 {
+    if let Some(r) = half::cvt(dty, sty, m, a) {
+        return r;
+    }
     match (dty.is_float(), sty.is_float()) {
         (false, false) => {
             let v: i128 = if sty.is_signed() { sty.extend(a) as i64 as i128 } else { (a & sty.mask()) as i128 };
@@ -883,7 +977,7 @@ mod tests {
         }
     }
 
-    const M: FloatMode = FloatMode { rnd: None, ftz: false, sat: false, approx: false };
+    const M: FloatMode = FloatMode { rnd: None, ftz: false, sat: false, approx: false, full: false };
 
     fn f(x: f32) -> u64 {
         x.to_bits() as u64
@@ -998,6 +1092,48 @@ mod tests {
         assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x3210), 0x4433_2211);
         assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x4433_2211, 0x8877_6655, 0x7654), 0x8877_6655);
         assert_eq!(arith(ArithOp::Prmt, Ty::B32, M, 0x0000_0080, 0, 0x8888), 0xFFFF_FFFF);
+    }
+
+    /// The `prmt` modes on bytes 0x00..0x77 of {b, a}, as PTX's table lists them.
+    #[test]
+    fn prmt_modes() {
+        let (a, b) = (0x3322_1100u64, 0x7766_5544u64);
+        let p = |op, s| arith(op, Ty::B32, M, a, b, s);
+        assert_eq!(p(ArithOp::PrmtF4e, 1), 0x4433_2211);
+        assert_eq!(p(ArithOp::PrmtB4e, 0), 0x5566_7700);
+        assert_eq!(p(ArithOp::PrmtB4e, 3), 0x0011_2233);
+        assert_eq!(p(ArithOp::PrmtRc8, 2), 0x2222_2222);
+        assert_eq!(p(ArithOp::PrmtEcl, 1), 0x3322_1111);
+        assert_eq!(p(ArithOp::PrmtEcr, 2), 0x2222_1100);
+        assert_eq!(p(ArithOp::PrmtRc16, 1), 0x3322_3322);
+        assert_eq!(p(ArithOp::PrmtRc16, 6), 0x1100_1100, "only the selector's two low bits count");
+    }
+
+    #[test]
+    fn bfind_and_dot_products() {
+        assert_eq!(arith(ArithOp::Bfind, Ty::U32, M, 0x10, 0, 0), 4);
+        assert_eq!(arith(ArithOp::Bfind, Ty::U32, M, 0, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::BfindShiftamt, Ty::U32, M, 0x10, 0, 0), 27);
+        assert_eq!(arith(ArithOp::Bfind, Ty::S32, M, 0xFFFF_FFF0, 0, 0), 3, "the top bit unlike the sign");
+        assert_eq!(arith(ArithOp::Bfind, Ty::S32, M, 0xFFFF_FFFF, 0, 0), 0xFFFF_FFFF);
+        assert_eq!(arith(ArithOp::Bfind, Ty::U64, M, 1 << 40, 0, 0), 40);
+        // bytes (1, 2, 3, 0xFF) . (4, 5, 6, 7) + 10: 0xFF is 255 unsigned, -1 signed
+        let (a, b) = (0xFF03_0201u64, 0x0706_0504u64);
+        assert_eq!(arith(ArithOp::Dp4aU, Ty::U32, M, a, b, 10), 10 + 4 + 10 + 18 + 255 * 7);
+        assert_eq!(arith(ArithOp::Dp4aU, Ty::S32, M, a, b, 10), 10 + 4 + 10 + 18 - 7);
+        // halves (0x0201, 0xFF03) times bytes 2, 3 of b (6, 7)
+        assert_eq!(arith(ArithOp::Dp2aHiU, Ty::S32, M, a, b, 0), (0x0201 * 6 + (0xFF03 - 0x10000) * 7) as u32 as u64);
+    }
+
+    #[test]
+    fn carry_chains() {
+        use crate::ptx::ir::CarryOp;
+        assert_eq!(carry(CarryOp::Add, Ty::U32, 0xFFFF_FFFF, 1, 0, 0), (0, 1));
+        assert_eq!(carry(CarryOp::Add, Ty::U32, 1, 1, 0, 1), (3, 0));
+        assert_eq!(carry(CarryOp::Sub, Ty::U32, 0, 0, 0, 1), (0xFFFF_FFFF, 1), "borrow in and out");
+        assert_eq!(carry(CarryOp::Sub, Ty::U64, 5, 3, 0, 0), (2, 0));
+        assert_eq!(carry(CarryOp::MadLo, Ty::U32, 0xFFFF_FFFF, 1, 0xFFFF_FFFF, 0), (0xFFFF_FFFE, 1));
+        assert_eq!(carry(CarryOp::MadHi, Ty::U32, 0xFFFF_FFFF, 1, 1, 1), (2, 0));
     }
 
     #[test]

@@ -14,6 +14,7 @@ use super::exec::{self, CtaMut, Ctx, Effect, PendingAtomic};
 use super::fault::FaultKind;
 use super::simt_stack::{SimtEntry, SimtStack};
 use super::warp::{Frame, Warp, WarpState};
+use crate::ptx::ir::{BarRedOp, Dst, PRED_TRUE};
 
 /// One executed warp instruction, as reported to a stepper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,6 +109,7 @@ impl Cta {
                     local: Vec::new(),
                     local_top: f.local_size,
                     frame_pool: Vec::new(),
+                    bar_red: None,
                 };
                 warp.ensure_local(f.local_size);
                 warp
@@ -201,6 +203,38 @@ impl Cta {
         Ok(None) // barrier deadlock: reported by the caller
     }
 
+    /// Writes the result of the `bar.red` reduction of the warps `waiting` at a
+    /// barrier that releases: the count of true predicates (`.popc`), or
+    /// whether all (`.and`) or any (`.or`) of the arriving threads' are true.
+    fn complete_bar_red(&mut self, waiting: &[usize]) {
+        let parts: Vec<_> = waiting.iter().filter_map(|&i| self.warps[i].bar_red).collect();
+        if parts.is_empty() {
+            return;
+        }
+        let popc: u32 = parts.iter().map(|r| (r.bits & r.lanes).count_ones()).sum();
+        let all = parts.iter().all(|r| r.bits & r.lanes == r.lanes);
+        let any = parts.iter().any(|r| r.bits & r.lanes != 0);
+        for &i in waiting {
+            let Some(r) = self.warps[i].bar_red.take() else { continue };
+            let fr = self.warps[i].frames.last_mut().expect("frame");
+            match (r.op, r.d) {
+                (BarRedOp::Popc, Some(d)) if d.reg != Dst::SINK => {
+                    for l in 0..32 {
+                        if r.lanes >> l & 1 != 0 {
+                            fr.regs[d.reg as usize][l] = popc as u64 & d.mask;
+                        }
+                    }
+                }
+                (BarRedOp::And | BarRedOp::Or, _) if r.p > PRED_TRUE => {
+                    let v = if (r.op == BarRedOp::And && all) || (r.op == BarRedOp::Or && any) { r.lanes } else { 0 };
+                    let p = &mut fr.preds[r.p as usize];
+                    *p = (*p & !r.lanes) | v;
+                }
+                _ => {}
+            }
+        }
+    }
+
     /// Completes every barrier whose condition holds. Returns true if any did.
     fn try_release(&mut self) -> bool {
         let alive = self.warps.iter().filter(|w| w.state != WarpState::Done).count();
@@ -234,6 +268,7 @@ impl Cta {
                     let warps: Vec<u32> = waiting.iter().map(|&i| i as u32).collect();
                     o.barrier_release(id, &warps);
                 }
+                self.complete_bar_red(&waiting);
                 for i in waiting {
                     self.warps[i].state = WarpState::Ready;
                 }

@@ -5,10 +5,14 @@
 //! instruction's [`Op`] up by PC and dispatches on it; the validated IR
 //! (`crate::ptx::ir`) stays the source of operands and of the rare forms.
 
+use std::collections::HashMap;
+
 use crate::ptx::ir::{ArithOp, FloatMode, InstClass, Kind, Program, Rounding};
 use crate::ptx::types::Ty;
 
 use super::alu;
+use super::contract::{self, Fused};
+use super::sfu::{self, SfuModel};
 
 /// 32 lanes of register bits.
 pub type Lanes = [u64; 32];
@@ -27,6 +31,8 @@ pub struct Op {
     pub reads_c: bool,
     /// Its class, for the class counters.
     pub class: InstClass,
+    /// An `add`/`sub` that executes fused with a `mul` ([`FnCode::fused`]).
+    pub fused: bool,
 }
 
 /// A function's decoded instructions, parallel to its IR instructions.
@@ -34,6 +40,25 @@ pub struct Op {
 pub struct FnCode {
     /// One per instruction.
     pub ops: Vec<Op>,
+    /// The `add`/`sub` instructions ptxas would contract with a `mul`, by
+    /// index ([`contract`]); empty when contraction is off.
+    pub fused: HashMap<u32, Fused>,
+}
+
+/// What the executable form models of the toolchain and the GPU's arithmetic.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FloatOptions {
+    /// ptxas's FFMA contraction of unrounded `mul` + `add`/`sub` ([`contract`]).
+    pub fmad: bool,
+    /// How approximate special functions are computed.
+    pub sfu: SfuModel,
+}
+
+impl Default for FloatOptions {
+    /// The H200's: contraction on, the MUFU table model.
+    fn default() -> Self {
+        FloatOptions { fmad: true, sfu: SfuModel::Sm90 }
+    }
 }
 
 /// A decoded module.
@@ -44,24 +69,34 @@ pub struct Code {
 }
 
 impl Code {
-    /// Decodes every function of `prog`.
-    pub fn decode(prog: &Program) -> Code {
+    /// Decodes every function of `prog`, with `opts` deciding contraction and
+    /// the special functions.
+    pub fn decode(prog: &Program, opts: FloatOptions) -> Code {
         let funcs = prog
             .functions
             .iter()
-            .map(|f| FnCode {
-                ops: f
+            .map(|f| {
+                let fused = if opts.fmad { contract::contract(f) } else { HashMap::new() };
+                let ops = f
                     .insts
                     .iter()
                     .zip(&f.info)
-                    .map(|(i, info)| {
+                    .enumerate()
+                    .map(|(k, (i, info))| {
+                        let is_fused = fused.contains_key(&(k as u32));
                         let r = match i.kind {
-                            Kind::Arith { op, ty, mode, .. } => resolve_arith(op, ty, mode),
+                            Kind::Arith { op, ty, mode, .. } if !is_fused => resolve_arith(op, ty, mode, opts.sfu),
                             _ => None,
                         };
-                        Op { lanes: r.map(|r| r.0), reads_c: r.is_some_and(|r| r.1), class: info.class }
+                        Op {
+                            lanes: r.map(|r| r.0),
+                            reads_c: r.is_some_and(|r| r.1),
+                            class: info.class,
+                            fused: is_fused,
+                        }
                     })
-                    .collect(),
+                    .collect();
+                FnCode { ops, fused }
             })
             .collect();
         Code { funcs }
@@ -166,13 +201,47 @@ lanefn2!(fabs, |x, _y| canon32(f32of(x).abs()));
 lanefn2!(frcp, |x, _y| canon32(1.0 / f32of(x)));
 lanefn2!(fsqrt, |x, _y| canon32(f32of(x).sqrt()));
 lanefn3!(ffma, |x, y, z| canon32(f32of(x).mul_add(f32of(y), f32of(z))));
+lanefn2!(mufu_rcp, |x, _y| sfu::rcp(x as u32, false) as u64);
+lanefn2!(mufu_rcp_ftz, |x, _y| sfu::rcp(x as u32, true) as u64);
+lanefn2!(mufu_rsq, |x, _y| sfu::rsq(x as u32, false, false) as u64);
+lanefn2!(mufu_rsq_ftz, |x, _y| sfu::rsq(x as u32, false, true) as u64);
+lanefn2!(mufu_sqrt, |x, _y| sfu::rsq(x as u32, true, false) as u64);
+lanefn2!(mufu_sqrt_ftz, |x, _y| sfu::rsq(x as u32, true, true) as u64);
+lanefn2!(div_approx, |x, y| sfu::div_approx(x as u32, y as u32, false) as u64);
+lanefn2!(div_approx_ftz, |x, y| sfu::div_approx(x as u32, y as u32, true) as u64);
+lanefn2!(div_full, |x, y| sfu::div_full(x as u32, y as u32, false) as u64);
+lanefn2!(div_full_ftz, |x, y| sfu::div_full(x as u32, y as u32, true) as u64);
+
+/// The H200 table model's function of an f32 approximation, when `sfu` asks
+/// for it and the form has one (no `.sat`, no rounding modifier).
+fn resolve_sfu(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<LaneFn> {
+    if sfu != SfuModel::Sm90 || ty != Ty::F32 || !mode.approx || mode.sat || mode.rnd.is_some() {
+        return None;
+    }
+    Some(match (op, mode.ftz, mode.full) {
+        (ArithOp::Rcp, false, _) => mufu_rcp,
+        (ArithOp::Rcp, true, _) => mufu_rcp_ftz,
+        (ArithOp::Rsqrt, false, _) => mufu_rsq,
+        (ArithOp::Rsqrt, true, _) => mufu_rsq_ftz,
+        (ArithOp::Sqrt, false, _) => mufu_sqrt,
+        (ArithOp::Sqrt, true, _) => mufu_sqrt_ftz,
+        (ArithOp::Div, false, false) => div_approx,
+        (ArithOp::Div, true, false) => div_approx_ftz,
+        (ArithOp::Div, false, true) => div_full,
+        (ArithOp::Div, true, true) => div_full_ftz,
+        _ => return None,
+    })
+}
 
 /// The 32-lane function of an arithmetic instruction whose semantics
 /// (`alu::arith`) reduce to a plain operation, and whether it reads `c`;
 /// `None` for the other forms, which the executor evaluates lane by lane.
-pub fn resolve_arith(op: ArithOp, ty: Ty, mode: FloatMode) -> Option<(LaneFn, bool)> {
+pub fn resolve_arith(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<(LaneFn, bool)> {
     use ArithOp as A;
     use Ty as T;
+    if let Some(f) = resolve_sfu(op, ty, mode, sfu) {
+        return Some((f, false));
+    }
     // Round-to-nearest is IEEE's default, so `.rn` and no rounding agree.
     let nearest = matches!(mode.rnd, None | Some(Rounding::Rn)) && !mode.ftz && !mode.sat;
     let int = !mode.sat;
@@ -291,7 +360,7 @@ mod tests {
         for op in ops {
             for ty in tys {
                 for mode in modes {
-                    let Some((func, _)) = resolve_arith(op, ty, mode) else { continue };
+                    let Some((func, _)) = resolve_arith(op, ty, mode, SfuModel::CorrectlyRounded) else { continue };
                     resolved += 1;
                     for (i, &x) in vals.iter().enumerate() {
                         // 32 lanes: x against every value, c rotating

@@ -32,13 +32,14 @@ use std::collections::HashMap;
 
 use super::cfg::Cfg;
 use super::counters::LaunchStats;
-use super::decode::Code;
+use super::decode::{Code, FloatOptions};
 use super::exec::Ctx;
 use super::fault::Fault;
 use super::fidelity::Fidelity;
 use super::grid::{GridRun, Schedule};
 use super::memory::DeviceMemory;
 use super::observer::ObserverFactory;
+use super::sfu::SfuModel;
 use crate::ptx::{self, Program, PtxError};
 
 /// Errors of loading and launching.
@@ -212,6 +213,14 @@ pub struct SimConfig {
     pub max_shared_per_cta: u32,
     /// How much beyond the results a launch models ([`Fidelity`]); never changes results.
     pub fidelity: Fidelity,
+    /// ptxas's FFMA contraction of unrounded `mul` + `add`/`sub` pairs
+    /// (`--fmad=true`, sm_50 and later; [`super::contract`]), applied when a
+    /// module is loaded. On by default; off reproduces `ptxas --fmad=false`
+    /// and the GT200 profile (whose FMAD truncates the product: not modelled).
+    pub fmad: bool,
+    /// How approximate special functions are computed ([`SfuModel`]): the
+    /// H200's table model by default.
+    pub sfu: SfuModel,
 }
 
 /// The default watchdog: warp instructions per launch (2^32, a few minutes of
@@ -263,6 +272,8 @@ impl Default for SimConfig {
             max_threads_per_cta: 1024,
             max_shared_per_cta: 228 * 1024,
             fidelity: super::fidelity::default_level(),
+            fmad: super::contract::default_on(),
+            sfu: SfuModel::Sm90,
         }
     }
 }
@@ -419,7 +430,7 @@ impl Device {
             }
             globals.push(p.0);
         }
-        let code = Code::decode(&prog);
+        let code = Code::decode(&prog, FloatOptions { fmad: self.config.fmad, sfu: self.config.sfu });
         Module { prog, cfgs, code, globals }
     }
 

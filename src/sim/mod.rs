@@ -3,12 +3,14 @@
 //! scheduler ([`cta`]), the grid scheduler ([`grid`]), device memory
 //! ([`memory`]), faults ([`fault`]), counters ([`counters`]), stepping
 //! ([`stepper`]), fidelity levels ([`fidelity`]), the decoded executable form
-//! ([`decode`]), device-side `printf` ([`printf`]) and the public [`Device`]
-//! API ([`device`]).
+//! ([`decode`], with ptxas's FMA contraction, [`contract`], and the SFU's
+//! approximations, [`sfu`]), device-side `printf` ([`printf`]) and the public
+//! [`Device`] API ([`device`]).
 
 pub mod access_log;
 pub mod alu;
 pub mod cfg;
+pub mod contract;
 pub mod counters;
 pub mod cta;
 pub mod decode;
@@ -17,9 +19,11 @@ pub mod exec;
 pub mod fault;
 pub mod fidelity;
 pub mod grid;
+pub mod half;
 pub mod memory;
 pub mod observer;
 pub mod printf;
+pub mod sfu;
 pub mod simt_stack;
 pub mod stepper;
 pub mod warp;

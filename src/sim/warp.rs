@@ -2,7 +2,7 @@
 //! stack, local memory, and what the warp is waiting for.
 
 use super::simt_stack::SimtStack;
-use crate::ptx::ir::Function;
+use crate::ptx::ir::{BarRedOp, Dst, Function, PredId};
 
 /// One call frame: the registers and parameter area of a function invocation.
 #[derive(Debug, Clone)]
@@ -86,6 +86,23 @@ pub struct Warp {
     pub local_top: u32,
     /// Frames of returned calls, kept for reuse so that calls do not allocate.
     pub frame_pool: Vec<Frame>,
+    /// The reduction this warp contributes to the barrier it waits at (`bar.red`).
+    pub bar_red: Option<BarRedWait>,
+}
+
+/// A warp's part of a `bar.red` reduction, completed when the barrier releases.
+#[derive(Debug, Clone, Copy)]
+pub struct BarRedWait {
+    /// The reduction.
+    pub op: BarRedOp,
+    /// The lanes that arrived.
+    pub lanes: u32,
+    /// Their predicate values.
+    pub bits: u32,
+    /// `.popc`: the register the count goes to.
+    pub d: Option<Dst>,
+    /// `.and`/`.or`: the predicate the result goes to.
+    pub p: PredId,
 }
 
 impl Warp {

@@ -61,7 +61,7 @@ fn reads(k: &Kind) -> Vec<RegId> {
             addr_reg(addr, &mut v);
             [b, c].into_iter().for_each(|s| src_reg(s, &mut v));
         }
-        Kind::Bar { id, count } => {
+        Kind::Bar { id, count } | Kind::BarRed { id, count, .. } => {
             src_reg(id, &mut v);
             if let Some(c) = count {
                 src_reg(c, &mut v);
@@ -69,6 +69,13 @@ fn reads(k: &Kind) -> Vec<RegId> {
         }
         Kind::Vote { membermask, .. } => src_reg(membermask, &mut v),
         Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(|s| src_reg(s, &mut v)),
+        Kind::Redux { a, membermask, .. } | Kind::Match { a, membermask, .. } => {
+            [a, membermask].into_iter().for_each(|s| src_reg(s, &mut v))
+        }
+        Kind::Carry { a, b, c, cc, .. } => {
+            [a, b, c].into_iter().for_each(|s| src_reg(s, &mut v));
+            v.push(*cc);
+        }
         Kind::PredLogic { .. }
         | Kind::Bra { .. }
         | Kind::Call { .. }

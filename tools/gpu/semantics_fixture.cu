@@ -14,6 +14,7 @@
 
 #include "../../kernels/tests/semantics_int.cu"
 #include "../../kernels/tests/semantics_float.cu"
+#include "../../kernels/tests/semantics_ext.cu"
 
 static const int N = 256;
 static const uint32_t INT_EDGES[16] = {0u, 1u, 2u, 3u, 7u, 31u, 32u, 33u, 0x7fffffffu, 0x80000000u,
@@ -96,6 +97,12 @@ int main() {
       {"sem_cvt_i2f", (const void *)sem_cvt_i2f, INT_LIST, 4},
       {"sem_cvt_sat_int", (const void *)sem_cvt_sat_int, INT_LIST, 2},
       {"sem_f64", (const void *)sem_f64, DOUBLE_PAIRS, 4}, {"sem_setp", (const void *)sem_setp, FLOAT_PAIRS, 1},
+      // semantics_ext.cu (issue 20, "Also")
+      {"sem_redux", (const void *)sem_redux, INT_PAIRS, 8}, {"sem_match", (const void *)sem_match, INT_PAIRS, 7},
+      {"sem_bar_red", (const void *)sem_bar_red, INT_PAIRS, 3},
+      {"sem_prmt_modes", (const void *)sem_prmt_modes, INT_PAIRS, 7}, {"sem_bits", (const void *)sem_bits, INT_PAIRS, 10},
+      {"sem_dp", (const void *)sem_dp, INT_PAIRS, 6}, {"sem_carry", (const void *)sem_carry, INT_PAIRS, 8},
+      {"sem_half", (const void *)sem_half, FLOAT_PAIRS, 18},
   };
   cudaDeviceProp prop;
   CHECK(cudaGetDeviceProperties(&prop, 0));

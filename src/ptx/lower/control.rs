@@ -25,6 +25,24 @@ impl FnLower<'_> {
             Exit => Kind::Exit,
             Trap => Kind::Trap,
             Bar | Barrier if m.has("warp") => Kind::Nop, // bar.warp.sync: the warp executes in lockstep here
+            Bar | Barrier if m.has("red") => {
+                let op = if m.has("popc") {
+                    BarRedOp::Popc
+                } else if m.has("and") {
+                    BarRedOp::And
+                } else {
+                    BarRedOp::Or
+                };
+                let (d, p) = if op == BarRedOp::Popc {
+                    (Some(self.dst(&ops[0], pos)?), PRED_FALSE)
+                } else {
+                    (None, self.pred_dst(&ops[0], pos)?)
+                };
+                let id = self.src(&ops[1], Ty::U32, pos)?;
+                let count = if ops.len() == 4 { Some(self.src(&ops[2], Ty::U32, pos)?) } else { None };
+                let a = self.pred_src(&ops[ops.len() - 1], pos)?;
+                Kind::BarRed { op, d, p, id, count, a }
+            }
             Bar | Barrier => {
                 let id = self.src(&ops[0], Ty::U32, pos)?;
                 let count = if ops.len() == 2 { Some(self.src(&ops[1], Ty::U32, pos)?) } else { None };

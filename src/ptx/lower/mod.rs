@@ -34,6 +34,10 @@ pub mod warp;
 use layout::{Signature, align_up, check_var_size, collect_shared, init_bytes, signature, var_size};
 use opcode::{Decoded, Family, Opcode};
 
+/// The name of the condition-code register of carry chains (no PTX name can
+/// have a space, so it cannot collide with a declared register).
+const CC_REG: &str = "%cc (carry)";
+
 /// A lowering result: errors carry the position; the file is added by [`super::load`].
 pub type LResult<T> = Result<T, (Pos, PtxErrorKind)>;
 
@@ -497,6 +501,17 @@ impl<'a> FnLower<'a> {
         Ok(())
     }
 
+    /// The register that holds the condition code of carry chains (`CC.CF`,
+    /// 0 or 1), added on first use; PTX declares no register for it.
+    fn cc_reg(&mut self) -> RegId {
+        if let Some(r) = self.out.reg_names.iter().position(|n| n == CC_REG) {
+            return r as RegId;
+        }
+        self.out.reg_masks.push(1);
+        self.out.reg_names.push(CC_REG.into());
+        (self.out.reg_masks.len() - 1) as RegId
+    }
+
     fn emit(&mut self, kind: Kind, guard: Option<PredSrc>, pos: Pos, opcode: String, class: InstClass) {
         self.out.insts.push(Inst { guard, kind });
         self.out.info.push(InstInfo { ptx_line: pos.line, ptx_col: pos.col, src: self.loc, opcode, class });
@@ -515,6 +530,8 @@ impl<'a> FnLower<'a> {
         let kind = match (d.family(), d.op) {
             (Family::Data, _) => self.lower_mov(i, &d)?,
             (Family::Arith, Opcode::Bfi) => self.lower_bfi(i, &d)?,
+            (Family::Arith, Opcode::Addc | Opcode::Subc | Opcode::Madc) => self.lower_carry(i, &d)?,
+            (Family::Arith, _) if d.mods.has("cc") => self.lower_carry(i, &d)?,
             (Family::Arith, _) => self.lower_arith(i, &d)?,
             (Family::Compare, Opcode::Setp | Opcode::Set) => self.lower_setp(i, &d)?,
             (Family::Compare, Opcode::Selp) => self.lower_selp(i, &d)?,
@@ -526,6 +543,8 @@ impl<'a> FnLower<'a> {
             (Family::Control, _) => self.lower_control(i, &d)?,
             (Family::Warp, Opcode::Vote) => self.lower_vote(i, &d)?,
             (Family::Warp, Opcode::Activemask) => self.lower_activemask(i)?,
+            (Family::Warp, Opcode::Redux) => self.lower_redux(i, &d)?,
+            (Family::Warp, Opcode::Match) => self.lower_match(i, &d)?,
             (Family::Warp, _) => self.lower_shfl(i, &d)?,
         };
         let class = d.op.class();

@@ -73,6 +73,14 @@ pub enum Opcode {
     Nanosleep,
     Brkpt,
     Nop,
+    Redux,
+    Match,
+    Bfind,
+    Dp4a,
+    Dp2a,
+    Addc,
+    Subc,
+    Madc,
 }
 
 /// The instruction families, one file of the lowering each.
@@ -162,6 +170,14 @@ impl Opcode {
             "nanosleep" => Nanosleep,
             "brkpt" => Brkpt,
             "nop" => Nop,
+            "redux" => Redux,
+            "match" => Match,
+            "bfind" => Bfind,
+            "dp4a" => Dp4a,
+            "dp2a" => Dp2a,
+            "addc" => Addc,
+            "subc" => Subc,
+            "madc" => Madc,
             _ => return None,
         })
     }
@@ -177,7 +193,7 @@ impl Opcode {
             Ld | St | Atom | Red => Family::Memory,
             Bra | Call | Ret | Exit | Trap | Bar | Barrier | Membar | Fence | Prefetch | Prefetchu | Pmevent
             | Nanosleep | Brkpt | Nop => Family::Control,
-            Vote | Activemask | Shfl => Family::Warp,
+            Vote | Activemask | Shfl | Redux | Match => Family::Warp,
             _ => Family::Arith,
         }
     }
@@ -188,7 +204,7 @@ impl Opcode {
         match self {
             Ld | St | Atom | Red => InstClass::Memory,
             Bra | Call | Ret | Exit | Bar | Barrier | Membar | Fence | Trap => InstClass::Control,
-            Vote | Shfl | Activemask => InstClass::Warp,
+            Vote | Shfl | Activemask | Redux | Match => InstClass::Warp,
             Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 => InstClass::Sfu,
             _ => InstClass::Alu,
         }
@@ -373,6 +389,6 @@ mod tests {
         for w in crate::ptx::parser::KNOWN_OPCODES {
             assert!(Opcode::parse(w).is_some(), "{w}");
         }
-        assert_eq!(Opcode::parse("redux"), None);
+        assert_eq!(Opcode::parse("tex"), None);
     }
 }

@@ -57,6 +57,7 @@ fn special_reg(name: &str) -> Option<SpecialReg> {
         "%clock64" => SpecialReg::Clock64,
         // deterministic, as %clock64 (docs/ptx-support.md); a 32-bit read keeps the low half
         "%globaltimer" | "%globaltimer_lo" => SpecialReg::Clock64,
+        "%globaltimer_hi" => SpecialReg::GlobalTimerHi,
         _ => return None,
     })
 }

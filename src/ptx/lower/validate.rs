@@ -85,7 +85,11 @@ pub fn arith_shape(op: Opcode) -> (usize, &'static [&'static str]) {
         Mul24 => (2, &["lo", "hi"]),
         Mad24 => (3, &["lo", "hi"]),
         Shf => (3, &["l", "r", "wrap", "clamp"]),
-        Bfe | Prmt => (3, &[]),
+        Bfe => (3, &[]),
+        Prmt => (3, &["f4e", "b4e", "rc8", "ecl", "ecr", "rc16"]),
+        Bfind => (1, &["shiftamt"]),
+        Addc | Subc => (2, &["cc"]),
+        Madc => (3, &["lo", "hi", "cc"]),
         Abs | Neg | Not | Cnot | Popc | Clz | Brev | Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 => (1, &[]),
         _ => (2, &[]),
     }
@@ -144,6 +148,9 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
                 return invalid(pos, format!("`{}` needs a comparison", d.full));
             }
             operands(i, if comb { 4 } else { 3 })?;
+            if m.types.iter().any(|t| matches!(t, Ty::F16x2 | Ty::BF16x2)) {
+                return unsupported(pos, format!("{} (packed halves)", d.full));
+            }
             if d.op == Setp {
                 one_type(d, i)?;
             } else if m.types.len() != 2 {
@@ -156,15 +163,19 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             one_type(d, i)?;
         }
         Cvt => {
-            operands(i, 2)?;
+            let pack = matches!(m.types.first(), Some(Ty::F16x2 | Ty::BF16x2));
+            operands(i, if pack { 3 } else { 2 })?;
+            if pack && m.types.get(1) != Some(&Ty::F32) {
+                return unsupported(pos, d.full.clone());
+            }
             let mut allowed = ROUNDINGS.to_vec();
             allowed.extend(["ftz", "sat"]);
             only(d, &allowed, i)?;
             let [dty, sty] = m.types.as_slice() else {
                 return invalid(pos, "`cvt` needs a destination and a source type");
             };
-            if *dty == Ty::F16 || *sty == Ty::F16 {
-                return unsupported(pos, format!("{} (.f16)", d.full));
+            if (matches!(dty, Ty::F16x2 | Ty::BF16x2) && *sty != Ty::F32) || matches!(sty, Ty::F16x2 | Ty::BF16x2) {
+                return unsupported(pos, format!("{} (packed halves)", d.full));
             }
             if dty.is_float()
                 && sty.is_int()
@@ -222,6 +233,20 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
         }
         Call | Ret => only(d, &["uni"], i)?,
         Bar | Barrier if m.has("warp") => {} // bar.warp.sync
+        Bar | Barrier if m.has("red") => {
+            only(d, &["red", "popc", "and", "or", "aligned", "sync"], i)?;
+            let t = one_type(d, i)?;
+            let ok = if m.has("popc") { t == Ty::U32 } else { (m.has("and") || m.has("or")) && t == Ty::Pred };
+            if !ok {
+                return invalid(pos, format!("`{}` needs .popc.u32, .and.pred or .or.pred", d.full));
+            }
+            if n_ops != 3 && n_ops != 4 {
+                return invalid(
+                    pos,
+                    format!("`{}` takes a destination, a barrier id, an optional count and a predicate", d.full),
+                );
+            }
+        }
         Bar | Barrier => {
             only(d, &["sync", "aligned"], i)?;
             if !m.has("sync") && d.op == Bar && !m.words.is_empty() {
@@ -239,6 +264,37 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             operands(i, if m.has("sync") { 3 } else { 2 })?;
         }
         Activemask => operands(i, 1)?,
+        Redux => {
+            only(d, &["sync", "add", "min", "max", "and", "or", "xor"], i)?;
+            operands(i, 3)?;
+            let t = one_type(d, i)?;
+            if !matches!(t, Ty::U32 | Ty::S32 | Ty::B32) {
+                return unsupported(pos, format!("{} (.{t})", d.full));
+            }
+            if m.words.iter().filter(|w| *w != "sync").count() != 1 {
+                return invalid(pos, format!("`{}` needs one operation", d.full));
+            }
+        }
+        Match => {
+            only(d, &["sync", "any", "all"], i)?;
+            operands(i, 3)?;
+            if !matches!(one_type(d, i)?, Ty::B32 | Ty::B64) {
+                return invalid(pos, format!("`{}` takes .b32 or .b64", d.full));
+            }
+            if m.has("any") == m.has("all") {
+                return invalid(pos, format!("`{}` needs .any or .all", d.full));
+            }
+        }
+        Dp4a | Dp2a => {
+            only(d, &["lo", "hi"], i)?;
+            operands(i, 4)?;
+            if m.types.len() != 2 || m.types.iter().any(|t| !matches!(t, Ty::U32 | Ty::S32)) {
+                return invalid(pos, format!("`{}` needs two types, each .u32 or .s32", d.full));
+            }
+            if d.op == Dp2a && m.has("lo") == m.has("hi") {
+                return invalid(pos, format!("`{}` needs .lo or .hi", d.full));
+            }
+        }
         Shfl => {
             only(d, &["sync", "up", "down", "bfly", "idx"], i)?;
             if m.shfl_mode().is_none() {
@@ -250,16 +306,21 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
         // the arithmetic opcodes
         _ => {
             let t = one_type(d, i)?;
-            if m.has("cc") {
-                return unsupported(pos, format!("{} (carry chains)", d.full));
+            let carry = m.has("cc") || matches!(d.op, Addc | Subc | Madc);
+            if carry && (!matches!(d.op, Add | Sub | Mad | Addc | Subc | Madc) || m.has("wide")) {
+                return invalid(pos, format!("`{}`: no carry-chain form", d.full));
+            }
+            if carry && !matches!(t, Ty::U32 | Ty::S32 | Ty::U64 | Ty::S64) {
+                return invalid(pos, format!("`{}`: carry chains take .u32 .s32 .u64 .s64", d.full));
             }
             let (nsrc, extra) = arith_shape(d.op);
-            let mut allowed: Vec<&str> = vec!["ftz", "sat", "approx", "full"];
+            let mut allowed: Vec<&str> = vec!["ftz", "sat", "approx", "full", "cc"];
             allowed.extend(ROUNDINGS);
             allowed.extend(extra);
             only(d, &allowed, i)?;
             operands(i, nsrc + 1)?;
-            if t.is_float() && t != Ty::F32 && t != Ty::F64 {
+            let half_ok = matches!(d.op, Add | Sub | Mul | Mad | Fma | Neg | Abs | Min | Max);
+            if t.is_float() && t != Ty::F32 && t != Ty::F64 && !half_ok {
                 return unsupported(pos, format!("{} (.{t})", d.full));
             }
             if t.is_float() && matches!(d.op, Mul | Mad | Fma) && (m.has("hi") || m.has("wide")) {

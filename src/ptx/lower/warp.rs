@@ -1,5 +1,6 @@
 //! Warp-level instructions: `vote` (all, any, uni, ballot), `activemask`
-//! (a ballot of `true`) and `shfl` (idx, up, down, bfly).
+//! (a ballot of `true`), `shfl` (idx, up, down, bfly), `redux.sync` and
+//! `match.sync`.
 
 use super::opcode::Decoded;
 use super::{FnLower, LResult};
@@ -34,6 +35,50 @@ impl FnLower<'_> {
             p: PRED_FALSE,
             a: PredSrc { reg: PRED_TRUE, neg: false },
             membermask: NO_MEMBER_MASK,
+        })
+    }
+
+    /// Lowers a validated `redux.sync`.
+    pub(super) fn lower_redux(&self, i: &ast::Instruction, d: &Decoded) -> LResult<Kind> {
+        let (pos, ops, m) = (i.pos, &i.operands, &d.mods);
+        let ty = m.types[0];
+        let op = if m.has("add") {
+            ReduxOp::Add
+        } else if m.has("min") {
+            ReduxOp::Min
+        } else if m.has("max") {
+            ReduxOp::Max
+        } else if m.has("and") {
+            ReduxOp::And
+        } else if m.has("or") {
+            ReduxOp::Or
+        } else {
+            ReduxOp::Xor
+        };
+        Ok(Kind::Redux {
+            op,
+            ty,
+            d: self.dst(&ops[0], pos)?,
+            a: self.src(&ops[1], ty, pos)?,
+            membermask: self.src(&ops[2], Ty::U32, pos)?,
+        })
+    }
+
+    /// Lowers a validated `match.sync`.
+    pub(super) fn lower_match(&self, i: &ast::Instruction, d: &Decoded) -> LResult<Kind> {
+        let (pos, ops, m) = (i.pos, &i.operands, &d.mods);
+        let ty = m.types[0];
+        let (dst, p) = match &ops[0] {
+            Operand::Pair(d, p) => (self.dst(&Operand::Name(d.clone()), pos)?, Some(self.pred_named(p, pos)?)),
+            o => (self.dst(o, pos)?, None),
+        };
+        Ok(Kind::Match {
+            all: m.has("all"),
+            ty,
+            d: dst,
+            p,
+            a: self.src(&ops[1], ty, pos)?,
+            membermask: self.src(&ops[2], Ty::U32, pos)?,
         })
     }
 

@@ -12,7 +12,7 @@ use crate::host::scene::Scene;
 use crate::model::Profile;
 use crate::repro::registry::{MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
-use crate::sim::{Device, SimError};
+use crate::sim::{Device, SimConfig, SimError};
 
 /// Totals of one variant over a flight.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
@@ -134,7 +134,13 @@ pub fn frame_timed(
     // a fresh device per frame: its memory holds one frame's buffers; the
     // watchdog's budget grows with the pixels
     let cam = camera(scene, f, res);
-    let mut dev = Device::with_config(rt_kernels::sim_config(&cam));
+    // the GT200: no FFMA contraction, correctly rounded special functions
+    let config = SimConfig {
+        fmad: false,
+        sfu: crate::sim::sfu::SfuModel::for_profile(Profile::Gt200),
+        ..rt_kernels::sim_config(&cam)
+    };
+    let mut dev = Device::with_config(config);
     let module = rt_kernels::load(&mut dev)?;
     let k = rt_kernels::render(&mut dev, &module, scene, tree, &cam, scene.flight.light_offset(f), v, Profile::Gt200)?;
     let timing = super::timing::counts_of(&module.prog, &k.launch, &k.memory);

@@ -1,10 +1,13 @@
 //! Data instructions: moves, arithmetic, comparisons, selects, conversions,
 //! predicate logic, and the lane exchanges `vote` and `shfl`.
 
+use super::super::contract::Fused;
 use super::super::decode::LaneFn;
 use super::super::warp::Warp;
 use super::{CtaMut, Ctx, Lanes, combine, map1, map3, operand, pred_bits, read, set_pred, write};
-use crate::ptx::ir::{ArithOp, BoolOp, Dst, FloatMode, Kind, PredId, PredSrc, ShflMode, Src, VoteMode};
+use crate::ptx::ir::{
+    ArithOp, BoolOp, CarryOp, Dst, FloatMode, Kind, PredId, PredSrc, ReduxOp, RegId, ShflMode, Src, VoteMode,
+};
 use crate::ptx::types::Ty;
 use crate::sim::alu;
 
@@ -87,6 +90,18 @@ pub(super) fn arith(
             | ArithOp::Mad24Hi
             | ArithOp::Bfe
             | ArithOp::Prmt
+            | ArithOp::PrmtF4e
+            | ArithOp::PrmtB4e
+            | ArithOp::PrmtRc8
+            | ArithOp::PrmtEcl
+            | ArithOp::PrmtEcr
+            | ArithOp::PrmtRc16
+            | ArithOp::Dp4aU
+            | ArithOp::Dp4aS
+            | ArithOp::Dp2aLoU
+            | ArithOp::Dp2aLoS
+            | ArithOp::Dp2aHiU
+            | ArithOp::Dp2aHiS
             | ArithOp::ShfLWrap
             | ArithOp::ShfLClamp
             | ArithOp::ShfRWrap
@@ -97,6 +112,18 @@ pub(super) fn arith(
         [0; 32]
     };
     let r = map3(&va, &vb, &vc, |x, y, z| alu::arith(op, ty, mode, x, y, z));
+    write(w.frames.last_mut().expect("frame"), d, &r, exec);
+}
+
+/// An `add`/`sub` that ptxas contracts with the `mul` feeding it
+/// ([`crate::sim::contract`]): fma(±a, b, ±c) with one rounding, the add's
+/// `.ftz` and `.sat`.
+pub(super) fn fused(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, (ty, mode): (Ty, FloatMode), d: Dst, fz: &Fused, exec: u32) {
+    let sign = 1u64 << (ty.bits() - 1);
+    let (va, vb, vc) = (read(ctx, w, cta, fz.a), read(ctx, w, cta, fz.b), read(ctx, w, cta, fz.c));
+    let (na, nc) = (if fz.neg_product { sign } else { 0 }, if fz.neg_c { sign } else { 0 });
+    let m = FloatMode { rnd: None, approx: false, full: false, ..mode };
+    let r = map3(&va, &vb, &vc, |x, y, z| alu::arith(ArithOp::Mad, ty, m, x ^ na, y, z ^ nc));
     write(w.frames.last_mut().expect("frame"), d, &r, exec);
 }
 
@@ -206,6 +233,86 @@ pub(super) fn vote(w: &mut Warp, mode: VoteMode, d: Option<Dst>, p: PredId, a: P
         VoteMode::All => set_pred(fr, p, if pv == exec { u32::MAX } else { 0 }, exec),
         VoteMode::Any => set_pred(fr, p, if pv != 0 { u32::MAX } else { 0 }, exec),
         VoteMode::Uni => set_pred(fr, p, if pv == 0 || pv == exec { u32::MAX } else { 0 }, exec),
+    }
+}
+
+/// `redux.sync`: the operation over the member lanes that execute it (`exec`),
+/// given to each of them.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn redux(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, op: ReduxOp, ty: Ty, d: Dst, a: Src, exec: u32) {
+    let va = read(ctx, w, cta, a);
+    let lanes = (0..32).filter(|l| exec >> l & 1 != 0).map(|l| va[l] & 0xFFFF_FFFF);
+    let r = match op {
+        ReduxOp::Add => lanes.fold(0u64, |s, x| (s + x) & 0xFFFF_FFFF),
+        ReduxOp::And => lanes.fold(0xFFFF_FFFF, |s, x| s & x),
+        ReduxOp::Or => lanes.fold(0, |s, x| s | x),
+        ReduxOp::Xor => lanes.fold(0, |s, x| s ^ x),
+        ReduxOp::Min | ReduxOp::Max if ty == Ty::S32 => {
+            let v = lanes.map(|x| x as u32 as i32);
+            let m = if op == ReduxOp::Min { v.min() } else { v.max() };
+            m.unwrap_or(0) as u32 as u64
+        }
+        ReduxOp::Min => lanes.min().unwrap_or(0),
+        ReduxOp::Max => lanes.max().unwrap_or(0),
+    };
+    write(w.frames.last_mut().expect("frame"), d, &[r; 32], exec);
+}
+
+/// `match.any.sync` / `match.all.sync` among the member lanes that execute it (`exec`).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn match_sync(
+    ctx: &Ctx,
+    w: &mut Warp,
+    cta: &CtaMut,
+    all: bool,
+    ty: Ty,
+    d: Dst,
+    p: Option<PredId>,
+    a: Src,
+    exec: u32,
+) {
+    let va = read(ctx, w, cta, a);
+    let m = ty.mask();
+    let same =
+        |l: usize| (0..32).filter(|&k| exec >> k & 1 != 0 && va[k] & m == va[l] & m).fold(0u32, |s, k| s | 1 << k);
+    let first = exec.trailing_zeros() as usize;
+    let agree = same(first) == exec;
+    let r: Lanes = std::array::from_fn(|l| match (all, agree) {
+        (false, _) => same(l) as u64,
+        (true, true) => exec as u64,
+        (true, false) => 0,
+    });
+    let fr = w.frames.last_mut().expect("frame");
+    write(fr, d, &r, exec);
+    if let Some(p) = p {
+        set_pred(fr, p, if agree { u32::MAX } else { 0 }, exec);
+    }
+}
+
+/// A carry-chain instruction (`alu::carry`), reading and writing the
+/// condition-code register `cc`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn carry(
+    ctx: &Ctx,
+    w: &mut Warp,
+    cta: &CtaMut,
+    (op, cin, cout, ty): (CarryOp, bool, bool, Ty),
+    d: Dst,
+    [a, b, c]: [Src; 3],
+    cc: RegId,
+    exec: u32,
+) {
+    let (va, vb, vc) = (read(ctx, w, cta, a), read(ctx, w, cta, b), read(ctx, w, cta, c));
+    let vcc = w.frame().regs[cc as usize];
+    let mut r = [0u64; 32];
+    let mut co = [0u64; 32];
+    for l in 0..32 {
+        (r[l], co[l]) = alu::carry(op, ty, va[l], vb[l], vc[l], if cin { vcc[l] } else { 0 });
+    }
+    let fr = w.frames.last_mut().expect("frame");
+    write(fr, d, &r, exec);
+    if cout {
+        write(fr, Dst { reg: cc, mask: 1 }, &co, exec);
     }
 }
 

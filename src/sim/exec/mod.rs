@@ -23,7 +23,7 @@ use super::fault::FaultKind;
 use super::memory::DeviceMemory;
 use super::observer::{MemObserver, ObserverFactory};
 use super::simt_stack::SimtEntry;
-use super::warp::{Frame, Warp};
+use super::warp::{BarRedWait, Frame, Warp};
 use crate::ptx::ir::*;
 
 /// Everything an instruction may read that is shared by all CTAs of a launch.
@@ -228,6 +228,7 @@ fn special(ctx: &Ctx, w: &Warp, cta: &CtaMut, sr: SpecialReg) -> Lanes {
         SpecialReg::LaneMaskGt => std::array::from_fn(|l| (0xFFFF_FFFFu64 << (l + 1)) & 0xFFFF_FFFF),
         // A deterministic clock: the CTA's issued warp instructions.
         SpecialReg::Clock | SpecialReg::Clock64 => [cta.counters.warp_instructions; 32],
+        SpecialReg::GlobalTimerHi => [cta.counters.warp_instructions >> 32; 32],
     }
 }
 
@@ -306,6 +307,14 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         return Ok(Effect::Continue);
     }
 
+    if op.fused
+        && let Kind::Arith { ty, mode, d, .. } = inst.kind
+        && let Some(fz) = ctx.code.funcs[func as usize].fused.get(&pc)
+    {
+        arith::fused(ctx, w, cta, (ty, mode), d, fz, exec);
+        return Ok(Effect::Continue);
+    }
+
     if let (Some(lanes), Kind::Arith { d, a, b, c, .. }) = (op.lanes, &inst.kind) {
         arith::resolved(ctx, w, cta, lanes, op.reads_c, *d, *a, *b, *c, exec);
         return Ok(Effect::Continue);
@@ -342,6 +351,24 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         Kind::Shfl { mode, d, p, a, b, c, membermask } => {
             control::member_mask(ctx, w, cta, *membermask, exec)?;
             arith::shfl(ctx, w, cta, *mode, *d, *p, [*a, *b, *c], exec)
+        }
+        Kind::BarRed { op, d, p, id, count, a } => {
+            let bits = pred_bits(w.frame(), *a) & exec;
+            w.bar_red = Some(BarRedWait { op: *op, lanes: exec, bits, d: *d, p: *p });
+            return control::bar(ctx, w, cta, *id, *count, exec);
+        }
+        Kind::Redux { op, ty, d, a, membermask } => {
+            control::member_mask(ctx, w, cta, *membermask, exec)?;
+            let members = exec & read(ctx, w, cta, *membermask)[exec.trailing_zeros() as usize] as u32;
+            arith::redux(ctx, w, cta, *op, *ty, *d, *a, members)
+        }
+        Kind::Match { all, ty, d, p, a, membermask } => {
+            control::member_mask(ctx, w, cta, *membermask, exec)?;
+            let members = exec & read(ctx, w, cta, *membermask)[exec.trailing_zeros() as usize] as u32;
+            arith::match_sync(ctx, w, cta, *all, *ty, *d, *p, *a, members)
+        }
+        Kind::Carry { op, cin, cout, ty, d, a, b, c, cc } => {
+            arith::carry(ctx, w, cta, (*op, *cin, *cout, *ty), *d, [*a, *b, *c], *cc, exec)
         }
         Kind::Membar => return Ok(control::membar(w, cta)),
         Kind::Nop => {}
