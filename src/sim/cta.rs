@@ -231,8 +231,7 @@ impl Cta {
             };
             if done {
                 if let Some(o) = self.observer.as_mut() {
-                    let warps: Vec<u32> = waiting.iter().map(|&i| i as u32).collect();
-                    o.barrier_release(id, &warps);
+                    o.barrier_release(id, &waiting);
                 }
                 for i in waiting {
                     self.warps[i].state = WarpState::Ready;
