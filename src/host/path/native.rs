@@ -4,6 +4,9 @@
 //! kernel's frame bit for bit. It is the oracle for the kernel and the
 //! native speed baseline.
 
+// `!(a < b)` is the kernel's comparison, NaN included: kept as written
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use rayon::prelude::*;
 
 use super::layout::{LEAF_AXIS, PathScene};
