@@ -71,8 +71,8 @@ fn an_isotropic_footprint_makes_a_sphere() {
         assert!((dd - 1.0).abs() < 1e-5, "{dir:?}: {dd}");
     }
     // the AABB is the sphere's cube
-    for c in 0..3 {
-        assert!((k.hi[c] - r).abs() <= 1e-6 && (k.lo[c] + r).abs() <= 1e-6, "{:?} {:?}", k.lo, k.hi);
+    for (hi, lo) in k.hi.iter().zip(k.lo) {
+        assert!((hi - r).abs() <= 1e-6 && (lo + r).abs() <= 1e-6, "{:?} {:?}", k.lo, k.hi);
     }
     // unskewed: the thesis' normal m' x M vanishes (extract §2.6), hence the stored normal
     assert!(v(recovered_normal(&k)).length() <= 1e-6 * r * r, "{:?}", recovered_normal(&k));
@@ -104,7 +104,7 @@ fn the_nine_float_distance_equals_the_inverse_transform() {
         // component i of basis * u over unit u peaks at the row norm, at u = row_i / |row_i|
         let e = (v(k.hi) - v(k.lo)) * 0.5;
         for a in 0..400 {
-            let (th, ph) = (a as f32 * 0.1, (a as f32 * 0.37).sin() * 1.57);
+            let (th, ph) = (a as f32 * 0.1, (a as f32 * 0.37).sin() * std::f32::consts::FRAC_PI_2);
             let unit = Vec3::new(th.cos() * ph.cos(), th.sin() * ph.cos(), ph.sin());
             assert!((basis * unit).abs().cmple(e * 1.0001).all(), "{unit:?} outside {e:?}");
         }
@@ -188,14 +188,14 @@ fn kernels_integrate_to_the_photon_flux() {
                 let x = [lo.x + (i as f32 + 0.5) * dx, lo.y + (j as f32 + 0.5) * dy, 0.0];
                 let q = Query { x, n: [0.0, 0.0, 1.0], weight: [std::f32::consts::PI; 3] };
                 let e = vkde::estimate(&map, &q, shape);
-                for c in 0..3 {
-                    total[c] += e.radiance[c] as f64 * (dx * dy) as f64;
+                for (t, l) in total.iter_mut().zip(e.radiance) {
+                    *t += l as f64 * (dx * dy) as f64;
                 }
             }
         }
-        for c in 0..3 {
+        for (c, t) in total.iter().enumerate() {
             let want = (c + 1) as f64;
-            assert!((total[c] / want - 1.0).abs() < 0.01, "{shape:?} channel {c}: {} vs {want}", total[c]);
+            assert!((t / want - 1.0).abs() < 0.01, "{shape:?} channel {c}: {t} vs {want}");
         }
         // the back side gets nothing
         let q = Query { x: [0.0, 0.0, 0.0], n: [0.0, 0.0, -1.0], weight: [1.0; 3] };

@@ -13,6 +13,7 @@
 //! estimate is L_r = (ρ/π) Σ_j K(‖x − x_j‖/h) Φ_j / h² over the heap (eq. 3.16
 //! with the kNN bandwidth), uniform or Epanechnikov K.
 
+use std::cmp::Ordering::{Greater, Less};
 use std::f32::consts::{FRAC_1_PI, FRAC_2_PI};
 
 use super::photons::{Photon, PhotonError, dot};
@@ -152,7 +153,7 @@ fn balance(pts: &mut [Point], idx: &mut [usize], at: usize, out: &mut [Point]) {
 fn sift_up(d: &mut [f32], id: &mut [u32], mut i: usize) {
     while i > 0 {
         let p = (i - 1) / 2;
-        if !(d[i] > d[p]) {
+        if d[i].partial_cmp(&d[p]) != Some(Greater) {
             break;
         }
         d.swap(i, p);
@@ -171,7 +172,7 @@ fn sift_down(d: &mut [f32], id: &mut [u32], n: usize) {
         }
         let r = l + 1;
         let c = if r < n && d[r] > d[l] { r } else { l };
-        if !(d[c] > d[i]) {
+        if d[c].partial_cmp(&d[i]) != Some(Greater) {
             break;
         }
         d.swap(i, c);
@@ -199,7 +200,7 @@ pub fn estimate(map: &KdMap, q: &Query, k: usize, h_max: f32, shape: Shape) -> E
     while size > 0 {
         size -= 1;
         let (mut i, plane) = stack[size];
-        if !(plane < r2) {
+        if plane.partial_cmp(&r2) != Some(Less) {
             continue;
         }
         loop {
@@ -241,7 +242,7 @@ pub fn estimate(map: &KdMap, q: &Query, k: usize, h_max: f32, shape: Shape) -> E
         }
     }
     let h2 = if count == k { hd[0] } else { hmax2 };
-    if !(h2 > 0.0) {
+    if h2.partial_cmp(&0.0) != Some(Greater) {
         return e;
     }
     let mut sum = [0.0f32; 3];
