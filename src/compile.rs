@@ -92,9 +92,10 @@ const MATH_NAMES: &[&str] = &[
 ];
 
 /// Which compiler makes the PTX.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Dialect {
     /// Debian's clang-16 (`$CLANG` overrides the program).
+    #[default]
     Clang,
     /// NVIDIA's nvcc (`$NVCC`, else `nvcc` on `PATH`).
     Nvcc,
@@ -197,12 +198,6 @@ pub struct CompileOptions {
     pub dialect: Dialect,
     /// libdevice as named by `--libdevice`; `None` looks for it ([`find_libdevice`]).
     pub libdevice: Option<PathBuf>,
-}
-
-impl Default for Dialect {
-    fn default() -> Self {
-        Dialect::Clang
-    }
 }
 
 /// The libdevice file under a CUDA installation or pip package root.

@@ -404,3 +404,23 @@ fn mutated_ptx_loads_and_runs_without_panic() {
     }
     assert!(runs >= 50 && loaded >= 10 && launched >= 10, "{runs} runs, {loaded} loaded, {launched} launches");
 }
+
+/// Issue 17 item 7: `--dump` files are checked before the launch and written
+/// all or none; a failed run leaves no dump and no temporary file.
+#[test]
+fn dumps_are_written_all_or_none() {
+    let dir = tempdir("dump");
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/reduce.toml");
+    let spec = spec.to_str().unwrap();
+    let (code, out) = warplight_in(&dir, &["launch", spec, "--dump", "input=a.bin", "--dump", "sums=nodir/b.bin"]);
+    assert_eq!(code, Some(1), "{out}");
+    assert!(out.contains("--dump nodir/b.bin: the folder nodir does not exist"), "{out}");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing is written");
+    let (code, out) = warplight_in(&dir, &["launch", spec, "--dump", "input=a.bin", "--dump", "sums=b.bin"]);
+    assert_eq!(code, Some(0), "{out}");
+    let mut left: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    left.sort();
+    assert_eq!(left, ["a.bin", "b.bin"]);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -291,7 +291,7 @@ impl MemObserver for CtaCheck {
         }
     }
 
-    fn barrier_release(&mut self, _id: u32, warps: &[u32]) {
+    fn barrier_release(&mut self, _id: u32, warps: &[usize]) {
         self.clocks.barrier(warps);
         if self.tools.synccheck {
             let threads = self.threads;

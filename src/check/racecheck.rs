@@ -90,17 +90,17 @@ impl Clocks {
 
     /// A barrier released `warps`: each learns what the others did, then
     /// starts a new epoch of its own.
-    pub fn barrier(&mut self, warps: &[u32]) {
+    pub fn barrier(&mut self, warps: &[usize]) {
         let mut m = [0u32; 32];
         for &w in warps {
-            for (x, y) in m.iter_mut().zip(&self.vc[w as usize]) {
+            for (x, y) in m.iter_mut().zip(&self.vc[w]) {
                 *x = (*x).max(*y);
             }
         }
         for &w in warps {
             let mut v = m;
-            v[w as usize] += 1;
-            self.vc[w as usize] = v;
+            v[w] += 1;
+            self.vc[w] = v;
         }
     }
 

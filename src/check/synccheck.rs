@@ -30,8 +30,8 @@ impl Arrivals {
     /// A barrier released `warps`: records a mismatch when they waited at
     /// different instructions (the lowest warp's instruction against the
     /// first other one), and forgets their arrivals.
-    pub fn release(&mut self, warps: &[u32], cta: u32, lanes: impl Fn(u32) -> u32, found: &mut Findings) {
-        let sites: Vec<(u32, Pc)> = warps.iter().filter_map(|&w| self.at[w as usize].map(|p| (w, p))).collect();
+    pub fn release(&mut self, warps: &[usize], cta: u32, lanes: impl Fn(u32) -> u32, found: &mut Findings) {
+        let sites: Vec<(u32, Pc)> = warps.iter().filter_map(|&w| self.at[w].map(|p| (w as u32, p))).collect();
         if let Some(&(w0, p0)) = sites.first()
             && let Some(&(w1, p1)) = sites.iter().find(|(_, p)| *p != p0)
         {
@@ -45,7 +45,7 @@ impl Arrivals {
             }
         }
         for &w in warps {
-            self.at[w as usize] = None;
+            self.at[w] = None;
         }
     }
 }

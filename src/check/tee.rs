@@ -35,7 +35,7 @@ impl MemObserver for Both {
         self.first.barrier_arrive(warp, func, pc, id);
         self.second.barrier_arrive(warp, func, pc, id);
     }
-    fn barrier_release(&mut self, id: u32, warps: &[u32]) {
+    fn barrier_release(&mut self, id: u32, warps: &[usize]) {
         self.first.barrier_release(id, warps);
         self.second.barrier_release(id, warps);
     }

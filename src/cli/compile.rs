@@ -3,13 +3,16 @@
 
 use std::path::PathBuf;
 
-use crate::compile::{Dialect, compile, demangle};
+use crate::compile::{CompileOptions, Dialect, compile_with, demangle};
 
 /// Options of `warplight compile`.
 #[derive(Debug, clap::Args)]
 #[command(after_help = "\
 The prelude (kernels/prelude.h: the CUDA keywords, threadIdx & co., atomics, shuffles, votes,
-__syncthreads, __ldg) is included first, so a .cu needs no #include. Kernels declared
+__syncthreads, __ldg, printf) is included first, so a .cu needs no #include. CUDA's math
+library (expf, sinf, powf, min, max, abs, ...; docs/prelude.md) comes from libdevice, found
+through --libdevice, WARPLIGHT_LIBDEVICE, a CUDA install or `pip install nvidia-cuda-nvcc`.
+Kernels declared
 `extern \"C\" __global__` keep their names; others get C++ names (_Z5saxpyifPfS_), which
 `compile` lists beside the plain name.
 
@@ -26,6 +29,10 @@ pub struct CompileArgs {
     /// clang (Debian's clang-16, the default) or nvcc.
     #[arg(long, default_value = "clang")]
     pub dialect: String,
+    /// libdevice.10.bc, CUDA's math library (default: WARPLIGHT_LIBDEVICE, CUDA installs,
+    /// the pip package nvidia-cuda-nvcc).
+    #[arg(long, value_name = "FILE")]
+    pub libdevice: Option<PathBuf>,
 }
 
 /// Runs the command.
@@ -35,7 +42,7 @@ pub fn run(a: CompileArgs) -> Result<(), Box<dyn std::error::Error>> {
     if out == a.source {
         return Err(format!("{}: the output would overwrite the source", out.display()).into());
     }
-    let ptx = compile(&a.source, d)?;
+    let ptx = compile_with(&a.source, &CompileOptions { dialect: d, libdevice: a.libdevice.clone() })?;
     // check that warplight can run what was made before writing it
     let prog = crate::ptx::load(&ptx, &out.display().to_string())?;
     super::write_atomically(&out, ptx.as_bytes())?;

@@ -3,6 +3,7 @@
 //! with units ([`report`]); for programs, JSON or CSV — and result buffers
 //! ([`print_buffer`]).
 
+pub mod dump;
 pub mod print_buffer;
 pub mod report;
 
@@ -103,6 +104,7 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
             None => Err(format!("--dump {d}: expected NAME=FILE")),
         })
         .collect::<Result<_, _>>()?;
+    dump::check_paths(dumps.iter().map(|(_, f)| f.as_path()))?;
     let prints: Vec<print_buffer::PrintRequest> =
         a.print.iter().map(|p| print_buffer::parse(p, &spec.buffers)).collect::<Result<_, _>>()?;
     if a.csv && !prints.is_empty() {
@@ -168,11 +170,14 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     }
     let stats = result?;
     // Outputs only after every launch succeeded: no partial files.
-    for (name, file) in &dumps {
-        let (p, b) = &prepared.buffers[name];
-        let bytes = dev.read::<u8>(*p, b.len * b.ty.size());
-        crate::cli::write_atomically(file, &bytes)?;
-    }
+    let files: Vec<(PathBuf, Vec<u8>)> = dumps
+        .iter()
+        .map(|(name, file)| {
+            let (p, b) = &prepared.buffers[name];
+            (file.clone(), dev.read::<u8>(*p, b.len * b.ty.size()))
+        })
+        .collect();
+    dump::write_all(&files)?;
     let printed: Vec<(&print_buffer::PrintRequest, launch_spec::ElemType, Vec<u8>)> = prints
         .iter()
         .map(|r| {

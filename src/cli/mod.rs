@@ -164,8 +164,12 @@ pub fn main() -> i32 {
 /// failure never leaves a partial file under the final name.
 pub fn write_atomically(file: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
     let tmp = file.with_extension("warplight-tmp");
-    std::fs::write(&tmp, bytes).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, file).map_err(|e| format!("{}: {e}", file.display()))
+    // on failure the temporary file goes too: nothing half-written is left
+    let r = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, file));
+    r.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: {e}", file.display())
+    })
 }
 
 fn validate(fixture: &std::path::Path, ptx: &std::path::Path, md: bool) -> Result<(), Box<dyn std::error::Error>> {

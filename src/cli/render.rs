@@ -57,6 +57,22 @@ pub struct RenderArgs {
     /// Also write the counters as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Method: `raycast` (thesis 000's Whitted ray caster) or `path` (thesis 003's
+    /// path tracer; `--variant native` or `emulated`).
+    #[arg(long, default_value = "raycast")]
+    pub method: String,
+    /// Path tracer: pt, nee, mis (balance heuristic) or mis-power.
+    #[arg(long, default_value = "nee")]
+    pub integrator: String,
+    /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
+    #[arg(long, default_value_t = 16)]
+    pub spp: u32,
+    /// Path tracer: the longest path in bounces.
+    #[arg(long, default_value_t = crate::host::path::DEFAULT_MAX_BOUNCES)]
+    pub bounces: u32,
+    /// Path tracer: seed of the random numbers.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
 }
 
 /// The trace counters as JSON; an emulated run's kernels do not count ray kinds
@@ -139,7 +155,11 @@ fn pixel_progress(dev: &mut Device, kernel: &str, pixels: u64) -> Option<indicat
 
 /// Renders one frame.
 fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+    if !matches!(a.method.as_str(), "raycast" | "path") {
+        return Err(format!("unknown method `{}`; expected raycast or path", a.method).into());
+    }
     let kernel_variant = match a.variant.as_str() {
+        _ if a.method == "path" => None,
         "native" => None,
         v => Some(Variant::parse(v).ok_or_else(|| {
             let names: Vec<&str> = Variant::EVERY.iter().map(|v| v.name()).collect();
@@ -182,6 +202,9 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         cam.resolution = [w, h];
     }
     let [width, height] = cam.resolution;
+    if a.method == "path" {
+        return crate::repro::lin2017::render::run(&a, &scene, &cam);
+    }
     crate::limits::check_memory(
         || format!("a render of {width} x {height} pixels"),
         (width as u64 * height as u64).saturating_mul(bytes_per_pixel(kernel_variant.is_some())),

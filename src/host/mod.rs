@@ -5,6 +5,7 @@
 pub mod camera;
 pub mod image;
 pub mod kdtree;
+pub mod path;
 pub mod procedural;
 pub mod raycast;
 pub mod rt_kernels;

@@ -97,8 +97,7 @@ mod tests {
 
     fn prog(regs: u32) -> Program {
         let src = format!(
-            ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{{\n.reg .b32 %r<{}>;\nret;\n}}\n",
-            regs + 1
+            ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{{\n.reg .b32 %r<{regs}>;\nret;\n}}\n"
         );
         crate::ptx::load(&src, "k.ptx").unwrap()
     }

@@ -265,8 +265,7 @@ impl Cta {
             };
             if done {
                 if let Some(o) = self.observer.as_mut() {
-                    let warps: Vec<u32> = waiting.iter().map(|&i| i as u32).collect();
-                    o.barrier_release(id, &warps);
+                    o.barrier_release(id, &waiting);
                 }
                 self.complete_bar_red(&waiting);
                 for i in waiting {

@@ -64,7 +64,7 @@ pub trait MemObserver: Send {
     fn barrier_arrive(&mut self, _warp: u32, _func: u32, _pc: u32, _id: u32) {}
     /// Barrier `id` completed and released `warps` (ascending): what they
     /// did before it happens before what they do after. Default: nothing.
-    fn barrier_release(&mut self, _id: u32, _warps: &[u32]) {}
+    fn barrier_release(&mut self, _id: u32, _warps: &[usize]) {}
 }
 
 /// Makes one observer per CTA and collects them when the CTA retires.

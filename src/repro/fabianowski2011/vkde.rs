@@ -41,6 +41,7 @@
 //! kernels' records and estimates equal the native ones bit for bit
 //! (`tests/vkde.rs`).
 
+use std::cmp::Ordering::{Equal, Greater, Less};
 use std::f32::consts::{FRAC_1_PI, FRAC_2_PI};
 
 use super::photons::{Photon, PhotonError, SLOT, cross, delta_p, dot, len, scale};
@@ -163,7 +164,8 @@ pub fn construct(p: &Photon, s: &Settings) -> Construction {
     let (a, b, la) = if l2 > l1 { (p.dz[1], p.dz[0], l2) } else { (p.dz[0], p.dz[1], l1) };
     // eq. 5.33: the footprint height |D_p'| |sin alpha| = |D_p x D_p'| / |D_p|
     let height = len(cross(a, b)) / la;
-    if !(height >= s.f * la) {
+    // (negated, so that a NaN height discards)
+    if !matches!(height.partial_cmp(&(s.f * la)), Some(Greater | Equal)) {
         return Construction::Discarded;
     }
     // dampening: |D_p|^(1/4) / |D_p| on both differentials, then the spanning vectors and the spread
@@ -486,16 +488,16 @@ pub fn estimate(map: &PhotonMap, q: &Query, shape: Shape) -> Estimate {
         }
         for k in &map.kernels[nd.a as usize..(nd.a + (nd.b & !LEAF_BIT)) as usize] {
             e.retrieved += 1;
-            if !(dot(k.normal, q.n) > 0.0) {
+            if dot(k.normal, q.n).partial_cmp(&0.0) != Some(Greater) {
                 continue;
             }
             let d = d2(k.z, k.m_prime, k.major, x);
-            if !(d < 1.0) {
+            if d.partial_cmp(&1.0) != Some(Less) {
                 continue;
             }
             let w = shape.weight(d);
-            for c in 0..3 {
-                sum[c] += w * k.flux[c];
+            for (s, f) in sum.iter_mut().zip(k.flux) {
+                *s += w * f;
             }
             e.contributions += 1;
         }

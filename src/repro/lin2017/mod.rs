@@ -5,6 +5,8 @@
 //! giving it measurement groups and a render function, as
 //! `src/repro/fabianowski2011/` does.
 
+pub mod render;
+
 use crate::repro::registry::{Status, TableDef, Thesis};
 
 /// The seed and its tables.

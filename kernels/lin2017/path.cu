@@ -1,0 +1,366 @@
+// Thesis 003 (Lin 2017): the path tracer, one megakernel launch per frame.
+//
+// One thread per path: pixel (x, y), subpixel (sx, sy) of the 2 x 2 grid
+// (§4.2, 003:L221-230), path index i = 4 * (y * width + x) + 2 * sy + sx.
+// Each launch is one frame of the outer loop (003:L119): every thread traces
+// one path with a tent-jittered camera ray (smallpt's warp), adds its
+// radiance to its slot of the accumulation buffer (progressive refinement
+// across launches) and stores it in `last` (the frame alone).
+//
+// Traversal: the thesis' flattened kd-tree (§6.1: 16-byte nodes, the word
+// axis 2 bits | leaf count 6 bits | left child 24 bits, split, right child,
+// triangle offset) walked with the 8-byte short stack of Santos et al.
+// (§3.4: entries {node, tfar}; tnear is the previous tfar on a pop) and the
+// branch-reduced step of Fig. 15 (003:L479-492, 24-bit mask, errata 3;
+// non-strict comparisons, see trace()).
+// Triangles: the affine test of §6.4 (three float4 rows of the inverse of
+// [A-C, B-C, N] with the translation in w; N = (A-C) x (B-C), errata 4).
+//
+// Shading (§4.4-4.5): Lambertian diffuse with cosine sampling, perfect
+// mirror, and a glass whose Fresnel switch (Schlick, (1 - c)^5 by repeated
+// multiplication) picks reflection or refraction; emitters are one-sided
+// (front = the winding's normal) and black. Integrators: pt (BSDF sampling
+// only), nee (a light sample and shadow ray at diffuse hits, emission after
+// a diffuse bounce not counted, 003:L249), mis (both, balance or power
+// heuristic, §4.6). Russian roulette on the per-bounce mask (003:L267-271):
+// continue with q = max RGB of the bounce's f cos / p, then divide by q.
+//
+// Random numbers are counter based: dimension d of path i in frame f is a
+// hash of (i, f, seed, d), so the native path tracer (src/host/path/) draws
+// the same numbers. It performs the same float operations in the same order
+// (no contraction), so both render the same image bit for bit.
+#include "../prelude.h"
+
+#if defined(__clang__) && !defined(__NVCC__)
+#pragma clang fp contract(off)
+#endif
+
+#define INTEGRATOR_PT 0
+#define INTEGRATOR_NEE 1
+#define INTEGRATOR_MIS_BALANCE 2
+#define INTEGRATOR_MIS_POWER 3
+#define KIND_DIFFUSE 0
+#define KIND_MIRROR 1
+#define KIND_GLASS 2
+#define KIND_EMITTER 3
+#define LEAF_AXIS 3u
+#define STACK_ENTRIES 32
+// random dimensions: 2 for the camera ray, then 8 per bounce
+#define DIMS_CAMERA 2u
+#define DIMS_PER_BOUNCE 8u
+#define INV_PI 0.318309886183790672f
+
+// Scene, camera and frame, laid out by src/host/path/kernel.rs.
+struct Params {
+  float cam_pos[3], cam_fwd[3], cam_right[3], cam_up[3];
+  float lo[3], hi[3];
+  float eps, tan_half, aspect, light_area;
+  int width, height, num_paths, frame, integrator, max_bounces, num_lights, seed;
+};
+
+struct V3 { float x, y, z; };
+static __device__ __forceinline__ V3 v3(float x, float y, float z) { V3 r = {x, y, z}; return r; }
+static __device__ __forceinline__ float comp(V3 v, unsigned k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+static __device__ __forceinline__ float dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static __device__ __forceinline__ V3 add3(V3 a, V3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static __device__ __forceinline__ V3 sub3(V3 a, V3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static __device__ __forceinline__ V3 mul3(V3 a, V3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }
+static __device__ __forceinline__ V3 scale3(V3 a, float s) { return v3(a.x * s, a.y * s, a.z * s); }
+static __device__ __forceinline__ V3 normalize3(V3 v) {
+  float inv = 1.0f / sqrtf(v.x * v.x + v.y * v.y + v.z * v.z);
+  return v3(v.x * inv, v.y * inv, v.z * inv);
+}
+
+struct Scene {
+  const Params *p;
+  const uint4 *nodes;      // 16-byte nodes (§6.1)
+  const unsigned *refs;    // the concatenated leaf triangle lists
+  const float4 *tris;      // 3 float4 per triangle: the affine rows (§6.4)
+  const float4 *tri_data;  // per triangle: unit geometric normal, material index (int bits)
+  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior]
+  const float4 *lights;    // per emitting triangle: [v0, cdf], [e1, triangle (int bits)], [e2, 0]
+};
+
+// The counter-based generator (two rounds of a 32-bit integer hash per draw).
+static __device__ __forceinline__ unsigned mix(unsigned h) {
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return h;
+}
+// The key of path i in frame f.
+static __device__ __forceinline__ unsigned path_key(unsigned i, unsigned frame, unsigned seed) {
+  return mix(i * 0x9e3779b9u ^ mix(frame * 0x632be5abu + seed));
+}
+// Dimension d of a path: a uniform float in [0, 1) with 24 random bits.
+static __device__ __forceinline__ float rng(unsigned key, unsigned d) {
+  unsigned h = mix(mix(key ^ (d + 1u) * 0x85ebca6bu));
+  return (float)(h >> 8) * (1.0f / 16777216.0f);
+}
+
+// (cos, sin) of the azimuth 2 pi y for y in [0, 1): a quarter turn q = floor(4y),
+// the rest x in [-pi/4, pi/4) by Taylor polynomials (error < 1e-8), rotated by
+// pi/4 and q quarter turns (the photon kernel's; no sin/cos instruction).
+static __device__ __forceinline__ void azimuth(float y, float *c, float *s) {
+  float f4 = y * 4.0f;
+  int q = (int)f4;
+  float x = (f4 - (float)q) * 1.57079632679489662f - 0.785398163397448310f;
+  float x2 = x * x;
+  float sx = x * (1.0f - x2 / 6.0f * (1.0f - x2 / 20.0f * (1.0f - x2 / 42.0f * (1.0f - x2 / 72.0f))));
+  float cx = 1.0f - x2 / 2.0f * (1.0f - x2 / 12.0f * (1.0f - x2 / 30.0f * (1.0f - x2 / 56.0f * (1.0f - x2 / 90.0f))));
+  float h = 0.707106781186547524f;
+  float cr = (cx - sx) * h, sr = (sx + cx) * h;
+  if (q == 0) { *c = cr; *s = sr; }
+  else if (q == 1) { *c = -sr; *s = cr; }
+  else if (q == 2) { *c = -cr; *s = -sr; }
+  else { *c = sr; *s = -cr; }
+}
+
+// smallpt's tent warp of a uniform y in [0, 1) to [-1, 1).
+static __device__ __forceinline__ float tent(float y) {
+  float r = 2.0f * y;
+  return r < 1.0f ? sqrtf(r) - 1.0f : 1.0f - sqrtf(2.0f - r);
+}
+
+// §6.4: the affine test; updates *t_hit and returns true on a hit in [t_min, *t_hit].
+static __device__ __forceinline__ bool affine(const Scene &s, unsigned t, V3 o, V3 d, float t_min, float *t_hit) {
+  const float4 *m = s.tris + 3 * t;
+  float4 r2 = m[2];
+  float oz = r2.x * o.x + r2.y * o.y + r2.z * o.z + r2.w;
+  float dz = r2.x * d.x + r2.y * d.y + r2.z * d.z;
+  float tt = -oz / dz;
+  if (!(tt >= t_min && tt <= *t_hit)) return false;
+  float4 r0 = m[0];
+  float u = r0.x * o.x + r0.y * o.y + r0.z * o.z + r0.w + tt * (r0.x * d.x + r0.y * d.y + r0.z * d.z);
+  if (u < 0.0f) return false;
+  float4 r1 = m[1];
+  float v = r1.x * o.x + r1.y * o.y + r1.z * o.z + r1.w + tt * (r1.x * d.x + r1.y * d.y + r1.z * d.z);
+  if (v < 0.0f || u + v > 1.0f) return false;
+  *t_hit = tt;
+  return true;
+}
+
+// The nearest hit in [t_min, t_max] (with `any`, the first found); -1 for none.
+static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out) {
+  const Params *p = s.p;
+  V3 inv = v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+  // clip to the scene box
+  float t0x = (p->lo[0] - o.x) * inv.x, t1x = (p->hi[0] - o.x) * inv.x;
+  float t0y = (p->lo[1] - o.y) * inv.y, t1y = (p->hi[1] - o.y) * inv.y;
+  float t0z = (p->lo[2] - o.z) * inv.z, t1z = (p->hi[2] - o.z) * inv.z;
+  float tn = fmaxf(fmaxf(fminf(t0x, t1x), fminf(t0y, t1y)), fminf(t0z, t1z));
+  float tf = fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z));
+  float tnear = fmaxf(t_min, tn), tfar = fminf(t_max, tf);
+  if (!(tnear <= tfar)) return -1;
+  float t_hit = t_max;
+  int found = -1;
+  struct Entry { unsigned node; float tfar; } stack[STACK_ENTRIES];   // 8-byte entries (Santos et al.)
+  int size = 0;
+  unsigned idx = 0;
+  for (;;) {
+    uint4 n = s.nodes[idx];
+    while ((n.x >> 30) != LEAF_AXIS) {                // Fig. 15: one branch-reduced step
+      unsigned axis = n.x >> 30;
+      float tsplit = (__uint_as_float(n.y) - comp(o, axis)) * comp(inv, axis);
+      unsigned first = n.x & 0xffffffu, second = n.z;
+      if (__float_as_int(comp(d, axis)) < 0) {
+        unsigned t = first;
+        first = second;
+        second = t;
+      }
+      // Fig. 15 computes f = int(floor(tnear - tsplit)) >> 31, -1 iff tnear < tsplit,
+      // and pushes when tsplit < tfar. Both comparisons are non-strict here:
+      // the project's builder keeps a triangle lying in a split plane on one
+      // side only (the thesis' builder puts it on both, 003:L566), so a ray
+      // that meets the plane at tnear or tfar must visit both children.
+      int f = -(int)(tnear <= tsplit);                 // mask and add, no branch
+      idx = (first & (unsigned)f) + (second & ~(unsigned)f);
+      if (f < 0 && tsplit <= tfar) {
+        stack[size].node = second;
+        stack[size].tfar = tfar;
+        size++;
+        tfar = tsplit;
+      }
+      n = s.nodes[idx];
+    }
+    unsigned count = (n.x >> 24) & 63u, first = n.w;
+    float lo = fmaxf(tnear - p->eps, t_min);
+    float hi = fminf(t_hit, tfar + p->eps);
+    for (unsigned r = 0; r < count; r++) {
+      unsigned t = s.refs[first + r];
+      if (affine(s, t, o, d, lo, &hi)) {
+        found = (int)t;
+        if (any) break;
+      }
+    }
+    if (found >= 0) {
+      t_hit = hi;
+      break;
+    }
+    if (size == 0) break;
+    size--;
+    tnear = tfar;
+    idx = stack[size].node;
+    tfar = stack[size].tfar;
+  }
+  *t_out = t_hit;
+  return found;
+}
+
+// A heuristic's weight of a strategy with pdf a against one with pdf b.
+static __device__ __forceinline__ float mis_weight(int integrator, float a, float b) {
+  if (integrator == INTEGRATOR_MIS_POWER) {
+    a = a * a;
+    b = b * b;
+  }
+  return a / (a + b);
+}
+
+// Duff et al.'s orthonormal basis around the unit n.
+static __device__ __forceinline__ void basis(V3 n, V3 *b1, V3 *b2) {
+  float sign = n.z >= 0.0f ? 1.0f : -1.0f;
+  float a = -1.0f / (sign + n.z);
+  float b = n.x * n.y * a;
+  *b1 = v3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  *b2 = v3(b, sign + n.y * n.y * a, -n.y);
+}
+
+extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                      const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                      const float4 *lights, float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights};
+  const Params *p = params;
+  int i = (int)WL_TID;
+  if (i >= p->num_paths) return;
+  int pixel = i >> 2, sub = i & 3;
+  int x = pixel % p->width, y = pixel / p->width;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  int integrator = p->integrator;
+  // the camera ray: tent-jittered in subpixel (sub & 1, sub >> 1) of the 2 x 2 grid
+  float px = (float)x + ((float)(sub & 1) + 0.5f + tent(rng(key, 0))) * 0.5f;
+  float py = (float)y + ((float)(sub >> 1) + 0.5f + tent(rng(key, 1))) * 0.5f;
+  float cx = (px / (float)p->width * 2.0f - 1.0f) * p->tan_half * p->aspect;
+  float cy = (1.0f - py / (float)p->height * 2.0f) * p->tan_half;
+  V3 fwd = v3(p->cam_fwd[0], p->cam_fwd[1], p->cam_fwd[2]);
+  V3 right = v3(p->cam_right[0], p->cam_right[1], p->cam_right[2]);
+  V3 up = v3(p->cam_up[0], p->cam_up[1], p->cam_up[2]);
+  V3 o = v3(p->cam_pos[0], p->cam_pos[1], p->cam_pos[2]);
+  V3 d = normalize3(add3(add3(fwd, scale3(right, cx)), scale3(up, cy)));
+  V3 L = v3(0.0f, 0.0f, 0.0f), beta = v3(1.0f, 1.0f, 1.0f);
+  bool count_emission = true;   // camera rays and specular bounces see emitters
+  float bsdf_pdf = 0.0f;        // solid-angle pdf of the last diffuse bounce (mis)
+  for (int bounce = 0; bounce <= p->max_bounces; bounce++) {
+    float t;
+    int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
+    if (tri < 0) break;
+    float4 td = s.tri_data[tri];
+    V3 n = v3(td.x, td.y, td.z);
+    float4 m0 = s.mats[2 * __float_as_int(td.w)];
+    int kind = __float_as_int(m0.w);
+    float cos_d = dot3(d, n);
+    if (kind == KIND_EMITTER) {
+      if (cos_d < 0.0f) {   // the front face emits
+        float4 m1 = s.mats[2 * __float_as_int(td.w) + 1];
+        float w = 1.0f;
+        if (!count_emission) {
+          if (integrator == INTEGRATOR_NEE) {
+            w = 0.0f;
+          } else if (integrator != INTEGRATOR_PT) {
+            float light_pdf = t * t / (-cos_d * p->light_area);
+            w = mis_weight(integrator, bsdf_pdf, light_pdf);
+          }
+        }
+        L = add3(L, scale3(mul3(beta, v3(m1.x, m1.y, m1.z)), w));
+      }
+      break;
+    }
+    V3 hitp = add3(o, scale3(d, t));
+    V3 ns = cos_d < 0.0f ? n : v3(-n.x, -n.y, -n.z);   // faces the ray
+    V3 color = v3(m0.x, m0.y, m0.z);
+    unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
+    if (kind == KIND_DIFFUSE && integrator != INTEGRATOR_PT && bounce < p->max_bounces) {
+      // next event estimation: a light triangle by area, a point on it uniformly
+      float yl = rng(key, dim);
+      int l = 0;
+      while (l + 1 < p->num_lights && !(yl < s.lights[3 * l].w)) l++;
+      float4 la = s.lights[3 * l], lb = s.lights[3 * l + 1], lc = s.lights[3 * l + 2];
+      float su = sqrtf(rng(key, dim + 1));
+      float yv = rng(key, dim + 2);
+      float bu = su * (1.0f - yv), bv = su * yv;
+      V3 q = add3(add3(v3(la.x, la.y, la.z), scale3(v3(lb.x, lb.y, lb.z), bu)), scale3(v3(lc.x, lc.y, lc.z), bv));
+      V3 wl = sub3(q, hitp);
+      float dist2 = dot3(wl, wl);
+      float dist = sqrtf(dist2);
+      wl = scale3(wl, 1.0f / dist);
+      int ltri = __float_as_int(lb.w);
+      float4 ld = s.tri_data[ltri];
+      float cos_s = dot3(ns, wl);
+      float cos_l = -dot3(v3(ld.x, ld.y, ld.z), wl);
+      if (cos_s > 0.0f && cos_l > 0.0f) {
+        float ts;
+        if (trace(s, hitp, wl, p->eps, dist - p->eps, true, &ts) < 0) {
+          float4 le = s.mats[2 * __float_as_int(ld.w) + 1];
+          float light_pdf = dist2 / (cos_l * p->light_area);
+          float w = 1.0f;
+          if (integrator != INTEGRATOR_NEE) w = mis_weight(integrator, light_pdf, cos_s * INV_PI);
+          float g = cos_s * INV_PI / light_pdf * w;
+          L = add3(L, scale3(mul3(mul3(beta, color), v3(le.x, le.y, le.z)), g));
+        }
+      }
+    }
+    if (bounce == p->max_bounces) break;
+    // the next direction
+    if (kind == KIND_DIFFUSE) {
+      float y1 = rng(key, dim + 3);
+      float r = sqrtf(y1), c, sn;
+      azimuth(rng(key, dim + 4), &c, &sn);
+      float lz = sqrtf(fmaxf(1.0f - y1, 0.0f));
+      V3 b1, b2;
+      basis(ns, &b1, &b2);
+      d = add3(add3(scale3(b1, r * c), scale3(b2, r * sn)), scale3(ns, lz));
+      bsdf_pdf = lz * INV_PI;
+      count_emission = false;
+    } else {
+      float cos_i = -dot3(d, ns);   // > 0: ns faces the ray
+      V3 next = add3(d, scale3(ns, 2.0f * cos_i));
+      if (kind == KIND_GLASS) {
+        // the Fresnel switch (Schlick): reflect with probability R, else refract
+        float ior = s.mats[2 * __float_as_int(td.w) + 1].w;
+        bool into = cos_d < 0.0f;
+        float eta = into ? 1.0f / ior : ior;
+        float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+        if (k > 0.0f) {   // else total internal reflection
+          float cos_t = sqrtf(k);
+          V3 tdir = add3(scale3(d, eta), scale3(ns, eta * cos_i - cos_t));
+          float r0 = (1.0f - ior) / (1.0f + ior);
+          r0 = r0 * r0;
+          float c = 1.0f - (into ? cos_i : cos_t);
+          float c2 = c * c;
+          float fr = r0 + (1.0f - r0) * (c2 * c2 * c);
+          if (!(rng(key, dim + 6) < fr)) next = tdir;
+        }
+      }
+      d = next;
+      count_emission = true;
+    }
+    // Russian roulette on the bounce's mask f cos / p = color
+    float q = fmaxf(fmaxf(color.x, color.y), color.z);
+    if (q < 1.0f) {
+      if (!(rng(key, dim + 5) < q)) break;
+      beta = v3(beta.x * (color.x / q), beta.y * (color.y / q), beta.z * (color.z / q));
+    } else {
+      beta = mul3(beta, color);
+    }
+    o = hitp;
+  }
+  float *a = accum + 3 * i;
+  a[0] += L.x;
+  a[1] += L.y;
+  a[2] += L.z;
+  float *l = last + 3 * i;
+  l[0] = L.x;
+  l[1] = L.y;
+  l[2] = L.z;
+}

@@ -1,0 +1,79 @@
+//! `launch --dump NAME=FILE`: the files are checked before anything runs and
+//! written all or none — each under a temporary name beside it first, then
+//! all renamed; a failure removes what was written, so a failed run leaves
+//! neither a stray temporary file nor some of the dumps.
+
+use std::path::{Path, PathBuf};
+
+/// The temporary name of `file` while it is written: `.NAME.warplight-tmp` beside it.
+fn temporary(file: &Path) -> PathBuf {
+    let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    file.with_file_name(format!(".{name}.warplight-tmp"))
+}
+
+/// An error unless each file can be made: a file name, in an existing folder.
+pub fn check_paths<'a>(files: impl IntoIterator<Item = &'a Path>) -> Result<(), String> {
+    for f in files {
+        if f.file_name().is_none() || f.is_dir() {
+            return Err(format!("--dump {}: expected a file name", f.display()));
+        }
+        let parent = f.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        if !parent.is_dir() {
+            return Err(format!("--dump {}: the folder {} does not exist", f.display(), parent.display()));
+        }
+    }
+    Ok(())
+}
+
+/// Writes every `(file, bytes)`, or none of them.
+pub fn write_all(files: &[(PathBuf, Vec<u8>)]) -> Result<(), String> {
+    let mut written: Vec<PathBuf> = Vec::new();
+    let clean = |written: &[PathBuf]| {
+        for t in written {
+            let _ = std::fs::remove_file(t);
+        }
+    };
+    for (file, bytes) in files {
+        let tmp = temporary(file);
+        if let Err(e) = std::fs::write(&tmp, bytes) {
+            let _ = std::fs::remove_file(&tmp);
+            clean(&written);
+            return Err(format!("{}: {e}", file.display()));
+        }
+        written.push(tmp);
+    }
+    for (i, (file, _)) in files.iter().enumerate() {
+        if let Err(e) = std::fs::rename(&written[i], file) {
+            // the files renamed before this one are complete dumps of this run; the rest are removed
+            clean(&written[i..]);
+            return Err(format!("{}: {e}", file.display()));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_or_none() {
+        let d = std::env::temp_dir().join(format!("warplight-dump-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let (a, b) = (d.join("a.bin"), d.join("b.bin"));
+        write_all(&[(a.clone(), vec![1, 2]), (b.clone(), vec![3])]).unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), [1, 2]);
+        assert_eq!(std::fs::read(&b).unwrap(), [3]);
+        std::fs::remove_file(&a).unwrap();
+        // the second file cannot be written (its name is a folder): neither is left, nor a temporary
+        std::fs::create_dir_all(d.join("dir.bin")).unwrap();
+        std::fs::create_dir_all(temporary(&d.join("dir.bin"))).unwrap();
+        let r = write_all(&[(a.clone(), vec![1]), (d.join("dir.bin"), vec![2])]);
+        assert!(r.is_err());
+        assert!(!a.exists() && !temporary(&a).exists());
+        assert!(check_paths([d.join("x/y.bin").as_path()]).unwrap_err().contains("does not exist"));
+        assert!(check_paths([d.join("dir.bin").as_path()]).unwrap_err().contains("expected a file name"));
+        assert!(check_paths([a.as_path()]).is_ok());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

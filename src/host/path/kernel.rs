@@ -1,0 +1,115 @@
+//! Runs `kernels/lin2017/path.cu` on the emulator: uploads the laid-out
+//! scene once, launches `path_frame` once per frame (one thread per path,
+//! 256-thread CTAs) and keeps the accumulation buffer on the device across
+//! launches; the counters of every launch are summed.
+
+use super::layout::PathScene;
+use super::{FrameParams, Progressive, eps_for, frame_of};
+use crate::host::camera::Camera;
+use crate::host::rt_kernels::upload;
+use crate::sim::device::to_bytes;
+use crate::sim::{Arg, Counters, Device, LaunchConfig, Module, SimConfig, SimError};
+
+/// The kernel's PTX (clang-16), compiled in.
+pub const PTX: &str = include_str!("../../../kernels/lin2017/path.ptx");
+/// The kernel's entry point.
+pub const KERNEL: &str = "path_frame";
+/// Threads per CTA.
+pub const THREADS: u32 = 256;
+/// Warp instructions per path the watchdog allows one launch (a path of the
+/// default 16 bounces needs well under a tenth of this).
+pub const WARP_INSTRUCTIONS_PER_PATH: u64 = 1 << 14;
+
+/// Loads the kernel on `dev`.
+pub fn load(dev: &mut Device) -> Result<Module, SimError> {
+    dev.load_ptx(PTX, "kernels/lin2017/path.ptx")
+}
+
+/// The simulator settings for frames of `params`: the default, with a
+/// watchdog that grows with the number of paths.
+pub fn sim_config(params: &FrameParams) -> SimConfig {
+    let mut c = SimConfig::default();
+    let budget = (params.paths() as u64).saturating_mul(WARP_INSTRUCTIONS_PER_PATH);
+    c.schedule.max_warp_instructions = c.schedule.max_warp_instructions.max(budget);
+    c
+}
+
+/// The kernel's parameter block for `frame`.
+pub fn params_bytes(scene: &PathScene, camera: &Camera, params: &FrameParams, frame: u32) -> Vec<u8> {
+    let c = frame_of(camera, eps_for(scene.lo, scene.hi));
+    let mut floats = Vec::with_capacity(22);
+    for v in [c.pos, c.fwd, c.right, c.up, scene.lo, scene.hi] {
+        floats.extend_from_slice(&v);
+    }
+    floats.extend_from_slice(&[c.eps, c.tan_half, c.aspect, scene.light_area]);
+    let mut bytes = to_bytes(&floats);
+    for v in [
+        params.width as i32,
+        params.height as i32,
+        params.paths() as i32,
+        frame as i32,
+        params.integrator.code(),
+        params.max_bounces as i32,
+        scene.lights.len() as i32,
+        params.seed as i32,
+    ] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    bytes
+}
+
+/// An emulated progressive render.
+#[derive(Debug, Clone)]
+pub struct KernelRender {
+    /// The accumulated image and, if kept, each frame's.
+    pub image: Progressive,
+    /// The emulator's counters summed over the frames' launches.
+    pub totals: Counters,
+}
+
+/// Renders `frames` frames of `camera`'s view on `dev` (with `module` loaded
+/// by [`load`]); `keep_frames` keeps each frame's image; `progress` is told
+/// each finished frame.
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    dev: &mut Device,
+    module: &Module,
+    scene: &PathScene,
+    camera: &Camera,
+    params: FrameParams,
+    frames: u32,
+    keep_frames: bool,
+    mut progress: impl FnMut(u32),
+) -> Result<KernelRender, SimError> {
+    let flat = |v: &[[f32; 4]]| -> Vec<f32> { v.iter().flatten().copied().collect() };
+    let nodes: Vec<u32> = scene.nodes.iter().flatten().copied().collect();
+    let tris: Vec<f32> = scene.tris.iter().flatten().copied().collect();
+    let mats: Vec<f32> = scene.mats.iter().flatten().copied().collect();
+    let lights: Vec<f32> = scene.lights.iter().flatten().copied().collect();
+    let pp = upload(dev, &params_bytes(scene, camera, &params, 0), "params")?;
+    let nb = upload(dev, &to_bytes(&nodes), "nodes")?;
+    let rb = upload(dev, &to_bytes(&scene.refs), "refs")?;
+    let tb = upload(dev, &to_bytes(&tris), "tris")?;
+    let db = upload(dev, &to_bytes(&flat(&scene.tri_data)), "tri_data")?;
+    let mb = upload(dev, &to_bytes(&mats), "materials")?;
+    let lb = upload(dev, &to_bytes(&lights), "lights")?;
+    let n = params.paths() * 3;
+    let accum = dev.alloc_zeroed::<f32>(n);
+    let last = dev.alloc_zeroed::<f32>(n);
+    let args: Vec<Arg> = [pp, nb, rb, tb, db, mb, lb, accum, last].into_iter().map(Arg::Ptr).collect();
+    let ctas = params.paths().div_ceil(THREADS as usize) as u32;
+    let mut out = Progressive::new(params.width, params.height);
+    let mut totals = Counters::default();
+    for f in 0..frames {
+        dev.write(pp, &params_bytes(scene, camera, &params, f))?;
+        let st = dev.launch(module, KERNEL, LaunchConfig::linear(ctas, THREADS), &args)?;
+        totals.merge(&st.totals);
+        out.frames += 1;
+        if keep_frames {
+            out.frame_images.push(Progressive::pixels_of(params.width, params.height, &dev.read::<f32>(last, n)));
+        }
+        progress(f + 1);
+    }
+    out.accum = dev.read::<f32>(accum, n);
+    Ok(KernelRender { image: out, totals })
+}

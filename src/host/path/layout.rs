@@ -1,0 +1,205 @@
+//! The path tracer's device layout (thesis 003 §6.1, §6.4): the project's
+//! CPU-built kd-tree flattened into 16-byte nodes, the concatenated leaf
+//! triangle lists, affine triangles, per-triangle normals and materials, and
+//! the emitting triangles for light sampling. The native path tracer reads
+//! the same arrays, so both see the same floats.
+//!
+//! Node, 4 words: 0 = `axis << 30 | count << 24 | left` (axis 3 = leaf, count
+//! the leaf's triangles, 6 bits; left the left child, 24 bits); 1 = split
+//! position (f32 bits); 2 = right child; 3 = offset of the leaf's triangles
+//! in the reference array. The bit order is warplight's (the thesis states
+//! the 2|6|24 partition, not the order). Nodes are in depth-first order, the
+//! left child right after its parent ("serial-recursive construction",
+//! 003:L434).
+
+use glam::{DVec3, Vec3};
+
+use crate::host::kdtree::{KdTree, Node};
+use crate::host::scene::{MaterialKind, Scene};
+
+/// The leaf's axis value.
+pub const LEAF_AXIS: u32 = 3;
+/// The largest leaf (6-bit count).
+pub const MAX_LEAF: usize = 63;
+/// The most nodes a 24-bit left index reaches.
+pub const MAX_NODES: usize = 1 << 24;
+
+/// Why a scene cannot be laid out for the path tracer.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LayoutError {
+    /// A leaf holds more triangles than the node's 6-bit count field.
+    #[error("a kd-tree leaf holds {0} triangles; the thesis' node stores at most {MAX_LEAF} (6 bits)")]
+    LeafTooLarge(usize),
+    /// More nodes than a 24-bit index reaches.
+    #[error("the kd-tree has {0} nodes; the thesis' node indexes at most {MAX_NODES} (24 bits)")]
+    TooManyNodes(usize),
+    /// No triangle emits: the path tracer needs an area light.
+    #[error("scene `{0}` has no emitting triangle: the path tracer needs an area light (an emitter material)")]
+    NoLight(String),
+}
+
+/// Material kinds as the kernel numbers them.
+pub fn kind_code(k: MaterialKind) -> u32 {
+    match k {
+        MaterialKind::Diffuse => 0,
+        MaterialKind::Mirror => 1,
+        MaterialKind::Glass { .. } => 2,
+        MaterialKind::Emitter => 3,
+    }
+}
+
+/// The scene as the path tracer reads it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathScene {
+    /// 16-byte nodes.
+    pub nodes: Vec<[u32; 4]>,
+    /// Leaf triangle lists, concatenated.
+    pub refs: Vec<u32>,
+    /// Per triangle, three rows (x, y, z, w) of the affine transform into unit-triangle space.
+    pub tris: Vec<[f32; 12]>,
+    /// Per triangle: unit geometric normal, material index (u32 bits).
+    pub tri_data: Vec<[f32; 4]>,
+    /// Per material: colour, kind (u32 bits); emission, index of refraction.
+    pub mats: Vec<[f32; 8]>,
+    /// Per emitting triangle: v0, cumulative area fraction; e1, triangle (u32 bits); e2, 0.
+    pub lights: Vec<[f32; 12]>,
+    /// Total emitting area.
+    pub light_area: f32,
+    /// Scene bounds (the root's box).
+    pub lo: [f32; 3],
+    /// Scene bounds.
+    pub hi: [f32; 3],
+}
+
+/// The affine rows of triangle (a, b, c): the inverse of [a − c, b − c, n]
+/// with n = (a − c) × (b − c), and the translation −M⁻¹c in w (in f64, rounded once).
+pub fn affine_rows(t: &[Vec3; 3]) -> [f32; 12] {
+    let (a, b, c) = (t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3());
+    let (e0, e1) = (a - c, b - c);
+    let n = e0.cross(e1);
+    let m = glam::DMat3::from_cols(e0, e1, n);
+    let inv = m.inverse();
+    let mut out = [0.0f32; 12];
+    for r in 0..3 {
+        let row = inv.row(r);
+        let w = -row.dot(c);
+        out[4 * r..4 * r + 4].copy_from_slice(&[row.x as f32, row.y as f32, row.z as f32, w as f32]);
+    }
+    out
+}
+
+fn unit_normal(t: &[Vec3; 3]) -> [f32; 3] {
+    let n: DVec3 = (t[1].as_dvec3() - t[0].as_dvec3()).cross(t[2].as_dvec3() - t[0].as_dvec3()).normalize();
+    [n.x as f32, n.y as f32, n.z as f32]
+}
+
+impl PathScene {
+    /// Lays out `scene` with `tree` (built over the scene's triangles in order).
+    pub fn new(scene: &Scene, tree: &KdTree) -> Result<PathScene, LayoutError> {
+        if tree.nodes.len() > MAX_NODES {
+            return Err(LayoutError::TooManyNodes(tree.nodes.len()));
+        }
+        let mut nodes = Vec::with_capacity(tree.nodes.len());
+        let mut refs = Vec::with_capacity(tree.tri_refs.len());
+        // depth first, left child first: (tree node, slot of the parent's right field to patch)
+        let mut todo: Vec<(u32, Option<usize>)> = vec![(0, None)];
+        while let Some((ti, patch)) = todo.pop() {
+            let at = nodes.len();
+            if let Some(p) = patch {
+                let parent: &mut [u32; 4] = &mut nodes[p];
+                parent[2] = at as u32;
+            }
+            match tree.nodes[ti as usize] {
+                Node::Inner { axis, split, left, right } => {
+                    // the left child is the next node
+                    nodes.push([(axis as u32) << 30 | (at as u32 + 1), split.to_bits(), 0, 0]);
+                    todo.push((right, Some(at)));
+                    todo.push((left, None));
+                }
+                Node::Leaf { first, count } => {
+                    if count as usize > MAX_LEAF {
+                        return Err(LayoutError::LeafTooLarge(count as usize));
+                    }
+                    let off = refs.len() as u32;
+                    refs.extend_from_slice(&tree.tri_refs[first as usize..(first + count) as usize]);
+                    nodes.push([LEAF_AXIS << 30 | count << 24, 0, 0, off]);
+                }
+            }
+        }
+        let tris = scene.triangles.iter().map(|t| affine_rows(&t.v)).collect();
+        let tri_data = scene
+            .triangles
+            .iter()
+            .map(|t| {
+                let n = unit_normal(&t.v);
+                [n[0], n[1], n[2], f32::from_bits(t.material)]
+            })
+            .collect();
+        let mats = scene
+            .materials
+            .iter()
+            .map(|m| {
+                let ior = if let MaterialKind::Glass { ior } = m.kind { ior } else { 1.0 };
+                let [r, g, b] = m.color;
+                let [er, eg, eb] = m.emission;
+                [r, g, b, f32::from_bits(kind_code(m.kind)), er, eg, eb, ior]
+            })
+            .collect();
+        let emitting: Vec<(usize, f64)> = scene
+            .triangles
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| scene.materials[t.material as usize].kind == MaterialKind::Emitter)
+            .map(|(i, t)| (i, 0.5 * (t.v[1] - t.v[0]).as_dvec3().cross((t.v[2] - t.v[0]).as_dvec3()).length()))
+            .collect();
+        let total: f64 = emitting.iter().map(|e| e.1).sum();
+        if emitting.is_empty() || total <= 0.0 {
+            return Err(LayoutError::NoLight(scene.name.clone()));
+        }
+        let mut acc = 0.0f64;
+        let n_lights = emitting.len();
+        let lights = emitting
+            .iter()
+            .enumerate()
+            .map(|(k, &(i, area))| {
+                acc += area;
+                let cdf = if k + 1 == n_lights { 1.0 } else { (acc / total) as f32 };
+                let v = scene.triangles[i].v;
+                let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+                [v[0].x, v[0].y, v[0].z, cdf, e1.x, e1.y, e1.z, f32::from_bits(i as u32), e2.x, e2.y, e2.z, 0.0]
+            })
+            .collect();
+        Ok(PathScene {
+            nodes,
+            refs,
+            tris,
+            tri_data,
+            mats,
+            lights,
+            light_area: total as f32,
+            lo: tree.bounds.lo.into(),
+            hi: tree.bounds.hi.into(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn affine_rows_map_the_vertices_to_the_unit_triangle() {
+        let t = [Vec3::new(1.0, 0.0, 2.0), Vec3::new(0.0, 3.0, 1.0), Vec3::new(-1.0, 0.5, 0.0)];
+        let r = affine_rows(&t);
+        let apply = |p: Vec3| -> [f32; 3] {
+            let f = |k: usize| r[4 * k] * p.x + r[4 * k + 1] * p.y + r[4 * k + 2] * p.z + r[4 * k + 3];
+            [f(0), f(1), f(2)]
+        };
+        for (p, want) in [(t[0], [1.0, 0.0, 0.0]), (t[1], [0.0, 1.0, 0.0]), (t[2], [0.0, 0.0, 0.0])] {
+            let got = apply(p);
+            for k in 0..3 {
+                assert!((got[k] - want[k]).abs() < 1e-5, "{p:?}: {got:?}");
+            }
+        }
+    }
+}

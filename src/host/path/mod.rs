@@ -1,0 +1,186 @@
+//! Thesis 003's path tracer (Lin 2017, chapters 3, 4 and 6), the kernel
+//! `kernels/lin2017/path.cu` run on the emulator ([`kernel`]) and its native
+//! mirror ([`native`]): tent-filtered camera rays in 4 subpixels, the
+//! flattened SAH kd-tree with the 8-byte short-stack traversal, the affine
+//! triangle test, Lambertian / mirror / Fresnel-switched glass shading,
+//! next-event estimation, multiple importance sampling and Russian roulette,
+//! accumulated progressively over frames (one launch per frame, 4 samples
+//! per pixel per frame). [`stats`] compares renders with a reference by a
+//! per-block Welch t-test under Holm's correction.
+
+pub mod kernel;
+pub mod layout;
+pub mod native;
+pub mod rng;
+pub mod stats;
+
+use super::camera::Camera;
+use super::image::FrameBuffer;
+
+/// The light-transport estimator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum Integrator {
+    /// BSDF sampling only: emission counted wherever a path hits a light.
+    Pt,
+    /// Next-event estimation at diffuse hits (§4.4); emission after a diffuse bounce not counted.
+    Nee,
+    /// Both strategies weighted by the balance heuristic (§4.6, β = 1).
+    MisBalance,
+    /// Both strategies weighted by the power heuristic (§4.6, β = 2).
+    MisPower,
+}
+
+impl Integrator {
+    /// Every integrator.
+    pub const ALL: [Integrator; 4] = [Integrator::Pt, Integrator::Nee, Integrator::MisBalance, Integrator::MisPower];
+
+    /// The kernel's code.
+    pub fn code(self) -> i32 {
+        match self {
+            Integrator::Pt => 0,
+            Integrator::Nee => 1,
+            Integrator::MisBalance => 2,
+            Integrator::MisPower => 3,
+        }
+    }
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Pt => "pt",
+            Integrator::Nee => "nee",
+            Integrator::MisBalance => "mis",
+            Integrator::MisPower => "mis-power",
+        }
+    }
+
+    /// Parses a command-line name (`mis` is the balance heuristic).
+    pub fn parse(s: &str) -> Option<Integrator> {
+        match s {
+            "mis-balance" => Some(Integrator::MisBalance),
+            _ => Integrator::ALL.into_iter().find(|i| i.name() == s),
+        }
+    }
+}
+
+/// Samples per pixel in one frame (the 2 x 2 subpixels, §4.2).
+pub const SAMPLES_PER_FRAME: u32 = 4;
+
+/// Default longest path, in bounces (not stated by the thesis; `docs/fixtures.md`).
+pub const DEFAULT_MAX_BOUNCES: u32 = 16;
+
+/// The settings of a frame as the kernel reads them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrameParams {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// The integrator.
+    pub integrator: Integrator,
+    /// Longest path in bounces: emission seen after up to this many bounces counts.
+    pub max_bounces: u32,
+    /// Seed of the random numbers.
+    pub seed: u32,
+}
+
+impl FrameParams {
+    /// Paths per frame: 4 per pixel.
+    pub fn paths(&self) -> usize {
+        self.width as usize * self.height as usize * SAMPLES_PER_FRAME as usize
+    }
+}
+
+/// The camera and ray epsilon in the kernel's form.
+pub fn frame_of(camera: &Camera, eps: f32) -> native::Frame {
+    let (r, u, f) = camera.frame();
+    let [w, h] = camera.resolution;
+    native::Frame {
+        pos: camera.position,
+        fwd: f.into(),
+        right: r.into(),
+        up: u.into(),
+        tan_half: (camera.fov_y.to_radians() * 0.5).tan(),
+        aspect: w as f32 / h as f32,
+        eps,
+    }
+}
+
+/// The ray epsilon for a scene of bounds `lo`..`hi`: the ray caster's rule
+/// (scene diagonal × 1e-5).
+pub fn eps_for(lo: [f32; 3], hi: [f32; 3]) -> f32 {
+    let d = glam::Vec3::from(hi) - glam::Vec3::from(lo);
+    d.max(glam::Vec3::ZERO).length().max(1e-3) * crate::host::raycast::EPS_REL
+}
+
+/// A progressive render: per-path sums over frames and, per pixel, the
+/// frames' pixel means (for the statistical test's batch estimates).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Progressive {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Frames accumulated.
+    pub frames: u32,
+    /// Per path (3 floats): the radiance summed over frames (the device's accumulation buffer).
+    pub accum: Vec<f32>,
+    /// Per frame, per pixel: the mean of its 4 subpixel paths (kept when asked).
+    pub frame_images: Vec<FrameBuffer>,
+}
+
+impl Progressive {
+    /// An empty accumulation.
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize * SAMPLES_PER_FRAME as usize * 3;
+        Progressive { width, height, frames: 0, accum: vec![0.0; n], frame_images: Vec::new() }
+    }
+
+    /// The pixel means of one frame's per-path radiance `last`.
+    pub fn pixels_of(width: u32, height: u32, last: &[f32]) -> FrameBuffer {
+        let mut fb = FrameBuffer::new(width, height);
+        for (p, px) in fb.pixels.iter_mut().enumerate() {
+            for (c, v) in px.iter_mut().enumerate() {
+                let s: f64 = (0..4).map(|k| last[3 * (4 * p + k) + c] as f64).sum();
+                *v = (s / 4.0) as f32;
+            }
+        }
+        fb
+    }
+
+    /// The image: each pixel's mean over its subpixels and frames.
+    pub fn image(&self) -> FrameBuffer {
+        let mut fb = Self::pixels_of(self.width, self.height, &self.accum);
+        let k = 1.0 / self.frames.max(1) as f32;
+        for px in &mut fb.pixels {
+            for c in px.iter_mut() {
+                *c *= k;
+            }
+        }
+        fb
+    }
+}
+
+/// Renders `frames` frames natively; `keep_frames` keeps each frame's image.
+pub fn render_native(
+    scene: &layout::PathScene,
+    camera: &Camera,
+    params: FrameParams,
+    frames: u32,
+    keep_frames: bool,
+    mut progress: impl FnMut(u32),
+) -> Progressive {
+    let eps = eps_for(scene.lo, scene.hi);
+    let tracer = native::Tracer { scene, frame: frame_of(camera, eps), params };
+    let mut out = Progressive::new(params.width, params.height);
+    let mut last = vec![0.0f32; out.accum.len()];
+    for f in 0..frames {
+        tracer.frame(f, &mut out.accum, &mut last);
+        out.frames += 1;
+        if keep_frames {
+            out.frame_images.push(Progressive::pixels_of(params.width, params.height, &last));
+        }
+        progress(f + 1);
+    }
+    out
+}

@@ -1,0 +1,348 @@
+//! The native path tracer: `kernels/lin2017/path.cu` in Rust, operation for
+//! operation (same traversal, same affine test, same random dimensions, no
+//! fused multiply-adds), so that a frame traced here equals the emulated
+//! kernel's frame bit for bit. It is the oracle for the kernel and the
+//! native speed baseline.
+
+// `!(a < b)` is the kernel's comparison, NaN included: kept as written
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use rayon::prelude::*;
+
+use super::layout::{LEAF_AXIS, PathScene};
+use super::rng::{azimuth, path_key, rng, tent};
+use super::{FrameParams, Integrator};
+
+/// Random dimensions of the camera ray.
+pub const DIMS_CAMERA: u32 = 2;
+/// Random dimensions per bounce.
+pub const DIMS_PER_BOUNCE: u32 = 8;
+const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
+const KIND_DIFFUSE: u32 = 0;
+const KIND_GLASS: u32 = 2;
+const KIND_EMITTER: u32 = 3;
+/// Stack entries of the traversal (the builder's depth limit).
+pub const STACK_ENTRIES: usize = 32;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct V3 {
+    x: f32,
+    y: f32,
+    z: f32,
+}
+
+fn v3(x: f32, y: f32, z: f32) -> V3 {
+    V3 { x, y, z }
+}
+
+impl V3 {
+    fn comp(self, k: u32) -> f32 {
+        if k == 0 {
+            self.x
+        } else if k == 1 {
+            self.y
+        } else {
+            self.z
+        }
+    }
+    fn dot(self, b: V3) -> f32 {
+        self.x * b.x + self.y * b.y + self.z * b.z
+    }
+    fn add(self, b: V3) -> V3 {
+        v3(self.x + b.x, self.y + b.y, self.z + b.z)
+    }
+    fn sub(self, b: V3) -> V3 {
+        v3(self.x - b.x, self.y - b.y, self.z - b.z)
+    }
+    fn mul(self, b: V3) -> V3 {
+        v3(self.x * b.x, self.y * b.y, self.z * b.z)
+    }
+    fn scale(self, s: f32) -> V3 {
+        v3(self.x * s, self.y * s, self.z * s)
+    }
+    fn normalize(self) -> V3 {
+        let inv = 1.0 / (self.x * self.x + self.y * self.y + self.z * self.z).sqrt();
+        v3(self.x * inv, self.y * inv, self.z * inv)
+    }
+}
+
+fn xyz(a: &[f32], at: usize) -> V3 {
+    v3(a[at], a[at + 1], a[at + 2])
+}
+
+/// A frame's camera and integrator settings, in the kernel's parameter form.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Camera position.
+    pub pos: [f32; 3],
+    /// Forward, right and up unit vectors.
+    pub fwd: [f32; 3],
+    /// Right.
+    pub right: [f32; 3],
+    /// Up.
+    pub up: [f32; 3],
+    /// tan(fov_y / 2).
+    pub tan_half: f32,
+    /// Width / height.
+    pub aspect: f32,
+    /// Ray epsilon.
+    pub eps: f32,
+}
+
+/// The scene's arrays and the frame settings, as the kernel sees them.
+pub struct Tracer<'a> {
+    /// The laid-out scene.
+    pub scene: &'a PathScene,
+    /// The camera.
+    pub frame: Frame,
+    /// Settings.
+    pub params: FrameParams,
+}
+
+impl Tracer<'_> {
+    fn affine(&self, t: u32, o: V3, d: V3, t_min: f32, t_hit: &mut f32) -> bool {
+        let m = &self.scene.tris[t as usize];
+        let oz = m[8] * o.x + m[9] * o.y + m[10] * o.z + m[11];
+        let dz = m[8] * d.x + m[9] * d.y + m[10] * d.z;
+        let tt = -oz / dz;
+        if !(tt >= t_min && tt <= *t_hit) {
+            return false;
+        }
+        let u = m[0] * o.x + m[1] * o.y + m[2] * o.z + m[3] + tt * (m[0] * d.x + m[1] * d.y + m[2] * d.z);
+        if u < 0.0 {
+            return false;
+        }
+        let v = m[4] * o.x + m[5] * o.y + m[6] * o.z + m[7] + tt * (m[4] * d.x + m[5] * d.y + m[6] * d.z);
+        if v < 0.0 || u + v > 1.0 {
+            return false;
+        }
+        *t_hit = tt;
+        true
+    }
+
+    /// The nearest hit in [t_min, t_max] (with `any`, the first found).
+    fn trace(&self, o: V3, d: V3, t_min: f32, t_max: f32, any: bool) -> Option<(u32, f32)> {
+        let s = self.scene;
+        let eps = self.frame.eps;
+        let inv = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+        let (t0x, t1x) = ((s.lo[0] - o.x) * inv.x, (s.hi[0] - o.x) * inv.x);
+        let (t0y, t1y) = ((s.lo[1] - o.y) * inv.y, (s.hi[1] - o.y) * inv.y);
+        let (t0z, t1z) = ((s.lo[2] - o.z) * inv.z, (s.hi[2] - o.z) * inv.z);
+        let tn = fmax(fmax(fmin(t0x, t1x), fmin(t0y, t1y)), fmin(t0z, t1z));
+        let tf = fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z));
+        let (mut tnear, mut tfar) = (fmax(t_min, tn), fmin(t_max, tf));
+        if !(tnear <= tfar) {
+            return None;
+        }
+        let t_hit = t_max;
+        let mut found: Option<u32> = None;
+        let mut stack = [(0u32, 0.0f32); STACK_ENTRIES];
+        let mut size = 0usize;
+        let mut idx = 0u32;
+        let mut hi;
+        loop {
+            let mut n = s.nodes[idx as usize];
+            while n[0] >> 30 != LEAF_AXIS {
+                let axis = n[0] >> 30;
+                let tsplit = (f32::from_bits(n[1]) - o.comp(axis)) * inv.comp(axis);
+                let (mut first, mut second) = (n[0] & 0xff_ffff, n[2]);
+                if (d.comp(axis).to_bits() as i32) < 0 {
+                    std::mem::swap(&mut first, &mut second);
+                }
+                let f = -((tnear <= tsplit) as i32);
+                idx = (first & f as u32).wrapping_add(second & !(f as u32));
+                if f < 0 && tsplit <= tfar {
+                    stack[size] = (second, tfar);
+                    size += 1;
+                    tfar = tsplit;
+                }
+                n = s.nodes[idx as usize];
+            }
+            let (count, first) = ((n[0] >> 24) & 63, n[3]);
+            let lo = fmax(tnear - eps, t_min);
+            hi = fmin(t_hit, tfar + eps);
+            for r in 0..count {
+                let t = s.refs[(first + r) as usize];
+                if self.affine(t, o, d, lo, &mut hi) {
+                    found = Some(t);
+                    if any {
+                        break;
+                    }
+                }
+            }
+            if found.is_some() {
+                break;
+            }
+            if size == 0 {
+                break;
+            }
+            size -= 1;
+            tnear = tfar;
+            (idx, tfar) = stack[size];
+        }
+        found.map(|t| (t, hi))
+    }
+
+    fn mis_weight(&self, a: f32, b: f32) -> f32 {
+        let (a, b) = if self.params.integrator == Integrator::MisPower { (a * a, b * b) } else { (a, b) };
+        a / (a + b)
+    }
+
+    /// Radiance of path `i` in frame `frame`.
+    pub fn path(&self, i: u32, frame: u32) -> [f32; 3] {
+        let s = self.scene;
+        let c = &self.frame;
+        let p = &self.params;
+        let (w, h) = (p.width, p.height);
+        let (pixel, sub) = (i >> 2, i & 3);
+        let (x, y) = (pixel % w, pixel / w);
+        let key = path_key(i, frame, p.seed);
+        let integrator = p.integrator;
+        let px = x as f32 + ((sub & 1) as f32 + 0.5 + tent(rng(key, 0))) * 0.5;
+        let py = y as f32 + ((sub >> 1) as f32 + 0.5 + tent(rng(key, 1))) * 0.5;
+        let cx = (px / w as f32 * 2.0 - 1.0) * c.tan_half * c.aspect;
+        let cy = (1.0 - py / h as f32 * 2.0) * c.tan_half;
+        let (fwd, right, up) = (xyz(&c.fwd, 0), xyz(&c.right, 0), xyz(&c.up, 0));
+        let mut o = xyz(&c.pos, 0);
+        let mut d = fwd.add(right.scale(cx)).add(up.scale(cy)).normalize();
+        let mut l = v3(0.0, 0.0, 0.0);
+        let mut beta = v3(1.0, 1.0, 1.0);
+        let mut count_emission = true;
+        let mut bsdf_pdf = 0.0f32;
+        let mut bounce = 0u32;
+        while bounce <= p.max_bounces {
+            let Some((tri, t)) = self.trace(o, d, c.eps, f32::INFINITY, false) else { break };
+            let td = s.tri_data[tri as usize];
+            let n = v3(td[0], td[1], td[2]);
+            let mat = &s.mats[td[3].to_bits() as usize];
+            let kind = mat[3].to_bits();
+            let cos_d = d.dot(n);
+            if kind == KIND_EMITTER {
+                if cos_d < 0.0 {
+                    let mut wgt = 1.0;
+                    if !count_emission {
+                        if integrator == Integrator::Nee {
+                            wgt = 0.0;
+                        } else if integrator != Integrator::Pt {
+                            let light_pdf = t * t / (-cos_d * s.light_area);
+                            wgt = self.mis_weight(bsdf_pdf, light_pdf);
+                        }
+                    }
+                    l = l.add(beta.mul(xyz(mat, 4)).scale(wgt));
+                }
+                break;
+            }
+            let hitp = o.add(d.scale(t));
+            let ns = if cos_d < 0.0 { n } else { v3(-n.x, -n.y, -n.z) };
+            let color = xyz(mat, 0);
+            let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
+            if kind == KIND_DIFFUSE && integrator != Integrator::Pt && bounce < p.max_bounces {
+                let yl = rng(key, dim);
+                let mut li = 0usize;
+                while li + 1 < s.lights.len() && !(yl < s.lights[li][3]) {
+                    li += 1;
+                }
+                let lg = &s.lights[li];
+                let su = rng(key, dim + 1).sqrt();
+                let yv = rng(key, dim + 2);
+                let (bu, bv) = (su * (1.0 - yv), su * yv);
+                let q = xyz(lg, 0).add(xyz(lg, 4).scale(bu)).add(xyz(lg, 8).scale(bv));
+                let mut wl = q.sub(hitp);
+                let dist2 = wl.dot(wl);
+                let dist = dist2.sqrt();
+                wl = wl.scale(1.0 / dist);
+                let ld = s.tri_data[lg[7].to_bits() as usize];
+                let cos_s = ns.dot(wl);
+                let cos_l = -v3(ld[0], ld[1], ld[2]).dot(wl);
+                if cos_s > 0.0 && cos_l > 0.0 && self.trace(hitp, wl, c.eps, dist - c.eps, true).is_none() {
+                    let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
+                    let light_pdf = dist2 / (cos_l * s.light_area);
+                    let mut wgt = 1.0;
+                    if integrator != Integrator::Nee {
+                        wgt = self.mis_weight(light_pdf, cos_s * INV_PI);
+                    }
+                    let g = cos_s * INV_PI / light_pdf * wgt;
+                    l = l.add(beta.mul(color).mul(le).scale(g));
+                }
+            }
+            if bounce == p.max_bounces {
+                break;
+            }
+            if kind == KIND_DIFFUSE {
+                let y1 = rng(key, dim + 3);
+                let r = y1.sqrt();
+                let (cs, sn) = azimuth(rng(key, dim + 4));
+                let lz = fmax(1.0 - y1, 0.0).sqrt();
+                let (b1, b2) = basis(ns);
+                d = b1.scale(r * cs).add(b2.scale(r * sn)).add(ns.scale(lz));
+                bsdf_pdf = lz * INV_PI;
+                count_emission = false;
+            } else {
+                let cos_i = -d.dot(ns);
+                let mut next = d.add(ns.scale(2.0 * cos_i));
+                if kind == KIND_GLASS {
+                    let ior = mat[7];
+                    let into = cos_d < 0.0;
+                    let eta = if into { 1.0 / ior } else { ior };
+                    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                    if k > 0.0 {
+                        let cos_t = k.sqrt();
+                        let tdir = d.scale(eta).add(ns.scale(eta * cos_i - cos_t));
+                        let mut r0 = (1.0 - ior) / (1.0 + ior);
+                        r0 = r0 * r0;
+                        let cc = 1.0 - if into { cos_i } else { cos_t };
+                        let c2 = cc * cc;
+                        let fr = r0 + (1.0 - r0) * (c2 * c2 * cc);
+                        if !(rng(key, dim + 6) < fr) {
+                            next = tdir;
+                        }
+                    }
+                }
+                d = next;
+                count_emission = true;
+            }
+            let q = fmax(fmax(color.x, color.y), color.z);
+            if q < 1.0 {
+                if !(rng(key, dim + 5) < q) {
+                    break;
+                }
+                beta = v3(beta.x * (color.x / q), beta.y * (color.y / q), beta.z * (color.z / q));
+            } else {
+                beta = beta.mul(color);
+            }
+            o = hitp;
+            bounce += 1;
+        }
+        [l.x, l.y, l.z]
+    }
+
+    /// Traces frame `frame`: adds each path's radiance to `accum` (3 floats
+    /// a path) and stores it in `last`, as one kernel launch does.
+    pub fn frame(&self, frame: u32, accum: &mut [f32], last: &mut [f32]) {
+        accum.par_chunks_mut(3).zip(last.par_chunks_mut(3)).enumerate().for_each(|(i, (a, l))| {
+            let r = self.path(i as u32, frame);
+            for ((a, l), r) in a.iter_mut().zip(l.iter_mut()).zip(r) {
+                *a += r;
+                *l = r;
+            }
+        });
+    }
+}
+
+/// PTX min.f32: the non-NaN operand if one is NaN.
+fn fmin(a: f32, b: f32) -> f32 {
+    a.min(b)
+}
+
+/// PTX max.f32: the non-NaN operand if one is NaN.
+fn fmax(a: f32, b: f32) -> f32 {
+    a.max(b)
+}
+
+/// Duff et al.'s orthonormal basis around the unit `n`.
+fn basis(n: V3) -> (V3, V3) {
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (v3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), v3(b, sign + n.y * n.y * a, -n.y))
+}

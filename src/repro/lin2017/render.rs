@@ -1,0 +1,152 @@
+//! `warplight render --method path`: thesis 003's path tracer, progressive
+//! over frames (4 samples per pixel a frame), native or on the emulator,
+//! written as EXR (linear) or PNG, with a progress bar on a terminal.
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::time::Instant;
+
+use crate::cli::render::RenderArgs;
+use crate::host::camera::Camera;
+use crate::host::image::FrameBuffer;
+use crate::host::kdtree::{BuildParams, Heuristic, build};
+use crate::host::path::layout::PathScene;
+use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, kernel, render_native};
+use crate::sim::Device;
+
+/// What a path render produced.
+#[derive(Debug, Clone)]
+pub struct PathRender {
+    /// The image.
+    pub image: FrameBuffer,
+    /// Frames traced.
+    pub frames: u32,
+    /// Seconds spent tracing.
+    pub seconds: f64,
+    /// The emulator's warp and thread instructions, when emulated.
+    pub instructions: Option<(u64, u64)>,
+}
+
+/// Frames for `spp` samples per pixel: `spp` must be a positive multiple of 4.
+pub fn frames_for(spp: u32) -> Result<u32, String> {
+    if spp == 0 || !spp.is_multiple_of(SAMPLES_PER_FRAME) {
+        return Err(format!(
+            "--spp {spp}: expected a positive multiple of {SAMPLES_PER_FRAME} (a frame traces one path in each of a pixel's 2 x 2 subpixels)"
+        ));
+    }
+    Ok(spp / SAMPLES_PER_FRAME)
+}
+
+/// A progress bar over `frames` frames, on a terminal only.
+fn bar(frames: u32, what: &str) -> Option<indicatif::ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let pb = indicatif::ProgressBar::new(frames as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} frames ({eta})") {
+            pb.set_style(style);
+        }
+        pb.set_message(what.to_string());
+        pb
+    })
+}
+
+/// Renders `scene` with the path tracer: `emulated` on the emulator at `fidelity`.
+pub fn render(
+    scene: &crate::host::scene::Scene,
+    camera: &Camera,
+    params: FrameParams,
+    frames: u32,
+    emulated: Option<crate::sim::Fidelity>,
+) -> Result<PathRender, Box<dyn std::error::Error>> {
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+    let ps = PathScene::new(scene, &tree)?;
+    let what = format!(
+        "{} {} {}x{}",
+        if emulated.is_some() { "emulating" } else { "tracing" },
+        params.integrator.name(),
+        params.width,
+        params.height
+    );
+    let pb = bar(frames, &what);
+    let tick = |f: u32| {
+        if let Some(pb) = &pb {
+            pb.set_position(f as u64);
+        }
+    };
+    let t0 = Instant::now();
+    let (image, instructions) = match emulated {
+        None => (render_native(&ps, camera, params, frames, false, tick).image(), None),
+        Some(fidelity) => {
+            let mut cfg = kernel::sim_config(&params);
+            cfg.fidelity = fidelity;
+            let mut dev = Device::with_config(cfg);
+            let module = kernel::load(&mut dev)?;
+            let k = kernel::render(&mut dev, &module, &ps, camera, params, frames, false, tick)?;
+            (k.image.image(), Some((k.totals.warp_instructions, k.totals.thread_instructions)))
+        }
+    };
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    Ok(PathRender { image, frames, seconds: t0.elapsed().as_secs_f64(), instructions })
+}
+
+/// Runs `warplight render --method path` with the command's options.
+pub fn run(
+    a: &RenderArgs,
+    scene: &crate::host::scene::Scene,
+    camera: &Camera,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
+        format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic) or mis-power", a.integrator)
+    })?;
+    let frames = frames_for(a.spp)?;
+    let emulated = match a.variant.as_str() {
+        "native" => None,
+        "emulated" => Some(a.fidelity),
+        v => return Err(format!("--method path --variant {v}: expected native or emulated").into()),
+    };
+    let [width, height] = camera.resolution;
+    let params = FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed };
+    let r = render(scene, camera, params, frames, emulated)?;
+    write_image(&r.image, &a.output, a.exposure)?;
+    println!(
+        "{} ({}x{}), path tracer {}, {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
+        scene.name,
+        width,
+        height,
+        integrator.name(),
+        a.spp,
+        frames,
+        a.bounces,
+        r.seconds,
+        params.paths() as f64 * frames as f64 / r.seconds.max(1e-9) / 1e6,
+        if emulated.is_some() { " (emulated)" } else { " (native)" }
+    );
+    if let Some((w, t)) = r.instructions {
+        println!("  emulated path_frame: {w} warp instructions, {t} thread instructions");
+    }
+    println!("  wrote {}", a.output.display());
+    Ok(())
+}
+
+/// Writes `img` as EXR or PNG (by extension) under a temporary name, then renames it.
+fn write_image(img: &FrameBuffer, out: &Path, exposure: f32) -> Result<(), Box<dyn std::error::Error>> {
+    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let tmp = parent.join(format!(
+        ".{}.warplight-tmp.{}",
+        out.file_stem().and_then(|s| s.to_str()).unwrap_or("render"),
+        ext.as_deref().unwrap_or("png")
+    ));
+    let written = if ext.as_deref() == Some("exr") { img.write_exr(&tmp) } else { img.write_png(&tmp, exposure) };
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e.into());
+    }
+    std::fs::rename(&tmp, out).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: {e}", out.display())
+    })?;
+    Ok(())
+}

@@ -1,0 +1,211 @@
+#!/usr/bin/env python3
+"""Renders a Mitsuba 3 reference of a warplight scene for the path tracer's
+statistical test (tests/lin2017_reference.rs).
+
+Exports the scene exactly as warplight's path tracer sees it: the OBJ's
+polygons as triangle fans, per material (MTL Kd, or an override of the scene
+file), Lambertian BSDFs made two-sided (warplight's diffuse reflects on both
+sides; Mitsuba's `diffuse` on the front only), emitters one-sided (the
+winding's normal, as warplight) with a black BSDF, the pinhole camera with
+the same vertical field of view, and the longest path (max_depth = bounces + 1).
+
+The pixel filter: warplight jitters a tent-distributed sample (radius one
+subpixel) in each of the 2 x 2 subpixels of a pixel (smallpt's filter).
+Mitsuba renders the same at twice the resolution with a tent filter of
+radius 1 (film pixel = subpixel) and the film's border sampled, and this
+tool averages each 2 x 2 block: the same pixel estimate in expectation.
+
+Variance: the reference is rendered in B independent batches (seeds
+0..B-1); the mean image is their mean and the variance image the batch
+variance divided by B (the variance of the mean).
+
+Needs `pip install mitsuba numpy` (not needed by the build or CI).
+Usage (the committed fixtures were made by):
+  python3 tools/mitsuba/reference.py scenes/cornell-lambert.toml \
+      --size 32 --batches 16 --spp 1024 --bounces 16 \
+      --out tests/fixtures/mitsuba/cornell-lambert-32
+writes OUT.exr (mean), OUT-var.exr (variance of the mean) and OUT.json.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+import tempfile
+import time
+import tomllib
+
+import numpy as np
+
+
+def parse_mtl(path):
+    mats, cur = {}, None
+    for line in open(path, encoding="utf-8"):
+        w = line.split("#")[0].split()
+        if not w:
+            continue
+        if w[0] == "newmtl":
+            cur = w[1]
+            mats[cur] = {}
+        elif cur and w[0] in ("Kd", "Ks", "Ke"):
+            mats[cur][w[0]] = [float(x) for x in w[1:4]]
+    return mats
+
+
+def parse_obj(path):
+    """(groups in order: (group name, material name, [triangles]), mtllib path)."""
+    verts, groups, mtllib = [], [], None
+    group, mat = "default", None
+    cur = None
+    for line in open(path, encoding="utf-8"):
+        w = line.split()
+        if not w:
+            continue
+        if w[0] == "v":
+            verts.append([float(x) for x in w[1:4]])
+        elif w[0] == "mtllib":
+            mtllib = os.path.join(os.path.dirname(path), w[1])
+        elif w[0] == "usemtl":
+            mat, cur = w[1], None
+        elif w[0] in ("g", "o"):
+            group, cur = w[1], None
+        elif w[0] == "f":
+            idx = []
+            for t in w[1:]:
+                i = int(t.split("/")[0])
+                idx.append(i - 1 if i > 0 else len(verts) + i)
+            if cur is None:
+                cur = (group, mat, [])
+                groups.append(cur)
+            for k in range(1, len(idx) - 1):   # a fan, as tobj splits polygons
+                cur[2].append([verts[idx[0]], verts[idx[k]], verts[idx[k + 1]]])
+    return groups, mtllib
+
+
+def load_scene(toml_path):
+    sc = tomllib.load(open(toml_path, "rb"))
+    base = os.path.dirname(toml_path)
+    groups, mtllib = parse_obj(os.path.join(base, sc["obj"]))
+    mtl = parse_mtl(mtllib) if mtllib else {}
+    own = {m["name"]: m for m in sc.get("material", [])}
+    over = {o["group"]: o["material"] for o in sc.get("override", [])}
+    shapes = {}   # material name -> (kind, colour, emission, triangles)
+    for g, m, tris in groups:
+        name = over.get(g) or (over.get(m) if m else None) or m or "default"
+        if name in own:
+            d = own[name]
+            kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.75] * 3), d.get("emission", [0.0] * 3)
+        else:
+            d = mtl.get(name, {})
+            kd, ks, ke = d.get("Kd", [0.75] * 3), d.get("Ks", [0.0] * 3), d.get("Ke", [0.0] * 3)
+            if any(x > 0 for x in ke):
+                kind, color, em = "emitter", kd, ke
+            elif all(x < 0.01 for x in kd) and any(x > 0 for x in ks):
+                kind, color, em = "mirror", ks, ke
+            else:
+                kind, color, em = "diffuse", kd, ke
+        if kind not in ("diffuse", "emitter"):
+            sys.exit(f"{toml_path}: material {name} is {kind}; this tool exports Lambertian scenes only")
+        # zero-area triangles are dropped, as warplight's loader does
+        keep = [t for t in tris if np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0]))) > 0]
+        shapes.setdefault(name, (kind, color, em, []))[3].extend(keep)
+    return sc, shapes
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scene")
+    ap.add_argument("--size", type=int, default=32, help="image width and height in pixels")
+    ap.add_argument("--batches", type=int, default=16)
+    ap.add_argument("--spp", type=int, default=1024, help="samples per film pixel (subpixel) per batch")
+    ap.add_argument("--bounces", type=int, default=16)
+    ap.add_argument("--out", required=True)
+    a = ap.parse_args()
+    import mitsuba as mi
+    mi.set_variant("scalar_rgb")
+    from mitsuba import ScalarTransform4f as T
+
+    sc, shapes = load_scene(a.scene)
+    cam = sc["camera"]
+    pos = cam["position"]
+    d = cam["direction"]
+    up = cam.get("up", [0.0, 1.0, 0.0])
+    tmp = tempfile.mkdtemp(prefix="warplight-mitsuba-")
+    desc = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": a.bounces + 1, "rr_depth": a.bounces + 2},
+        "sensor": {
+            "type": "perspective",
+            "fov": cam["fov"],
+            "fov_axis": "y",
+            "to_world": T().look_at(origin=pos, target=[pos[i] + d[i] for i in range(3)], up=up),
+            "film": {
+                "type": "hdrfilm",
+                "width": 2 * a.size,
+                "height": 2 * a.size,
+                "rfilter": {"type": "tent", "radius": 1.0},
+                "sample_border": True,
+                "pixel_format": "rgb",
+            },
+            "sampler": {"type": "independent", "sample_count": a.spp},
+        },
+    }
+    triangles, light_area = 0, 0.0
+    for k, (name, (kind, color, em, tris)) in enumerate(sorted(shapes.items())):
+        if not tris:
+            continue
+        f = os.path.join(tmp, f"{k}.obj")
+        with open(f, "w") as o:
+            for t in tris:
+                for v in t:
+                    o.write("v %r %r %r\n" % tuple(v))
+            for i in range(len(tris)):
+                o.write(f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}\n")
+        triangles += len(tris)
+        shape = {"type": "obj", "filename": f, "face_normals": True}
+        if kind == "emitter":
+            shape["bsdf"] = {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}}
+            shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": em}}
+            for t in tris:
+                light_area += 0.5 * np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0])))
+        else:
+            shape["bsdf"] = {
+                "type": "twosided",
+                "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": color}},
+            }
+        desc[f"shape_{k}_{name}"] = shape
+    scene = mi.load_dict(desc)
+    t0 = time.time()
+    batches = []
+    for b in range(a.batches):
+        img = np.array(mi.render(scene, seed=b, spp=a.spp), dtype=np.float64)[:, :, :3]
+        s = a.size
+        batches.append(img.reshape(s, 2, s, 2, 3).mean(axis=(1, 3)))
+        print(f"batch {b + 1}/{a.batches} ({time.time() - t0:.0f} s)", file=sys.stderr)
+    x = np.stack(batches)
+    mean = x.mean(axis=0)
+    var = x.var(axis=0, ddof=1) / a.batches
+    os.makedirs(os.path.dirname(a.out) or ".", exist_ok=True)
+    mi.Bitmap(mean.astype(np.float32)).write(a.out + ".exr")
+    mi.Bitmap(var.astype(np.float32)).write(a.out + "-var.exr")
+    meta = {
+        "scene": a.scene,
+        "size": a.size,
+        "batches": a.batches,
+        "spp_per_subpixel_per_batch": a.spp,
+        "max_bounces": a.bounces,
+        "mitsuba": mi.__version__,
+        "variant": "scalar_rgb",
+        "triangles": triangles,
+        "light_area": light_area,
+        "seconds": round(time.time() - t0, 1),
+        "command": "python3 tools/mitsuba/reference.py " + " ".join(sys.argv[1:]),
+        "mean_rgb": [float(v) for v in mean.reshape(-1, 3).mean(axis=0)],
+    }
+    json.dump(meta, open(a.out + ".json", "w"), indent=2)
+    print(json.dumps(meta, indent=2))
+
+
+if __name__ == "__main__":
+    main()
