@@ -160,13 +160,13 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     if let Some(pb) = spinner {
         pb.finish_and_clear();
     }
-    if let Some(reports) = checked.as_ref().filter(|_| !a.json || result.is_err()) {
-        crate::check::cli::print_reports(reports, spec.launches.len(), tools, a.csv || a.json);
-    }
     // the kernels' printf output comes first, also when a launch faulted (it shows how far it got)
     let printf = dev.take_printf();
     if !a.json || result.is_err() {
         show_printf(&printf, a.csv || a.json);
+    }
+    if let Some(reports) = checked.as_ref().filter(|_| !a.json || result.is_err()) {
+        crate::check::cli::print_reports(reports, spec.launches.len(), tools, a.csv || a.json);
     }
     let stats = result?;
     // Outputs only after every launch succeeded: no partial files.
