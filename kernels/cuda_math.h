@@ -26,6 +26,7 @@
 // The prelude defines these already (same PTX instructions); clang's
 // definitions of them are renamed so that the two headers do not collide.
 #define __brev __wl_clang___brev
+#define __brevll __wl_clang___brevll
 #define __byte_perm __wl_clang___byte_perm
 #define __clz __wl_clang___clz
 #define __cosf __wl_clang___cosf
@@ -50,6 +51,10 @@
 #define __mulhi __wl_clang___mulhi
 #define __saturatef __wl_clang___saturatef
 #define __sinf __wl_clang___sinf
+#define __clzll __wl_clang___clzll
+#define __syncthreads_and __wl_clang___syncthreads_and
+#define __syncthreads_count __wl_clang___syncthreads_count
+#define __syncthreads_or __wl_clang___syncthreads_or
 #define __threadfence __wl_clang___threadfence
 #define __threadfence_block __wl_clang___threadfence_block
 #define __uint2float_ru __wl_clang___uint2float_ru
@@ -68,6 +73,7 @@
 #include <__clang_cuda_math.h>
 
 #undef __brev
+#undef __brevll
 #undef __byte_perm
 #undef __clz
 #undef __cosf
@@ -92,6 +98,10 @@
 #undef __mulhi
 #undef __saturatef
 #undef __sinf
+#undef __clzll
+#undef __syncthreads_and
+#undef __syncthreads_count
+#undef __syncthreads_or
 #undef __threadfence
 #undef __threadfence_block
 #undef __uint2float_ru
