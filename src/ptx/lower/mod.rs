@@ -490,7 +490,8 @@ impl<'a> FnLower<'a> {
                 let align = d.align.unwrap_or(d.ty.bytes()) as u64;
                 self.frame_param = align_up(self.frame_param, align);
                 let off = self.frame_param;
-                let size = if d.dims.is_empty() { d.ty.bytes() as u64 * d.vector.unwrap_or(1) as u64 } else { var_size(d)? };
+                let size =
+                    if d.dims.is_empty() { d.ty.bytes() as u64 * d.vector.unwrap_or(1) as u64 } else { var_size(d)? };
                 self.frame_param = off.saturating_add(size);
                 check_var_size(d, size, self.frame_param)?;
                 self.declare(d.name.clone(), Sym::FrameParam(off as u32, size as u32));
