@@ -37,7 +37,7 @@ WL_DEV unsigned __ballot_sync(unsigned mask, int p) { return __nvvm_vote_ballot_
 WL_DEV int __all_sync(unsigned mask, int p) { return __nvvm_vote_all_sync(mask, p); }
 WL_DEV int __any_sync(unsigned mask, int p) { return __nvvm_vote_any_sync(mask, p); }
 WL_DEV int __uni_sync(unsigned mask, int p) { return __nvvm_vote_uni_sync(mask, p); }
-WL_DEV unsigned __activemask() { return __nvvm_vote_ballot_sync(0xffffffffu, 1); }
+WL_DEV unsigned __activemask() { unsigned m; asm volatile("activemask.b32 %0;" : "=r"(m)); return m; }
 // c operand: clamp value in bits 0-4, segment mask in bits 8-12 (as CUDA computes it).
 WL_DEV int __shfl_sync(unsigned mask, int v, int lane, int width = 32) {
   return __nvvm_shfl_sync_idx_i32(mask, v, lane, ((32 - width) << 8) | 0x1f);

@@ -169,6 +169,11 @@ impl Names<'_> {
         ds.iter().map(|d| self.dst(*d)).collect::<Vec<_>>().join(", ")
     }
 
+    /// A `.sync` form's member mask, or `none` for the forms without one.
+    fn member_mask(&self, m: Src) -> String {
+        if m == crate::ptx::lower::warp::NO_MEMBER_MASK { "none".into() } else { self.src(m) }
+    }
+
     fn src(&self, s: Src) -> String {
         match s {
             Src::Reg(r) => self.reg(r),
@@ -298,7 +303,7 @@ impl Names<'_> {
                 d.map(|d| self.dst(d)).unwrap_or_else(|| "-".into()),
                 self.pred(*p),
                 self.pred_src(*a),
-                self.src(*membermask)
+                self.member_mask(*membermask)
             ),
             Kind::Shfl { mode, d, p, a, b, c, membermask } => format!(
                 "shfl.{} {}{} <- {}, {}, {}, mask {}",
@@ -308,7 +313,7 @@ impl Names<'_> {
                 self.src(*a),
                 self.src(*b),
                 self.src(*c),
-                self.src(*membermask)
+                self.member_mask(*membermask)
             ),
             Kind::Redux { op, ty, d, a, membermask } => {
                 format!("redux.{}.{ty} {} <- {}, mask {}", lc(op), self.dst(*d), self.src(*a), self.src(*membermask))
