@@ -137,42 +137,10 @@ fn effect(k: &Kind) -> Effect {
 
 /// Data registers an instruction reads (None: an instruction the pass does not know).
 fn reads(k: &Kind) -> Option<Vec<RegId>> {
-    let mut v = Vec::new();
-    let mut src = |s: &Src| {
-        if let Src::Reg(r) = s {
-            v.push(*r);
-        }
-    };
     match k {
-        Kind::Mov { a, .. } | Kind::Cvt { a, .. } | Kind::Cvta { a, .. } | Kind::Unpack { a, .. } => src(a),
-        Kind::Pack { parts, .. } => parts.iter().for_each(src),
-        Kind::Arith { a, b, c, .. } => [a, b, c].into_iter().for_each(src),
-        Kind::Setp { a, b, .. } | Kind::Set { a, b, .. } | Kind::Selp { a, b, .. } => [a, b].into_iter().for_each(src),
-        Kind::Bfi { a, b, c, e, .. } => [a, b, c, e].into_iter().for_each(src),
-        Kind::Ld { addr, .. } => src(&addr.base),
-        Kind::St { vals, addr, .. } => {
-            vals.iter().for_each(&mut src);
-            src(&addr.base);
-        }
-        Kind::Atom { addr, b, c, .. } => [&addr.base, b, c].into_iter().for_each(src),
-        Kind::Bar { id, count } => {
-            src(id);
-            if let Some(c) = count {
-                src(c);
-            }
-        }
-        Kind::Vote { membermask, .. } => src(membermask),
-        Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(src),
-        Kind::PredLogic { .. }
-        | Kind::Bra { .. }
-        | Kind::Call { .. }
-        | Kind::Ret
-        | Kind::Exit
-        | Kind::Membar
-        | Kind::Nop => {}
-        _ => return None,
+        Kind::BarRed { .. } | Kind::Redux { .. } | Kind::Match { .. } | Kind::Carry { .. } | Kind::Trap => None,
+        _ => Some(k.reads()),
     }
-    Some(v)
 }
 
 /// Trailing zero bits of an immediate (64 for 0).

@@ -400,6 +400,57 @@ pub enum Kind {
     Trap,
 }
 
+impl Kind {
+    /// The data registers the instruction reads (its sources, address bases,
+    /// member masks and carry flag), in operand order; predicates are not data.
+    pub fn reads(&self) -> Vec<RegId> {
+        let k = self;
+        let mut v = Vec::new();
+        let mut s = |x: &Src| {
+            if let Src::Reg(r) = x {
+                v.push(*r)
+            }
+        };
+        match k {
+            Kind::Mov { a, .. } | Kind::Unpack { a, .. } | Kind::Cvt { a, .. } | Kind::Cvta { a, .. } => s(a),
+            Kind::Pack { parts, .. } => parts.iter().for_each(s),
+            Kind::Arith { a, b, c, .. } => [a, b, c].into_iter().for_each(s),
+            Kind::Setp { a, b, .. } | Kind::Set { a, b, .. } | Kind::Selp { a, b, .. } => {
+                [a, b].into_iter().for_each(s)
+            }
+            Kind::Bfi { a, b, c, e, .. } => [a, b, c, e].into_iter().for_each(s),
+            Kind::Ld { addr, .. } => s(&addr.base),
+            Kind::St { vals, addr, .. } => {
+                vals.iter().for_each(&mut s);
+                s(&addr.base)
+            }
+            Kind::Atom { addr, b, c, .. } => [&addr.base, b, c].into_iter().for_each(s),
+            Kind::Bar { id, count } | Kind::BarRed { id, count, .. } => {
+                s(id);
+                count.iter().for_each(s)
+            }
+            Kind::Vote { membermask, .. } => s(membermask),
+            Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(s),
+            Kind::Redux { a, membermask, .. } | Kind::Match { a, membermask, .. } => {
+                [a, membermask].into_iter().for_each(s)
+            }
+            Kind::Carry { a, b, c, cc, .. } => {
+                [a, b, c].into_iter().for_each(s);
+                v.push(*cc)
+            }
+            Kind::PredLogic { .. }
+            | Kind::Bra { .. }
+            | Kind::Call { .. }
+            | Kind::Ret
+            | Kind::Exit
+            | Kind::Membar
+            | Kind::Nop
+            | Kind::Trap => {}
+        }
+        v
+    }
+}
+
 /// One instruction with its guard.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Inst {

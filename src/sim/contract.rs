@@ -77,51 +77,6 @@ pub struct Fused {
     pub neg_c: bool,
 }
 
-/// The data registers an instruction reads.
-fn reads(k: &Kind) -> Vec<RegId> {
-    let mut v = Vec::new();
-    let mut s = |x: &Src| {
-        if let Src::Reg(r) = x {
-            v.push(*r)
-        }
-    };
-    match k {
-        Kind::Mov { a, .. } | Kind::Unpack { a, .. } | Kind::Cvt { a, .. } | Kind::Cvta { a, .. } => s(a),
-        Kind::Pack { parts, .. } => parts.iter().for_each(s),
-        Kind::Arith { a, b, c, .. } => [a, b, c].into_iter().for_each(s),
-        Kind::Setp { a, b, .. } | Kind::Set { a, b, .. } | Kind::Selp { a, b, .. } => [a, b].into_iter().for_each(s),
-        Kind::Bfi { a, b, c, e, .. } => [a, b, c, e].into_iter().for_each(s),
-        Kind::Ld { addr, .. } => s(&addr.base),
-        Kind::St { vals, addr, .. } => {
-            vals.iter().for_each(&mut s);
-            s(&addr.base)
-        }
-        Kind::Atom { addr, b, c, .. } => [&addr.base, b, c].into_iter().for_each(s),
-        Kind::Bar { id, count } | Kind::BarRed { id, count, .. } => {
-            s(id);
-            count.iter().for_each(s)
-        }
-        Kind::Vote { membermask, .. } => s(membermask),
-        Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(s),
-        Kind::Redux { a, membermask, .. } | Kind::Match { a, membermask, .. } => {
-            [a, membermask].into_iter().for_each(s)
-        }
-        Kind::Carry { a, b, c, cc, .. } => {
-            [a, b, c].into_iter().for_each(s);
-            v.push(*cc)
-        }
-        Kind::PredLogic { .. }
-        | Kind::Bra { .. }
-        | Kind::Call { .. }
-        | Kind::Ret
-        | Kind::Exit
-        | Kind::Membar
-        | Kind::Nop
-        | Kind::Trap => {}
-    }
-    v
-}
-
 /// The data registers an instruction writes.
 fn writes(k: &Kind) -> Vec<RegId> {
     let d = |d: &Dst| d.reg;
@@ -193,7 +148,7 @@ struct Facts<'a> {
 
 impl<'a> Facts<'a> {
     fn new(f: &'a Function) -> Self {
-        let reads: Vec<_> = f.insts.iter().map(|i| reads(&i.kind)).collect();
+        let reads: Vec<_> = f.insts.iter().map(|i| i.kind.reads()).collect();
         let writes: Vec<_> = f.insts.iter().map(|i| writes(&i.kind)).collect();
         let mut defs = HashMap::new();
         for w in writes.iter().flatten() {

@@ -9,7 +9,7 @@
 //! loads at a branch or a branch target count as a wait there.
 
 use crate::ptx::Program;
-use crate::ptx::ir::{Address, Function, Kind, MemSpace, RegId, Src};
+use crate::ptx::ir::{Function, Kind, MemSpace, RegId};
 use crate::sim::counters::InstProfile;
 
 /// Warp-level waits by the slowest space a wait is for.
@@ -29,63 +29,6 @@ enum Space {
     Shared,
     Texture,
     Global,
-}
-
-fn src_reg(s: &Src, out: &mut Vec<RegId>) {
-    if let Src::Reg(r) = s {
-        out.push(*r);
-    }
-}
-
-fn addr_reg(a: &Address, out: &mut Vec<RegId>) {
-    src_reg(&a.base, out);
-}
-
-/// Data registers an instruction reads.
-fn reads(k: &Kind) -> Vec<RegId> {
-    let mut v = Vec::new();
-    match k {
-        Kind::Mov { a, .. } | Kind::Cvt { a, .. } | Kind::Cvta { a, .. } | Kind::Unpack { a, .. } => src_reg(a, &mut v),
-        Kind::Pack { parts, .. } => parts.iter().for_each(|p| src_reg(p, &mut v)),
-        Kind::Arith { a, b, c, .. } => [a, b, c].into_iter().for_each(|s| src_reg(s, &mut v)),
-        Kind::Setp { a, b, .. } | Kind::Set { a, b, .. } | Kind::Selp { a, b, .. } => {
-            [a, b].into_iter().for_each(|s| src_reg(s, &mut v))
-        }
-        Kind::Bfi { a, b, c, e, .. } => [a, b, c, e].into_iter().for_each(|s| src_reg(s, &mut v)),
-        Kind::Ld { addr, .. } => addr_reg(addr, &mut v),
-        Kind::St { vals, addr, .. } => {
-            vals.iter().for_each(|s| src_reg(s, &mut v));
-            addr_reg(addr, &mut v);
-        }
-        Kind::Atom { addr, b, c, .. } => {
-            addr_reg(addr, &mut v);
-            [b, c].into_iter().for_each(|s| src_reg(s, &mut v));
-        }
-        Kind::Bar { id, count } | Kind::BarRed { id, count, .. } => {
-            src_reg(id, &mut v);
-            if let Some(c) = count {
-                src_reg(c, &mut v);
-            }
-        }
-        Kind::Vote { membermask, .. } => src_reg(membermask, &mut v),
-        Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(|s| src_reg(s, &mut v)),
-        Kind::Redux { a, membermask, .. } | Kind::Match { a, membermask, .. } => {
-            [a, membermask].into_iter().for_each(|s| src_reg(s, &mut v))
-        }
-        Kind::Carry { a, b, c, cc, .. } => {
-            [a, b, c].into_iter().for_each(|s| src_reg(s, &mut v));
-            v.push(*cc);
-        }
-        Kind::PredLogic { .. }
-        | Kind::Bra { .. }
-        | Kind::Call { .. }
-        | Kind::Ret
-        | Kind::Exit
-        | Kind::Membar
-        | Kind::Nop
-        | Kind::Trap => {}
-    }
-    v
 }
 
 /// The load's destination registers and the space it waits on, if it is a load that stalls.
@@ -119,7 +62,7 @@ fn wait_points(f: &Function) -> Vec<Option<Space>> {
     for (pc, inst) in f.insts.iter().enumerate() {
         let barrier = targets[pc]
             || matches!(inst.kind, Kind::Bra { .. } | Kind::Call { .. } | Kind::Ret | Kind::Exit | Kind::Bar { .. });
-        let r = reads(&inst.kind);
+        let r = inst.kind.reads();
         let hit = pending.iter().any(|(p, _)| r.contains(p));
         if (hit || barrier) && !pending.is_empty() {
             out[pc] = pending.iter().map(|(_, s)| *s).max();
