@@ -449,6 +449,98 @@ impl Kind {
         }
         v
     }
+
+    /// Calls `f(reg, read, written)` exactly once for every data-register
+    /// field of the instruction: sources, address bases, member masks,
+    /// destinations and the carry flag (read as [`Kind::reads`] counts it,
+    /// written when the instruction sets it). The `_` sink is not a register
+    /// and is not visited. Register allocation renames registers through it
+    /// and takes the instruction's uses and definitions from it.
+    pub fn visit_regs_mut(&mut self, f: &mut dyn FnMut(&mut RegId, bool, bool)) {
+        let s = |x: &mut Src, f: &mut dyn FnMut(&mut RegId, bool, bool)| {
+            if let Src::Reg(r) = x {
+                f(r, true, false)
+            }
+        };
+        let d = |x: &mut Dst, f: &mut dyn FnMut(&mut RegId, bool, bool)| {
+            if x.reg != Dst::SINK {
+                f(&mut x.reg, false, true)
+            }
+        };
+        match self {
+            Kind::Mov { d: x, a } | Kind::Cvt { d: x, a, .. } | Kind::Cvta { d: x, a, .. } => {
+                s(a, f);
+                d(x, f)
+            }
+            Kind::Pack { d: x, parts, .. } => {
+                parts.iter_mut().for_each(|p| s(p, f));
+                d(x, f)
+            }
+            Kind::Unpack { ds, a, .. } => {
+                s(a, f);
+                ds.iter_mut().for_each(|x| d(x, f))
+            }
+            Kind::Arith { d: x, a, b, c, .. } => {
+                [a, b, c].into_iter().for_each(|y| s(y, f));
+                d(x, f)
+            }
+            Kind::Setp { a, b, .. } => [a, b].into_iter().for_each(|y| s(y, f)),
+            Kind::Set { d: x, a, b, .. } | Kind::Selp { d: x, a, b, .. } => {
+                [a, b].into_iter().for_each(|y| s(y, f));
+                d(x, f)
+            }
+            Kind::Bfi { d: x, a, b, c, e, .. } => {
+                [a, b, c, e].into_iter().for_each(|y| s(y, f));
+                d(x, f)
+            }
+            Kind::Ld { ds, addr, .. } => {
+                s(&mut addr.base, f);
+                ds.iter_mut().for_each(|x| d(x, f))
+            }
+            Kind::St { vals, addr, .. } => {
+                vals.iter_mut().for_each(|v| s(v, f));
+                s(&mut addr.base, f)
+            }
+            Kind::Atom { d: x, addr, b, c, .. } => {
+                [&mut addr.base, b, c].into_iter().for_each(|y| s(y, f));
+                x.iter_mut().for_each(|x| d(x, f))
+            }
+            Kind::Bar { id, count } => {
+                s(id, f);
+                count.iter_mut().for_each(|c| s(c, f))
+            }
+            Kind::BarRed { d: x, id, count, .. } => {
+                s(id, f);
+                count.iter_mut().for_each(|c| s(c, f));
+                x.iter_mut().for_each(|x| d(x, f))
+            }
+            Kind::Vote { d: x, membermask, .. } => {
+                s(membermask, f);
+                x.iter_mut().for_each(|x| d(x, f))
+            }
+            Kind::Shfl { d: x, a, b, c, membermask, .. } => {
+                [a, b, c, membermask].into_iter().for_each(|y| s(y, f));
+                d(x, f)
+            }
+            Kind::Redux { d: x, a, membermask, .. } | Kind::Match { d: x, a, membermask, .. } => {
+                [a, membermask].into_iter().for_each(|y| s(y, f));
+                d(x, f)
+            }
+            Kind::Carry { d: x, a, b, c, cc, cout, .. } => {
+                [a, b, c].into_iter().for_each(|y| s(y, f));
+                d(x, f);
+                f(cc, true, *cout)
+            }
+            Kind::PredLogic { .. }
+            | Kind::Bra { .. }
+            | Kind::Call { .. }
+            | Kind::Ret
+            | Kind::Exit
+            | Kind::Membar
+            | Kind::Nop
+            | Kind::Trap => {}
+        }
+    }
 }
 
 /// One instruction with its guard.

@@ -101,7 +101,7 @@ impl Cta {
                 let lanes = if n == 32 { u32::MAX } else { (1u32 << n) - 1 };
                 let mut warp = Warp {
                     id: w,
-                    frames: vec![Frame::new(kernel, f, 0, 0, 0)],
+                    frames: vec![Frame::new(kernel, f, ctx.code.funcs[kernel as usize].rows(), 0, 0, 0)],
                     stack: SimtStack { entries: vec![SimtEntry { pc: 0, rpc: EXIT_PC, mask: lanes }] },
                     lanes,
                     live: lanes,

@@ -2,16 +2,20 @@
 //! instruction, what the executor would otherwise work out on every issue —
 //! its counter class and, for arithmetic, the 32-lane function that the
 //! `(operation, type, rounding)` triple selects. The executor looks the
-//! instruction's [`Op`] up by PC and dispatches on it; the validated IR
-//! (`crate::ptx::ir`) stays the source of operands and of the rare forms.
+//! instruction's [`Op`] up by PC and dispatches on it. Operands come from a
+//! copy of the IR instructions whose registers are renamed to frame slots
+//! ([`regalloc`](super::regalloc): a frame holds the live maximum of rows,
+//! not one per virtual register).
 
 use std::collections::HashMap;
 
-use crate::ptx::ir::{ArithOp, FloatMode, InstClass, Kind, Program, Rounding};
+use crate::ptx::ir::{ArithOp, FloatMode, Inst, InstClass, Kind, Program, RegId, Rounding, Src};
 use crate::ptx::types::Ty;
 
 use super::alu;
+use super::cfg::Cfg;
 use super::contract::{self, Fused};
+use super::regalloc::Allocation;
 use super::sfu::{self, SfuModel};
 
 /// 32 lanes of register bits.
@@ -36,13 +40,33 @@ pub struct Op {
 }
 
 /// A function's decoded instructions, parallel to its IR instructions.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct FnCode {
     /// One per instruction.
     pub ops: Vec<Op>,
+    /// The IR instructions with every data register renamed to its frame
+    /// slot ([`FnCode::alloc`]): what the executor reads operands from.
+    pub insts: Vec<Inst>,
     /// The `add`/`sub` instructions ptxas would contract with a `mul`, by
-    /// index ([`contract`]); empty when contraction is off.
+    /// index ([`contract`]), operands renamed to slots; empty when
+    /// contraction is off.
     pub fused: HashMap<u32, Fused>,
+    /// Where each virtual register lives in a frame.
+    pub alloc: Allocation,
+}
+
+impl FnCode {
+    /// Rows of a register frame of this function.
+    #[inline]
+    pub fn rows(&self) -> usize {
+        self.alloc.rows as usize
+    }
+
+    /// The frame row of virtual register `r` (the IR's numbering).
+    #[inline]
+    pub fn slot(&self, r: RegId) -> usize {
+        self.alloc.slot[r as usize] as usize
+    }
 }
 
 /// What the executable form models of the toolchain and the GPU's arithmetic.
@@ -70,13 +94,35 @@ pub struct Code {
 
 impl Code {
     /// Decodes every function of `prog`, with `opts` deciding contraction and
-    /// the special functions.
+    /// the special functions, and registers compacted to their live maximum.
     pub fn decode(prog: &Program, opts: FloatOptions) -> Code {
+        Code::decode_with(prog, opts, true)
+    }
+
+    /// As [`Code::decode`]; `compact: false` keeps one frame row per virtual
+    /// register (every register keeps its last value, for inspection).
+    pub fn decode_with(prog: &Program, opts: FloatOptions, compact: bool) -> Code {
         let funcs = prog
             .functions
             .iter()
             .map(|f| {
-                let fused = if opts.fmad { contract::contract(f) } else { HashMap::new() };
+                let mut fused = if opts.fmad { contract::contract(f) } else { HashMap::new() };
+                let alloc =
+                    if compact { Allocation::compact(f, &Cfg::build(f), &fused) } else { Allocation::identity(f) };
+                let mut insts = f.insts.clone();
+                for i in &mut insts {
+                    i.kind.visit_regs_mut(&mut |r, _, _| *r = alloc.slot[*r as usize]);
+                }
+                let rename = |s: &mut Src| {
+                    if let Src::Reg(r) = s {
+                        *r = alloc.slot[*r as usize];
+                    }
+                };
+                for fz in fused.values_mut() {
+                    rename(&mut fz.a);
+                    rename(&mut fz.b);
+                    rename(&mut fz.c);
+                }
                 let ops = f
                     .insts
                     .iter()
@@ -96,7 +142,7 @@ impl Code {
                         }
                     })
                     .collect();
-                FnCode { ops, fused }
+                FnCode { ops, insts, fused, alloc }
             })
             .collect();
         Code { funcs }

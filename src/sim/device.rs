@@ -287,10 +287,22 @@ pub struct Module {
     pub cfgs: Vec<Cfg>,
     /// The decoded, executable form.
     pub code: Code,
+    /// The decoded form with one frame row per virtual register, made on the
+    /// first [`Module::stepping_code`] (steppers inspect every register by name).
+    stepping: std::sync::OnceLock<Code>,
+    /// What `code` was decoded with.
+    opts: FloatOptions,
     globals: Vec<u64>,
 }
 
 impl Module {
+    /// The executable form steppers run: as [`Module::code`], with registers
+    /// not compacted, so that every register shows its last value by name.
+    /// Results and counters are the same as `code`'s.
+    pub fn stepping_code(&self) -> &Code {
+        self.stepping.get_or_init(|| Code::decode_with(&self.prog, self.opts, false))
+    }
+
     /// The device address of a module-scope `.global` variable.
     pub fn global(&self, name: &str) -> Option<DevicePtr> {
         self.prog.globals.iter().position(|g| g.name == name).map(|i| DevicePtr(self.globals[i]))
@@ -430,8 +442,9 @@ impl Device {
             }
             globals.push(p.0);
         }
-        let code = Code::decode(&prog, FloatOptions { fmad: self.config.fmad, sfu: self.config.sfu });
-        Module { prog, cfgs, code, globals }
+        let opts = FloatOptions { fmad: self.config.fmad, sfu: self.config.sfu };
+        let code = Code::decode(&prog, opts);
+        Module { prog, cfgs, code, stepping: std::sync::OnceLock::new(), opts, globals }
     }
 
     fn prepare(
@@ -503,13 +516,14 @@ impl Device {
     fn ctx<'a>(
         &'a self,
         m: &'a Module,
+        code: &'a Code,
         kp: Vec<u8>,
         cfg: &LaunchConfig,
         observers: Option<&'a dyn ObserverFactory>,
     ) -> Ctx<'a> {
         Ctx {
             prog: &m.prog,
-            code: &m.code,
+            code,
             cfgs: &m.cfgs,
             mem: &self.mem,
             kparams: kp,
@@ -559,13 +573,14 @@ impl Device {
         if let Some(o) = observers {
             o.set_fidelity(fidelity);
         }
-        let ctx = self.ctx(m, kp, &cfg, observers);
+        let ctx = self.ctx(m, &m.code, kp, &cfg, observers);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
         run.run_with_progress(self.pool.as_ref(), self.progress.as_ref()).map_err(SimError::Fault)
     }
 
     /// Checks a launch and makes its runner (for [`super::stepper`], which
-    /// adds the stepping entry points to `Device`).
+    /// adds the stepping entry points to `Device`), running the module's
+    /// [`Module::stepping_code`].
     pub(crate) fn prepare_run<'a>(
         &'a self,
         m: &'a Module,
@@ -575,18 +590,7 @@ impl Device {
         observers: Option<&'a dyn ObserverFactory>,
     ) -> Result<GridRun<'a>, SimError> {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
-        Ok(self.make_run(m, k, kp, shared, &cfg, observers))
-    }
-
-    fn make_run<'a>(
-        &'a self,
-        m: &'a Module,
-        k: u32,
-        kp: Vec<u8>,
-        shared: usize,
-        cfg: &LaunchConfig,
-        observers: Option<&'a dyn ObserverFactory>,
-    ) -> GridRun<'a> {
-        GridRun::new(self.ctx(m, kp, cfg, observers), k, shared, self.config.schedule.clone())
+        let ctx = self.ctx(m, m.stepping_code(), kp, &cfg, observers);
+        Ok(GridRun::new(ctx, k, shared, self.config.schedule.clone()))
     }
 }

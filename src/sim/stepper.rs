@@ -207,7 +207,9 @@ impl<'a> Stepper<'a> {
         let fr = w.frame();
         let f = &self.module.prog.functions[fr.func as usize];
         if let Some(i) = f.reg_names.iter().position(|n| n == name) {
-            return Some(fr.regs[i]);
+            // by name through the decoded form's slot map (one row per register when stepping)
+            let code = &self.module.stepping_code().funcs[fr.func as usize];
+            return fr.regs.get(code.slot(i as crate::ptx::ir::RegId)).copied();
         }
         let p = f.pred_names.iter().position(|n| n == name)?;
         let bits = fr.preds[p];

@@ -28,13 +28,14 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// A fresh frame for `f` (registers zeroed).
-    pub fn new(func: u32, f: &Function, local_base: u32, stack_base: usize, call_pc: u32) -> Frame {
+    /// A fresh frame for `f` with `rows` register rows (zeroed): the slots
+    /// its decoded form allocates (`FnCode::rows`).
+    pub fn new(func: u32, f: &Function, rows: usize, local_base: u32, stack_base: usize, call_pc: u32) -> Frame {
         let mut preds = vec![0u32; f.num_preds as usize];
         preds[1] = u32::MAX;
         Frame {
             func,
-            regs: vec![[0u64; 32]; f.reg_masks.len()],
+            regs: vec![[0u64; 32]; rows],
             preds,
             params: vec![0u8; f.frame_param_size as usize * 32],
             param_size: f.frame_param_size,
@@ -108,7 +109,15 @@ pub struct BarRedWait {
 impl Warp {
     /// A frame for a call of `func`, reused from an earlier call when possible.
     /// Registers keep stale values: PTX leaves them undefined at entry.
-    pub fn take_frame(&mut self, func: u32, f: &Function, local_base: u32, stack_base: usize, call_pc: u32) -> Frame {
+    pub fn take_frame(
+        &mut self,
+        func: u32,
+        f: &Function,
+        rows: usize,
+        local_base: u32,
+        stack_base: usize,
+        call_pc: u32,
+    ) -> Frame {
         match self.frame_pool.iter().rposition(|fr| fr.func == func) {
             Some(i) => {
                 let mut fr = self.frame_pool.swap_remove(i);
@@ -118,7 +127,7 @@ impl Warp {
                 fr.returned = 0;
                 fr
             }
-            None => Frame::new(func, f, local_base, stack_base, call_pc),
+            None => Frame::new(func, f, rows, local_base, stack_base, call_pc),
         }
     }
 

@@ -47,7 +47,8 @@ pub(super) fn call(
         return Err(fault(FaultKind::LocalStackOverflow { needed: need, limit: ctx.local_limit as u64 }, None));
     }
     let (caller_func, caller_ps) = (caller.func, caller.param_size);
-    let mut nf = w.take_frame(callee, cf, lb, w.stack.entries.len(), pc);
+    let rows = ctx.code.funcs[callee as usize].rows();
+    let mut nf = w.take_frame(callee, cf, rows, lb, w.stack.entries.len(), pc);
     let caller = w.frames.last().expect("caller");
     debug_assert_eq!(caller.func, caller_func);
     let ps_c = caller_ps as usize;

@@ -257,10 +257,12 @@ fn advance(w: &mut Warp, pc: u32) {
 }
 
 fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, Box<ExecFault>> {
-    let f = &ctx.prog.functions[func as usize];
     let pc = top.pc;
-    let (Some(inst), Some(op)) = (f.insts.get(pc as usize), ctx.code.funcs[func as usize].ops.get(pc as usize)) else {
-        return Err(fault(FaultKind::Unsupported(format!("execution ran past the end of `{}`", f.name)), None));
+    let code = &ctx.code.funcs[func as usize];
+    // operands in frame slots (`FnCode::insts`), not the IR's register numbers
+    let (Some(inst), Some(op)) = (code.insts.get(pc as usize), code.ops.get(pc as usize)) else {
+        let name = &ctx.prog.functions[func as usize].name;
+        return Err(fault(FaultKind::Unsupported(format!("execution ran past the end of `{name}`")), None));
     };
     let mask = top.mask;
     let exec = match inst.guard {
@@ -309,7 +311,7 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
 
     if op.fused
         && let Kind::Arith { ty, mode, d, .. } = inst.kind
-        && let Some(fz) = ctx.code.funcs[func as usize].fused.get(&pc)
+        && let Some(fz) = code.fused.get(&pc)
     {
         arith::fused(ctx, w, cta, (ty, mode), d, fz, exec);
         return Ok(Effect::Continue);

@@ -1,0 +1,145 @@
+//! Register compaction at decode time (`sim::regalloc`): a warp's frame holds
+//! the live maximum of registers, not one row per PTX virtual register, and
+//! nothing a kernel computes or counts changes. A launch runs the compacted
+//! form; a stepper runs one row per register (`Module::stepping_code`), so
+//! stepping to the end and launching compare the two.
+
+mod common;
+use common::*;
+use warplight::host::rt_kernels;
+use warplight::ptx::ir::RegId;
+use warplight::sim::cfg::Cfg;
+use warplight::sim::regalloc::{Allocation, Liveness};
+use warplight::sim::{Arg, Device, LaunchConfig, Module, SimConfig};
+
+/// Frame rows of `trace_stack` after compaction. It declares 684 data
+/// registers (`%f<410>`, `%r<170>`, `%rd<100>`, `%SP`, `%SPL` and the
+/// parameter temporaries); at most this many are live at once (or pinned).
+/// A change to the allocator or the kernel's PTX that moves this figure
+/// should be looked at, not just updated.
+const TRACE_STACK_ROWS: usize = 90;
+
+fn rt_module() -> (Device, Module) {
+    let mut dev = Device::with_config(SimConfig::default());
+    let m = rt_kernels::load(&mut dev).expect("ray-tracing kernels");
+    (dev, m)
+}
+
+#[test]
+fn trace_stack_frame_is_its_live_maximum() {
+    let (_, m) = rt_module();
+    let k = m.prog.kernel("trace_stack").expect("trace_stack") as usize;
+    let declared = m.prog.functions[k].reg_masks.len();
+    let rows = m.code.funcs[k].rows();
+    eprintln!("trace_stack: {declared} virtual registers, {rows} frame rows");
+    assert_eq!(rows, TRACE_STACK_ROWS, "trace_stack frame rows (of {declared} declared)");
+    assert!(rows * 4 < declared, "compaction should shrink the frame at least 4x");
+    // the stepper keeps one row per register
+    assert_eq!(m.stepping_code().funcs[k].rows(), declared);
+}
+
+/// On every function of the ray-tracing kernels: registers live before the
+/// same instruction, and a register an instruction writes and those live
+/// after it, are in different slots; pinned registers share with nothing.
+#[test]
+fn no_two_live_registers_share_a_slot_in_the_ray_tracer() {
+    let (_, m) = rt_module();
+    for (fi, f) in m.prog.functions.iter().enumerate() {
+        if f.insts.is_empty() {
+            continue;
+        }
+        let cfg = Cfg::build(f);
+        // the contracted instructions the module decoded with (none when contraction is off)
+        let fused =
+            &if m.code.funcs[fi].fused.is_empty() { Default::default() } else { warplight::sim::contract::contract(f) };
+        let live = Liveness::of(f, &cfg, fused);
+        let a: &Allocation = &m.code.funcs[fi].alloc;
+        assert_eq!(a, &Allocation::compact(f, &cfg, fused), "the module's allocation is the analysis's");
+        let mut slot_owner: Vec<Option<RegId>> = vec![None; a.rows as usize];
+        for &p in &a.pinned {
+            slot_owner[a.slot[p as usize] as usize] = Some(p);
+        }
+        for (pc, inst) in f.insts.iter().enumerate() {
+            let mut regs: Vec<RegId> = live.live_in[pc].iter().collect();
+            let mut k = inst.kind.clone();
+            let mut defs = Vec::new();
+            k.visit_regs_mut(&mut |r, _, w| {
+                if w {
+                    defs.push(*r)
+                }
+            });
+            if !defs.is_empty() {
+                regs.extend(defs);
+                regs.extend(live.live_in.get(pc + 1).into_iter().flat_map(|s| s.iter()));
+            }
+            regs.sort_unstable();
+            regs.dedup();
+            let mut seen = vec![None; a.rows as usize];
+            for r in regs {
+                let s = a.slot[r as usize] as usize;
+                if let Some(o) = seen[s] {
+                    panic!(
+                        "{}: {} and {} share slot {s} at pc {pc}",
+                        f.name, f.reg_names[o as usize], f.reg_names[r as usize]
+                    );
+                }
+                seen[s] = Some(r);
+                if let Some(p) = slot_owner[s] {
+                    assert_eq!(
+                        p, r,
+                        "{}: {} is in pinned {}'s slot",
+                        f.name, f.reg_names[r as usize], f.reg_names[p as usize]
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Launch (compacted frames) and stepping to the end (one row per register)
+/// write the same memory and count the same, on kernels with divergent calls,
+/// recursion, local arrays and shuffles.
+#[test]
+fn compacted_and_full_frames_compute_and_count_the_same() {
+    let cases = [
+        ("calls", "call_divergent", 64),
+        ("calls", "recursive_fib", 64),
+        ("warp_ops", "shuffles", 32),
+        ("warp_ops", "votes", 64),
+        ("divergence", "if_else", 64),
+    ];
+    for (file, kernel, n) in cases {
+        for d in BOTH {
+            let run = |step: bool| {
+                let mut dev = device(1);
+                let m = load(&mut dev, file, d);
+                let out = dev.alloc_zeroed::<i32>(2048);
+                let other = dev.alloc_from(&(0..2048).map(|x| x * 7 - 3).collect::<Vec<i32>>());
+                let f = &m.prog.functions[m.prog.kernel(kernel).unwrap() as usize];
+                let args: Vec<Arg> = f
+                    .params
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| match (i, p.size) {
+                        (0, 8) => Arg::Ptr(out),
+                        (_, 8) => Arg::Ptr(other),
+                        _ => Arg::I32(5 + i as i32),
+                    })
+                    .collect();
+                let cfg = LaunchConfig::linear(1, n);
+                let counters = if step {
+                    let mut st = dev.stepper(&m, kernel, cfg, &args).unwrap();
+                    while st.step().unwrap().is_some() {}
+                    st.counters()
+                } else {
+                    dev.launch(&m, kernel, cfg, &args).unwrap().totals
+                };
+                (dev.read::<i32>(out, 2048), dev.read::<i32>(other, 2048), counters)
+            };
+            let (launched, stepped) = (run(false), run(true));
+            assert_eq!(launched.0, stepped.0, "{kernel} ({d:?}): output");
+            assert_eq!(launched.1, stepped.1, "{kernel} ({d:?}): second buffer");
+            assert_eq!(launched.2, stepped.2, "{kernel} ({d:?}): counters");
+        }
+    }
+}
