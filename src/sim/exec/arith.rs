@@ -181,7 +181,9 @@ pub(super) fn set(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, kind: &Kind, exec: u32)
 pub(super) fn selp(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, d: Dst, a: Src, b: Src, p: PredSrc, exec: u32) {
     let mut r = [0u64; 32];
     {
-        let (va, vb) = (operand(ctx, w, cta, a), operand(ctx, w, cta, b));
+        let (oa, ob) = (operand(ctx, w, cta, a), operand(ctx, w, cta, b));
+        // the lanes borrowed once, so that the loop is over two plain arrays
+        let (va, vb): (&Lanes, &Lanes) = (&oa, &ob);
         let pv = pred_bits(w.frame(), p);
         for l in 0..32 {
             // branch-free: the predicate bit as an all-ones or all-zeros mask
