@@ -64,7 +64,7 @@ impl Allocation {
     /// `mul`'s factors at their own PC.
     pub fn compact(f: &Function, cfg: &Cfg, fused: &HashMap<u32, Fused>) -> Allocation {
         let n = f.reg_masks.len();
-        let live = Liveness::of(f, cfg, fused);
+        let live = Liveness::intervals(f, cfg, fused);
         let end = f.insts.len() as u32;
         let (mut start, mut stop) = (live.start, live.end);
         let mut pinned: Vec<RegId> = live.entry.iter().collect();
@@ -143,10 +143,16 @@ impl RegSet {
 
     /// The registers in the set, in increasing order.
     pub fn iter(&self) -> impl Iterator<Item = RegId> + '_ {
-        self.0
-            .iter()
-            .enumerate()
-            .flat_map(|(k, &w)| (0..64).filter(move |b| w >> b & 1 != 0).map(move |b| (k * 64 + b) as RegId))
+        self.0.iter().enumerate().flat_map(|(k, &w)| {
+            let mut rest = w;
+            std::iter::from_fn(move || {
+                (rest != 0).then(|| {
+                    let b = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    (k * 64 + b) as RegId
+                })
+            })
+        })
     }
 }
 
@@ -187,7 +193,8 @@ fn effect(i: &Inst, fused: Option<&Fused>) -> Effect {
 /// Liveness of a function's data registers.
 #[derive(Debug, Clone)]
 pub struct Liveness {
-    /// Registers live at each instruction, before it executes.
+    /// Registers live at each instruction, before it executes (empty from
+    /// [`Liveness::intervals`]).
     pub live_in: Vec<RegSet>,
     /// Registers live at the function's entry (read before written on some path).
     pub entry: RegSet,
@@ -200,8 +207,18 @@ pub struct Liveness {
 
 impl Liveness {
     /// Iterative backward dataflow over the blocks of `cfg`, then one pass
-    /// over each block's instructions.
+    /// over each block's instructions for the registers live before each.
     pub fn of(f: &Function, cfg: &Cfg, fused: &HashMap<u32, Fused>) -> Liveness {
+        Liveness::analyse(f, cfg, fused, true)
+    }
+
+    /// As [`Liveness::of`] without the sets per instruction (`live_in` is
+    /// empty): what the allocator needs, in memory proportional to the blocks.
+    pub fn intervals(f: &Function, cfg: &Cfg, fused: &HashMap<u32, Fused>) -> Liveness {
+        Liveness::analyse(f, cfg, fused, false)
+    }
+
+    fn analyse(f: &Function, cfg: &Cfg, fused: &HashMap<u32, Fused>, per_pc: bool) -> Liveness {
         let n = f.reg_masks.len();
         let effects: Vec<Effect> =
             f.insts.iter().enumerate().map(|(pc, i)| effect(i, fused.get(&(pc as u32)))).collect();
@@ -243,29 +260,42 @@ impl Liveness {
                 }
             }
         }
-        // per instruction, and the intervals
-        let ni = f.insts.len();
-        let mut live_in = vec![RegSet::new(n); ni];
+        // the intervals: a register's uses and definitions, and the first
+        // (last) instruction of each block it is live into (out of) span the
+        // instructions at which it is live
         let (mut start, mut end) = (vec![u32::MAX; n], vec![0u32; n]);
         let mut mark = |r: RegId, pc: u32| {
             start[r as usize] = start[r as usize].min(pc);
             end[r as usize] = end[r as usize].max(pc);
         };
         for (b, blk) in cfg.blocks.iter().enumerate() {
-            let mut live = live_out_b[b].clone();
-            for pc in (blk.start..blk.end).rev() {
+            live_in_b[b].iter().for_each(|r| mark(r, blk.start));
+            live_out_b[b].iter().for_each(|r| mark(r, blk.end - 1));
+            for pc in blk.start..blk.end {
                 let e = &effects[pc as usize];
-                live.iter().for_each(|r| mark(r, pc));
-                e.defs.iter().for_each(|&d| mark(d, pc));
-                if e.kills {
-                    e.defs.iter().for_each(|&d| live.remove(d));
-                }
-                e.uses.iter().for_each(|&u| live.insert(u));
-                live.iter().for_each(|r| mark(r, pc));
-                live_in[pc as usize] = live.clone();
+                e.uses.iter().chain(&e.defs).for_each(|&r| mark(r, pc));
             }
         }
-        let entry = live_in.first().cloned().unwrap_or_else(|| RegSet::new(n));
+        // per instruction, when asked for
+        let mut live_in = Vec::new();
+        if per_pc {
+            live_in = vec![RegSet::new(n); f.insts.len()];
+            for (b, blk) in cfg.blocks.iter().enumerate() {
+                let mut live = live_out_b[b].clone();
+                for pc in (blk.start..blk.end).rev() {
+                    let e = &effects[pc as usize];
+                    if e.kills {
+                        e.defs.iter().for_each(|&d| live.remove(d));
+                    }
+                    e.uses.iter().for_each(|&u| live.insert(u));
+                    live_in[pc as usize] = live.clone();
+                }
+            }
+        }
+        let entry = match cfg.blocks.first() {
+            Some(b) if b.start == 0 => live_in_b[0].clone(),
+            _ => RegSet::new(n),
+        };
         Liveness { live_in, entry, start, end }
     }
 }
