@@ -31,6 +31,14 @@
 //! A `call` reads and writes no register of the caller (arguments travel
 //! through the parameter area, and the callee has its own frame), so live
 //! ranges simply span it.
+//!
+//! **Adding an instruction.** Its register fields must be visited by
+//! `Kind::visit_regs_mut` (renaming and liveness come from there); if its
+//! handler writes fewer than all executing lanes, it must not kill (`effect`
+//! in this file); if it reads registers of other lanes, those registers must
+//! be pinned ([`Allocation::compact`]). An instruction's sources and
+//! destinations never share a slot, so a handler may write a destination
+//! before it has read every source.
 
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
