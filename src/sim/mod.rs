@@ -26,6 +26,7 @@ pub mod printf;
 pub mod sfu;
 pub mod simt_stack;
 pub mod stepper;
+pub mod texture;
 pub mod warp;
 
 pub use counters::{Counters, LaunchStats};
