@@ -239,3 +239,29 @@ fn txq_reports_the_dimensions() {
         assert_eq!(dev.read::<u32>(out, 6), vec![3, 3, 2, TexelFormat::F32.code(), 1, 0], "{d:?}");
     }
 }
+
+#[test]
+fn texture_counters_equal_the_h200() {
+    // Nsight Compute on the H200: one texture instruction per warp that
+    // fetches, one request per quad of lanes with an active lane
+    let m: Value =
+        serde_json::from_str(&std::fs::read_to_string("tests/fixtures/gpu_textures_ncu.json").unwrap()).unwrap();
+    let f = fixture();
+    let c = case(&f, m["case"].as_str().unwrap());
+    for d in BOTH {
+        let mut dev = Device::new();
+        let t = texture(&mut dev, &c["texture"]);
+        let n = c["x"].as_array().unwrap().len();
+        assert_eq!(n as u64, m["threads_fetching"].as_u64().unwrap());
+        let x = floats(&mut dev, &c["x"]);
+        let out = dev.alloc_zeroed::<u32>(n);
+        let module = load(&mut dev, "textures", d);
+        let cfg = LaunchConfig::linear(m["grid"].as_u64().unwrap() as u32, m["block"].as_u64().unwrap() as u32);
+        let s = dev
+            .launch(&module, "tex1d_f", cfg, &[Arg::U64(t), Arg::Ptr(x), Arg::Ptr(out), Arg::I32(n as i32)])
+            .unwrap();
+        for name in ["smsp__inst_executed_op_texture.sum", "l1tex__t_requests_pipe_tex_mem_texture.sum"] {
+            assert_eq!(s.totals.get(name), m["metrics"][name].as_u64(), "{name} ({d:?})");
+        }
+    }
+}

@@ -77,6 +77,9 @@ impl ClassCounts {
 pub struct TextureCounts {
     /// `tex` and `tld4` (Nsight Compute: `smsp__inst_executed_op_texture`).
     pub instructions: u64,
+    /// Texture requests: one per quad (four consecutive lanes) with an
+    /// active lane, per `tex`/`tld4` (`l1tex__t_requests_pipe_tex_mem_texture`).
+    pub requests: u64,
     /// `txq`.
     pub queries: u64,
     /// `suld` (`smsp__inst_executed_op_surface_ld`).
@@ -126,6 +129,7 @@ impl Counters {
         }
         add!(atomic_lane_ops);
         add!(textures.instructions);
+        add!(textures.requests);
         add!(textures.queries);
         add!(textures.surface_loads);
         add!(textures.surface_stores);
@@ -256,6 +260,7 @@ pub const NCU_ALIASES: &[(&str, &str)] = &[
     ("smsp__sass_branch_targets_threads_divergent.sum", "divergent_branches"),
     ("launch__grid_size", "ctas"),
     ("smsp__inst_executed_op_texture.sum", "textures.instructions"),
+    ("l1tex__t_requests_pipe_tex_mem_texture.sum", "textures.requests"),
     ("smsp__inst_executed_op_surface_ld.sum", "textures.surface_loads"),
     ("smsp__inst_executed_op_surface_st.sum", "textures.surface_stores"),
 ];

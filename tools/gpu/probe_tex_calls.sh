@@ -25,9 +25,10 @@ mv "$X/probe.json" "$OUT/probe.json"
 cuobjdump -sass "$X/probe" | awk '/Function : /{p = ($0 ~ /tex|tld4|surf|call_|op_|describe|Square|Disc|ex2|tanh|setp/)} p' > "$X/sass.txt" 2>&1
 ncu --query-metrics > "$X/all_metrics.txt" 2>&1
 grep -iE "tex|surf" "$X/all_metrics.txt" > "$X/metrics.txt"
-metrics=$(awk '{print $1}' "$X/metrics.txt" | grep -E '^(smsp__inst_executed_op_(texture|surface)|smsp__sass_inst_executed_op_(texture|surface)|l1tex__t_(requests|sectors)_pipe_tex|l1tex__texin_requests|l1tex__f_wavefronts|l1tex__texin_sm2tex_req_cycles_active)' | sed 's/$/.sum/' | paste -sd, -)
-echo "metrics: $metrics" >> "$OUT/env.txt"
-timeout 300 ncu --metrics "smsp__inst_executed.sum,$metrics" -k 'regex:tex|tld4|surf' --csv --page raw "$X/probe" "$X/n" > "$OUT/ncu.csv" 2> "$X/ncu.err" || { echo "ncu failed"; tail -20 "$X/ncu.err"; }
+# the texture and surface metrics warplight reports (tests/textures.rs compares them)
+metrics=smsp__inst_executed.sum,smsp__inst_executed_op_texture.sum,smsp__inst_executed_op_surface_ld.sum,smsp__inst_executed_op_surface_st.sum,l1tex__t_requests_pipe_tex_mem_texture.sum,l1tex__texin_requests_mem_texture.sum,l1tex__t_sectors_pipe_tex_mem_texture.sum,l1tex__t_requests_pipe_tex_mem_surface_op_ld.sum,l1tex__t_requests_pipe_tex_mem_surface_op_st.sum
+mkdir -p "$X/n"
+timeout 300 ncu --metrics "$metrics" -k 'regex:tex|tld4|surf' --csv --page raw "$X/probe" "$X/n" > "$OUT/ncu.csv" 2> "$X/ncu.err" || { echo "ncu failed"; tail -20 "$X/ncu.err"; }
 tail -5 "$X/ncu.err" >> "$OUT/env.txt"
 (cd "$X" && tar czf "$OUT/extra.tgz" half_*.bin sass.txt metrics.txt)
 python3 -c "import json; d = json.load(open('$OUT/probe.json')); print(d['device'], len(d['cases']), 'cases')"

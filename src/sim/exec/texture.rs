@@ -52,6 +52,7 @@ pub(super) fn tex(
     exec: u32,
 ) -> Result<(), Box<ExecFault>> {
     cta.counters.textures.instructions += 1;
+    cta.counters.textures.requests += (0..8).filter(|q| exec >> (4 * q) & 0xF != 0).count() as u64;
     let h = read(ctx, w, cta, handle);
     let cs: Vec<Lanes> = coords.iter().map(|c| read(ctx, w, cta, *c)).collect();
     let rd = |a: u64, n: u32| load(ctx, a, n);
