@@ -81,3 +81,73 @@ fn the_kernels_execute_the_model_in_both_dialects() {
         }
     }
 }
+
+/// The cases of `tests/fixtures/gpu_textures.json` named `name`.
+fn probe_case(name: &str) -> serde_json::Value {
+    let f: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("tests/fixtures/gpu_textures.json").unwrap()).unwrap();
+    f["cases"].as_array().unwrap().iter().find(|c| c["name"] == name).unwrap().clone()
+}
+
+fn u32s(v: &serde_json::Value) -> Vec<u32> {
+    v.as_array().unwrap().iter().map(|x| x.as_u64().unwrap() as u32).collect()
+}
+
+#[test]
+fn setp_on_packed_halves_equals_the_h200() {
+    // 14 comparisons (eq ne lt le gt ge equ neu ltu leu gtu geu nan num) of
+    // every pair of 11 values (zeros, ±1, ±inf, NaNs, a subnormal ...), two
+    // predicates each
+    for name in ["setp_f16x2", "setp_bf16x2"] {
+        let c = probe_case(name);
+        let (a, b, want) = (u32s(&c["a"]), u32s(&c["b"]), u32s(&c["out"]));
+        for d in BOTH {
+            let mut dev = Device::new();
+            let m = load(&mut dev, "half_sfu", d);
+            let (pa, pb) = (dev.alloc_from(&a), dev.alloc_from(&b));
+            let out = dev.alloc_zeroed::<u32>(want.len());
+            let n = want.len() as i32;
+            dev.launch(
+                &m,
+                name,
+                LaunchConfig::linear(1, 128),
+                &[Arg::Ptr(pa), Arg::Ptr(pb), Arg::Ptr(out), Arg::I32(n)],
+            )
+            .unwrap();
+            assert_eq!(dev.read::<u32>(out, want.len()), want, "{name} ({d:?})");
+        }
+    }
+}
+
+#[test]
+fn tanh_approx_f32_is_within_the_measured_error() {
+    // the H200's tanh.approx.f32 samples (tests/fixtures/gpu_sfu_samples.json):
+    // warplight computes tanh correctly rounded; the GPU is within 134 ulp of it
+    let f: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("tests/fixtures/gpu_sfu_samples.json").unwrap()).unwrap();
+    let op = f["ops"].as_array().unwrap().iter().find(|o| o["name"] == "tanh.approx.f32").unwrap();
+    let (x, y) = (u32s(&op["x"]), u32s(&op["y"]));
+    for d in BOTH {
+        let mut dev = Device::new();
+        let m = load(&mut dev, "half_sfu", d);
+        let (px, out) = (dev.alloc_from(&x), dev.alloc_zeroed::<u32>(x.len()));
+        let n = x.len();
+        dev.launch(
+            &m,
+            "tanh_f32",
+            LaunchConfig::linear(n.div_ceil(128) as u32, 128),
+            &[Arg::Ptr(px), Arg::Ptr(out), Arg::I32(n as i32)],
+        )
+        .unwrap();
+        let got: Vec<u32> = dev.read(out, n);
+        let ord = |v: u32| if v >> 31 == 1 { -((v & 0x7fff_ffff) as i64) } else { v as i64 };
+        for i in 0..n {
+            let (g, w) = (f32::from_bits(got[i]), f32::from_bits(y[i]));
+            if g.is_nan() || w.is_nan() {
+                assert_eq!(g.is_nan(), w.is_nan(), "tanh({:#x})", x[i]);
+                continue;
+            }
+            assert!((ord(got[i]) - ord(y[i])).abs() <= 134, "tanh({:#x}): warplight {g}, H200 {w}", x[i]);
+        }
+    }
+}

@@ -148,7 +148,9 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
                 return invalid(pos, format!("`{}` needs a comparison", d.full));
             }
             operands(i, if comb { 4 } else { 3 })?;
-            if m.types.iter().any(|t| matches!(t, Ty::F16x2 | Ty::BF16x2)) {
+            let packed = m.types.iter().any(|t| matches!(t, Ty::F16x2 | Ty::BF16x2));
+            if packed && (d.op == Set || !matches!(i.operands[0], Operand::Pair(..))) {
+                // `set` on packed halves writes two halves; `setp` needs `p|q`
                 return unsupported(pos, format!("{} (packed halves)", d.full));
             }
             if d.op == Setp {
