@@ -294,10 +294,7 @@ fn the_command_line_names_unusable_kernels() {
         let (ok, _, err) = warplight(&["launch", f.to_str().unwrap()]);
         assert_eq!(ok, runs, "{k}: {err}");
         if !runs {
-            assert!(
-                err.contains("unsupported instruction `sad.u32`") && err.contains("mixed.ptx:"),
-                "{k}: {err}"
-            );
+            assert!(err.contains("unsupported instruction `sad.u32`") && err.contains("mixed.ptx:"), "{k}: {err}");
         }
     }
     // stepping and tracing it fail the same way
