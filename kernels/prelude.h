@@ -142,6 +142,106 @@ WL_DEV int __popcll(unsigned long long x) { return __builtin_popcountll(x); }
 WL_DEV int __clzll(long long x) { return x == 0 ? 64 : __builtin_clzll((unsigned long long)x); }
 WL_DEV unsigned long long __brevll(unsigned long long x) { return __builtin_bitreverse64(x); }
 
+
+// ---- texture and surface objects (tex.*, tld4, suld.b, sust.b) ----
+// The SDK's cudaTextureObject_t / cudaSurfaceObject_t and the fetch
+// functions, as inline PTX in the forms nvcc writes for them.
+typedef unsigned long long cudaTextureObject_t;
+typedef unsigned long long cudaSurfaceObject_t;
+enum cudaSurfaceBoundaryMode { cudaBoundaryModeZero = 0, cudaBoundaryModeClamp = 1, cudaBoundaryModeTrap = 2 };
+struct alignas(4) uchar4 { unsigned char x, y, z, w; };
+WL_DEV float4 __wl_tex1d(cudaTextureObject_t t, float x) {
+  float4 r;
+  asm("tex.1d.v4.f32.f32 {%0, %1, %2, %3}, [%4, {%5}];"
+      : "=f"(r.x), "=f"(r.y), "=f"(r.z), "=f"(r.w) : "l"(t), "f"(x));
+  return r;
+}
+WL_DEV float4 __wl_tex1dfetch(cudaTextureObject_t t, int x) {
+  float4 r;
+  asm("tex.1d.v4.f32.s32 {%0, %1, %2, %3}, [%4, {%5}];"
+      : "=f"(r.x), "=f"(r.y), "=f"(r.z), "=f"(r.w) : "l"(t), "r"(x));
+  return r;
+}
+WL_DEV float4 __wl_tex2d(cudaTextureObject_t t, float x, float y) {
+  float4 r;
+  asm("tex.2d.v4.f32.f32 {%0, %1, %2, %3}, [%4, {%5, %6}];"
+      : "=f"(r.x), "=f"(r.y), "=f"(r.z), "=f"(r.w) : "l"(t), "f"(x), "f"(y));
+  return r;
+}
+WL_DEV uint4 __wl_tex2d_u(cudaTextureObject_t t, float x, float y) {
+  uint4 r;
+  asm("tex.2d.v4.u32.f32 {%0, %1, %2, %3}, [%4, {%5, %6}];"
+      : "=r"(r.x), "=r"(r.y), "=r"(r.z), "=r"(r.w) : "l"(t), "f"(x), "f"(y));
+  return r;
+}
+WL_DEV float4 __wl_tex3d(cudaTextureObject_t t, float x, float y, float z) {
+  float4 r;
+  asm("tex.3d.v4.f32.f32 {%0, %1, %2, %3}, [%4, {%5, %6, %7, %7}];"
+      : "=f"(r.x), "=f"(r.y), "=f"(r.z), "=f"(r.w) : "l"(t), "f"(x), "f"(y), "f"(z));
+  return r;
+}
+template <class T> __device__ __forceinline__ T tex1D(cudaTextureObject_t t, float x);
+template <> __device__ __forceinline__ float tex1D<float>(cudaTextureObject_t t, float x) { return __wl_tex1d(t, x).x; }
+template <> __device__ __forceinline__ float4 tex1D<float4>(cudaTextureObject_t t, float x) { return __wl_tex1d(t, x); }
+template <class T> __device__ __forceinline__ T tex1Dfetch(cudaTextureObject_t t, int x);
+template <> __device__ __forceinline__ float tex1Dfetch<float>(cudaTextureObject_t t, int x) { return __wl_tex1dfetch(t, x).x; }
+template <class T> __device__ __forceinline__ T tex2D(cudaTextureObject_t t, float x, float y);
+template <> __device__ __forceinline__ float tex2D<float>(cudaTextureObject_t t, float x, float y) { return __wl_tex2d(t, x, y).x; }
+template <> __device__ __forceinline__ float4 tex2D<float4>(cudaTextureObject_t t, float x, float y) { return __wl_tex2d(t, x, y); }
+template <> __device__ __forceinline__ uchar4 tex2D<uchar4>(cudaTextureObject_t t, float x, float y) {
+  uint4 v = __wl_tex2d_u(t, x, y);
+  return {(unsigned char)v.x, (unsigned char)v.y, (unsigned char)v.z, (unsigned char)v.w};
+}
+template <class T> __device__ __forceinline__ T tex3D(cudaTextureObject_t t, float x, float y, float z);
+template <> __device__ __forceinline__ float tex3D<float>(cudaTextureObject_t t, float x, float y, float z) { return __wl_tex3d(t, x, y, z).x; }
+// tex2Dgather: the component `comp` of the four texels bilinear filtering would use (tld4)
+#define WL_TLD4(c)                                                                 \
+  asm("tld4." #c ".2d.v4.f32.f32 {%0, %1, %2, %3}, [%4, {%5, %6}];"                \
+      : "=f"(r.x), "=f"(r.y), "=f"(r.z), "=f"(r.w) : "l"(t), "f"(x), "f"(y))
+template <class T> __device__ __forceinline__ T tex2Dgather(cudaTextureObject_t t, float x, float y, int comp = 0);
+template <> __device__ __forceinline__ float4 tex2Dgather<float4>(cudaTextureObject_t t, float x, float y, int comp) {
+  float4 r;
+  switch (comp) {
+  case 1: WL_TLD4(g); break;
+  case 2: WL_TLD4(b); break;
+  case 3: WL_TLD4(a); break;
+  default: WL_TLD4(r); break;
+  }
+  return r;
+}
+#undef WL_TLD4
+// surf2Dread / surf2Dwrite of 32-bit elements; x is in bytes, as in CUDA
+#define WL_SULD(mode)                                                              \
+  asm volatile("suld.b.2d.b32." #mode " {%0}, [%1, {%2, %3}];" : "=r"(v) : "l"(s), "r"(x), "r"(y))
+#define WL_SUST(mode)                                                              \
+  asm volatile("sust.b.2d.b32." #mode " [%0, {%1, %2}], {%3};" ::"l"(s), "r"(x), "r"(y), "r"(v) : "memory")
+WL_DEV int __wl_suld2d(cudaSurfaceObject_t s, int x, int y, cudaSurfaceBoundaryMode m) {
+  int v;
+  switch (m) {
+  case cudaBoundaryModeZero: WL_SULD(zero); break;
+  case cudaBoundaryModeClamp: WL_SULD(clamp); break;
+  default: WL_SULD(trap); break;
+  }
+  return v;
+}
+WL_DEV void __wl_sust2d(cudaSurfaceObject_t s, int x, int y, int v, cudaSurfaceBoundaryMode m) {
+  switch (m) {
+  case cudaBoundaryModeZero: WL_SUST(zero); break;
+  case cudaBoundaryModeClamp: WL_SUST(clamp); break;
+  default: WL_SUST(trap); break;
+  }
+}
+#undef WL_SULD
+#undef WL_SUST
+template <class T> __device__ __forceinline__ T surf2Dread(cudaSurfaceObject_t s, int x, int y, cudaSurfaceBoundaryMode m = cudaBoundaryModeTrap);
+template <> __device__ __forceinline__ int surf2Dread<int>(cudaSurfaceObject_t s, int x, int y, cudaSurfaceBoundaryMode m) { return __wl_suld2d(s, x, y, m); }
+template <> __device__ __forceinline__ float surf2Dread<float>(cudaSurfaceObject_t s, int x, int y, cudaSurfaceBoundaryMode m) {
+  return __int_as_float(__wl_suld2d(s, x, y, m));
+}
+WL_DEV void surf2Dread(int *out, cudaSurfaceObject_t s, int x, int y, cudaSurfaceBoundaryMode m = cudaBoundaryModeTrap) { *out = __wl_suld2d(s, x, y, m); }
+WL_DEV void surf2Dwrite(int v, cudaSurfaceObject_t s, int x, int y, cudaSurfaceBoundaryMode m = cudaBoundaryModeTrap) { __wl_sust2d(s, x, y, v, m); }
+WL_DEV void surf2Dwrite(float v, cudaSurfaceObject_t s, int x, int y, cudaSurfaceBoundaryMode m = cudaBoundaryModeTrap) { __wl_sust2d(s, x, y, __float_as_int(v), m); }
+
 #endif // !__NVCC__
 
 // ---- warplight helpers, for both compilers ----

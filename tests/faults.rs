@@ -85,11 +85,11 @@ fn launch_errors_are_clear() {
 
 #[test]
 fn ptx_errors_name_file_line_and_instruction() {
-    let src = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n .reg .b32 %r<3>;\n tex.2d.v4.f32.f32 %r1, [t, {%r1, %r2}];\n ret;\n}\n";
+    let src = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n .reg .b32 %r<3>;\n tex.a2d.v4.f32.f32 %r1, [t, {%r1, %r2}];\n ret;\n}\n";
     let e = warplight::ptx::load(src, "bad.ptx").unwrap_err();
     let msg = e.to_string();
-    assert!(msg.starts_with("bad.ptx:7:2: unsupported instruction `tex.2d.v4.f32.f32`"), "{msg}");
-    assert!(msg.contains("tex.2d.v4.f32.f32 %r1"), "shows the line: {msg}");
+    assert!(msg.starts_with("bad.ptx:7:2: unsupported instruction `tex.a2d.v4.f32.f32`"), "{msg}");
+    assert!(msg.contains("tex.a2d.v4.f32.f32 %r1"), "shows the line: {msg}");
 
     let src =
         ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n add.s32 %r1, %r2, 1;\n ret;\n}\n";

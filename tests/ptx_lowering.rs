@@ -196,7 +196,9 @@ fn validation_names_what_is_wrong() {
         ("match.sync.b32 %r1, %r2, -1;", "invalid: `match.sync.b32` needs .any or .all"),
         ("dp4a.u32.f32 %r1, %r2, %r3, %r4;", "invalid: `dp4a.u32.f32` needs two types, each .u32 or .s32"),
         ("bfind.u32 %r1, %r2, %r3;", "invalid: `bfind.u32` takes 2 operands, found 3"),
-        ("tanh.approx.f32 %f1, %f1;", "unsupported instruction `tanh.approx.f32`"),
+        ("tanh.f32 %f1, %f1;", "invalid: `tanh.f32`: tanh is .approx on .f32 and halves"),
+        ("tex.2d.v4.f32.f32 {%f1, %f1, %f1, %f1}, [%rd1, {%f1}];", "takes 2 coordinate(s), found 1"),
+        ("sust.p.2d.b32.trap [%rd1, {%r1, %r2}], {%r3};", "`sust.p.2d.b32.trap (modifier .p)`"),
     ];
     for (inst, expected) in cases {
         let src = format!(

@@ -124,8 +124,8 @@ fn a_spec_initialises_constant_memory() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A module with a kernel that needs `tanh.approx` (not executed yet), a kernel
-/// that reaches it through a device function, one that samples a texture,
+/// A module with a kernel that needs `sad` (not executed yet), a kernel
+/// that reaches it through a device function, one that samples a layered texture,
 /// and two ordinary kernels.
 const MIXED: &str = "\
 .version 7.8
@@ -136,7 +136,7 @@ const MIXED: &str = "\
 {
 	.reg .b32 %r<3>;
 	ld.param.b32 %r1, [a];
-	tanh.approx.f32 %r2, %r1;
+	sad.u32 %r2, %r1, %r1, %r1;
 	st.param.b32 [r], %r2;
 	ret;
 }
@@ -159,7 +159,7 @@ const MIXED: &str = "\
 	.reg .b64 %rd<2>;
 	ld.param.u64 %rd1, [out];
 	mov.u32 %r1, %tid.x;
-	tanh.approx.f32 %r2, %r1;
+	sad.u32 %r2, %r1, %r1, %r1;
 	st.global.u32 [%rd1], %r2;
 	ret;
 }
@@ -185,7 +185,7 @@ const MIXED: &str = "\
 	.reg .f32 %f<5>;
 	.reg .b64 %rd<3>;
 	ld.param.u64 %rd1, [t];
-	tex.2d.v4.f32.f32 {%f1, %f2, %f3, %f4}, [%rd1, {%f1, %f1}];
+	tex.a2d.v4.f32.f32 {%f1, %f2, %f3, %f4}, [%rd1, {%f1, %f1}];
 	ret;
 }
 
@@ -217,19 +217,19 @@ fn an_unsupported_instruction_fails_only_its_kernels() {
     assert_eq!(error("good"), None);
     assert_eq!(error("also_good"), None);
     let bad = error("bad").expect("`bad` is unusable");
-    assert!(bad.starts_with("mixed.ptx:32:2: unsupported instruction `tanh.approx.f32`"), "{bad}");
-    assert!(bad.contains("| tanh.approx.f32 %r2, %r1;"), "quotes the line: {bad}");
+    assert!(bad.starts_with("mixed.ptx:32:2: unsupported instruction `sad.u32`"), "{bad}");
+    assert!(bad.contains("| sad.u32 %r2, %r1, %r1, %r1;"), "quotes the line: {bad}");
     // through the device function: the callee's instruction is named
     let calls = error("calls_bad").expect("`calls_bad` is unusable");
-    assert!(calls.starts_with("mixed.ptx:9:2: unsupported instruction `tanh.approx.f32`"), "{calls}");
+    assert!(calls.starts_with("mixed.ptx:9:2: unsupported instruction `sad.u32`"), "{calls}");
     let tex = error("texture").expect("`texture` is unusable");
-    assert!(tex.starts_with("mixed.ptx:58:2: unsupported instruction `tex.2d.v4.f32.f32`"), "{tex}");
+    assert!(tex.starts_with("mixed.ptx:58:2: unsupported instruction `tex.a2d.v4.f32.f32`"), "{tex}");
 
     // launched anyway through the library, the launch is refused with the same error
     let e = dev.launch(&m, "bad", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err().to_string();
-    assert!(e.contains("mixed.ptx:32:2: unsupported instruction `tanh.approx.f32`"), "{e}");
+    assert!(e.contains("mixed.ptx:32:2: unsupported instruction `sad.u32`"), "{e}");
     let e = dev.launch(&m, "calls_bad", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap_err().to_string();
-    assert!(e.contains("mixed.ptx:9:2: unsupported instruction `tanh.approx.f32`"), "{e}");
+    assert!(e.contains("mixed.ptx:9:2: unsupported instruction `sad.u32`"), "{e}");
 }
 
 /// A module none of whose kernels can run still fails to load, with the first error.
@@ -238,7 +238,7 @@ fn a_module_with_no_usable_kernel_fails_to_load() {
     let only_bad =
         MIXED.replace(".visible .entry good(", ".func good(").replace(".visible .entry also_good(", ".func also_good(");
     let e = warplight::ptx::load(&only_bad, "bad.ptx").unwrap_err().to_string();
-    assert!(e.starts_with("bad.ptx:9:2: unsupported instruction `tanh.approx.f32`"), "{e}");
+    assert!(e.starts_with("bad.ptx:9:2: unsupported instruction `sad.u32`"), "{e}");
 }
 
 /// `check` reports every unusable kernel and fails, `kernels` marks them, and
@@ -261,7 +261,7 @@ fn the_command_line_names_unusable_kernels() {
     let (ok, _, err) = warplight(&["check", p]);
     assert!(!ok && err.contains("3 of 5 kernels cannot run"), "{err}");
     assert!(
-        err.contains("kernel `bad`: ") && err.contains("mixed.ptx:32:2: unsupported instruction `tanh.approx.f32`"),
+        err.contains("kernel `bad`: ") && err.contains("mixed.ptx:32:2: unsupported instruction `sad.u32`"),
         "{err}"
     );
     let calls = err.lines().find(|l| l.starts_with("kernel `calls_bad`")).unwrap_or_default();
@@ -278,7 +278,7 @@ fn the_command_line_names_unusable_kernels() {
         lines[i + 1].to_string()
     };
     assert!(
-        next("bad").contains("unusable: ") && next("bad").contains(":32:2: unsupported instruction `tanh.approx.f32`"),
+        next("bad").contains("unusable: ") && next("bad").contains(":32:2: unsupported instruction `sad.u32`"),
         "{out}"
     );
     assert!(next("good").contains("instructions") && next("also_good").contains("instructions"), "{out}");
@@ -294,10 +294,7 @@ fn the_command_line_names_unusable_kernels() {
         let (ok, _, err) = warplight(&["launch", f.to_str().unwrap()]);
         assert_eq!(ok, runs, "{k}: {err}");
         if !runs {
-            assert!(
-                err.contains("unsupported instruction `tanh.approx.f32`") && err.contains("mixed.ptx:"),
-                "{k}: {err}"
-            );
+            assert!(err.contains("unsupported instruction `sad.u32`") && err.contains("mixed.ptx:"), "{k}: {err}");
         }
     }
     // stepping and tracing it fail the same way
@@ -308,7 +305,7 @@ fn the_command_line_names_unusable_kernels() {
         vec!["trace", bad.to_str().unwrap(), "-o", html.to_str().unwrap()],
     ] {
         let (ok, _, err) = warplight(&args);
-        assert!(!ok && err.contains(":32:2: unsupported instruction `tanh.approx.f32`"), "{args:?}: {err}");
+        assert!(!ok && err.contains(":32:2: unsupported instruction `sad.u32`"), "{args:?}: {err}");
     }
     std::fs::remove_dir_all(&dir).ok();
 }

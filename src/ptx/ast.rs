@@ -52,6 +52,10 @@ pub struct VarDecl {
     pub dims: Vec<Option<u64>>,
     /// Initializer, flattened.
     pub init: Option<Vec<Literal>>,
+    /// Elements of the initializer that name a symbol (a function, for tables
+    /// of function pointers and vtables): element index and name; `init`
+    /// holds 0 there.
+    pub init_syms: Vec<(usize, String)>,
     /// `.extern`.
     pub is_extern: bool,
     /// Where it was declared.
@@ -158,4 +162,7 @@ pub enum Operand {
     List(Vec<Operand>),
     /// `p|q` (the two results of `setp`).
     Pair(String, String),
+    /// `[handle, {c0, c1, ...}]`: a texture or surface object (register or
+    /// name) and its coordinates (`tex`, `tld4`, `suld`, `sust`).
+    TexAddr(String, Vec<Operand>),
 }

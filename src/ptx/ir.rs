@@ -43,6 +43,69 @@ pub enum SpecialReg {
     GlobalTimerHi,
 }
 
+/// The value a function's address has (`mov.u64 %rd, f;`, `.u64 t[] = {f}`):
+/// function `i` is at `FUNC_ADDR_BASE + 16 i`, outside every memory window.
+pub const FUNC_ADDR_BASE: u64 = 0xF0F0_0000_0000_0000;
+
+/// The address of function `idx`.
+pub fn func_addr(idx: u32) -> u64 {
+    FUNC_ADDR_BASE + 16 * idx as u64
+}
+
+/// The function at address `a`, when `a` is one of [`func_addr`]'s values.
+pub fn func_at(a: u64, functions: usize) -> Option<u32> {
+    let off = a.checked_sub(FUNC_ADDR_BASE)?;
+    (off % 16 == 0 && off / 16 < functions as u64).then_some((off / 16) as u32)
+}
+
+/// The dimensionality of a texture or surface access (`.1d .2d .3d`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum TexGeom {
+    D1,
+    D2,
+    D3,
+}
+
+impl TexGeom {
+    /// Coordinates it uses.
+    pub fn dims(self) -> usize {
+        match self {
+            TexGeom::D1 => 1,
+            TexGeom::D2 => 2,
+            TexGeom::D3 => 3,
+        }
+    }
+}
+
+/// What `txq` asks of a texture object.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum TxqQuery {
+    Width,
+    Height,
+    Depth,
+    ChannelDataType,
+    ChannelOrder,
+    NormalizedCoords,
+    FilterMode,
+    AddrMode0,
+    AddrMode1,
+    AddrMode2,
+    ArraySize,
+    NumMipmapLevels,
+    NumSamples,
+}
+
+/// What a surface access out of range does (`.trap .clamp .zero`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum SurfClamp {
+    Trap,
+    Clamp,
+    Zero,
+}
+
 /// A source operand.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Src {
@@ -207,6 +270,8 @@ pub enum ArithOp {
     Cos,
     Ex2,
     Lg2,
+    /// `tanh.approx`.
+    Tanh,
     Copysign,
     /// `bfind`: the bit position of the most significant non-sign bit (all
     /// ones when none).
@@ -370,6 +435,19 @@ pub enum Kind {
     Bra { target: u32, uni: bool },
     /// `call` of a function: copy `args` (caller offset → callee offset, size) in, `rets` back.
     Call { func: u32, args: Vec<(u32, u32, u32)>, rets: Vec<(u32, u32, u32)> },
+    /// `call` through a register holding a function's address ([`func_addr`]),
+    /// with a `.callprototype`: `args` (caller offset, size) are copied into the
+    /// called function's parameters in order, its return parameters into `rets`.
+    CallIndirect { target: Src, args: Vec<(u32, u32)>, rets: Vec<(u32, u32)> },
+    /// `tex.geom.v4.dty.cty d, [handle, {coords}]`, or with `gather` the
+    /// component of `tld4.comp.2d` (0 r, 1 g, 2 b, 3 a).
+    Tex { geom: TexGeom, gather: Option<u8>, dty: Ty, cty: Ty, ds: Vec<Dst>, handle: Src, coords: Vec<Src> },
+    /// `txq.query.b32 d, [handle]`.
+    Txq { query: TxqQuery, d: Dst, handle: Src },
+    /// `suld.b.geom[.vec].ty.clamp d, [handle, {coords}]` (x in bytes).
+    Suld { geom: TexGeom, ty: Ty, ds: Vec<Dst>, handle: Src, coords: Vec<Src>, clamp: SurfClamp },
+    /// `sust.b.geom[.vec].ty.clamp [handle, {coords}], vals`.
+    Sust { geom: TexGeom, ty: Ty, vals: Vec<Src>, handle: Src, coords: Vec<Src>, clamp: SurfClamp },
     /// `ret`
     Ret,
     /// `exit`
@@ -437,6 +515,17 @@ impl Kind {
             Kind::Carry { a, b, c, cc, .. } => {
                 [a, b, c].into_iter().for_each(s);
                 v.push(*cc)
+            }
+            Kind::CallIndirect { target, .. } => s(target),
+            Kind::Tex { handle, coords, .. } | Kind::Suld { handle, coords, .. } => {
+                s(handle);
+                coords.iter().for_each(s)
+            }
+            Kind::Txq { handle, .. } => s(handle),
+            Kind::Sust { vals, handle, coords, .. } => {
+                s(handle);
+                coords.iter().for_each(&mut s);
+                vals.iter().for_each(s)
             }
             Kind::PredLogic { .. }
             | Kind::Bra { .. }

@@ -292,6 +292,34 @@ impl Names<'_> {
             ),
             Kind::Bra { target, uni } => format!("bra{} {target}", if *uni { ".uni" } else { "" }),
             Kind::Call { func, args, rets } => format!("call f{func} args {args:?} rets {rets:?}"),
+            Kind::CallIndirect { target, args, rets } => {
+                format!("call.indirect {} args {args:?} rets {rets:?}", self.src(*target))
+            }
+            Kind::Tex { geom, gather, dty, cty, ds, handle, coords } => format!(
+                "{}.{}.{dty}.{cty} {{{}}} <- [{}, {{{}}}]",
+                gather.map(|c| format!("tld4.{}", ["r", "g", "b", "a"][c as usize])).unwrap_or_else(|| "tex".into()),
+                lc(geom),
+                self.dsts(ds),
+                self.src(*handle),
+                self.srcs(coords)
+            ),
+            Kind::Txq { query, d, handle } => format!("txq.{} {} <- [{}]", lc(query), self.dst(*d), self.src(*handle)),
+            Kind::Suld { geom, ty, ds, handle, coords, clamp } => format!(
+                "suld.{}.{ty}.{} {{{}}} <- [{}, {{{}}}]",
+                lc(geom),
+                lc(clamp),
+                self.dsts(ds),
+                self.src(*handle),
+                self.srcs(coords)
+            ),
+            Kind::Sust { geom, ty, vals, handle, coords, clamp } => format!(
+                "sust.{}.{ty}.{} [{}, {{{}}}] <- {{{}}}",
+                lc(geom),
+                lc(clamp),
+                self.src(*handle),
+                self.srcs(coords),
+                self.srcs(vals)
+            ),
             Kind::Ret => "ret".into(),
             Kind::Exit => "exit".into(),
             Kind::Bar { id, count } => {

@@ -78,6 +78,12 @@ pub const KNOWN_OPCODES: &[&str] = &[
     "bfind",
     "dp4a",
     "dp2a",
+    "tex",
+    "tld4",
+    "txq",
+    "suld",
+    "sust",
+    "tanh",
     "addc",
     "subc",
     "madc",
@@ -339,6 +345,7 @@ impl<'a> Parser<'a> {
             range: None,
             dims: Vec::new(),
             init: None,
+            init_syms: Vec::new(),
             is_extern: false,
             pos,
         })
@@ -376,31 +383,42 @@ impl<'a> Parser<'a> {
             }
         }
         let mut init = None;
+        let mut init_syms = Vec::new();
         if self.eat_punct('=') {
             let mut vals = Vec::new();
-            self.initializer(&mut vals)?;
+            self.initializer(&mut vals, &mut init_syms)?;
             if dims.len() == 1 && dims[0].is_none() {
                 dims[0] = Some(vals.len() as u64 / vector.unwrap_or(1) as u64);
             }
             init = Some(vals);
         }
-        Ok(VarDecl { space, align, vector, ty, name, range, dims, init, is_extern: false, pos })
+        Ok(VarDecl { space, align, vector, ty, name, range, dims, init, init_syms, is_extern: false, pos })
     }
 
-    fn initializer(&mut self, out: &mut Vec<Literal>) -> PResult<()> {
+    fn initializer(&mut self, out: &mut Vec<Literal>, syms: &mut Vec<(usize, String)>) -> PResult<()> {
         let pos = self.pos();
         if self.eat_punct('{') {
             self.nested(pos, "initializer braces", |p| {
                 if !p.is_punct('}') {
-                    p.initializer(out)?;
+                    p.initializer(out, syms)?;
                     while p.eat_punct(',') {
-                        p.initializer(out)?;
+                        p.initializer(out, syms)?;
                     }
                 }
                 p.expect_punct('}')
             })
         } else {
             let pos = self.pos();
+            // a symbol's address (`{_Z4addfff, ...}`): resolved by the lowering
+            if let Some(Tok::Ident(name)) = self.peek()
+                && !name.starts_with('%')
+                && self.peek_at(1) != Some(&Tok::Punct('('))
+            {
+                syms.push((out.len(), name.clone()));
+                out.push(Literal::Int(0));
+                self.i += 1;
+                return Ok(());
+            }
             match self.literal()? {
                 Some(l) => {
                     out.push(l);
@@ -524,6 +542,16 @@ impl<'a> Parser<'a> {
                     }
                     _ => return Err((pos, PtxErrorKind::UnsupportedDirective(format!(".{d}")))),
                 },
+                // `prototype_0 : .callprototype (...) _ (...);`: the signature of an
+                // indirect call, which warplight takes from the called function itself
+                Some(Tok::Ident(_))
+                    if self.peek_at(1) == Some(&Tok::Punct(':'))
+                        && matches!(self.peek_at(2), Some(Tok::Dot(d)) if d == "callprototype") =>
+                {
+                    if !self.skip_statement() {
+                        return syntax(pos, "missing `;` after `.callprototype`");
+                    }
+                }
                 Some(Tok::Ident(name)) if self.peek_at(1) == Some(&Tok::Punct(':')) => {
                     self.i += 2;
                     out.push(Stmt::Label(name.clone(), pos));
@@ -642,6 +670,18 @@ impl<'a> Parser<'a> {
                     let neg = self.eat_punct('-');
                     let v = self.expect_int()? as i64;
                     off = if neg { -v } else { v };
+                }
+                // `[handle, {coordinates}]` of texture and surface instructions
+                if let Some(b) = base.as_ref().filter(|_| off == 0 && self.is_punct(','))
+                    && self.eat_punct(',')
+                {
+                    let b = b.clone();
+                    let coords = match self.operand()? {
+                        Operand::Vector(v) => v,
+                        one => vec![one],
+                    };
+                    self.expect_punct(']')?;
+                    return Ok(Operand::TexAddr(b, coords));
                 }
                 self.expect_punct(']')?;
                 Ok(Operand::Addr(base, off))

@@ -295,6 +295,7 @@ fn f32op(op: ArithOp, m: FloatMode, a: u64, b: u64, c: u64) -> u64 {
         ArithOp::Cos => (fa as f64).cos() as f32,
         ArithOp::Ex2 => (fa as f64).exp2() as f32,
         ArithOp::Lg2 => (fa as f64).log2() as f32,
+        ArithOp::Tanh => (fa as f64).tanh() as f32,
         _ => f32::NAN,
     };
     out32(r, m)

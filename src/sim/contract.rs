@@ -93,13 +93,18 @@ fn writes(k: &Kind) -> Vec<RegId> {
         | Kind::Redux { d: x, .. }
         | Kind::Match { d: x, .. } => vec![d(x)],
         Kind::Carry { d: x, cc, .. } => vec![d(x), *cc],
-        Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } => ds.iter().map(d).collect(),
+        Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } | Kind::Tex { ds, .. } | Kind::Suld { ds, .. } => {
+            ds.iter().map(d).collect()
+        }
+        Kind::Txq { d: x, .. } => vec![d(x)],
         Kind::Atom { d: x, .. } | Kind::Vote { d: x, .. } | Kind::BarRed { d: x, .. } => x.iter().map(d).collect(),
         Kind::Setp { .. }
         | Kind::PredLogic { .. }
         | Kind::St { .. }
         | Kind::Bra { .. }
         | Kind::Call { .. }
+        | Kind::CallIndirect { .. }
+        | Kind::Sust { .. }
         | Kind::Ret
         | Kind::Exit
         | Kind::Bar { .. }
@@ -181,7 +186,7 @@ impl<'a> Facts<'a> {
             let inst = &self.insts[k];
             let unguarded = inst.guard.is_none();
             match inst.kind {
-                Kind::Bra { .. } | Kind::Call { .. } => return None,
+                Kind::Bra { .. } | Kind::Call { .. } | Kind::CallIndirect { .. } => return None,
                 Kind::Ret | Kind::Exit if unguarded => return Some(out),
                 _ => {}
             }
@@ -216,7 +221,7 @@ impl<'a> Facts<'a> {
                     }
                     branchy = true;
                 }
-                Kind::Call { .. } | Kind::Ret | Kind::Exit | Kind::Trap => return false,
+                Kind::Call { .. } | Kind::CallIndirect { .. } | Kind::Ret | Kind::Exit | Kind::Trap => return false,
                 _ => {}
             }
         }

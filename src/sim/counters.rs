@@ -37,6 +37,8 @@ pub struct Counters {
     pub atomics: SpaceCounts,
     /// Lane-level atomic operations performed.
     pub atomic_lane_ops: u64,
+    /// Texture and surface instructions (warp level).
+    pub textures: TextureCounts,
     /// CTAs executed.
     pub ctas: u64,
     /// Warps executed.
@@ -68,6 +70,22 @@ impl ClassCounts {
             InstClass::Warp => self.warp += 1,
         }
     }
+}
+
+/// Warp-level texture and surface instructions.
+#[derive(Debug, Clone, Default, PartialEq, Eq, serde::Serialize)]
+pub struct TextureCounts {
+    /// `tex` and `tld4` (Nsight Compute: `smsp__inst_executed_op_texture`).
+    pub instructions: u64,
+    /// Texture requests: one per quad (four consecutive lanes) with an
+    /// active lane, per `tex`/`tld4` (`l1tex__t_requests_pipe_tex_mem_texture`).
+    pub requests: u64,
+    /// `txq`.
+    pub queries: u64,
+    /// `suld` (`smsp__inst_executed_op_surface_ld`).
+    pub surface_loads: u64,
+    /// `sust` (`smsp__inst_executed_op_surface_st`).
+    pub surface_stores: u64,
 }
 
 /// Counts per memory space (generic accesses are counted in the space they resolve to
@@ -110,6 +128,11 @@ impl Counters {
             a.param += b.param;
         }
         add!(atomic_lane_ops);
+        add!(textures.instructions);
+        add!(textures.requests);
+        add!(textures.queries);
+        add!(textures.surface_loads);
+        add!(textures.surface_stores);
         add!(ctas);
         add!(warps);
     }
@@ -236,6 +259,10 @@ pub const NCU_ALIASES: &[(&str, &str)] = &[
     ("smsp__sass_branch_targets.sum", "branches"),
     ("smsp__sass_branch_targets_threads_divergent.sum", "divergent_branches"),
     ("launch__grid_size", "ctas"),
+    ("smsp__inst_executed_op_texture.sum", "textures.instructions"),
+    ("l1tex__t_requests_pipe_tex_mem_texture.sum", "textures.requests"),
+    ("smsp__inst_executed_op_surface_ld.sum", "textures.surface_loads"),
+    ("smsp__inst_executed_op_surface_st.sum", "textures.surface_stores"),
 ];
 
 impl Counters {

@@ -330,6 +330,7 @@ pub struct Device {
     sizes: HashMap<u64, u64>,
     printf: super::printf::PrintfSink,
     progress: Option<super::grid::ProgressHook>,
+    textures: Vec<super::texture::Object>,
 }
 
 impl Default for Device {
@@ -355,6 +356,7 @@ impl Device {
             sizes: HashMap::new(),
             printf: Default::default(),
             progress: None,
+            textures: Vec::new(),
         }
     }
 
@@ -418,6 +420,21 @@ impl Device {
         let mut b = vec![0u8; len as usize];
         al.read_bytes(off, &mut b);
         Ok(from_bytes(&b))
+    }
+
+    /// Creates a texture object (`cudaCreateTextureObject`) over texels already
+    /// in device memory; the handle is what a kernel's `cudaTextureObject_t`
+    /// parameter takes ([`Arg::U64`]).
+    pub fn create_texture(&mut self, desc: super::texture::TextureDesc) -> u64 {
+        self.textures.push(super::texture::Object::Texture(desc));
+        super::texture::handle_of(self.textures.len() - 1)
+    }
+
+    /// Creates a surface object (`cudaCreateSurfaceObject`); the handle is a
+    /// `cudaSurfaceObject_t` argument ([`Arg::U64`]).
+    pub fn create_surface(&mut self, desc: super::texture::SurfaceDesc) -> u64 {
+        self.textures.push(super::texture::Object::Surface(desc));
+        super::texture::handle_of(self.textures.len() - 1)
     }
 
     /// Size of the allocation starting at `p`.
@@ -536,6 +553,7 @@ impl Device {
             observers,
             per_inst: self.config.fidelity >= Fidelity::Instructions,
             printf: super::printf::PrintfTarget { sink: &self.printf, launch: self.printf.begin_launch() },
+            textures: &self.textures,
         }
     }
 

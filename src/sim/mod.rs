@@ -27,6 +27,7 @@ pub mod regalloc;
 pub mod sfu;
 pub mod simt_stack;
 pub mod stepper;
+pub mod texture;
 pub mod warp;
 
 pub use counters::{Counters, LaunchStats};

@@ -75,6 +75,7 @@ fn arith_op(d: &Decoded) -> ArithOp {
         Cos => ArithOp::Cos,
         Ex2 => ArithOp::Ex2,
         Lg2 => ArithOp::Lg2,
+        Tanh => ArithOp::Tanh,
         Copysign => ArithOp::Copysign,
         other => unreachable!("{other:?} is not an arithmetic opcode"),
     }

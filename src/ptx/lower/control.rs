@@ -71,16 +71,18 @@ impl FnLower<'_> {
         let args: &[Operand] = match ops.get(k + 1) {
             Some(Operand::List(a)) => a,
             None => &[],
-            Some(_) => return unsupported(pos, "indirect call with a prototype"),
+            // `call (r), %rd, prototype;` with no arguments
+            Some(Operand::Name(_)) if ops.len() == k + 2 => &[],
+            Some(_) => return invalid(pos, "`call` arguments must be a list `(...)`"),
         };
-        if ops.len() > k + 2 {
-            return unsupported(pos, "indirect call with a prototype");
-        }
         let fidx = match self.lookup(fname) {
             Some(Sym::Func(f)) => f as usize,
-            Some(Sym::Reg(_)) => return unsupported(pos, "indirect call through a register"),
+            Some(Sym::Reg(_)) => return self.call_indirect(i, fname, rets, args),
             _ => return invalid(pos, format!("call of undeclared function `{fname}`")),
         };
+        if ops.len() > k + 2 {
+            return invalid(pos, "a direct `call` takes no prototype");
+        }
         let callee = &self.sigs[fidx];
         if callee.is_entry {
             return invalid(pos, format!("`{fname}` is a kernel and cannot be called"));
@@ -122,5 +124,27 @@ impl FnLower<'_> {
             r.push((p.offset, off, size.min(p.size)));
         }
         Ok(Kind::Call { func: fidx as u32, args: a, rets: r })
+    }
+
+    /// An indirect call: `call (rets), %reg, (args), prototype;`. The called
+    /// function is known only at run time; its signature is checked then
+    /// against the arguments (`.param` variables: offset and size).
+    fn call_indirect(&self, i: &ast::Instruction, reg: &str, rets: &[Operand], args: &[Operand]) -> LResult<Kind> {
+        let pos = i.pos;
+        let param_var = |o: &Operand| -> LResult<(u32, u32)> {
+            match o {
+                Operand::Name(n) => match self.lookup(n) {
+                    Some(Sym::FrameParam(off, size)) => Ok((off, size)),
+                    _ => unsupported(pos, format!("call argument `{n}` that is not a .param variable")),
+                },
+                _ => unsupported(pos, "call argument that is not a .param variable"),
+            }
+        };
+        let target = self.src(&Operand::Name(reg.to_string()), Ty::U64, pos)?;
+        Ok(Kind::CallIndirect {
+            target,
+            args: args.iter().map(param_var).collect::<LResult<_>>()?,
+            rets: rets.iter().map(param_var).collect::<LResult<_>>()?,
+        })
     }
 }

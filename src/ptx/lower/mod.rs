@@ -28,6 +28,7 @@ pub mod layout;
 pub mod memory;
 pub mod opcode;
 pub mod operands;
+pub mod texture;
 pub mod validate;
 pub mod warp;
 
@@ -131,6 +132,9 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
         Ok(off as u32)
     };
     let mut global_bytes: u64 = 0;
+    // initializer elements naming a symbol: (global index or None for the
+    // const bank, byte offset of the variable, element bytes, the names)
+    let mut sym_inits: Vec<(Option<usize>, usize, usize, &ast::VarDecl)> = Vec::new();
     for v in &m.vars {
         match v.space {
             Space::Shared => {
@@ -145,6 +149,9 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
                 let bytes = init_bytes(v)?;
                 prog.const_bank.resize(off as usize, 0);
                 prog.const_bank.extend_from_slice(&bytes);
+                if !v.init_syms.is_empty() {
+                    sym_inits.push((None, off as usize, v.ty.bytes() as usize, v));
+                }
                 prog.const_vars.push((v.name.clone(), off as u32, bytes.len() as u32));
                 module_syms.insert(v.name.clone(), Sym::Const(off as u32));
             }
@@ -157,6 +164,9 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
                 check_var_size(v, size, global_bytes)?;
                 let bytes = init_bytes(v)?;
                 let idx = prog.globals.len() as u32;
+                if !v.init_syms.is_empty() {
+                    sym_inits.push((Some(idx as usize), 0, v.ty.bytes() as usize, v));
+                }
                 prog.globals.push(GlobalVar {
                     name: v.name.clone(),
                     size,
@@ -223,6 +233,27 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
     }
     for (name, &i) in &by_name {
         module_syms.insert(name.clone(), Sym::Func(i as u32));
+    }
+    // function addresses in initializers (tables of function pointers, vtables)
+    for (global, off, eb, v) in sym_inits {
+        for (k, name) in &v.init_syms {
+            let Some(&f) = by_name.get(name) else {
+                return unsupported(
+                    v.pos,
+                    format!("initializer of `{}` naming `{name}`, which is not a function", v.name),
+                );
+            };
+            if eb != 8 {
+                return invalid(v.pos, format!("function address `{name}` in a {eb}-byte element of `{}`", v.name));
+            }
+            let bytes = func_addr(f as u32).to_le_bytes();
+            let at = off + k * eb;
+            let dst = match global {
+                Some(g) => &mut prog.globals[g].init,
+                None => &mut prog.const_bank,
+            };
+            dst[at..at + 8].copy_from_slice(&bytes);
+        }
     }
     let sigs: Vec<Signature> = defs.iter().map(|f| signature(f)).collect::<LResult<_>>()?;
     // the first unsupported instruction or declaration of each function
@@ -547,6 +578,7 @@ impl<'a> FnLower<'a> {
             (Family::Warp, Opcode::Redux) => self.lower_redux(i, &d)?,
             (Family::Warp, Opcode::Match) => self.lower_match(i, &d)?,
             (Family::Warp, _) => self.lower_shfl(i, &d)?,
+            (Family::Texture, _) => self.lower_texture(i, &d)?,
         };
         let class = d.op.class();
         self.emit(kind, guard, pos, d.full, class);

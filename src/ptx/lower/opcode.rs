@@ -81,6 +81,12 @@ pub enum Opcode {
     Addc,
     Subc,
     Madc,
+    Tanh,
+    Tex,
+    Tld4,
+    Txq,
+    Suld,
+    Sust,
 }
 
 /// The instruction families, one file of the lowering each.
@@ -100,6 +106,8 @@ pub enum Family {
     Control,
     /// Votes and shuffles ([`super::warp`]).
     Warp,
+    /// Texture and surface objects ([`super::texture`]).
+    Texture,
 }
 
 impl Opcode {
@@ -178,6 +186,12 @@ impl Opcode {
             "addc" => Addc,
             "subc" => Subc,
             "madc" => Madc,
+            "tanh" => Tanh,
+            "tex" => Tex,
+            "tld4" => Tld4,
+            "txq" => Txq,
+            "suld" => Suld,
+            "sust" => Sust,
             _ => return None,
         })
     }
@@ -194,6 +208,7 @@ impl Opcode {
             Bra | Call | Ret | Exit | Trap | Bar | Barrier | Membar | Fence | Prefetch | Prefetchu | Pmevent
             | Nanosleep | Brkpt | Nop => Family::Control,
             Vote | Activemask | Shfl | Redux | Match => Family::Warp,
+            Tex | Tld4 | Txq | Suld | Sust => Family::Texture,
             _ => Family::Arith,
         }
     }
@@ -202,10 +217,10 @@ impl Opcode {
     pub fn class(self) -> InstClass {
         use Opcode::*;
         match self {
-            Ld | St | Atom | Red => InstClass::Memory,
+            Ld | St | Atom | Red | Tex | Tld4 | Txq | Suld | Sust => InstClass::Memory,
             Bra | Call | Ret | Exit | Bar | Barrier | Membar | Fence | Trap => InstClass::Control,
             Vote | Shfl | Activemask | Redux | Match => InstClass::Warp,
-            Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 => InstClass::Sfu,
+            Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 | Tanh => InstClass::Sfu,
             _ => InstClass::Alu,
         }
     }
@@ -389,6 +404,6 @@ mod tests {
         for w in crate::ptx::parser::KNOWN_OPCODES {
             assert!(Opcode::parse(w).is_some(), "{w}");
         }
-        assert_eq!(Opcode::parse("tex"), None);
+        assert_eq!(Opcode::parse("wmma"), None);
     }
 }

@@ -119,7 +119,8 @@ impl FnLower<'_> {
                 Some(Sym::Local(o)) => Ok(Src::LocalAddr(o)),
                 Some(Sym::Global(g)) => Ok(Src::GlobalAddr(g, 0)),
                 Some(Sym::Pred(_)) => invalid(pos, format!("predicate `{n}` used as a value")),
-                Some(Sym::Func(_)) => unsupported(pos, format!("address of function `{n}`")),
+                // a function pointer: an address outside memory that indirect calls resolve
+                Some(Sym::Func(f)) => Ok(Src::Imm(func_addr(f))),
                 None => match special_reg(n) {
                     Some(s) => Ok(Src::Special(s)),
                     // PTX's predefined constant (nvcc writes it for `warpSize`)

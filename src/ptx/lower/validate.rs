@@ -90,7 +90,7 @@ pub fn arith_shape(op: Opcode) -> (usize, &'static [&'static str]) {
         Bfind => (1, &["shiftamt"]),
         Addc | Subc => (2, &["cc"]),
         Madc => (3, &["lo", "hi", "cc"]),
-        Abs | Neg | Not | Cnot | Popc | Clz | Brev | Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 => (1, &[]),
+        Abs | Neg | Not | Cnot | Popc | Clz | Brev | Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 | Tanh => (1, &[]),
         _ => (2, &[]),
     }
 }
@@ -148,7 +148,9 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
                 return invalid(pos, format!("`{}` needs a comparison", d.full));
             }
             operands(i, if comb { 4 } else { 3 })?;
-            if m.types.iter().any(|t| matches!(t, Ty::F16x2 | Ty::BF16x2)) {
+            let packed = m.types.iter().any(|t| matches!(t, Ty::F16x2 | Ty::BF16x2));
+            if packed && (d.op == Set || !matches!(i.operands[0], Operand::Pair(..))) {
+                // `set` on packed halves writes two halves; `setp` needs `p|q`
                 return unsupported(pos, format!("{} (packed halves)", d.full));
             }
             if d.op == Setp {
@@ -303,6 +305,7 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             operands(i, if m.has("sync") { 5 } else { 4 })?;
         }
         Exit | Trap | Membar | Fence | Prefetch | Prefetchu | Pmevent | Nanosleep | Brkpt | Nop => {}
+        Tex | Tld4 | Txq | Suld | Sust => super::texture::validate(d, i)?,
         // the arithmetic opcodes
         _ => {
             let t = one_type(d, i)?;
@@ -319,9 +322,14 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             allowed.extend(extra);
             only(d, &allowed, i)?;
             operands(i, nsrc + 1)?;
-            let half_ok = matches!(d.op, Add | Sub | Mul | Mad | Fma | Neg | Abs | Min | Max);
+            // ex2 and tanh on halves: `.approx` only, as PTX defines them
+            let half_sfu = matches!(d.op, Ex2 | Tanh) && m.has("approx");
+            let half_ok = matches!(d.op, Add | Sub | Mul | Mad | Fma | Neg | Abs | Min | Max) || half_sfu;
             if t.is_float() && t != Ty::F32 && t != Ty::F64 && !half_ok {
                 return unsupported(pos, format!("{} (.{t})", d.full));
+            }
+            if d.op == Tanh && (!m.has("approx") || t == Ty::F64) {
+                return invalid(pos, format!("`{}`: tanh is .approx on .f32 and halves", d.full));
             }
             if t.is_float() && matches!(d.op, Mul | Mad | Fma) && (m.has("hi") || m.has("wide")) {
                 return invalid(pos, format!("`{}`: .hi/.wide apply to integers", d.full));

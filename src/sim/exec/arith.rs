@@ -137,6 +137,9 @@ pub(super) fn bfi(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, ty: Ty, d: Dst, [a, b, 
 /// `setp`.
 pub(super) fn setp(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, kind: &Kind, exec: u32) {
     let Kind::Setp { cmp, ty, p, q, a, b, comb, ftz } = kind else { unreachable!("setp") };
+    if matches!(ty, Ty::F16x2 | Ty::BF16x2) {
+        return setp_x2(ctx, w, cta, kind, exec);
+    }
     let t = {
         let (va, vb) = (operand(ctx, w, cta, *a), operand(ctx, w, cta, *b));
         alu::compare_lanes(*cmp, *ty, *ftz, &va, &vb)
@@ -148,6 +151,31 @@ pub(super) fn setp(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, kind: &Kind, exec: u32
             (combine(*op, t, cv), combine(*op, !t, cv))
         }
         None => (t, !t),
+    };
+    set_pred(fr, *p, pv, exec);
+    if let Some(q) = q {
+        set_pred(fr, *q, qv, exec);
+    }
+}
+
+/// `setp.cmp[.bool].f16x2 p|q, a, b[, c]` (and `.bf16x2`): `p` compares the
+/// lower halves, `q` the upper ones, each combined with `c`.
+fn setp_x2(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, kind: &Kind, exec: u32) {
+    let Kind::Setp { cmp, ty, p, q, a, b, comb, ftz } = kind else { unreachable!("setp") };
+    let half = if *ty == Ty::BF16x2 { Ty::BF16 } else { Ty::F16 };
+    let (va, vb) = (read(ctx, w, cta, *a), read(ctx, w, cta, *b));
+    let (mut lo, mut hi) = (0u32, 0u32);
+    for l in 0..32 {
+        lo |= (alu::compare(*cmp, half, *ftz, va[l] & 0xFFFF, vb[l] & 0xFFFF) as u32) << l;
+        hi |= (alu::compare(*cmp, half, *ftz, va[l] >> 16 & 0xFFFF, vb[l] >> 16 & 0xFFFF) as u32) << l;
+    }
+    let fr = w.frames.last_mut().expect("frame");
+    let (pv, qv) = match comb {
+        Some((op, c)) => {
+            let cv = pred_bits(fr, *c);
+            (combine(*op, lo, cv), combine(*op, hi, cv))
+        }
+        None => (lo, hi),
     };
     set_pred(fr, *p, pv, exec);
     if let Some(q) = q {

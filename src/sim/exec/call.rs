@@ -69,6 +69,70 @@ pub(super) fn call(
     Ok(Effect::Continue)
 }
 
+/// `call` through a register: the lanes calling the function of the lowest
+/// active lane's address call it now; the others re-issue the call after it
+/// returns (one call per distinct target, as the GPU serialises them), and all
+/// rejoin after the call.
+pub(super) fn call_indirect(
+    ctx: &Ctx,
+    w: &mut Warp,
+    cta: &mut CtaMut,
+    pc: u32,
+    target: crate::ptx::ir::Src,
+    args: &[(u32, u32)],
+    exec: u32,
+) -> Result<Effect, Box<ExecFault>> {
+    if exec == 0 {
+        return Ok(Effect::Continue);
+    }
+    let t = super::read(ctx, w, cta, target);
+    let first = exec.trailing_zeros() as usize;
+    let n = ctx.prog.functions.len();
+    let Some(callee) = crate::ptx::ir::func_at(t[first], n) else {
+        return Err(fault(
+            FaultKind::Unsupported(format!("indirect call of {:#x}, which is not a function's address", t[first])),
+            Some(first),
+        ));
+    };
+    let group = (0..32).filter(|&l| exec >> l & 1 != 0 && t[l] == t[first]).fold(0u32, |m, l| m | 1 << l);
+    let cf = &ctx.prog.functions[callee as usize];
+    if cf.is_entry || cf.params.len() != args.len() {
+        return Err(fault(
+            FaultKind::Unsupported(format!(
+                "indirect call of `{}` with {} argument(s); it takes {}",
+                cf.name,
+                args.len(),
+                cf.params.len()
+            )),
+            Some(first),
+        ));
+    }
+    let rest = exec & !group;
+    if rest != 0 {
+        // the others call again from the same instruction; the group rejoins after it
+        let next = pc + 1;
+        w.stack.push(SimtEntry { pc, rpc: next, mask: rest });
+        w.stack.push(SimtEntry { pc: next, rpc: next, mask: group });
+    }
+    let triples: Vec<(u32, u32, u32)> =
+        args.iter().zip(&cf.params).map(|(&(off, size), p)| (off, p.offset, size.min(p.size))).collect();
+    call(ctx, w, cta, pc, callee, &triples, group)
+}
+
+/// The return values a call at `pc` of `caller` copies back: (callee offset,
+/// caller offset, size).
+fn call_rets(ctx: &Ctx, caller: u32, pc: u32, callee: u32) -> Vec<(u32, u32, u32)> {
+    match &ctx.prog.functions[caller as usize].insts[pc as usize].kind {
+        Kind::Call { rets, .. } => rets.clone(),
+        Kind::CallIndirect { rets, .. } => rets
+            .iter()
+            .zip(&ctx.prog.functions[callee as usize].returns)
+            .map(|(&(off, size), r)| (r.offset, off, size.min(r.size)))
+            .collect(),
+        _ => unreachable!("call_pc names a call"),
+    }
+}
+
 /// One lane's view of memory for `printf`: generic addresses resolved as
 /// loads resolve them.
 struct LaneMemory<'a, 'c, 'm> {
@@ -196,15 +260,13 @@ pub(super) fn pop_empty_frames(ctx: &Ctx, w: &mut Warp) {
 fn return_from_call(ctx: &Ctx, w: &mut Warp) {
     let callee = w.frames.pop().expect("callee frame");
     let caller = w.frames.last_mut().expect("caller frame");
-    let Kind::Call { rets, .. } = &ctx.prog.functions[caller.func as usize].insts[callee.call_pc as usize].kind else {
-        unreachable!("call_pc names a call");
-    };
+    let rets = call_rets(ctx, caller.func, callee.call_pc, callee.func);
     let (ps_n, ps_c) = (callee.param_size as usize, caller.param_size as usize);
     for l in 0..32 {
         if callee.returned >> l & 1 == 0 {
             continue;
         }
-        for &(src, dst, size) in rets {
+        for &(src, dst, size) in &rets {
             let (s, d, n) = (src as usize, dst as usize, size as usize);
             caller.params[l * ps_c + d..l * ps_c + d + n]
                 .copy_from_slice(&callee.params[l * ps_n + s..l * ps_n + s + n]);

@@ -12,6 +12,7 @@ mod atomic;
 mod call;
 mod control;
 mod memory;
+mod texture;
 
 pub use atomic::{PendingAtomic, apply_pending};
 pub use call::call_chain;
@@ -56,6 +57,8 @@ pub struct Ctx<'a> {
     pub per_inst: bool,
     /// Where `printf` output goes.
     pub printf: super::printf::PrintfTarget<'a>,
+    /// The device's texture and surface objects (handle = index + 1).
+    pub textures: &'a [super::texture::Object],
 }
 
 /// The CTA-owned state an instruction may change besides its warp.
@@ -300,6 +303,10 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             advance(w, pc);
             return call::call(ctx, w, cta, pc, *callee, args, exec);
         }
+        Kind::CallIndirect { target, args, .. } => {
+            advance(w, pc);
+            return call::call_indirect(ctx, w, cta, pc, *target, args, exec);
+        }
         _ => {}
     }
 
@@ -372,10 +379,20 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         Kind::Carry { op, cin, cout, ty, d, a, b, c, cc } => {
             arith::carry(ctx, w, cta, (*op, *cin, *cout, *ty), *d, [*a, *b, *c], *cc, exec)
         }
+        Kind::Tex { geom, gather, cty, ds, handle, coords, .. } => {
+            texture::tex(ctx, w, cta, *geom, *gather, *cty, ds, *handle, coords, exec)?
+        }
+        Kind::Txq { query, d, handle } => texture::txq(ctx, w, cta, *query, *d, *handle, exec)?,
+        Kind::Suld { geom, ty, ds, handle, coords, clamp } => {
+            texture::suld(ctx, w, cta, *geom, *ty, ds, *handle, coords, *clamp, exec)?
+        }
+        Kind::Sust { geom, ty, vals, handle, coords, clamp } => {
+            texture::sust(ctx, w, cta, *geom, *ty, vals, *handle, coords, *clamp, exec)?
+        }
         Kind::Membar => return Ok(control::membar(w, cta)),
         Kind::Nop => {}
         Kind::Trap => return Err(fault(FaultKind::Trap, lane_of_mask(exec))),
-        Kind::Bra { .. } | Kind::Exit | Kind::Ret | Kind::Call { .. } => {
+        Kind::Bra { .. } | Kind::Exit | Kind::Ret | Kind::Call { .. } | Kind::CallIndirect { .. } => {
             unreachable!("handled above")
         }
     }

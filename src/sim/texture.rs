@@ -1,0 +1,318 @@
+//! Texture and surface objects: what `cudaCreateTextureObject` /
+//! `cudaCreateSurfaceObject` describe, held by the [`Device`](super::Device)
+//! and named in kernels by a 64-bit handle, and the sampling the texture unit
+//! does (addressing, point and linear filtering, read modes), as the CUDA
+//! Programming Guide's "Texture Fetching" appendix defines it and an H200
+//! measured it (`tests/textures.rs`, `docs/semantics.md`).
+//!
+//! Texels live in device memory, row-major (x fastest, channels innermost),
+//! rows `row_pitch` bytes apart and slices `row_pitch × height` apart: the
+//! emulator's layout of a CUDA array (the GPU's is opaque).
+
+use super::device::DevicePtr;
+
+/// The type of one channel of a texel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum TexelFormat {
+    U8,
+    S8,
+    U16,
+    S16,
+    U32,
+    S32,
+    F16,
+    F32,
+}
+
+impl TexelFormat {
+    /// Bytes of one channel.
+    pub fn bytes(self) -> u32 {
+        match self {
+            TexelFormat::U8 | TexelFormat::S8 => 1,
+            TexelFormat::U16 | TexelFormat::S16 | TexelFormat::F16 => 2,
+            TexelFormat::U32 | TexelFormat::S32 | TexelFormat::F32 => 4,
+        }
+    }
+
+    /// The `txq.channel_data_type` value (CUDA's `cudaChannelFormatKind`-like
+    /// code the PTX ISA leaves to the driver; warplight's numbering).
+    pub fn code(self) -> u32 {
+        self as u32
+    }
+}
+
+/// What a coordinate outside the texture reads (`cudaTextureAddressMode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum AddressMode {
+    Wrap,
+    Clamp,
+    Mirror,
+    Border,
+}
+
+/// Point or linear filtering (`cudaTextureFilterMode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum FilterMode {
+    Point,
+    Linear,
+}
+
+/// Whether 8- and 16-bit integer texels are returned as integers or scaled
+/// to [0, 1] ([-1, 1] signed) floats (`cudaTextureReadMode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum ReadMode {
+    ElementType,
+    NormalizedFloat,
+}
+
+/// A texture object's resource and sampler.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextureDesc {
+    /// The first texel.
+    pub data: DevicePtr,
+    /// Channel type.
+    pub format: TexelFormat,
+    /// Channels per texel (1, 2 or 4).
+    pub channels: u32,
+    /// Width, height, depth in texels (0 for absent dimensions).
+    pub dims: [u32; 3],
+    /// Bytes between rows (0: packed, width × texel bytes).
+    pub row_pitch: u64,
+    /// A linear-memory resource (`cudaResourceTypeLinear`, `tex1Dfetch`):
+    /// integer coordinates out of range read zeros.
+    pub linear: bool,
+    /// Address mode per dimension.
+    pub addr: [AddressMode; 3],
+    /// Filtering.
+    pub filter: FilterMode,
+    /// Read mode.
+    pub read: ReadMode,
+    /// Coordinates in [0, 1) instead of texels.
+    pub normalized: bool,
+}
+
+/// A surface object: texels read and written by byte coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceDesc {
+    /// The first element.
+    pub data: DevicePtr,
+    /// Bytes of one element.
+    pub elem_bytes: u32,
+    /// Width, height, depth in elements (0 for absent dimensions).
+    pub dims: [u32; 3],
+    /// Bytes between rows (0: packed).
+    pub row_pitch: u64,
+}
+
+/// A texture or surface object.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Object {
+    /// `cudaTextureObject_t`.
+    Texture(TextureDesc),
+    /// `cudaSurfaceObject_t`.
+    Surface(SurfaceDesc),
+}
+
+/// The handle of the `i`-th object (0 is never a handle, as in CUDA).
+pub fn handle_of(i: usize) -> u64 {
+    i as u64 + 1
+}
+
+/// The object of `handle`.
+pub fn object(objects: &[Object], handle: u64) -> Option<&Object> {
+    objects.get((handle as usize).wrapping_sub(1))
+}
+
+/// The size of dimension `d` (1 for absent ones).
+fn size(dims: [u32; 3], d: usize) -> i64 {
+    dims[d].max(1) as i64
+}
+
+/// Texel index `i` of a dimension of `n` texels under `mode`; `None` for a
+/// border texel (reads zeros).
+pub fn address(i: i64, n: i64, mode: AddressMode) -> Option<i64> {
+    match mode {
+        AddressMode::Clamp => Some(i.clamp(0, n - 1)),
+        AddressMode::Border => (0..n).contains(&i).then_some(i),
+        AddressMode::Wrap => Some(i.rem_euclid(n)),
+        AddressMode::Mirror => {
+            let m = i.rem_euclid(2 * n);
+            Some(if m >= n { 2 * n - 1 - m } else { m })
+        }
+    }
+}
+
+/// A coordinate in texels: normalized ones scaled by the size; NaN reads as 0
+/// and infinities as the largest finite values.
+fn texel_coord(x: f32, n: i64, normalized: bool) -> f64 {
+    let x = if x.is_nan() { 0.0 } else { x.clamp(f32::MIN, f32::MAX) } as f64;
+    let x = if normalized { x * n as f64 } else { x };
+    x.clamp(-(2f64.powi(40)), 2f64.powi(40))
+}
+
+/// One texel of a texture as four channels of f32 bits (integer formats under
+/// the element read mode: the integer, sign-extended), missing channels 0 and
+/// the fourth 1.0 (as the hardware fills them).
+pub fn texel(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, idx: [i64; 3]) -> [u32; 4] {
+    let eb = t.format.bytes();
+    let tb = eb as u64 * t.channels as u64;
+    let pitch = if t.row_pitch == 0 { tb * t.dims[0].max(1) as u64 } else { t.row_pitch };
+    let base = t.data.0 + idx[0] as u64 * tb + idx[1] as u64 * pitch + idx[2] as u64 * pitch * t.dims[1].max(1) as u64;
+    let int = t.read == ReadMode::ElementType;
+    let mut out = [0, 0, 0, 1f32.to_bits()];
+    if int && !matches!(t.format, TexelFormat::F16 | TexelFormat::F32) {
+        out[3] = 1;
+    }
+    for (c, o) in out.iter_mut().enumerate().take(t.channels as usize) {
+        let v = read(base + c as u64 * eb as u64, eb);
+        *o = match t.format {
+            TexelFormat::F32 => v as u32,
+            TexelFormat::F16 => (super::half::to_f64(v as u16, false) as f32).to_bits(),
+            TexelFormat::U8 if !int => (v as f32 / 255.0).to_bits(),
+            TexelFormat::U16 if !int => (v as f32 / 65535.0).to_bits(),
+            TexelFormat::S8 if !int => ((v as u8 as i8) as f32 / 127.0).max(-1.0).to_bits(),
+            TexelFormat::S16 if !int => ((v as u16 as i16) as f32 / 32767.0).max(-1.0).to_bits(),
+            TexelFormat::S8 => v as u8 as i8 as i32 as u32,
+            TexelFormat::S16 => v as u16 as i16 as i32 as u32,
+            _ => v as u32,
+        };
+    }
+    out
+}
+
+/// One texel through the address modes (zeros for border texels).
+fn fetch(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, idx: [i64; 3]) -> [u32; 4] {
+    let mut a = [0i64; 3];
+    for d in 0..3 {
+        match address(idx[d], size(t.dims, d), t.addr[d]) {
+            Some(i) => a[d] = i,
+            None => return [0; 4],
+        }
+    }
+    texel(t, read, a)
+}
+
+/// The linear-filtering footprint along one dimension: the first texel and
+/// the weight of the second, 8 fractional bits (1.8 fixed point, rounded
+/// half up, as the H200 does).
+fn footprint(x: f64) -> (i64, f64) {
+    let q = ((x - 0.5) * 256.0 + 0.5).floor() / 256.0;
+    let i = q.floor();
+    (i as i64, q - i)
+}
+
+/// `tex` with float coordinates (`dims` of them used).
+pub fn sample(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [f32; 3], dims: usize) -> [u32; 4] {
+    let x: Vec<f64> = (0..dims).map(|d| texel_coord(coords[d], size(t.dims, d), t.normalized)).collect();
+    if t.filter == FilterMode::Point {
+        let mut idx = [0i64; 3];
+        for d in 0..dims {
+            idx[d] = x[d].floor() as i64;
+        }
+        return fetch(t, read, idx);
+    }
+    // A 1-D texture filters as a 2-D one of height 1 sampled at y = 0: the
+    // footprint's other row is row -1, which the border mode reads as zeros
+    // (the H200 returns half the value there).
+    let mut x = x;
+    let dims = if dims == 1 {
+        x.push(0.0);
+        2
+    } else {
+        dims
+    };
+    let fp: Vec<(i64, f64)> = x.iter().map(|&v| footprint(v)).collect();
+    let mut acc = [0f64; 4];
+    for corner in 0..(1usize << dims) {
+        let mut idx = [0i64; 3];
+        let mut w = 1.0;
+        for d in 0..dims {
+            let hi = corner >> d & 1 == 1;
+            idx[d] = fp[d].0 + hi as i64;
+            w *= if hi { fp[d].1 } else { 1.0 - fp[d].1 };
+        }
+        if w == 0.0 {
+            continue;
+        }
+        let v = fetch(t, read, idx);
+        for c in 0..4 {
+            acc[c] += w * f32::from_bits(v[c]) as f64;
+        }
+    }
+    acc.map(|v| (v as f32).to_bits())
+}
+
+/// `tex` with integer coordinates: the texel, no filtering; out of range a
+/// linear resource reads zeros, an array its address mode.
+pub fn fetch_int(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [i32; 3], dims: usize) -> [u32; 4] {
+    let mut idx = [0i64; 3];
+    for d in 0..dims {
+        idx[d] = coords[d] as i64;
+        if t.linear && !(0..size(t.dims, d)).contains(&idx[d]) {
+            return [0; 4];
+        }
+    }
+    fetch(t, read, idx)
+}
+
+/// `tld4.comp.2d`: component `comp` of the four texels bilinear filtering at
+/// (x, y) would use, in the order (i, j+1), (i+1, j+1), (i+1, j), (i, j).
+pub fn gather(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, x: f32, y: f32, comp: u8) -> [u32; 4] {
+    let (i, _) = footprint(texel_coord(x, size(t.dims, 0), t.normalized));
+    let (j, _) = footprint(texel_coord(y, size(t.dims, 1), t.normalized));
+    [(i, j + 1), (i + 1, j + 1), (i + 1, j), (i, j)].map(|(a, b)| fetch(t, read, [a, b, 0])[comp as usize])
+}
+
+/// The byte address of a surface access of `size` bytes at byte x and rows
+/// y, z; `None` when out of range (after `.clamp` clamps it).
+pub fn surface_addr(s: &SurfaceDesc, coords: [i32; 3], dims: usize, size: u32, clamp: bool) -> Option<u64> {
+    let row = s.elem_bytes as i64 * s.dims[0].max(1) as i64;
+    let pitch = if s.row_pitch == 0 { row as u64 } else { s.row_pitch };
+    let mut x = coords[0] as i64;
+    let mut yz = [0i64; 2];
+    for d in 1..dims {
+        yz[d - 1] = coords[d] as i64;
+    }
+    if clamp {
+        x = x.clamp(0, row - size as i64);
+        for d in 1..dims {
+            yz[d - 1] = yz[d - 1].clamp(0, size_dim(s.dims, d) - 1);
+        }
+    }
+    if !(0..=row - size as i64).contains(&x) || (1..dims).any(|d| !(0..size_dim(s.dims, d)).contains(&yz[d - 1])) {
+        return None;
+    }
+    Some(s.data.0 + x as u64 + yz[0] as u64 * pitch + yz[1] as u64 * pitch * s.dims[1].max(1) as u64)
+}
+
+fn size_dim(dims: [u32; 3], d: usize) -> i64 {
+    size(dims, d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn address_modes_fold_indices() {
+        assert_eq!(address(-1, 4, AddressMode::Clamp), Some(0));
+        assert_eq!(address(5, 4, AddressMode::Clamp), Some(3));
+        assert_eq!(address(-1, 4, AddressMode::Border), None);
+        assert_eq!(address(-1, 4, AddressMode::Wrap), Some(3));
+        assert_eq!(address(4, 4, AddressMode::Mirror), Some(3));
+        assert_eq!(address(-1, 4, AddressMode::Mirror), Some(0));
+        assert_eq!(address(8, 4, AddressMode::Mirror), Some(0));
+    }
+
+    #[test]
+    fn footprint_weights_have_eight_fractional_bits() {
+        assert_eq!(footprint(1.0), (0, 0.5));
+        assert_eq!(footprint(0.5 + 1.0 / 1024.0), (0, 0.0));
+        assert_eq!(footprint(0.5 + 2.0 / 1024.0), (0, 1.0 / 256.0));
+        assert_eq!(footprint(0.5 + 3.0 / 1024.0), (0, 1.0 / 256.0));
+    }
+}
