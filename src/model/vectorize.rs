@@ -128,9 +128,13 @@ fn effect(k: &Kind) -> Effect {
         Kind::Shfl { d, .. } => Effect::WritesPred(dst_regs([d.reg])),
         Kind::Ld { .. } | Kind::St { .. } | Kind::Atom { .. } => Effect::Access,
         Kind::Nop => Effect::Writes(Vec::new()),
-        Kind::Bra { .. } | Kind::Call { .. } | Kind::Ret | Kind::Exit | Kind::Bar { .. } | Kind::Membar => {
-            Effect::Boundary
-        }
+        Kind::Bra { .. }
+        | Kind::Call { .. }
+        | Kind::CallIndirect { .. }
+        | Kind::Ret
+        | Kind::Exit
+        | Kind::Bar { .. }
+        | Kind::Membar => Effect::Boundary,
         _ => Effect::Unknown,
     }
 }

@@ -620,6 +620,21 @@ impl Kind {
                 d(x, f);
                 f(cc, true, *cout)
             }
+            Kind::CallIndirect { target, .. } => s(target, f),
+            Kind::Tex { ds, handle, coords, .. } | Kind::Suld { ds, handle, coords, .. } => {
+                s(handle, f);
+                coords.iter_mut().for_each(|c| s(c, f));
+                ds.iter_mut().for_each(|x| d(x, f))
+            }
+            Kind::Txq { d: x, handle, .. } => {
+                s(handle, f);
+                d(x, f)
+            }
+            Kind::Sust { vals, handle, coords, .. } => {
+                s(handle, f);
+                coords.iter_mut().for_each(|c| s(c, f));
+                vals.iter_mut().for_each(|v| s(v, f))
+            }
             Kind::PredLogic { .. }
             | Kind::Bra { .. }
             | Kind::Call { .. }

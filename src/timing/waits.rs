@@ -61,7 +61,15 @@ fn wait_points(f: &Function) -> Vec<Option<Space>> {
     let mut pending: Vec<(RegId, Space)> = Vec::new();
     for (pc, inst) in f.insts.iter().enumerate() {
         let barrier = targets[pc]
-            || matches!(inst.kind, Kind::Bra { .. } | Kind::Call { .. } | Kind::Ret | Kind::Exit | Kind::Bar { .. });
+            || matches!(
+                inst.kind,
+                Kind::Bra { .. }
+                    | Kind::Call { .. }
+                    | Kind::CallIndirect { .. }
+                    | Kind::Ret
+                    | Kind::Exit
+                    | Kind::Bar { .. }
+            );
         let r = inst.kind.reads();
         let hit = pending.iter().any(|(p, _)| r.contains(p));
         if (hit || barrier) && !pending.is_empty() {
