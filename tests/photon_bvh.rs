@@ -255,3 +255,38 @@ fn the_emulated_gathers_equal_the_native_ones_and_the_byte_model_holds_on_the_em
     assert_eq!((b.nodes, b.retrieved), (cw.nodes, cw.retrieved));
     assert!(16 * cw.nodes + 4 * cw.stack() < 36 * b.nodes / 2 + 4 * b.stack());
 }
+
+/// Stability (extract §3.15 items 1 and 4): leaf-size thresholds 1 and 128
+/// against n_auto move n_T and n_I in opposite directions (small leaves: many
+/// nodes, few extraneous kernels; large leaves: the reverse) and never change
+/// what is gathered; identical Morton codes force a leaf larger than n_auto.
+#[test]
+fn leaf_size_extremes_trade_nodes_for_retrievals_and_equal_codes_make_one_leaf() {
+    let c = cornell();
+    let q = queries(&c, 12);
+    let walk = |n_auto: u32| {
+        let l = Layouts::new(&lbvh::build(&c.kernels, n_auto).tree(), &c.kernels);
+        pm_layout::gather_all(&l, Layout::Compact, &q, Shape::Uniform)
+    };
+    let (r1, w1) = walk(1);
+    let (ra, wa) = walk(lbvh::n_auto(&c.kernels, &c.scene));
+    let (r128, w128) = walk(128);
+    assert!(w1.nodes > wa.nodes && wa.nodes > w128.nodes, "{w1:?} {wa:?} {w128:?}");
+    assert!(w1.retrieved < wa.retrieved && wa.retrieved < w128.retrieved, "{w1:?} {wa:?} {w128:?}");
+    for (a, b) in r1.iter().zip(&r128).chain(ra.iter().zip(&r128)) {
+        for ch in 0..3 {
+            assert!((a[ch] - b[ch]).abs() <= 1e-4 * b[ch].abs() + 1e-12, "{a:?} {b:?}");
+        }
+    }
+    // 40 kernels at one point and 10 spread out: the 40 share a code and stay one leaf at n_auto = 5
+    let mut ks: Vec<Kernel> = c.kernels[..50].to_vec();
+    for k in &mut ks[..40] {
+        k.z = [0.25, 0.25, 0.25];
+    }
+    let t = lbvh::build(&ks, 5).tree();
+    let big = t.nodes.iter().filter_map(|n| match n.kind {
+        PmKind::Leaf { count, .. } => Some(count),
+        _ => None,
+    });
+    assert_eq!(big.max(), Some(40));
+}

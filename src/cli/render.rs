@@ -57,8 +57,9 @@ pub struct RenderArgs {
     /// Also write the counters as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Method: `raycast` (thesis 000's Whitted ray caster) or `path` (thesis 003's
-    /// path tracer; `--variant native` or `emulated`).
+    /// Method: `raycast` (thesis 000's Whitted ray caster), `path` (thesis 003's
+    /// path tracer) or `photon-map` (thesis 000 ch. 5; `--estimator`); the last two
+    /// take `--variant native` or `emulated`.
     #[arg(long, default_value = "raycast")]
     pub method: String,
     /// Path tracer: pt, nee, mis (balance heuristic) or mis-power.
@@ -73,6 +74,9 @@ pub struct RenderArgs {
     /// Path tracer: seed of the random numbers.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// Photon map (thesis 000 ch. 5): vkde, vkde-epanechnikov, knn (Table 5.1's k) or knn:K.
+    #[arg(long, default_value = "vkde")]
+    pub estimator: String,
 }
 
 /// The trace counters as JSON; an emulated run's kernels do not count ray kinds
@@ -155,11 +159,11 @@ fn pixel_progress(dev: &mut Device, kernel: &str, pixels: u64) -> Option<indicat
 
 /// Renders one frame.
 fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if !matches!(a.method.as_str(), "raycast" | "path") {
-        return Err(format!("unknown method `{}`; expected raycast or path", a.method).into());
+    if !matches!(a.method.as_str(), "raycast" | "path" | "photon-map") {
+        return Err(format!("unknown method `{}`; expected raycast, path or photon-map", a.method).into());
     }
     let kernel_variant = match a.variant.as_str() {
-        _ if a.method == "path" => None,
+        _ if a.method == "path" || a.method == "photon-map" => None,
         "native" => None,
         v => Some(Variant::parse(v).ok_or_else(|| {
             let names: Vec<&str> = Variant::EVERY.iter().map(|v| v.name()).collect();
@@ -204,6 +208,9 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let [width, height] = cam.resolution;
     if a.method == "path" {
         return crate::repro::lin2017::render::run(&a, &scene, &cam);
+    }
+    if a.method == "photon-map" {
+        return crate::repro::fabianowski2011::photon_image::run_cli(&a, &scene, &cam);
     }
     crate::limits::check_memory(
         || format!("a render of {width} x {height} pixels"),
