@@ -157,6 +157,27 @@ fn pixel_progress(dev: &mut Device, kernel: &str, pixels: u64) -> Option<indicat
     Some(pb)
 }
 
+/// The image as the bytes of a PNG (sRGB, `exposure` stops) or an OpenEXR
+/// file (linear 32-bit float RGB).
+fn encode(fb: &crate::host::image::FrameBuffer, exr: bool, exposure: f32) -> Result<Vec<u8>, String> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    if exr {
+        use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+        let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+            let p = fb.get(x as u32, y as u32);
+            (p[0], p[1], p[2])
+        });
+        let image = Image::from_channels((fb.width as usize, fb.height as usize), channels);
+        image.write().to_buffered(&mut bytes).map_err(|e| format!("encoding the EXR image: {e}"))?;
+    } else {
+        use image::ImageEncoder;
+        image::codecs::png::PngEncoder::new(&mut bytes)
+            .write_image(&fb.to_srgb8(exposure), fb.width, fb.height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| format!("encoding the PNG image: {e}"))?;
+    }
+    Ok(bytes.into_inner())
+}
+
 /// Renders one frame.
 fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if !matches!(a.method.as_str(), "raycast" | "path" | "photon-map") {
@@ -253,21 +274,10 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let render_s = t1.elapsed().as_secs_f64();
-    // written beside the output under a temporary name, then renamed: never a partial image
-    let tmp = parent.join(format!(
-        ".{}.warplight-tmp.{}",
-        a.output.file_stem().and_then(|s| s.to_str()).unwrap_or("render"),
-        ext.as_deref().unwrap_or("png")
-    ));
-    let written = if ext.as_deref() == Some("exr") { fb.write_exr(&tmp) } else { fb.write_png(&tmp, a.exposure) };
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e.into());
-    }
-    std::fs::rename(&tmp, &a.output).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", a.output.display())
-    })?;
+    // encoded in memory, then written beside the output under a temporary name and renamed:
+    // never a partial image, also on a signal
+    let bytes = encode(&fb, ext.as_deref() == Some("exr"), a.exposure)?;
+    super::write_atomically(&a.output, &bytes)?;
     let ts = tree.stats();
     println!(
         "{} frame {} ({}x{}), {} triangles, {} tree: {} inner nodes, {} references, depth {} (built in {:.3} s)",
