@@ -37,7 +37,8 @@ pub fn install() {
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
         return;
     };
-    let spawned = std::thread::Builder::new().name("signals".into()).spawn(move || {
+    // a thread that cannot start (the host is out of threads) is not worth failing the command for
+    let _ = std::thread::Builder::new().name("signals".into()).spawn(move || {
         if let Some(sig) = signals.forever().next() {
             let held = pending();
             remove_all(&held);
@@ -45,7 +46,6 @@ pub fn install() {
             std::process::exit(exit_status(sig));
         }
     });
-    drop(spawned);
 }
 
 /// Removes `files` (those that still exist).
@@ -79,9 +79,10 @@ impl Temporary {
     pub fn create(output: &Path) -> std::io::Result<Temporary> {
         let path = temporary_name(output);
         let mut held = pending();
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(e),
-            _ => {}
+        if let Err(e) = std::fs::remove_file(&path)
+            && e.kind() != std::io::ErrorKind::NotFound
+        {
+            return Err(e);
         }
         let file = std::fs::OpenOptions::new().write(true).create_new(true).open(&path)?;
         held.push(path.clone());
