@@ -79,16 +79,11 @@ pub struct RenderArgs {
     pub estimator: String,
 }
 
-/// The trace counters as JSON; an emulated run's kernels do not count ray kinds
-/// and stack pushes, so those are null rather than a false 0.
-fn counters_json(st: &crate::host::raycast::TraceStats, emulated: bool) -> serde_json::Value {
-    let mut v = serde_json::to_value(st).unwrap_or_default();
-    if emulated && let Some(m) = v.as_object_mut() {
-        for k in ["primary", "reflection", "shadow", "pushes"] {
-            m.insert(k.into(), serde_json::Value::Null);
-        }
-    }
-    v
+/// The trace counters as JSON. An emulated run's ray kinds, stack pushes
+/// (local memory) and texel fetches are the emulator's per-line counts of the
+/// kernel's `@count` lines, like its other counters.
+fn counters_json(st: &crate::host::raycast::TraceStats) -> serde_json::Value {
+    serde_json::to_value(st).unwrap_or_default()
 }
 
 /// The largest image `render` makes (its frame buffer holds 12 bytes a pixel).
@@ -292,12 +287,8 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         ts.depth,
         build_s
     );
-    // the kernels count rays, not their kinds: an emulated run prints no breakdown rather than zeros
-    let kinds = if emulated.is_some() {
-        "kinds counted by the native caster only".to_string()
-    } else {
-        format!("primary {}, reflection {}, shadow {}", st.primary, st.reflection, st.shadow)
-    };
+    // an emulated run's ray kinds come from the emulator's counts of the kernel's `@count` lines
+    let kinds = format!("primary {}, reflection {}, shadow {}", st.primary, st.reflection, st.shadow);
     // the functional level keeps no per-line counters: the kernels' work is then unknown, not zero
     let counted = emulated.as_ref().is_none_or(|k| k.counted);
     if !counted {
@@ -307,12 +298,17 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         println!("  rays {} ({kinds})  in {:.3} s: {:.2} M rays/s", st.rays, render_s, st.rays as f64 / render_s / 1e6);
         println!(
-            "  per ray: {:.2} inner nodes, {:.2} leaves, {:.2} plane tests, {:.2} barycentric tests",
+            "  per ray: {:.2} inner nodes, {:.2} leaves, {:.2} plane tests, {:.2} barycentric tests, {:.2} stack pushes{}",
             st.inner_nodes as f64 / st.rays.max(1) as f64,
             st.leaves as f64 / st.rays.max(1) as f64,
             st.plane_tests as f64 / st.rays.max(1) as f64,
-            st.barycentric_tests as f64 / st.rays.max(1) as f64
+            st.barycentric_tests as f64 / st.rays.max(1) as f64,
+            st.pushes as f64 / st.rays.max(1) as f64,
+            if emulated.is_some() { " (local memory)" } else { "" }
         );
+        if st.texel_fetches > 0 {
+            println!("  texture maps: {} texel fetches", st.texel_fetches);
+        }
     }
     if let Some(k) = &emulated {
         let c = &k.launch.totals;
@@ -345,7 +341,7 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(j) = &a.json {
         let v = serde_json::json!({
             "scene": scene.name, "frame": a.frame, "variant": a.variant, "heuristic": h,
-            "resolution": cam.resolution, "tree": ts, "counters": if counted { counters_json(&st, emulated.is_some()) } else { serde_json::Value::Null }, "render_seconds": render_s,
+            "resolution": cam.resolution, "tree": ts, "counters": if counted { counters_json(&st) } else { serde_json::Value::Null }, "render_seconds": render_s,
             "emulator": emulated.as_ref().map(|k| serde_json::json!({
                 "totals": k.launch.totals, "memory": k.memory.metrics(&k.launch.totals).into_iter().collect::<std::collections::BTreeMap<_, _>>(),
             })),

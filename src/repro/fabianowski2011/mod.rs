@@ -491,7 +491,7 @@ pub fn flight_table(
         "SIROH trees, 30 persistent CTAs x 256 threads, 32-pixel job blocks, clang-16 PTX, gt200 profile",
     ));
     t.notes.push(COUNTING.into());
-    t.notes.push(MATERIALS.into());
+    t.notes.push(flight::materials_note(r, group, &scenes, variants[0].name()));
     t
 }
 
@@ -502,11 +502,6 @@ pub const COUNTING: &str = "Counts by the emulator: the kernels run without in-k
      the inner nodes the shared-memory node cache served (an observer of the emulator's memory events). An instrumented \
      build agrees exactly (tests/raytrace.rs). Shadow rays go from the point light toward the hit (seed 000 L3411, L1561).";
 
-/// What the scenes lack that the thesis' had.
-pub const MATERIALS: &str = "Materials: none of Sponza, Sibenik and Conference has mirrors or texture maps attached \
-     (scene files as loaded; the MTL files and textures of Sponza and Sibenik in the shared scenes are not used yet), \
-     so these scenes trace no reflection rays and the texture cache sees kd-tree, reference and triangle fetches only, \
-     none of the thesis' texture-map traffic (Table A.1: 64 MB Sponza, 16 MB Sibenik).";
 
 /// A frame-rate table through the GTX 280 timing model ([`timing`]; no
 /// parameter from the thesis): every column predicted, the absolute one
