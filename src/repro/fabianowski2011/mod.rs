@@ -502,7 +502,6 @@ pub const COUNTING: &str = "Counts by the emulator: the kernels run without in-k
      the inner nodes the shared-memory node cache served (an observer of the emulator's memory events). An instrumented \
      build agrees exactly (tests/raytrace.rs). Shadow rays go from the point light toward the hit (seed 000 L3411, L1561).";
 
-
 /// A frame-rate table through the GTX 280 timing model ([`timing`]; no
 /// parameter from the thesis): every column predicted, the absolute one
 /// compared within ±15 %, the relative ones within the ratio tolerance.
