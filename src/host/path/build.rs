@@ -270,15 +270,15 @@ pub fn build(tris: &[[Vec3; 3]], p: &Params) -> KdTree {
             let (a, c) = (it.lo[s.axis], it.hi[s.axis]);
             let flat_here = a == s.pos && c == s.pos;
             let t = &tris[it.tri as usize];
-            if a < s.pos || flat_here {
-                if let Some(e) = extent(t, &bl, p.clip) {
-                    left.push(Item { tri: it.tri, lo: e.lo, hi: e.hi });
-                }
+            if (a < s.pos || flat_here)
+                && let Some(e) = extent(t, &bl, p.clip)
+            {
+                left.push(Item { tri: it.tri, lo: e.lo, hi: e.hi });
             }
-            if c > s.pos || flat_here {
-                if let Some(e) = extent(t, &br, p.clip) {
-                    right.push(Item { tri: it.tri, lo: e.lo, hi: e.hi });
-                }
+            if (c > s.pos || flat_here)
+                && let Some(e) = extent(t, &br, p.clip)
+            {
+                right.push(Item { tri: it.tri, lo: e.lo, hi: e.hi });
             }
         }
         let l = tree.nodes.len();

@@ -186,7 +186,10 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
                 ours,
                 thesis: Some(format!("{} (derived)", Unit::Change.format(thesis))),
                 thesis_value: Some(thesis),
-                verdict: ours.map(|o| Tolerance::RATIO.verdict(o, thesis)),
+                // the reference cell is 0 by definition: shown, not compared
+                verdict: ours
+                    .filter(|_| (t, c) != (Traversal::ShortStack, Construction::Sah))
+                    .map(|o| Tolerance::RATIO.verdict(o, thesis)),
             });
         }
         for c in Construction::ALL {
