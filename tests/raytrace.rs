@@ -323,8 +323,8 @@ fn textured_scenes_match_the_native_caster() {
     let mut dev = Device::new();
     let module = rt_kernels::load(&mut dev).unwrap();
     for (name, frame) in [("sponza", 0), ("sibenik", 0)] {
-        let (scene, tree, mut cam) = setup(name, 20);
-        cam = scene.flight.camera(&scene.camera, frame);
+        let (scene, tree, _) = setup(name, 20);
+        let mut cam = scene.flight.camera(&scene.camera, frame);
         cam.resolution = [20, 20];
         assert!(!scene.textures.is_empty() && scene.uvs.len() == scene.triangles.len(), "{name}: textures loaded");
         let caster = Caster::new(&scene, &tree);

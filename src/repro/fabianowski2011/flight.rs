@@ -350,7 +350,7 @@ pub fn materials_note(r: &Results, group: &str, scenes: &[String], variant: &str
         note.push_str(&format!(
             "No specular materials and no texture maps in {} (no reflection rays, no texture-map traffic{})",
             without.join(", "),
-            if without.iter().any(|s| *s == "conference") {
+            if without.contains(&"conference") {
                 "; Conference has neither in the thesis either (Table A.1: no textures)"
             } else {
                 ""
