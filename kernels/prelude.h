@@ -138,6 +138,7 @@ WL_DEV unsigned __match_all_sync(unsigned m, unsigned v, int *pred) { return __n
 WL_DEV int __syncthreads_count(int p) { return __nvvm_bar0_popc(p); }
 WL_DEV int __syncthreads_and(int p) { return __nvvm_bar0_and(p); }
 WL_DEV int __syncthreads_or(int p) { return __nvvm_bar0_or(p); }
+WL_DEV void __syncwarp(unsigned mask = 0xffffffffu) { __nvvm_bar_warp_sync(mask); }
 WL_DEV int __popcll(unsigned long long x) { return __builtin_popcountll(x); }
 WL_DEV int __clzll(long long x) { return x == 0 ? 64 : __builtin_clzll((unsigned long long)x); }
 WL_DEV unsigned long long __brevll(unsigned long long x) { return __builtin_bitreverse64(x); }

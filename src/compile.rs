@@ -19,6 +19,12 @@ pub const PRELUDE: &str = include_str!("../kernels/prelude.h");
 /// `WL_CUDA_MATH` is defined, which [`compile`] does when libdevice is found).
 pub const CUDA_MATH: &str = include_str!("../kernels/cuda_math.h");
 
+/// The folder the PTX's line table names for the prelude and
+/// `cuda_math.h` (`.file 3 "kernels/prelude.h"`): the project's copies, which
+/// are compiled into the binary, so that PTX does not depend on where it was
+/// compiled.
+pub const PRELUDE_DIR: &str = "kernels";
+
 /// The environment variable naming libdevice (`libdevice.10.bc`).
 pub const LIBDEVICE_ENV: &str = "WARPLIGHT_LIBDEVICE";
 
@@ -270,47 +276,17 @@ pub fn find_libdevice(explicit: Option<&Path>) -> Result<Option<PathBuf>, Compil
 }
 
 /// Rewrites what libdevice brings that warplight does not execute into
-/// equivalent PTX, each on the line of the original so that line numbers
-/// stay: `min/max.NaN.f32` ([`nan_min_max`]), register lists
-/// ([`split_reg_list`]) and this carry chain.
-///
-/// libdevice implements 64-bit products with inline assembly, a carry chain
-/// `mad.lo.cc.u32 lo, a, b, c; madc.hi.u32 hi, a, b, 0;` (that is,
-/// `{hi, lo} = a * b + c` in 64 bits), which warplight does not execute.
-/// Rewrites each such pair into the same computation without the carry flag,
-/// `mad.wide.u32` of `c` widened, on the first line (the second becomes a
-/// comment), so line numbers stay. Other carry chains are left alone.
+/// equivalent PTX on the same line, so that line numbers stay:
+/// `min/max.NaN.f32` ([`nan_min_max`], `sinhf`). Everything else of
+/// libdevice's, the inline-assembly carry chains (`mad.lo.cc.u32`,
+/// `madc.hi.cc.u32`, `addc`, `subc`: the trigonometric functions' argument
+/// reduction) and register lists (`.reg .u32 r0, r1;`) included, runs as clang
+/// wrote it.
 pub fn rewrite_for_warplight(ptx: &str) -> String {
-    let lines: Vec<&str> = ptx.lines().collect();
-    let operands = |l: &str, op: &str| -> Option<Vec<String>> {
-        let rest = l.trim().strip_prefix(op)?.trim().strip_suffix(';')?;
-        Some(rest.split(',').map(|o| o.trim().to_string()).collect())
-    };
     let mut out = String::with_capacity(ptx.len() + 256);
-    let mut i = 0;
-    while i < lines.len() {
-        let pair = operands(lines[i], "mad.lo.cc.u32").zip(lines.get(i + 1).and_then(|l| operands(l, "madc.hi.u32")));
-        if let Some((lo, hi)) = pair
-            && lo.len() == 4
-            && hi.len() == 4
-            && lo[1] == hi[1]
-            && lo[2] == hi[2]
-            && hi[3] == "0"
-        {
-            let (d_lo, a, b, c, d_hi) = (&lo[0], &lo[1], &lo[2], &lo[3], &hi[0]);
-            let widen =
-                if c.starts_with('%') { format!("cvt.u64.u32 %wl_c, {c};") } else { format!("mov.u64 %wl_c, {c};") };
-            out.push_str(&format!(
-                "\t{{ .reg .b64 %wl_c; .reg .b64 %wl_m; {widen} mad.wide.u32 %wl_m, {a}, {b}, %wl_c; \
-                 mov.b64 {{{d_lo}, {d_hi}}}, %wl_m; }} // warplight: mad.lo.cc.u32 + madc.hi.u32 without the carry flag\n"
-            ));
-            out.push_str(&format!("\t// madc.hi.u32 {d_hi}, {a}, {b}, 0 (in the line above)\n"));
-            i += 2;
-            continue;
-        }
-        out.push_str(&nan_min_max(&split_reg_list(lines[i])));
+    for line in ptx.lines() {
+        out.push_str(&nan_min_max(line));
         out.push('\n');
-        i += 1;
     }
     out
 }
@@ -336,27 +312,24 @@ fn nan_min_max(line: &str) -> std::borrow::Cow<'_, str> {
     .into()
 }
 
-/// `.reg .u32 r0, r1;` (libdevice's inline assembly names several registers
-/// without `<N>`) as one declaration each, on the same line.
-fn split_reg_list(line: &str) -> std::borrow::Cow<'_, str> {
-    let t = line.trim();
-    let Some(rest) = t.strip_prefix(".reg ").and_then(|r| r.strip_suffix(';')) else {
-        return line.into();
-    };
-    let Some((ty, names)) = rest.trim().split_once(char::is_whitespace) else {
-        return line.into();
-    };
-    if !names.contains(',') || names.contains('<') {
-        return line.into();
-    }
-    let decls: Vec<String> = names.split(',').map(|n| format!(".reg {ty} {};", n.trim())).collect();
-    format!("\t{}", decls.join(" ")).into()
+static COMMAND_LINE: std::sync::OnceLock<CompileOptions> = std::sync::OnceLock::new();
+
+/// Sets the options of the command line (`warplight run kernel.cu --dialect
+/// nvcc --libdevice FILE`) for every `.cu` this process compiles through
+/// [`compile`] (a launch spec's `ptx = "kernel.cu"` included); once, before
+/// any work.
+pub fn set_command_line_options(o: CompileOptions) {
+    let _ = COMMAND_LINE.set(o);
 }
 
 /// Compiles `src` to PTX with clang-16 or nvcc, libdevice looked for
-/// ([`compile_with`] with default options but the dialect).
+/// ([`compile_with`]): with the command line's options when they were set
+/// ([`set_command_line_options`]), else with dialect `d` and the default options.
 pub fn compile(src: &Path, d: Dialect) -> Result<String, CompileError> {
-    compile_with(src, &CompileOptions { dialect: d, libdevice: None })
+    match COMMAND_LINE.get() {
+        Some(o) => compile_with(src, o),
+        None => compile_with(src, &CompileOptions { dialect: d, libdevice: None }),
+    }
 }
 
 /// Compiles `src` to PTX (sm_90, PTX 7.8 for clang) with the prelude
@@ -374,7 +347,10 @@ pub fn compile_with(src: &Path, opts: &CompileOptions) -> Result<String, Compile
         Dialect::Clang => find_libdevice(opts.libdevice.as_deref())?,
         Dialect::Nvcc => None, // nvcc brings its own math library
     };
-    let dir = std::env::temp_dir().join(format!("warplight-compile-{}", std::process::id()));
+    // one folder per compilation: tests and threads compile at the same time
+    static COMPILATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COMPILATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("warplight-compile-{}-{n}", std::process::id()));
     let io = |f: &Path, e: std::io::Error| CompileError::Io { file: f.display().to_string(), msg: e.to_string() };
     std::fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
     let prelude = dir.join("prelude.h");
@@ -387,7 +363,9 @@ pub fn compile_with(src: &Path, opts: &CompileOptions) -> Result<String, Compile
         Dialect::Clang => {
             cmd.args(["-x", "cuda", "--cuda-device-only", "-nocudainc", "-nocudalib", "--cuda-gpu-arch=sm_90"])
                 .args(["-Xclang", "-target-feature", "-Xclang", "+ptx78", "-O3", "-ffp-contract=on"])
-                .args(["-gline-tables-only", "-fdebug-compilation-dir=.", "-S"]);
+                .args(["-gline-tables-only", "-fdebug-compilation-dir=.", "-S"])
+                // the prelude's lines name the project's copy, not this temporary folder
+                .arg(format!("-fdebug-prefix-map={}={PRELUDE_DIR}", dir.display()));
             if let Some(lib) = &libdevice {
                 // nvcc's defaults: no flush to zero, precise transcendentals
                 cmd.arg("-DWL_CUDA_MATH").args(["-Xclang", "-mlink-builtin-bitcode", "-Xclang"]).arg(lib);
@@ -441,6 +419,18 @@ mod tests {
         assert_eq!(demangle("_Z10reduce_sumPiPKi").as_deref(), Some("reduce_sum"));
         assert_eq!(demangle("reduce_sum"), None);
         assert_eq!(demangle("_Z99x"), None);
+    }
+
+    #[test]
+    fn only_nan_min_max_is_rewritten_and_lines_stay() {
+        let ptx = "\tmad.lo.cc.u32 r0, a, b, c;\n\tmadc.hi.u32 r1, a, b, 0;\n\tmin.NaN.f32 %f2, %f1, 0f42FC0000;\n\t.reg .u32 r0, r1;\n";
+        let out = rewrite_for_warplight(ptx);
+        assert_eq!(out.lines().count(), 4);
+        let lines: Vec<&str> = out.lines().collect();
+        assert_eq!(lines[..2], ["\tmad.lo.cc.u32 r0, a, b, c;", "\tmadc.hi.u32 r1, a, b, 0;"]);
+        assert!(lines[2].contains("setp.nan.f32 %wl_p, %f1, 0f42FC0000; min.f32 %wl_t, %f1, 0f42FC0000;"));
+        assert!(lines[2].contains("selp.f32 %f2, 0f7FFFFFFF, %wl_t, %wl_p;"));
+        assert_eq!(lines[3], "\t.reg .u32 r0, r1;");
     }
 
     #[test]

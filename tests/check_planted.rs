@@ -234,92 +234,30 @@ fn the_command_line_checks_and_names() {
 }
 
 /// The thesis' ray-tracing kernel (every variant) on a 12×12 frame of the
-/// Cornell box, its buffers laid out as `rt_kernels::render` lays them out,
-/// reports nothing.
+/// Cornell box, its buffers laid out by `rt_kernels::upload_scene` as
+/// `rt_kernels::render` lays them out, reports nothing.
 #[test]
 fn the_ray_tracing_kernel_reports_nothing() {
     use glam::Vec3;
     use warplight::check::{CheckOptions, Tools, launch_checked};
     use warplight::host::kdtree::layout::layout;
     use warplight::host::kdtree::{BuildParams, Heuristic, build};
-    use warplight::host::raycast::EPS_REL;
     use warplight::host::rt_kernels::{self, Variant};
-    use warplight::host::scene::Light;
-    use warplight::sim::device::to_bytes;
-    use warplight::sim::{Arg, LaunchConfig};
+    use warplight::sim::LaunchConfig;
 
     let scene = warplight::host::scene_file::load(Path::new("scenes/cornell-box.toml")).unwrap();
     let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
     let mut cam = scene.flight.camera(&scene.camera, 0);
     cam.resolution = [12, 12];
-    let (r, u, f) = cam.frame();
-    let (w, h) = (12u32, 12u32);
-    let npix = (w * h) as usize;
-    let (lp, li) = scene
-        .lights
-        .iter()
-        .find_map(|l| match l {
-            Light::Point { position, intensity } => Some((Vec3::from(*position), *intensity)),
-            _ => None,
-        })
-        .unwrap_or((Vec3::ZERO, [0.0; 3]));
-    let eps = tree.bounds.size().length().max(1e-3) * EPS_REL;
-    let mut params = to_bytes(&[
-        cam.position[0],
-        cam.position[1],
-        cam.position[2],
-        f.x,
-        f.y,
-        f.z,
-        r.x,
-        r.y,
-        r.z,
-        u.x,
-        u.y,
-        u.z,
-        lp.x,
-        lp.y,
-        lp.z,
-        li[0],
-        li[1],
-        li[2],
-        tree.bounds.lo.x,
-        tree.bounds.lo.y,
-        tree.bounds.lo.z,
-        tree.bounds.hi.x,
-        tree.bounds.hi.y,
-        tree.bounds.hi.z,
-        eps,
-        (cam.fov_y.to_radians() * 0.5).tan(),
-        w as f32 / h as f32,
-    ]);
-    for v in [w as i32, h as i32, npix as i32, 1] {
-        params.extend_from_slice(&v.to_le_bytes());
-    }
     let mut dev = Device::new();
     let module = rt_kernels::load(&mut dev).unwrap();
     let opts = CheckOptions { tools: Tools::ALL, ..Default::default() };
     for v in Variant::ALL {
         let lay = layout(&tree, &tris, v.heap_levels());
-        let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
-        let up = |dev: &mut Device, b: &[u8], n: &str| rt_kernels::upload(dev, b, n).unwrap();
-        let bufs = [
-            up(&mut dev, &params, "params"),
-            up(&mut dev, &lay.nodes, "nodes"),
-            up(&mut dev, &lay.tri_refs, "tri_refs"),
-            up(&mut dev, &lay.triangles, "triangles"),
-            up(&mut dev, &to_bytes(&tri_mat), "tri_mat"),
-            up(&mut dev, &to_bytes(&rt_kernels::material_table(&scene)), "materials"),
-            up(&mut dev, &lay.aabbs, "aabbs"),
-            dev.alloc_zeroed::<u32>(1),
-            dev.alloc_zeroed::<f32>(4 * npix),
-            dev.alloc_zeroed::<i32>(npix),
-            dev.alloc_zeroed::<u32>(8 * npix),
-        ];
-        let args: Vec<Arg> = bufs.into_iter().map(Arg::Ptr).collect();
+        let bufs = rt_kernels::upload_scene(&mut dev, &scene, &tree, &lay, &cam, Vec3::ZERO).unwrap();
         let cfg = LaunchConfig::linear(rt_kernels::CTAS, rt_kernels::THREADS);
-        let c = launch_checked(&mut dev, &module, v.kernel(), cfg, &args, &opts, None).unwrap();
+        let c = launch_checked(&mut dev, &module, v.kernel(), cfg, &bufs.launch_args(), &opts, None).unwrap();
         assert!(c.fault.is_none(), "{v:?}: {:?}", c.fault);
         assert!(c.reports.is_empty(), "{v:?}: {:#?}", c.reports);
     }

@@ -269,29 +269,37 @@ fn render_checks_its_output_before_working_and_never_leaves_a_partial_file() {
     assert_eq!(names, ["y.png"], "only the finished image is left");
 }
 
+/// An emulated render prints the ray kinds and stack pushes the emulator
+/// counted on the kernel's `@count` lines: on the stack-based kernel they are
+/// the native caster's, ray for ray.
 #[test]
-fn emulated_renders_report_no_false_zeros() {
+fn emulated_renders_report_ray_kinds_and_pushes() {
     let dir = tempdir();
-    let json = dir.join("s.json").display().to_string();
     let png = dir.join("s.png").display().to_string();
-    let (ok, out, err) = warplight(&[
-        "render",
-        "--scene",
-        "scene6",
-        "--variant",
-        "stack",
-        "--resolution",
-        "16x16",
-        "-o",
-        &png,
-        "--json",
-        &json,
-    ]);
-    assert!(ok && out.contains("(kinds counted by the native caster only)"), "{err}{out}");
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert!(v["counters"]["shadow"].is_null() && v["counters"]["rays"].as_u64().unwrap() > 0, "{v}");
-    let (ok, out, _) = warplight(&["render", "--scene", "scene6", "--resolution", "16x16", "-o", &png]);
-    assert!(ok && out.contains("primary 256,"), "{out}");
+    let counters = |variant: &str| {
+        let json = dir.join(format!("{variant}.json")).display().to_string();
+        let (ok, out, err) = warplight(&[
+            "render",
+            "--scene",
+            "scene6",
+            "--variant",
+            variant,
+            "--resolution",
+            "16x16",
+            "-o",
+            &png,
+            "--json",
+            &json,
+        ]);
+        assert!(ok && out.contains("(primary 256, reflection ") && out.contains("stack pushes"), "{err}{out}");
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        v["counters"].clone()
+    };
+    let (native, emulated) = (counters("native"), counters("stack"));
+    for k in ["rays", "primary", "reflection", "shadow", "pushes"] {
+        assert_eq!(emulated[k], native[k], "{k}: {emulated} vs {native}");
+    }
+    assert!(emulated["shadow"].as_u64().unwrap() > 0 && emulated["pushes"].as_u64().unwrap() > 0, "{emulated}");
 }
 
 #[test]

@@ -5,7 +5,7 @@
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -28,7 +28,8 @@ fn emulated_frames_equal_native_frames_bit_for_bit() {
     let (w, h) = (12, 10);
     let cam = camera(&scene, w, h);
     for integrator in Integrator::ALL {
-        let params = FrameParams { width: w, height: h, integrator, max_bounces: 16, seed: 3 };
+        let params =
+            FrameParams { width: w, height: h, integrator, max_bounces: 16, seed: 3, traversal: Traversal::ShortStack };
         let native = render_native(&ps, &cam, params, 2, true, |_| {});
         let mut cfg = kernel::sim_config(&params);
         cfg.fidelity = Fidelity::Functional;

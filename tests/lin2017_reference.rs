@@ -14,7 +14,7 @@ use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::stats::{Estimate, Outcome, from_frames, from_reference, read_exr, welch_holm};
-use warplight::host::path::{FrameParams, Integrator, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
 use warplight::host::scene::{MaterialKind, Scene};
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -45,7 +45,7 @@ fn cornell(size: u32) -> (Scene, PathScene, Camera) {
 }
 
 fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
-    FrameParams { width: size, height: size, integrator, max_bounces: 16, seed }
+    FrameParams { width: size, height: size, integrator, max_bounces: 16, seed, traversal: Traversal::ShortStack }
 }
 
 fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32, reference: &Estimate) -> Outcome {

@@ -190,3 +190,44 @@ fn the_inputs_cover_special_values_and_every_magnitude() {
         assert!(x.iter().any(|v| (lo..hi).contains(&v.abs())), "no input with |x| in [2^{e}, 2^{})", e + 1);
     }
 }
+
+/// libdevice's double `sin`, `cos` and `tan` (`tools/device/trig64.cu`): no
+/// `.approx` instruction, so bit for bit; arguments past 2^20 or so take the
+/// long (Payne-Hanek) reduction, an inline-assembly carry chain
+/// (`mad.lo.cc`/`madc.hi.cc`/`addc`, `sub.cc`/`subc`) that warplight runs as
+/// clang wrote it. The same PTX ran on an H200 (`tools/device/trig64.sh`).
+#[test]
+fn double_sin_cos_tan_match_the_gpu_through_the_carry_chains() {
+    const N: usize = 2560;
+    let dir = "tests/fixtures/mathlib";
+    let x: Vec<f64> = read_f64(&format!("{dir}/trig64_inputs.bin")).into_iter().map(f64::from_bits).collect();
+    assert_eq!(x.len(), N);
+    assert!(x.iter().filter(|v| v.abs() > 1e300).count() >= 5, "the sample reaches the largest exponents");
+    let ptx = std::fs::read_to_string(format!("{dir}/trig64.ptx")).unwrap();
+    for chain in ["mad.lo.cc.u32", "madc.hi.cc.u32", "addc.u32", "sub.cc.u32", "subc.cc.u32"] {
+        assert!(ptx.contains(chain), "the fixture's PTX runs the carry chain ({chain}) itself");
+    }
+    let mut dev = Device::new();
+    let m = dev.load_ptx(&ptx, "trig64.ptx").unwrap_or_else(|e| panic!("{e}"));
+    let px = dev.alloc_from(&x);
+    let out = dev.alloc_zeroed::<u64>(3 * N);
+    let args = [Arg::Ptr(px), Arg::Ptr(out), Arg::I32(N as i32)];
+    dev.launch(&m, "trig64", LaunchConfig::linear((N / 128) as u32, 128), &args).unwrap_or_else(|e| panic!("{e}"));
+    let emu = dev.read::<u64>(out, 3 * N);
+    let gpu = read_f64(&format!("{dir}/h200_trig64_clang.f64.bin"));
+    assert_eq!(gpu.len(), emu.len());
+    let mut failures = Vec::new();
+    for (k, name) in ["sin", "cos", "tan"].iter().enumerate() {
+        let bad: Vec<usize> = (0..N).filter(|&i| !same64(emu[k * N + i], gpu[k * N + i])).collect();
+        if let Some(&i) = bad.first() {
+            failures.push(format!(
+                "{name}: {} inputs differ, first x = {:e}: emulator {:e}, H200 {:e}",
+                bad.len(),
+                x[i],
+                f64::from_bits(emu[k * N + i]),
+                f64::from_bits(gpu[k * N + i])
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "the emulator differs from the H200:\n{}", failures.join("\n"));
+}

@@ -212,6 +212,7 @@ fn map_a_sorts_photons_by_cell_and_the_binary_search_finds_each_cells_first_phot
 }
 
 use warplight::repro::purcell2003::knn::{self, Map, Params, RADIANCE_ESTIMATE};
+use warplight::repro::purcell2003::knn_2003;
 use warplight::repro::purcell2003::photons::{PhotonArrays, Queries};
 use warplight::repro::purcell2003::stencil;
 
@@ -437,4 +438,41 @@ fn tiles_that_finish_stop_being_drawn_and_the_saving_follows_from_per_pixel_look
     // and the tiled passes ran fewer thread instructions
     let tiled_inst = after.thread_instructions - before.thread_instructions;
     assert!(tiled_inst < before.thread_instructions);
+}
+
+#[test]
+fn the_2003_faithful_estimate_with_float_addressing_and_packed_state_finds_the_same_photons() {
+    // the setting of the test above, photon powers varied; the packed state
+    // keeps the radius as a half and the power as 12-bit mantissas
+    let grid = Grid::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(16.0, 1.0, 16.0), [16, 1, 16]);
+    let u = |i: u32, d: u32| photons::rng_unit(11, i, 0, d);
+    let pts: Vec<(Vec3, f32)> =
+        (0..400).map(|i| (Vec3::new(16.0 * u(i, 0) * u(i, 0), 0.5, 16.0 * u(i, 1)), 0.5 + u(i, 2))).collect();
+    let mut p = Passes::new(None).unwrap();
+    let ph = photon_arrays(&mut p, &pts);
+    let bmap = bitonic::build(&mut p, grid, &ph).unwrap();
+    let smap = stencil::build(&mut p, grid, &ph, 64).unwrap();
+    // the last pixel has no query point: finished from the start
+    let qs: Vec<Option<Vec3>> =
+        (0..256).map(|i| (i < 255).then(|| Vec3::new((i % 16) as f32 + 0.5, 0.5, (i / 16) as f32 + 0.5))).collect();
+    let q = queries(&mut p, 16, 16, &qs);
+    let params = Params { k: 8, r_max: 3.0, iters: 16, tiled: true };
+    for map in [Map::Bitonic(&bmap, &ph), Map::Stencil(&smap)] {
+        let a = knn::estimate(&mut p, &map, &q, &params, 1000).unwrap();
+        let b = knn_2003::estimate(&mut p, &map, &q, &params, 1000).unwrap();
+        assert!(a.finished && b.finished);
+        assert_eq!(b.states[255].n, 0, "no query point, nothing searched");
+        let mut same = 0;
+        for (i, (x, y)) in a.states.iter().zip(&b.states).enumerate() {
+            if x.n == y.n {
+                same += 1;
+                assert!((x.r - y.r).abs() <= 1e-3 * x.r, "pixel {i}: radius {} vs {}", x.r, y.r);
+                for c in 0..3 {
+                    assert!((x.sum[c] - y.sum[c]).abs() <= 1e-3 * x.sum[c], "pixel {i}: {:?} vs {:?}", x.sum, y.sum);
+                }
+            }
+        }
+        // a photon at the radius's distance can fall either side of its half
+        assert!(same >= 250, "{same} of 256 pixels found as many photons");
+    }
 }

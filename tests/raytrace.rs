@@ -51,11 +51,19 @@ fn every_variant_matches_the_native_caster() {
                 }
             }
             assert_eq!(k.trace.rays, nst.rays, "{name} {v:?}: the same rays");
+            assert_eq!(
+                (k.trace.primary, k.trace.shadow, k.trace.reflection),
+                (nst.primary, nst.shadow, nst.reflection),
+                "{name} {v:?}: the same kinds of rays"
+            );
             if matches!(v, Variant::Stack | Variant::NodeCache1 | Variant::StackCache1 | Variant::NodeCache1StackCache1)
             {
                 assert_eq!(k.trace.inner_nodes, nst.inner_nodes, "{name} {v:?}: the same traversal");
                 assert_eq!(k.trace.plane_tests, nst.plane_tests);
                 assert_eq!(k.trace.barycentric_tests, nst.barycentric_tests);
+                if matches!(v, Variant::Stack | Variant::NodeCache1) {
+                    assert_eq!(k.trace.pushes, nst.pushes, "{name} {v:?}: every push goes to local memory");
+                }
             } else {
                 assert!(k.trace.inner_nodes >= nst.inner_nodes, "{name} {v:?}: restarts only add node visits");
             }
@@ -257,7 +265,11 @@ fn emulator_counts_equal_the_instrumented_tallies() {
     let mut dev = Device::new();
     let plain = rt_kernels::load_build(&mut dev, Build::Plain).unwrap();
     let inst = rt_kernels::load_build(&mut dev, Build::Instrumented).unwrap();
-    for (name, variants) in [("scene6", &Variant::EVERY[..]), ("sponza", &Variant::CACHES[..])] {
+    for (name, variants) in [
+        ("scene6", &Variant::EVERY[..]),
+        ("sponza", &Variant::CACHES[..]),
+        ("sibenik", &[Variant::Stack, Variant::PushDownShortStack][..]),
+    ] {
         let (scene, tree, cam) = setup(name, 12);
         for &v in variants {
             let mut run = |m, b| {
@@ -282,7 +294,9 @@ fn emulator_counts_equal_the_instrumented_tallies() {
 fn every_count_tag_has_its_instruction_in_the_ptx() {
     let tags = rt_kernels::count_tags(rt_kernels::SOURCE);
     let names: std::collections::BTreeSet<&str> = tags.iter().map(|t| t.name.as_str()).collect();
-    for n in ["rays", "inner", "leaves", "planes", "barys", "push", "pop", "cached_node"] {
+    for n in
+        ["rays", "inner", "leaves", "planes", "barys", "push", "pop", "cached_node", "shadow", "reflection", "texels"]
+    {
         assert!(names.contains(n), "no @count tag for {n}: {names:?}");
     }
     let mut dev = Device::new();
@@ -297,4 +311,57 @@ fn every_count_tag_has_its_instruction_in_the_ptx() {
             .any(|i| i.src.is_some_and(|s| s.file == file && s.line == t.line) && i.opcode == t.opcode);
         assert!(found, "raytrace.cu:{}: no {} for @count {}", t.line, t.opcode, t.name);
     }
+}
+
+/// Sponza and Sibenik with their MTL materials: the kernels fetch a texel of
+/// the texture map at every shaded hit on a textured material and trace a
+/// reflection ray at every hit on a specular one (Sibenik's glass and floor),
+/// exactly as the native caster does: the same hits,
+/// colours, rays of each kind and texel fetches.
+#[test]
+fn textured_scenes_match_the_native_caster() {
+    let mut dev = Device::new();
+    let module = rt_kernels::load(&mut dev).unwrap();
+    for (name, frame) in [("sponza", 0), ("sibenik", 0)] {
+        let (scene, tree, _) = setup(name, 20);
+        let mut cam = scene.flight.camera(&scene.camera, frame);
+        cam.resolution = [20, 20];
+        assert!(!scene.textures.is_empty() && scene.uvs.len() == scene.triangles.len(), "{name}: textures loaded");
+        let caster = Caster::new(&scene, &tree);
+        let (native, nst) = render(&caster, &cam, glam::Vec3::ZERO);
+        assert!(nst.texel_fetches > 0, "{name}: textured surfaces are seen");
+        for v in [Variant::Stack, Variant::Stackless] {
+            let k = rt_kernels::render(&mut dev, &module, &scene, &tree, &cam, glam::Vec3::ZERO, v, Profile::Gt200)
+                .unwrap();
+            for (i, (a, b)) in k.image.pixels.iter().zip(&native.pixels).enumerate() {
+                for c in 0..3 {
+                    assert!(
+                        (a[c] - b[c]).abs() <= 1e-6 * b[c].abs().max(1.0),
+                        "{name} {v:?} pixel {i}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+            assert_eq!(
+                (k.trace.rays, k.trace.shadow, k.trace.reflection, k.trace.texel_fetches),
+                (nst.rays, nst.shadow, nst.reflection, nst.texel_fetches),
+                "{name} {v:?}: rays, shadow rays, reflection rays, texel fetches"
+            );
+        }
+        // without its texture maps the scene renders other colours
+        let mut plain = scene.clone();
+        plain.surfaces.iter_mut().for_each(|s| s.texture = None);
+        let (untextured, _) = render(&Caster::new(&plain, &tree), &cam, glam::Vec3::ZERO);
+        assert_ne!(untextured.pixels, native.pixels, "{name}: the texture maps change the image");
+    }
+    // Sibenik's floor and glass reflect (the thesis: "Glass surfaces and the floor blend a specular and a
+    // diffuse BRDF"); a texel is the texture's colour at (u, v), v = 0 the bottom row, repeated
+    let (scene, tree, cam) = setup("sibenik", 20);
+    let (_, st) = render(&Caster::new(&scene, &tree), &cam, glam::Vec3::ZERO);
+    assert!(st.reflection > 0, "sibenik: the floor reflects");
+    let t = &scene.textures[0];
+    let (w, h) = (t.width, t.height);
+    assert_eq!(warplight::host::scene::Texture::index(w, h, 0.0, 0.999), 0);
+    assert_eq!(warplight::host::scene::Texture::index(w, h, 0.0, 0.001), ((h - 1) * w) as usize);
+    assert_eq!(warplight::host::scene::Texture::index(w, h, 1.25, 1.999), (w / 4) as usize);
+    assert_eq!(warplight::host::scene::Texture::index(w, h, -0.001, 0.999), (w - 1) as usize);
 }

@@ -27,16 +27,6 @@ bar.sync %r1, %r2;
 END:
 ret;
 }
-.visible .entry bar_16()
-{
-bar.sync 16;
-ret;
-}
-.visible .entry bar_1_33()
-{
-bar.sync 1, 33;
-ret;
-}
 ";
 
 /// Shuffles and votes: lanes below `split` branch away; the others shuffle
@@ -110,22 +100,25 @@ fn barrier_ids_past_15_are_faults() {
     let msg = f.to_string();
     assert!(msg.contains("barrier id 16 is out of range (a CTA has barriers 0 to 15)"), "{msg}");
     assert!(msg.contains("bar_param") && msg.contains("bar.ptx:15"), "{msg}");
-    let mut dev = device();
-    let m = dev.load_ptx(&format!("{HEAD}{BARRIERS}"), "bar.ptx").unwrap();
-    let f = fault_of(dev.launch(&m, "bar_16", LaunchConfig::linear(1, 32), &[]));
-    assert!(matches!(f.kind, FaultKind::BadBarrier { id: 16, count: None, .. }), "{f}");
-    assert_eq!(f.ptx_line, 21);
+    // a constant id past 15 is refused when the module loads, naming the line (as ptxas does)
+    let e = device().load_ptx(&format!("{HEAD}.visible .entry bar_16()\n{{\nbar.sync 16;\nret;\n}}\n"), "b.ptx");
+    let e = e.unwrap_err().to_string();
+    assert!(e.contains("b.ptx:6") && e.contains("barrier id 16 is out of range (a CTA has barriers 0 to 15)"), "{e}");
     // 15 is the last valid id
     bar_launch(64, 15, 64, 64).unwrap();
 }
 
 #[test]
 fn barrier_counts_are_whole_warps_within_the_cta() {
-    let mut dev = device();
-    let m = dev.load_ptx(&format!("{HEAD}{BARRIERS}"), "bar.ptx").unwrap();
-    let f = fault_of(dev.launch(&m, "bar_1_33", LaunchConfig::linear(1, 64), &[]));
+    let f = fault_of(bar_launch(64, 1, 33, 64));
     assert_eq!(f.kind, FaultKind::BadBarrier { id: 1, count: Some(33), cta_threads: 64 });
     assert!(f.to_string().contains("thread count of 33: it must be a positive multiple of 32"), "{f}");
+    // constant counts are refused when the module loads, naming the line
+    for count in [33, 0, 2048] {
+        let src = format!("{HEAD}.visible .entry k()\n{{\nbar.sync 1, {count};\nret;\n}}\n");
+        let e = device().load_ptx(&src, "b.ptx").unwrap_err().to_string();
+        assert!(e.contains("b.ptx:6") && e.contains(&format!("a barrier thread count of {count}")), "{e}");
+    }
     for count in [0, 48, 96] {
         let f = fault_of(bar_launch(64, 1, count, 64));
         assert_eq!(f.kind, FaultKind::BadBarrier { id: 1, count: Some(count), cta_threads: 64 }, "{count}");

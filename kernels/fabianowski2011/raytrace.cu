@@ -2,7 +2,13 @@
 //
 // Persistent threads: each warp takes blocks of 32 consecutive pixels from a
 // global job queue (atomicAdd) until the image is done. Per pixel up to four
-// rays: primary, shadow, mirror reflection and its shadow ray (Whitted).
+// rays: primary, shadow, mirror reflection and its shadow ray (Whitted). A
+// reflection ray is traced where the surface seen is specular: a mirror, or a
+// diffuse material with a specular part (the MTL's Ks), whose reflection is
+// added to its diffuse shading. Diffuse colours are the material's times the
+// texel of its texture map, where it has one: all maps lie in one texel array
+// read through the texture path (the thesis stacks them in one 3-D texture,
+// seed extract L3431), nearest texel, repeated outside [0, 1).
 // kd-tree nodes (8 bytes), triangle references and triangles are read through
 // the read-only (texture) path (__ldg). Traversal variants (one template,
 // one entry point each):
@@ -15,8 +21,9 @@
 // in the same order, so hits agree bit for bit; keep the two in step.
 //
 // Counting. This file compiles to the kernels as the thesis runs them: no
-// tallies. The work the tables count (rays, inner-node steps, leaf visits,
-// plane and barycentric tests, local-memory stack pushes and pops) is read off
+// tallies. The work the tables count (rays, shadow and reflection rays among
+// them, inner-node steps, leaf visits, plane and barycentric tests,
+// local-memory stack pushes and pops, texture-map texel fetches) is read off
 // the emulator's per-instruction counters: a line ending in the comment
 // `@count NAME OPCODE` executes exactly one OPCODE instruction per NAME event,
 // and src/host/rt_kernels.rs sums, over every PTX instruction that `.loc`
@@ -38,6 +45,7 @@
 #define SHORT_CAPACITY 4
 #define CTA_THREADS 256
 #define SS_WORDS (3 * SHORT_CAPACITY * CTA_THREADS)
+#define STATS_WORDS 11                                // per pixel, the instrumented build's tallies
 
 // Node caches (§4.3.1): the heap-ordered top of the tree, preloaded by each CTA.
 // I: the top 10 levels as 8-byte nodes; II: the top 8 levels with their AABBs.
@@ -75,11 +83,15 @@ struct Scene {
   const float4 *tris;      // 3 float4 per triangle: [n'i n'j n'd k], [e'1], [e'2]
   const unsigned *tri_mat; // material per triangle
   const float4 *mats;      // [r g b kind], kind: 0 diffuse, 1 mirror, 2 emitter; then [emission, 0]
+  const float4 *surf;      // per material [reflection weight r g b, texture (int bits; -1: none)]
+  const float *uvs;        // per triangle the texture coordinates of its 3 vertices (u, v)
+  const uint4 *tex_info;   // per texture [first texel, width, height, 0]
+  const unsigned *texels;  // every texture's texels, r | g << 8 | b << 16 | a << 24, rows top down
   const float *aabbs;      // 6 floats per heap node (node cache II)
 };
 
 #ifdef RAYTRACE_STATS
-struct Stats { unsigned inner, leaves, planes, barys, rays, tex_nodes, local_stack; };
+struct Stats { unsigned inner, leaves, planes, barys, rays, tex_nodes, local_stack, shadow, reflection, texels, pushes; };
 #define TALLY(x) (x)
 #else
 struct Stats {};
@@ -200,6 +212,7 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
               stack[size].tb = head_tb;
               size++;
               TALLY(st.local_stack++);
+              TALLY(st.pushes++);
             }
             head_node = far;
             head_tb = tb;
@@ -211,6 +224,7 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
             stack[size].tb = tb;
             size++;
             TALLY(st.local_stack++);
+            TALLY(st.pushes++);
           }
           tb = ts;
           node = near;
@@ -374,6 +388,32 @@ static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, S
   V3 c = v3(__ldg(mat + 4), __ldg(mat + 5), __ldg(mat + 6));
   if (kind != 0) return c;
   const Params *p = s.p;
+  int tex = __float_as_int(__ldg((const float *)(s.surf + m) + 3));
+  if (tex >= 0) {
+    // the texture map: barycentric weights of the hit as Wald's test computed them (Alg. 3.3 lines 7-8)
+    const float *w = (const float *)(s.tris + 3 * tri);
+    int k = __float_as_int(__ldg(w + 3));
+    int a = k == 2 ? 0 : k + 1, b = k == 0 ? 2 : k - 1;
+    float hx = comp(o, a) + t * comp(d, a);
+    float hy = comp(o, b) + t * comp(d, b);
+    float u = __ldg(w + 8) * hx + __ldg(w + 9) * hy + __ldg(w + 10);
+    float v = __ldg(w + 4) * hx + __ldg(w + 5) * hy + __ldg(w + 6);
+    const float *uv = s.uvs + 6 * tri;
+    float wt = 1.0f - u - v;
+    float tu = wt * __ldg(uv) + u * __ldg(uv + 2) + v * __ldg(uv + 4);
+    float tv = wt * __ldg(uv + 1) + u * __ldg(uv + 3) + v * __ldg(uv + 5);
+    const unsigned *ti = (const unsigned *)(s.tex_info + tex);
+    unsigned first = __ldg(ti);
+    int tw = (int)__ldg(ti + 1), th = (int)__ldg(ti + 2);
+    int x = __float2int_rd(tu * (float)tw) % tw;    // nearest texel, repeated
+    int y = __float2int_rd((1.0f - tv) * (float)th) % th;
+    if (x < 0) x += tw;
+    if (y < 0) y += th;
+    TALLY(st.texels++);
+    unsigned texel = __ldg(s.texels + first + (unsigned)(y * tw + x));   // @count texels mad.lo.s32
+    col = v3(col.x * ((float)(texel & 255u) / 255.0f), col.y * ((float)((texel >> 8) & 255u) / 255.0f),
+             col.z * ((float)((texel >> 16) & 255u) / 255.0f));
+  }
   V3 pt = v3(o.x + d.x * t, o.y + d.y * t, o.z + d.z * t);
   V3 n = normal_of(s, tri, d);
   if (p->has_light) {
@@ -386,7 +426,9 @@ static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, S
     float cos = -dot3(n, dir);
     if (cos > 0.0f) {
       float ts;
-      if (trace<V, NC, SC>(s, lp, dir, p->eps, dist - p->eps, true, &ts, st, ss) < 0) {
+      TALLY(st.shadow++);
+      float t_end = dist - p->eps;                    // @count shadow sub.rn.f32
+      if (trace<V, NC, SC>(s, lp, dir, p->eps, t_end, true, &ts, st, ss) < 0) {
         float g = cos / (dist * dist) / 3.14159265358979323846f;
         c.x += col.x * p->light_int[0] * g;
         c.y += col.y * p->light_int[1] * g;
@@ -402,9 +444,10 @@ static __device__ V3 direct(const Scene &s, V3 o, V3 d, float t, unsigned tri, S
 
 template <int V, int NC, int SC>
 static __device__ void render(const Params *p, const uint2 *nodes, const unsigned *refs, const float4 *tris,
-                              const unsigned *tri_mat, const float4 *mats, const float *aabbs, unsigned *next,
+                              const unsigned *tri_mat, const float4 *mats, const float4 *surf, const float *uvs,
+                              const uint4 *tex_info, const unsigned *texels, const float *aabbs, unsigned *next,
                               float4 *color, int *hit_tri, unsigned *stats) {
-  Scene s = {p, nodes, refs, tris, tri_mat, mats, aabbs};
+  Scene s = {p, nodes, refs, tris, tri_mat, mats, surf, uvs, tex_info, texels, aabbs};
   if (NC == 1) {
     // every thread preloads 4 nodes of the top 10 levels, then the CTA synchronises
     for (int i = threadIdx.x; i < NC1_NODES; i += CTA_THREADS) {
@@ -435,7 +478,7 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     if (pix >= p->num_pixels) continue;
     int x = pix % p->width, y = pix / p->width;
 #ifdef RAYTRACE_STATS
-    Stats st = {0, 0, 0, 0, 0, 0, 0};
+    Stats st = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
 #else
     Stats st;
 #endif
@@ -451,26 +494,28 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     if (h >= 0) {
       c = direct<V, NC, SC>(s, o, d, t, (unsigned)h, st, ss);
       unsigned m = __ldg(tri_mat + h);
-      if (__ldg((const float *)(mats + 2 * m) + 3) == 1.0f) {                         // a mirror: reflect
+      const float *rw = (const float *)(surf + m);
+      V3 w = v3(__ldg(rw), __ldg(rw + 1), __ldg(rw + 2));
+      if (w.x > 0.0f || w.y > 0.0f || w.z > 0.0f) {    // a specular surface: reflect
         V3 n = normal_of(s, (unsigned)h, d);
         V3 pt = v3(o.x + d.x * t, o.y + d.y * t, o.z + d.z * t);
-        float s2 = 2.0f * dot3(d, n);
+        TALLY(st.reflection++);
+        float s2 = 2.0f * dot3(d, n);                   // @count reflection add.rn.f32 (2 x: x + x)
         V3 r = normalize3(v3(d.x - s2 * n.x, d.y - s2 * n.y, d.z - s2 * n.z));
         float t2;
         int h2 = trace<V, NC, SC>(s, pt, r, p->eps, __int_as_float(0x7f800000), false, &t2, st, ss);
         if (h2 >= 0) {
           V3 c2 = direct<V, NC, SC>(s, pt, r, t2, (unsigned)h2, st, ss);
-          const float *mat = (const float *)(mats + 2 * m);
-          c.x += __ldg(mat) * c2.x;
-          c.y += __ldg(mat + 1) * c2.y;
-          c.z += __ldg(mat + 2) * c2.z;
+          c.x += w.x * c2.x;
+          c.y += w.y * c2.y;
+          c.z += w.z * c2.z;
         }
       }
     }
     color[pix] = make_float4(c.x, c.y, c.z, 1.0f);
     hit_tri[pix] = h;
 #ifdef RAYTRACE_STATS
-    unsigned *sp = stats + 8 * pix;
+    unsigned *sp = stats + STATS_WORDS * pix;
     sp[0] = st.inner;
     sp[1] = st.leaves;
     sp[2] = st.planes;
@@ -478,6 +523,10 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
     sp[4] = st.rays;
     sp[5] = st.tex_nodes;
     sp[6] = st.local_stack;
+    sp[7] = st.shadow;
+    sp[8] = st.reflection;
+    sp[9] = st.texels;
+    sp[10] = st.pushes;
 #else
     (void)stats;
 #endif
@@ -487,9 +536,11 @@ static __device__ void render(const Params *p, const uint2 *nodes, const unsigne
 #define ENTRY(name, V, NC, SC)                                                                             \
   extern "C" __global__ void name(const Params *p, const uint2 *nodes, const unsigned *refs,               \
                                   const float4 *tris, const unsigned *tri_mat, const float4 *mats,         \
-                                  const float *aabbs, unsigned *next, float4 *color, int *hit_tri,         \
-                                  unsigned *stats) {                                                       \
-    render<V, NC, SC>(p, nodes, refs, tris, tri_mat, mats, aabbs, next, color, hit_tri, stats);          \
+                                  const float4 *surf, const float *uvs, const uint4 *tex_info,             \
+                                  const unsigned *texels, const float *aabbs, unsigned *next,              \
+                                  float4 *color, int *hit_tri, unsigned *stats) {                          \
+    render<V, NC, SC>(p, nodes, refs, tris, tri_mat, mats, surf, uvs, tex_info, texels, aabbs, next, color, \
+                      hit_tri, stats);                                                                     \
   }
 ENTRY(trace_stack, STACK, 0, 0)
 ENTRY(trace_stackless, STACKLESS, 0, 0)

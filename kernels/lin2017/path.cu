@@ -43,6 +43,14 @@
 #define KIND_MIRROR 1
 #define KIND_GLASS 2
 #define KIND_EMITTER 3
+#if defined(__NVCC__)
+#define FLOORF floorf
+#else
+#define FLOORF __builtin_floorf   // cvt.rmi.f32.f32, as CUDA's floorf
+#endif
+#define TRAVERSAL_SHORT_STACK 0
+#define TRAVERSAL_RESTART 1
+#define TRAVERSAL_BACKTRACK 2
 #define LEAF_AXIS 3u
 #define STACK_ENTRIES 32
 // random dimensions: 2 for the camera ray, then 8 per bounce
@@ -55,7 +63,7 @@ struct Params {
   float cam_pos[3], cam_fwd[3], cam_right[3], cam_up[3];
   float lo[3], hi[3];
   float eps, tan_half, aspect, light_area;
-  int width, height, num_paths, frame, integrator, max_bounces, num_lights, seed;
+  int width, height, num_paths, frame, integrator, max_bounces, num_lights, seed, traversal;
 };
 
 struct V3 { float x, y, z; };
@@ -79,6 +87,7 @@ struct Scene {
   const float4 *tri_data;  // per triangle: unit geometric normal, material index (int bits)
   const float4 *mats;      // per material: [r g b kind], [emission rgb, ior]
   const float4 *lights;    // per emitting triangle: [v0, cdf], [e1, triangle (int bits)], [e2, 0]
+  const float4 *boxes;     // per node (kd-backtrack): [box lo, parent (int bits)], [box hi, 0]
 };
 
 // The counter-based generator (two rounds of a 32-bit integer hash per draw).
@@ -130,7 +139,7 @@ static __device__ __forceinline__ bool affine(const Scene &s, unsigned t, V3 o, 
   float4 r2 = m[2];
   float oz = r2.x * o.x + r2.y * o.y + r2.z * o.z + r2.w;
   float dz = r2.x * d.x + r2.y * d.y + r2.z * d.z;
-  float tt = -oz / dz;
+  float tt = -oz / dz;                                   // @count tri_tests div.rn.f32
   if (!(tt >= t_min && tt <= *t_hit)) return false;
   float4 r0 = m[0];
   float u = r0.x * o.x + r0.y * o.y + r0.z * o.z + r0.w + tt * (r0.x * d.x + r0.y * d.y + r0.z * d.z);
@@ -142,10 +151,82 @@ static __device__ __forceinline__ bool affine(const Scene &s, unsigned t, V3 o, 
   return true;
 }
 
+// The exit distance of the ray from box [lo, hi] (the scene clip's expression).
+static __device__ __forceinline__ float box_exit(float4 lo, float4 hi, V3 o, V3 inv) {
+  float t0x = (lo.x - o.x) * inv.x, t1x = (hi.x - o.x) * inv.x;
+  float t0y = (lo.y - o.y) * inv.y, t1y = (hi.y - o.y) * inv.y;
+  float t0z = (lo.z - o.z) * inv.z, t1z = (hi.z - o.z) * inv.z;
+  return fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z));
+}
+
+// kd-restart and kd-backtrack (Foley and Sugerman 2005; §3.4, 003:L173): no
+// stack. Each descent goes to the nearest leaf of [tnear, tfar] with Fig. 15's
+// step as printed (f = int(floor(tnear - tsplit)) >> 31, strict, narrowing
+// tfar when tsplit < tfar); a leaf without a hit moves tnear to its exit.
+// kd-restart then descends again from the root with tfar the scene exit;
+// kd-backtrack climbs the parent links until a node's box reaches past tnear
+// and descends from there with tfar that box's exit. Both visit the same
+// leaves; the trees put triangles lying in a split plane on both sides
+// (003:L566; src/host/path/build.rs), so no zero-thickness leaf is skipped.
+static __device__ int trace_stackless(const Scene &s, bool backtrack, V3 o, V3 d, V3 inv, float t_min, float t_max,
+                                      float tnear, float t_exit, bool any, float *t_out) {
+  const Params *p = s.p;
+  float t_hit = t_max, tfar = t_exit;
+  int found = -1;
+  unsigned idx = 0;
+  for (;;) {
+    uint4 n = s.nodes[idx];
+    while ((n.x >> 30) != LEAF_AXIS) {
+      unsigned axis = n.x >> 30;
+      float tsplit = (__uint_as_float(n.y) - comp(o, axis)) * comp(inv, axis);   // @count inner mul.rn.f32
+      unsigned first = n.x & 0xffffffu, second = n.z;
+      if (__float_as_int(comp(d, axis)) < 0) {
+        unsigned t = first;
+        first = second;
+        second = t;
+      }
+      int f = (int)FLOORF(tnear - tsplit) >> 31;      // Fig. 15 as printed
+      idx = (first & (unsigned)f) + (second & ~(unsigned)f);
+      if (f < 0 && tsplit < tfar) tfar = tsplit;
+      n = s.nodes[idx];
+    }
+    unsigned count = (n.x >> 24) & 63u, first = n.w;   // @count leaves bfe.u32
+    float lo = fmaxf(tnear - p->eps, t_min);
+    float hi = fminf(t_hit, tfar + p->eps);
+    for (unsigned r = 0; r < count; r++) {
+      unsigned t = s.refs[first + r];
+      if (affine(s, t, o, d, lo, &hi)) {
+        found = (int)t;
+        if (any) break;
+      }
+    }
+    if (found >= 0) {
+      t_hit = hi;
+      break;
+    }
+    if (!(tfar < t_exit)) break;
+    tnear = tfar;
+    if (backtrack) {
+      for (;;) {
+        idx = __float_as_uint(s.boxes[2 * idx].w);
+        float4 blo = s.boxes[2 * idx], bhi = s.boxes[2 * idx + 1];   // @count ascents shl.b32
+        tfar = fminf(t_max, box_exit(blo, bhi, o, inv));
+        if (idx == 0 || tnear < tfar) break;
+      }
+    } else {
+      idx = 0;
+      tfar = t_exit;
+    }
+  }
+  *t_out = t_hit;
+  return found;
+}
+
 // The nearest hit in [t_min, t_max] (with `any`, the first found); -1 for none.
 static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out) {
   const Params *p = s.p;
-  V3 inv = v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
+  float inv_x = 1.0f / d.x;                          // @count rays rcp.rn.f32
+  V3 inv = v3(inv_x, 1.0f / d.y, 1.0f / d.z);
   // clip to the scene box
   float t0x = (p->lo[0] - o.x) * inv.x, t1x = (p->hi[0] - o.x) * inv.x;
   float t0y = (p->lo[1] - o.y) * inv.y, t1y = (p->hi[1] - o.y) * inv.y;
@@ -154,6 +235,8 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
   float tf = fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z));
   float tnear = fmaxf(t_min, tn), tfar = fminf(t_max, tf);
   if (!(tnear <= tfar)) return -1;
+  if (p->traversal != TRAVERSAL_SHORT_STACK)
+    return trace_stackless(s, p->traversal == TRAVERSAL_BACKTRACK, o, d, inv, t_min, t_max, tnear, tfar, any, t_out);
   float t_hit = t_max;
   int found = -1;
   struct Entry { unsigned node; float tfar; } stack[STACK_ENTRIES];   // 8-byte entries (Santos et al.)
@@ -163,7 +246,7 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
     uint4 n = s.nodes[idx];
     while ((n.x >> 30) != LEAF_AXIS) {                // Fig. 15: one branch-reduced step
       unsigned axis = n.x >> 30;
-      float tsplit = (__uint_as_float(n.y) - comp(o, axis)) * comp(inv, axis);
+      float tsplit = (__uint_as_float(n.y) - comp(o, axis)) * comp(inv, axis);   // @count inner mul.rn.f32
       unsigned first = n.x & 0xffffffu, second = n.z;
       if (__float_as_int(comp(d, axis)) < 0) {
         unsigned t = first;
@@ -178,14 +261,14 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
       int f = -(int)(tnear <= tsplit);                 // mask and add, no branch
       idx = (first & (unsigned)f) + (second & ~(unsigned)f);
       if (f < 0 && tsplit <= tfar) {
-        stack[size].node = second;
+        stack[size].node = second;                    // @count push st.local.u32
         stack[size].tfar = tfar;
         size++;
         tfar = tsplit;
       }
       n = s.nodes[idx];
     }
-    unsigned count = (n.x >> 24) & 63u, first = n.w;
+    unsigned count = (n.x >> 24) & 63u, first = n.w;   // @count leaves bfe.u32
     float lo = fmaxf(tnear - p->eps, t_min);
     float hi = fminf(t_hit, tfar + p->eps);
     for (unsigned r = 0; r < count; r++) {
@@ -202,7 +285,7 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
     if (size == 0) break;
     size--;
     tnear = tfar;
-    idx = stack[size].node;
+    idx = stack[size].node;                            // @count pop ld.local.u32
     tfar = stack[size].tfar;
   }
   *t_out = t_hit;
@@ -229,8 +312,8 @@ static __device__ __forceinline__ void basis(V3 n, V3 *b1, V3 *b2) {
 
 extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
                                       const float4 *tris, const float4 *tri_data, const float4 *mats,
-                                      const float4 *lights, float *accum, float *last) {
-  Scene s = {params, nodes, refs, tris, tri_data, mats, lights};
+                                      const float4 *lights, const float4 *boxes, float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes};
   const Params *p = params;
   int i = (int)WL_TID;
   if (i >= p->num_paths) return;

@@ -69,6 +69,7 @@ struct Scene {
   float pad;
   float light[4];    // point light position (num_lights == 0)
   float power[4];    // power per emitted photon (rgb)
+  float cone[4];     // point light: axis and cosine of the half-angle of the emission cone
 };
 
 struct Hit { float t; int tri; };
@@ -130,7 +131,8 @@ static __device__ __forceinline__ V3 specular(V3 d, V3 n, int kind, float ior, f
 }
 
 // Pass 0: emission. Photon i starts on the light: a point light emits
-// uniformly over the sphere; an area light (emissive triangles lights[]) from
+// uniformly into the cone of directions about sc.cone's axis that holds the
+// scene (a projection map; cos = -1 and axis +z: the whole sphere); an area light (emissive triangles lights[]) from
 // a uniformly chosen triangle, uniformly on it, cosine-weighted about its
 // normal turned towards `toward`.
 extern "C" __global__ void emit(Scene sc, const float *tris, const int *lights, float4 *pos, float4 *pw,
@@ -142,8 +144,13 @@ extern "C" __global__ void emit(Scene sc, const float *tris, const int *lights, 
   V3 p, d;
   if (sc.num_lights == 0) {
     p = v3(sc.light[0], sc.light[1], sc.light[2]);
-    float z = 1.0f - 2.0f * u0, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 6.28318530718f * u1;
-    d = v3(r * __cosf(phi), r * __sinf(phi), z);
+    float z = 1.0f - u0 * (1.0f - sc.cone[3]), r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 6.28318530718f * u1;
+    V3 a = v3(sc.cone[0], sc.cone[1], sc.cone[2]), t = v3(1.0f, 0.0f, 0.0f), b = v3(0.0f, 1.0f, 0.0f);
+    if (a.z < 0.999999f) {
+      t = normalize(cross(v3(0.0f, 0.0f, 1.0f), a));
+      b = cross(a, t);
+    }
+    d = add(add(mul(t, r * __cosf(phi)), mul(b, r * __sinf(phi))), mul(a, z));
   } else {
     int l = imin((int)(u0 * sc.num_lights), sc.num_lights - 1);
     int ti = lights[l];

@@ -238,6 +238,16 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
             for (k, v) in selected(s, &a.metrics)? {
                 println!("{i},{},{k},{v}", l.kernel);
             }
+            // the cells stay numeric: the registers the PTX declares beside the clamped count, the words on stderr
+            let declared = prog.kernel(&l.kernel).map(|k| prog.functions[k as usize].declared_reg_words);
+            if a.metrics.is_empty()
+                && let Some(d) = declared.filter(|d| *d > s.occupancy.registers_per_thread)
+            {
+                println!("{i},{},occupancy.registers_declared,{d}", l.kernel);
+            }
+            if let Some(n) = &s.occupancy.notice {
+                eprintln!("note: launch {i} ({}): {n}", l.kernel);
+            }
         }
         return Ok(());
     }

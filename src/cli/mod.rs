@@ -2,6 +2,7 @@
 
 pub mod chart;
 pub mod compile;
+pub mod interrupt;
 pub mod launch;
 pub mod ptx_info;
 pub mod render;
@@ -123,6 +124,8 @@ pub enum SceneCommand {
 /// Runs the CLI; returns the process exit code.
 pub fn main() -> i32 {
     let cli = Cli::parse();
+    // from here on a signal removes the temporary files of the outputs being written
+    interrupt::install();
     if let Some(b) = cli.memory_budget {
         crate::limits::set_memory_budget(b);
     }
@@ -160,16 +163,15 @@ pub fn main() -> i32 {
     }
 }
 
-/// Writes `bytes` to `file` through a temporary file beside it, so that a
-/// failure never leaves a partial file under the final name.
+/// Writes `bytes` to `file` through a temporary file beside it
+/// ([`interrupt::Temporary`]), so that neither a failure nor a signal ever
+/// leaves a partial file under the final name, or the temporary file.
 pub fn write_atomically(file: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
-    let tmp = file.with_extension("warplight-tmp");
-    // on failure the temporary file goes too: nothing half-written is left
-    let r = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, file));
-    r.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", file.display())
-    })
+    let err = |e: std::io::Error| format!("{}: {e}", file.display());
+    let mut tmp = interrupt::Temporary::create(file).map_err(err)?;
+    // on failure the temporary file goes too (dropped): nothing half-written is left
+    tmp.write_all(bytes).map_err(err)?;
+    interrupt::commit(vec![(tmp, file)]).map_err(|(_, e)| err(e))
 }
 
 fn validate(fixture: &std::path::Path, ptx: &std::path::Path, md: bool) -> Result<(), Box<dyn std::error::Error>> {

@@ -57,8 +57,9 @@ pub struct RenderArgs {
     /// Also write the counters as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
-    /// Method: `raycast` (thesis 000's Whitted ray caster) or `path` (thesis 003's
-    /// path tracer; `--variant native` or `emulated`).
+    /// Method: `raycast` (thesis 000's Whitted ray caster), `path` (thesis 003's
+    /// path tracer) or `photon-map` (thesis 000 ch. 5; `--estimator`); the last two
+    /// take `--variant native` or `emulated`.
     #[arg(long, default_value = "raycast")]
     pub method: String,
     /// Path tracer: pt, nee, mis (balance heuristic) or mis-power.
@@ -73,18 +74,16 @@ pub struct RenderArgs {
     /// Path tracer: seed of the random numbers.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// Photon map (thesis 000 ch. 5): vkde, vkde-epanechnikov, knn (Table 5.1's k) or knn:K.
+    #[arg(long, default_value = "vkde")]
+    pub estimator: String,
 }
 
-/// The trace counters as JSON; an emulated run's kernels do not count ray kinds
-/// and stack pushes, so those are null rather than a false 0.
-fn counters_json(st: &crate::host::raycast::TraceStats, emulated: bool) -> serde_json::Value {
-    let mut v = serde_json::to_value(st).unwrap_or_default();
-    if emulated && let Some(m) = v.as_object_mut() {
-        for k in ["primary", "reflection", "shadow", "pushes"] {
-            m.insert(k.into(), serde_json::Value::Null);
-        }
-    }
-    v
+/// The trace counters as JSON. An emulated run's ray kinds, stack pushes
+/// (local memory) and texel fetches are the emulator's per-line counts of the
+/// kernel's `@count` lines, like its other counters.
+fn counters_json(st: &crate::host::raycast::TraceStats) -> serde_json::Value {
+    serde_json::to_value(st).unwrap_or_default()
 }
 
 /// The largest image `render` makes (its frame buffer holds 12 bytes a pixel).
@@ -153,13 +152,34 @@ fn pixel_progress(dev: &mut Device, kernel: &str, pixels: u64) -> Option<indicat
     Some(pb)
 }
 
+/// The image as the bytes of a PNG (sRGB, `exposure` stops) or an OpenEXR
+/// file (linear 32-bit float RGB).
+fn encode(fb: &crate::host::image::FrameBuffer, exr: bool, exposure: f32) -> Result<Vec<u8>, String> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    if exr {
+        use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+        let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+            let p = fb.get(x as u32, y as u32);
+            (p[0], p[1], p[2])
+        });
+        let image = Image::from_channels((fb.width as usize, fb.height as usize), channels);
+        image.write().to_buffered(&mut bytes).map_err(|e| format!("encoding the EXR image: {e}"))?;
+    } else {
+        use image::ImageEncoder;
+        image::codecs::png::PngEncoder::new(&mut bytes)
+            .write_image(&fb.to_srgb8(exposure), fb.width, fb.height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| format!("encoding the PNG image: {e}"))?;
+    }
+    Ok(bytes.into_inner())
+}
+
 /// Renders one frame.
 fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if !matches!(a.method.as_str(), "raycast" | "path") {
-        return Err(format!("unknown method `{}`; expected raycast or path", a.method).into());
+    if !matches!(a.method.as_str(), "raycast" | "path" | "photon-map") {
+        return Err(format!("unknown method `{}`; expected raycast, path or photon-map", a.method).into());
     }
     let kernel_variant = match a.variant.as_str() {
-        _ if a.method == "path" => None,
+        _ if a.method == "path" || a.method == "photon-map" => None,
         "native" => None,
         v => Some(Variant::parse(v).ok_or_else(|| {
             let names: Vec<&str> = Variant::EVERY.iter().map(|v| v.name()).collect();
@@ -205,6 +225,9 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.method == "path" {
         return crate::repro::lin2017::render::run(&a, &scene, &cam);
     }
+    if a.method == "photon-map" {
+        return crate::repro::fabianowski2011::photon_image::run_cli(&a, &scene, &cam);
+    }
     crate::limits::check_memory(
         || format!("a render of {width} x {height} pixels"),
         (width as u64 * height as u64).saturating_mul(bytes_per_pixel(kernel_variant.is_some())),
@@ -246,21 +269,10 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let render_s = t1.elapsed().as_secs_f64();
-    // written beside the output under a temporary name, then renamed: never a partial image
-    let tmp = parent.join(format!(
-        ".{}.warplight-tmp.{}",
-        a.output.file_stem().and_then(|s| s.to_str()).unwrap_or("render"),
-        ext.as_deref().unwrap_or("png")
-    ));
-    let written = if ext.as_deref() == Some("exr") { fb.write_exr(&tmp) } else { fb.write_png(&tmp, a.exposure) };
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e.into());
-    }
-    std::fs::rename(&tmp, &a.output).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", a.output.display())
-    })?;
+    // encoded in memory, then written beside the output under a temporary name and renamed:
+    // never a partial image, also on a signal
+    let bytes = encode(&fb, ext.as_deref() == Some("exr"), a.exposure)?;
+    super::write_atomically(&a.output, &bytes)?;
     let ts = tree.stats();
     println!(
         "{} frame {} ({}x{}), {} triangles, {} tree: {} inner nodes, {} references, depth {} (built in {:.3} s)",
@@ -275,12 +287,8 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         ts.depth,
         build_s
     );
-    // the kernels count rays, not their kinds: an emulated run prints no breakdown rather than zeros
-    let kinds = if emulated.is_some() {
-        "kinds counted by the native caster only".to_string()
-    } else {
-        format!("primary {}, reflection {}, shadow {}", st.primary, st.reflection, st.shadow)
-    };
+    // an emulated run's ray kinds come from the emulator's counts of the kernel's `@count` lines
+    let kinds = format!("primary {}, reflection {}, shadow {}", st.primary, st.reflection, st.shadow);
     // the functional level keeps no per-line counters: the kernels' work is then unknown, not zero
     let counted = emulated.as_ref().is_none_or(|k| k.counted);
     if !counted {
@@ -290,12 +298,17 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         println!("  rays {} ({kinds})  in {:.3} s: {:.2} M rays/s", st.rays, render_s, st.rays as f64 / render_s / 1e6);
         println!(
-            "  per ray: {:.2} inner nodes, {:.2} leaves, {:.2} plane tests, {:.2} barycentric tests",
+            "  per ray: {:.2} inner nodes, {:.2} leaves, {:.2} plane tests, {:.2} barycentric tests, {:.2} stack pushes{}",
             st.inner_nodes as f64 / st.rays.max(1) as f64,
             st.leaves as f64 / st.rays.max(1) as f64,
             st.plane_tests as f64 / st.rays.max(1) as f64,
-            st.barycentric_tests as f64 / st.rays.max(1) as f64
+            st.barycentric_tests as f64 / st.rays.max(1) as f64,
+            st.pushes as f64 / st.rays.max(1) as f64,
+            if emulated.is_some() { " (local memory)" } else { "" }
         );
+        if st.texel_fetches > 0 {
+            println!("  texture maps: {} texel fetches", st.texel_fetches);
+        }
     }
     if let Some(k) = &emulated {
         let c = &k.launch.totals;
@@ -328,7 +341,7 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(j) = &a.json {
         let v = serde_json::json!({
             "scene": scene.name, "frame": a.frame, "variant": a.variant, "heuristic": h,
-            "resolution": cam.resolution, "tree": ts, "counters": if counted { counters_json(&st, emulated.is_some()) } else { serde_json::Value::Null }, "render_seconds": render_s,
+            "resolution": cam.resolution, "tree": ts, "counters": if counted { counters_json(&st) } else { serde_json::Value::Null }, "render_seconds": render_s,
             "emulator": emulated.as_ref().map(|k| serde_json::json!({
                 "totals": k.launch.totals, "memory": k.memory.metrics(&k.launch.totals).into_iter().collect::<std::collections::BTreeMap<_, _>>(),
             })),

@@ -39,6 +39,13 @@ pub struct RunArgs {
     /// The kernel's arguments, comma-separated: buffer names or numbers.
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub args: Vec<String>,
+    /// The compiler of a .cu: clang (Debian's clang-16, the default) or nvcc (as `compile`).
+    #[arg(long, default_value = "clang")]
+    pub dialect: String,
+    /// libdevice.10.bc, CUDA's math library (default: WARPLIGHT_LIBDEVICE, CUDA installs,
+    /// the pip package nvidia-cuda-nvcc; as `compile`).
+    #[arg(long, value_name = "FILE")]
+    pub libdevice: Option<PathBuf>,
     /// How to run and what to print (as `launch`).
     #[command(flatten)]
     pub options: LaunchOptions,
@@ -116,7 +123,14 @@ pub fn spec_text(a: &RunArgs, kernel: &str) -> Result<String, String> {
 }
 
 /// Runs the command.
-pub fn run(a: RunArgs) -> Result<(), Box<dyn std::error::Error>> {
+pub fn run(mut a: RunArgs) -> Result<(), Box<dyn std::error::Error>> {
+    // `examples/softmax.cu` from any directory: the checkout's or $WARPLIGHT_HOME's copy when not here
+    a.source = crate::host::scene_file::data_file(&a.source);
+    let dialect = crate::compile::Dialect::named(&a.dialect)?;
+    crate::compile::set_command_line_options(crate::compile::CompileOptions {
+        dialect,
+        libdevice: a.libdevice.clone(),
+    });
     let kernel = match &a.kernel {
         Some(k) => k.clone(),
         None => only_kernel(&a.source)?,

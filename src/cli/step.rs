@@ -60,7 +60,7 @@ pub struct StepArgs {
     #[arg(long)]
     pub device: Option<String>,
     /// Checking (`--check`, `--uninit`; the reports come before the view) and
-    /// the schedule of that checked run (`--schedule random --seed N`).
+    /// the warp schedule of the stepped launch (`--schedule random --seed N`).
     #[command(flatten)]
     pub checks: crate::check::cli::CheckArgs,
 }
@@ -84,8 +84,10 @@ pub fn profile(session: &Session, device: Option<&str>) -> Result<Profile, Box<d
 
 /// Runs the command.
 pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let mut session = Session::load_launch(&a.spec, a.launch)?;
+    // `examples/…` from any directory: the checkout's or $WARPLIGHT_HOME's copy when not here
+    let mut session = Session::load_launch(&crate::host::scene_file::data_file(&a.spec), a.launch)?;
     session.max_instructions = a.max_instructions;
+    session.random_seed = a.checks.random_seed();
     crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
     let only = a.warp.as_deref().map(parse_warp).transpose()?;
     let profile = profile(&session, a.device.as_deref())?;
@@ -99,9 +101,29 @@ pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
             profile,
             max_steps: a.max_steps,
         };
-        return tui::run(&session, o);
+        let r = tui::run(&session, o);
+        print_printf(&session, &mut std::io::stdout().lock())?;
+        return r;
     }
     let o = log::LogOptions { breaks, watches: a.watches, only, trace: a.trace, max_steps: a.max_steps };
     let stdout = std::io::stdout();
-    log::run(&session, &o, &mut stdout.lock())
+    let r = log::run(&session, &o, &mut stdout.lock());
+    print_printf(&session, &mut stdout.lock())?;
+    r
+}
+
+/// Writes the stepped launch's `printf` output up to where the last stepping
+/// stopped (the log's last step, the view's position when it closed), after
+/// a header; nothing when the kernel printed nothing.
+pub fn print_printf(session: &Session, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+    let recs = session.printf_output();
+    if recs.is_empty() {
+        return Ok(());
+    }
+    writeln!(out, "printf output of `{}` (by CTA, warp, call, then lane):", session.kernel)?;
+    let mut text = crate::sim::printf::text(&recs);
+    if !text.ends_with('\n') {
+        text.push('\n');
+    }
+    out.write_all(text.as_bytes())
 }

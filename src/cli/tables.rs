@@ -266,17 +266,16 @@ fn measure(a: &TablesArgs) -> Result<Results, Box<dyn std::error::Error>> {
     let (plan, scenes, unavailable) = plan(a)?;
     let threads = rayon::current_num_threads();
     eprint!("{}", plan.describe(&scenes, &unavailable, threads));
-    let bar = bar(plan.units(&scenes));
+    let progress = UnitProgress::new(plan.units(&scenes), plan.protocol.resolution);
     let t0 = std::time::Instant::now();
     let r = run::execute(&plan, &scenes, &unavailable, crate::repro::COMMIT, &mut |p| {
-        if let Some(b) = &bar {
+        if let Some(u) = &progress {
             let frame = p.frame.map(|f| format!(" frame {f}")).unwrap_or_default();
-            b.set_message(format!("{} {}{frame} {}", p.scene, p.group, p.variant));
-            b.inc(1);
+            u.unit_done(format!("{} {}{frame} {}", p.scene, p.group, p.variant));
         }
     });
-    if let Some(b) = bar {
-        b.finish_and_clear();
+    if let Some(u) = progress {
+        u.finish();
     }
     eprintln!("  took {}", run::human(t0.elapsed().as_secs_f64()));
     Ok(r?)
@@ -293,15 +292,101 @@ fn load(names: &[String]) -> (Vec<Scene>, Vec<Unavailable>) {
     (ok, missing)
 }
 
-fn bar(total: u64) -> Option<indicatif::ProgressBar> {
-    std::io::stderr().is_terminal().then(|| {
-        let pb = indicatif::ProgressBar::new(total);
-        pb.set_style(
-            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}, eta {eta}]")
-                .expect("template"),
-        );
-        pb
-    })
+/// The run's progress on a terminal: a bar over its units (a frame of a
+/// variant, or a variant), moved inside a unit by the emulator's progress
+/// hook (the share of the kernels' pixels claimed, else of their CTAs
+/// retired), with an ETA.
+struct UnitProgress {
+    bar: indicatif::ProgressBar,
+    units: u64,
+    /// Each launch in flight (by its device memory's address): the share of it done.
+    running: std::sync::Arc<std::sync::Mutex<std::collections::BTreeMap<usize, f64>>>,
+    done: std::sync::Arc<std::sync::atomic::AtomicU64>,
+}
+
+/// Steps of the bar per unit.
+const STEPS: u64 = 1000;
+
+impl UnitProgress {
+    /// On a terminal only: `units` units whose ray-casting kernels shade `side`² pixels each.
+    fn new(units: u64, side: u32) -> Option<UnitProgress> {
+        if !std::io::stderr().is_terminal() {
+            return None;
+        }
+        let bar = indicatif::ProgressBar::new(units * STEPS);
+        let style = "{bar:30} {percent:>3}% {msg} [{elapsed}, eta {eta}]";
+        bar.set_style(indicatif::ProgressStyle::with_template(style).ok()?);
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        Some(UnitProgress::with_bar(units, side, bar))
+    }
+
+    /// The progress on `bar` (of `units` × [`STEPS`]); the hook of every device made until [`UnitProgress::finish`].
+    fn with_bar(units: u64, side: u32, bar: indicatif::ProgressBar) -> UnitProgress {
+        use std::sync::atomic::Ordering;
+        bar.set_message(format!("0/{units} runs"));
+        let u = UnitProgress { bar, units, running: Default::default(), done: Default::default() };
+        let (bar, running, done) = (u.bar.clone(), u.running.clone(), u.done.clone());
+        let pixels = side as u64 * side as u64;
+        let hook = move |p: &crate::sim::grid::Progress| {
+            let queue = p.memory.allocations().iter().find(|a| a.name == crate::host::rt_kernels::JOB_QUEUE);
+            let share = match queue {
+                Some(q) if pixels > 0 => q.load(0, 4).min(pixels) as f64 / pixels as f64,
+                _ => p.ctas_retired as f64 / p.ctas.max(1) as f64,
+            };
+            let Ok(mut r) = running.lock() else { return };
+            let key = p.memory as *const _ as usize;
+            if share >= 1.0 {
+                r.remove(&key);
+            } else {
+                r.insert(key, share);
+            }
+            let within = (r.values().sum::<f64>() * STEPS as f64) as u64;
+            let at = (done.load(Ordering::Relaxed) * STEPS + within).min((units * STEPS).saturating_sub(1));
+            if at > bar.position() {
+                bar.set_position(at);
+            }
+        };
+        crate::sim::device::set_default_progress(Some(std::sync::Arc::new(hook)));
+        u
+    }
+
+    /// A unit finished: `what` it was.
+    fn unit_done(&self, what: String) {
+        let n = self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if let Ok(mut r) = self.running.lock() {
+            r.clear();
+        }
+        self.bar.set_position((n * STEPS).max(self.bar.position()));
+        self.bar.set_message(format!("{n}/{} runs, last {what}", self.units));
+    }
+
+    fn finish(self) {
+        crate::sim::device::set_default_progress(None);
+        self.bar.finish_and_clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Devices made while the progress is on move its bar within the unit:
+    /// 480 CTAs, 240 resident at a time, half of them retired after the first round.
+    #[test]
+    fn the_emulators_hook_moves_the_bar_within_a_unit() {
+        let u = UnitProgress::with_bar(2, 0, indicatif::ProgressBar::hidden());
+        u.bar.set_length(2 * STEPS);
+        let ptx = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n ret;\n}\n";
+        let mut dev = crate::sim::Device::new();
+        let m = dev.load_ptx(ptx, "k.ptx").unwrap();
+        dev.launch(&m, "k", crate::sim::LaunchConfig::linear(480, 32), &[]).unwrap();
+        // other tests' devices, made in this process while the hook is set, may move it further
+        assert!((STEPS / 2..2 * STEPS).contains(&u.bar.position()), "{}", u.bar.position());
+        u.unit_done("one".into());
+        assert!(u.bar.position() >= STEPS);
+        assert_eq!(u.bar.message(), "1/2 runs, last one");
+        u.finish();
+    }
 }
 
 fn merge(files: &[PathBuf], partial: bool) -> Result<Results, Box<dyn std::error::Error>> {

@@ -47,7 +47,7 @@ pub struct TraceArgs {
     #[arg(long)]
     pub device: Option<String>,
     /// Checking (`--check`, `--uninit`; the reports go to stderr) and the
-    /// schedule of that checked run (`--schedule random --seed N`).
+    /// warp schedule of the recorded launch (`--schedule random --seed N`).
     #[command(flatten)]
     pub checks: crate::check::cli::CheckArgs,
 }
@@ -57,9 +57,11 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.from > a.to {
         return Err(format!("--from {} is after --to {}", a.from, a.to).into());
     }
-    let mut session = Session::load_launch(&a.spec, a.launch)?;
+    // `examples/…` from any directory: the checkout's or $WARPLIGHT_HOME's copy when not here
+    let mut session = Session::load_launch(&crate::host::scene_file::data_file(&a.spec), a.launch)?;
     let profile = crate::cli::step::profile(&session, a.device.as_deref())?;
     session.max_instructions = a.max_instructions;
+    session.random_seed = a.checks.random_seed();
     crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
     let spinner = std::io::stderr().is_terminal().then(|| {
@@ -91,5 +93,6 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
         t.warps.len(),
         if t.truncated { format!(" (cut at --max-events {})", a.max_events) } else { String::new() }
     );
+    crate::cli::step::print_printf(&session, &mut std::io::stdout().lock())?;
     Ok(())
 }

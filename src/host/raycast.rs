@@ -67,6 +67,8 @@ pub struct TraceStats {
     pub tex_node_fetches: u64,
     /// Pushes and pops that touched the local-memory stack (kernels; register-cached entries excluded).
     pub local_stack_accesses: u64,
+    /// Texels fetched from texture maps (one per shaded hit on a textured material).
+    pub texel_fetches: u64,
 }
 
 impl TraceStats {
@@ -83,6 +85,7 @@ impl TraceStats {
         self.pushes += o.pushes;
         self.tex_node_fetches += o.tex_node_fetches;
         self.local_stack_accesses += o.local_stack_accesses;
+        self.texel_fetches += o.texel_fetches;
     }
 }
 
@@ -207,8 +210,9 @@ impl<'a> Caster<'a> {
         st.primary += 1;
         let Some(h) = self.intersect(ray, self.eps, f32::INFINITY, false, st) else { return [0.0; 3] };
         let mut c = self.direct(ray, &h, light_offset, st);
-        let m = &self.scene.materials[self.scene.triangles[h.tri as usize].material as usize];
-        if matches!(m.kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) {
+        // a specular surface (a mirror, or a diffuse one with a specular part) reflects
+        let w = self.scene.reflectance(self.scene.triangles[h.tri as usize].material);
+        if w[0] > 0.0 || w[1] > 0.0 || w[2] > 0.0 {
             let n = self.normal(h.tri, ray.dir);
             let p = ray.origin + ray.dir * h.t;
             let r = Ray { origin: p, dir: (ray.dir - 2.0 * ray.dir.dot(n) * n).normalize() };
@@ -216,7 +220,7 @@ impl<'a> Caster<'a> {
             if let Some(h2) = self.intersect(&r, self.eps, f32::INFINITY, false, st) {
                 let c2 = self.direct(&r, &h2, light_offset, st);
                 for i in 0..3 {
-                    c[i] += m.color[i] * c2[i];
+                    c[i] += w[i] * c2[i];
                 }
             }
         }
@@ -238,11 +242,15 @@ impl<'a> Caster<'a> {
 
     /// Emission plus diffuse direct light from the point lights (one shadow ray each).
     fn direct(&self, ray: &Ray, h: &Hit, light_offset: Vec3, st: &mut TraceStats) -> [f32; 3] {
-        let m = &self.scene.materials[self.scene.triangles[h.tri as usize].material as usize];
+        let mi = self.scene.triangles[h.tri as usize].material;
+        let m = &self.scene.materials[mi as usize];
         let mut c = m.emission;
         if m.kind != MaterialKind::Diffuse {
             return c;
         }
+        // the diffuse colour, through the texture map at the hit's barycentric weights where there is one
+        st.texel_fetches += self.scene.surface(mi).texture.is_some() as u64;
+        let color = self.scene.diffuse_color(mi, h.tri, h.u, h.v);
         let p = ray.origin + ray.dir * h.t;
         let n = self.normal(h.tri, ray.dir);
         for l in &self.scene.lights {
@@ -264,12 +272,12 @@ impl<'a> Caster<'a> {
                 }
                 let g = cos / (dist * dist) / std::f32::consts::PI;
                 for i in 0..3 {
-                    c[i] += m.color[i] * intensity[i] * g;
+                    c[i] += color[i] * intensity[i] * g;
                 }
             }
         }
         // a small ambient term keeps unlit surfaces visible
-        for (ci, mc) in c.iter_mut().zip(m.color) {
+        for (ci, mc) in c.iter_mut().zip(color) {
             *ci += 0.02 * mc;
         }
         c

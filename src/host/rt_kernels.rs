@@ -5,9 +5,10 @@
 //!
 //! The work is counted by the emulator, not the kernel: the plain build
 //! ([`Build::Plain`], what the tables run) has no tallies, and [`line_counts`]
-//! reads rays, inner-node steps, leaf visits, plane and barycentric tests and
-//! local-memory stack pushes and pops off the per-instruction counters of the
-//! source lines tagged `@count` in `raytrace.cu`; a node-cache observer
+//! reads rays (shadow and reflection rays among them), inner-node steps, leaf
+//! visits, plane and barycentric tests, local-memory stack pushes and pops and
+//! texture-map texel fetches off the per-instruction counters of the source
+//! lines tagged `@count` in `raytrace.cu`; a node-cache observer
 //! ([`NodeCacheFetches`]) tells inner nodes from leaves among the shared-memory
 //! node fetches, so that the texture fetches of inner nodes follow. The
 //! instrumented build ([`Build::Instrumented`]) tallies the same quantities in
@@ -353,36 +354,39 @@ pub fn material_table(scene: &Scene) -> Vec<f32> {
     mats
 }
 
-/// Renders `camera`'s view with kernel `variant` under device profile `profile`.
-#[allow(clippy::too_many_arguments)]
-pub fn render(
-    dev: &mut Device,
-    module: &Module,
-    scene: &Scene,
-    tree: &KdTree,
-    camera: &Camera,
-    light_offset: Vec3,
-    variant: Variant,
-    profile: Profile,
-) -> Result<KernelRender, SimError> {
-    render_build(dev, module, Build::Plain, scene, tree, camera, light_offset, variant, profile)
+/// The kernels' surface table: per material `reflection weight r, g, b`
+/// ([`Scene::reflectance`]: a hit on it traces a reflection ray when one is
+/// positive) and its texture's index as the bits of an `i32` (-1: none).
+pub fn surface_table(scene: &Scene) -> Vec<f32> {
+    let mut out = Vec::with_capacity(4 * scene.materials.len());
+    for m in 0..scene.materials.len() as u32 {
+        let w = scene.reflectance(m);
+        let tex = match scene.materials[m as usize].kind {
+            MaterialKind::Diffuse => scene.surface(m).texture.map_or(-1, |t| t as i32),
+            _ => -1,
+        };
+        out.extend_from_slice(&[w[0], w[1], w[2], f32::from_bits(tex as u32)]);
+    }
+    out
 }
 
-/// As [`render`], with `module` loaded from `build` ([`load_build`]).
-#[allow(clippy::too_many_arguments)]
-pub fn render_build(
-    dev: &mut Device,
-    module: &Module,
-    build: Build,
-    scene: &Scene,
-    tree: &KdTree,
-    camera: &Camera,
-    light_offset: Vec3,
-    variant: Variant,
-    profile: Profile,
-) -> Result<KernelRender, SimError> {
-    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let lay = layout(tree, &tris, variant.heap_levels());
+/// The kernels' textures: per texture `[first texel, width, height, 0]`, and
+/// every texture's texels in one array (the thesis stacks its maps in one
+/// 3-D texture, seed 000 L3431).
+pub fn texture_tables(scene: &Scene) -> (Vec<u32>, Vec<u32>) {
+    let mut info = Vec::with_capacity(4 * scene.textures.len());
+    let mut texels = Vec::new();
+    for t in &scene.textures {
+        info.extend_from_slice(&[texels.len() as u32, t.width, t.height, 0]);
+        texels.extend_from_slice(&t.texels);
+    }
+    (info, texels)
+}
+
+/// The kernels' parameter block (`struct Params` in `raytrace.cu`): the
+/// camera, the first point light moved by `light_offset` (none: `has_light`
+/// 0), the tree's bounds, the ray epsilon and the image size.
+pub fn params(scene: &Scene, tree: &KdTree, camera: &Camera, light_offset: Vec3) -> Vec<u8> {
     let (r, u, f) = camera.frame();
     let [w, h] = camera.resolution;
     let npix = w as usize * h as usize; // not w * h in u32: it wraps past 4 Gi pixels
@@ -424,26 +428,122 @@ pub fn render_build(
     for v in [w as i32, h as i32, npix as i32, light.is_some() as i32] {
         params.extend_from_slice(&v.to_le_bytes());
     }
-    let mats = material_table(scene);
+    params
+}
+
+/// Words per pixel of the instrumented build's stats buffer (`STATS_WORDS` in `raytrace.cu`).
+pub const STATS_WORDS: usize = 11;
+
+/// The device buffers of one kernel launch, in the kernels' argument order.
+#[derive(Debug, Clone, Copy)]
+pub struct Buffers {
+    /// Every argument: params, nodes, refs, triangles, material per triangle,
+    /// materials, surfaces, texture coordinates, texture table, texels,
+    /// AABBs, job queue, colour, hit triangle, stats.
+    pub args: [crate::sim::DevicePtr; 15],
+}
+
+impl Buffers {
+    /// The colour buffer (4 floats a pixel).
+    pub fn color(&self) -> crate::sim::DevicePtr {
+        self.args[12]
+    }
+
+    /// The primary hit triangle of each pixel.
+    pub fn hit(&self) -> crate::sim::DevicePtr {
+        self.args[13]
+    }
+
+    /// The instrumented build's tallies ([`STATS_WORDS`] a pixel).
+    pub fn stats(&self) -> crate::sim::DevicePtr {
+        self.args[14]
+    }
+
+    /// As launch arguments.
+    pub fn launch_args(&self) -> Vec<Arg> {
+        self.args.iter().copied().map(Arg::Ptr).collect()
+    }
+}
+
+/// Uploads what kernel `variant` reads to render `camera`'s view of `scene`
+/// over `tree` (laid out as `lay`), and allocates its outputs.
+pub fn upload_scene(
+    dev: &mut Device,
+    scene: &Scene,
+    tree: &KdTree,
+    lay: &crate::host::kdtree::layout::DeviceTree,
+    camera: &Camera,
+    light_offset: Vec3,
+) -> Result<Buffers, SimError> {
+    let npix = camera.resolution[0] as usize * camera.resolution[1] as usize;
     let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
+    let uvs: Vec<f32> = if scene.uvs.is_empty() {
+        Vec::new()
+    } else {
+        (0..scene.triangles.len() as u32).flat_map(|t| scene.uv(t).into_iter().flatten()).collect()
+    };
+    let (tex_info, texels) = texture_tables(scene);
     let up = upload;
-    let pp = up(dev, &params, "params")?;
-    let nodes = up(dev, &lay.nodes, "nodes")?;
-    let refs = up(dev, &lay.tri_refs, "tri_refs")?;
-    let tb = up(dev, &lay.triangles, "triangles")?;
-    let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
-    let mb = up(dev, &to_bytes(&mats), "materials")?;
-    let ab = up(dev, &lay.aabbs, "aabbs")?;
-    let next = up(dev, &[0; 4], JOB_QUEUE)?;
-    let color = dev.alloc_zeroed::<f32>(4 * npix);
-    let hit = dev.alloc_zeroed::<i32>(npix);
-    let stats = dev.alloc_zeroed::<u32>(8 * npix);
+    Ok(Buffers {
+        args: [
+            up(dev, &params(scene, tree, camera, light_offset), "params")?,
+            up(dev, &lay.nodes, "nodes")?,
+            up(dev, &lay.tri_refs, "tri_refs")?,
+            up(dev, &lay.triangles, "triangles")?,
+            up(dev, &to_bytes(&tri_mat), "tri_mat")?,
+            up(dev, &to_bytes(&material_table(scene)), "materials")?,
+            up(dev, &to_bytes(&surface_table(scene)), "surfaces")?,
+            up(dev, &to_bytes(&uvs), "uvs")?,
+            up(dev, &to_bytes(&tex_info), "tex_info")?,
+            up(dev, &to_bytes(&texels), "texels")?,
+            up(dev, &lay.aabbs, "aabbs")?,
+            up(dev, &[0; 4], JOB_QUEUE)?,
+            dev.alloc_zeroed::<f32>(4 * npix),
+            dev.alloc_zeroed::<i32>(npix),
+            dev.alloc_zeroed::<u32>(STATS_WORDS * npix),
+        ],
+    })
+}
+
+/// Renders `camera`'s view with kernel `variant` under device profile `profile`.
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    dev: &mut Device,
+    module: &Module,
+    scene: &Scene,
+    tree: &KdTree,
+    camera: &Camera,
+    light_offset: Vec3,
+    variant: Variant,
+    profile: Profile,
+) -> Result<KernelRender, SimError> {
+    render_build(dev, module, Build::Plain, scene, tree, camera, light_offset, variant, profile)
+}
+
+/// As [`render`], with `module` loaded from `build` ([`load_build`]).
+#[allow(clippy::too_many_arguments)]
+pub fn render_build(
+    dev: &mut Device,
+    module: &Module,
+    build: Build,
+    scene: &Scene,
+    tree: &KdTree,
+    camera: &Camera,
+    light_offset: Vec3,
+    variant: Variant,
+    profile: Profile,
+) -> Result<KernelRender, SimError> {
+    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let lay = layout(tree, &tris, variant.heap_levels());
+    let [w, h] = camera.resolution;
+    let npix = w as usize * h as usize;
+    let bufs = upload_scene(dev, scene, tree, &lay, camera, light_offset)?;
     let model = Model::new(profile, &module.prog);
     let cache = NodeCacheFetches::new(&model, &module.prog, &lay.nodes);
-    let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, ab, next, color, hit, stats].into_iter().map(Arg::Ptr).collect();
+    let args = bufs.launch_args();
     let launch =
         dev.launch_observed(module, variant.kernel(), LaunchConfig::linear(CTAS, THREADS), &args, Some(&cache))?;
-    let rgba = dev.read::<f32>(color, 4 * npix);
+    let rgba = dev.read::<f32>(bufs.color(), 4 * npix);
     let mut image = FrameBuffer::new(w, h);
     for (i, px) in rgba.chunks_exact(4).enumerate() {
         image.pixels[i] = [px[0], px[1], px[2]];
@@ -452,8 +552,8 @@ pub fn render_build(
     let counted = build == Build::Instrumented || dev.config().fidelity >= crate::sim::Fidelity::Instructions;
     match build {
         Build::Instrumented => {
-            let st = dev.read::<u32>(stats, 8 * npix);
-            for s in st.chunks_exact(8) {
+            let st = dev.read::<u32>(bufs.stats(), STATS_WORDS * npix);
+            for s in st.chunks_exact(STATS_WORDS) {
                 trace.inner_nodes += s[0] as u64;
                 trace.leaves += s[1] as u64;
                 trace.plane_tests += s[2] as u64;
@@ -461,6 +561,10 @@ pub fn render_build(
                 trace.rays += s[4] as u64;
                 trace.tex_node_fetches += s[5] as u64;
                 trace.local_stack_accesses += s[6] as u64;
+                trace.shadow += s[7] as u64;
+                trace.reflection += s[8] as u64;
+                trace.texel_fetches += s[9] as u64;
+                trace.pushes += s[10] as u64;
             }
         }
         Build::Plain if !counted => {}
@@ -473,11 +577,22 @@ pub fn render_build(
             trace.plane_tests = get("planes");
             trace.barycentric_tests = get("barys");
             trace.local_stack_accesses = get("push") + get("pop");
+            trace.pushes = get("push");
+            trace.shadow = get("shadow");
+            trace.reflection = get("reflection");
+            trace.texel_fetches = get("texels");
             trace.tex_node_fetches = trace.inner_nodes - cache.served().min(trace.inner_nodes);
         }
     }
     trace.primary = npix as u64;
-    Ok(KernelRender { image, hit_tri: dev.read::<i32>(hit, npix), trace, counted, launch, memory: model.finish() })
+    Ok(KernelRender {
+        image,
+        hit_tri: dev.read::<i32>(bufs.hit(), npix),
+        trace,
+        counted,
+        launch,
+        memory: model.finish(),
+    })
 }
 
 /// Allocates a buffer named `name` holding `bytes` (at least 4 bytes, so that

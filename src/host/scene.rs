@@ -83,6 +83,51 @@ impl Triangle {
     }
 }
 
+/// A texture map: 8-bit RGB texels packed `r | g << 8 | b << 16 | 255 << 24`,
+/// row by row from the top of the image (texture coordinate v = 1) down.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texture {
+    /// The file it was read from, relative to the scene file.
+    pub name: String,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// The texels, `width * height` of them.
+    pub texels: Vec<u32>,
+}
+
+impl Texture {
+    /// The texel that texture coordinates (`u`, `v`) fall in: nearest texel,
+    /// repeated outside [0, 1), v = 0 the bottom row. The ray-tracing kernel
+    /// (`direct` in `kernels/fabianowski2011/raytrace.cu`) computes the same
+    /// float and integer operations.
+    pub fn index(width: u32, height: u32, u: f32, v: f32) -> usize {
+        let x = (u * width as f32).floor() as i32;
+        let y = ((1.0 - v) * height as f32).floor() as i32;
+        (y.rem_euclid(height as i32) as u32 * width + x.rem_euclid(width as i32) as u32) as usize
+    }
+
+    /// The colour of the texel at (`u`, `v`) ([`Texture::index`]), each channel in [0, 1].
+    pub fn sample(&self, u: f32, v: f32) -> [f32; 3] {
+        let t = self.texels[Texture::index(self.width, self.height, u, v)];
+        [(t & 255) as f32 / 255.0, ((t >> 8) & 255) as f32 / 255.0, ((t >> 16) & 255) as f32 / 255.0]
+    }
+}
+
+/// What thesis 000's ray tracer reads of a material beside its [`MaterialKind`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Surface {
+    /// The diffuse texture map (index into [`Scene::textures`]); the diffuse
+    /// colour is the material's colour times the texel's.
+    pub texture: Option<u32>,
+    /// A diffuse material's specular part: the weight per channel of a mirror
+    /// reflection added to its diffuse shading (an MTL `Ks` beside a non-zero
+    /// `Kd` where `illum` is 3 to 7, the models that trace reflections, or a
+    /// scene file's `[[reflect]]`).
+    pub reflect: [f32; 3],
+}
+
 /// What thesis 000 Table A.1 says of a scene.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ThesisScene {
@@ -115,6 +160,12 @@ pub struct Scene {
     pub thesis: Option<ThesisScene>,
     /// How this variant differs from the thesis'.
     pub variant: String,
+    /// Texture maps.
+    pub textures: Vec<Texture>,
+    /// Per material, its texture and specular part (a material past the end has neither).
+    pub surfaces: Vec<Surface>,
+    /// Per triangle, the texture coordinates of its three vertices (empty: none).
+    pub uvs: Vec<[[f32; 2]; 3]>,
 }
 
 impl Scene {
@@ -154,6 +205,46 @@ impl Scene {
             dropped_degenerate: dropped,
             thesis: None,
             variant: String::new(),
+            textures: Vec::new(),
+            surfaces: Vec::new(),
+            uvs: Vec::new(),
         }
+    }
+
+    /// Material `m`'s texture and specular part.
+    pub fn surface(&self, m: u32) -> Surface {
+        self.surfaces.get(m as usize).copied().unwrap_or_default()
+    }
+
+    /// The weight per channel of the mirror reflection a surface of material
+    /// `m` adds: a mirror's (or glass') colour, a diffuse material's specular
+    /// part, zero for emitters. A hit reflects when any channel is positive.
+    pub fn reflectance(&self, m: u32) -> [f32; 3] {
+        let mat = &self.materials[m as usize];
+        match mat.kind {
+            MaterialKind::Mirror | MaterialKind::Glass { .. } => mat.color,
+            MaterialKind::Diffuse => self.surface(m).reflect,
+            MaterialKind::Emitter => [0.0; 3],
+        }
+    }
+
+    /// Texture coordinates of triangle `t`'s vertices (zero when the scene has none).
+    pub fn uv(&self, t: u32) -> [[f32; 2]; 3] {
+        self.uvs.get(t as usize).copied().unwrap_or_default()
+    }
+
+    /// The diffuse colour of material `m` at barycentric weights (`u`, `v`)
+    /// of vertices 1 and 2 of triangle `t`: the material's colour, times its
+    /// texture's texel where it has one. The ray-tracing kernel computes the
+    /// same operations in the same order.
+    pub fn diffuse_color(&self, m: u32, t: u32, u: f32, v: f32) -> [f32; 3] {
+        let col = self.materials[m as usize].color;
+        let Some(tex) = self.surface(m).texture.and_then(|i| self.textures.get(i as usize)) else { return col };
+        let uv = self.uv(t);
+        let w = 1.0 - u - v;
+        let tu = w * uv[0][0] + u * uv[1][0] + v * uv[2][0];
+        let tv = w * uv[0][1] + u * uv[1][1] + v * uv[2][1];
+        let s = tex.sample(tu, tv);
+        [col[0] * s[0], col[1] * s[1], col[2] * s[2]]
     }
 }

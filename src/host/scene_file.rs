@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::camera::{Camera, Flight};
 use super::procedural;
-use super::scene::{Light, Material, MaterialKind, Scene, ThesisScene, Triangle};
+use super::scene::{Light, Material, MaterialKind, Scene, Surface, Texture, ThesisScene, Triangle};
 
 /// A scene file that could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -193,6 +193,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         return cx.err("scale", "must not be zero");
     }
     let translate = Vec3::from(cx.vec3(&t, "translate", "", Some([0.0; 3]))?);
+    let mut extra = ObjExtras::default();
     let tris = match (t.get("obj"), t.get("procedural")) {
         (Some(_), Some(_)) => return cx.err("obj", "give either `obj` or `procedural`, not both"),
         (None, None) => return cx.err("obj", "missing; expected `obj = \"file.obj\"` or `procedural = \"scene6\"`"),
@@ -221,12 +222,38 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         }
         (Some(o), None) => {
             let Some(rel) = o.as_str() else { return cx.err("obj", "expected a file name") };
-            load_obj(&cx, &dir.join(rel), &t, &mut materials)?
+            load_obj(&cx, &dir.join(rel), &t, &mut materials, &mut extra)?
         }
     };
     let tris: Vec<Triangle> =
         tris.into_iter().map(|tr| Triangle { v: tr.v.map(|p| p * scale + translate), material: tr.material }).collect();
+    // texture coordinates of the triangles `assemble` keeps (it drops those of zero area)
+    let uvs: Vec<[[f32; 2]; 3]> = if extra.uvs.is_empty() {
+        Vec::new()
+    } else {
+        tris.iter().zip(&extra.uvs).filter(|(tr, _)| tr.double_area() > 0.0).map(|(_, uv)| *uv).collect()
+    };
+    for (i, r) in cx.tables(&t, "reflect")?.into_iter().enumerate() {
+        let p = format!("reflect[{i}].");
+        let Some(name) = r.get("material").and_then(|v| v.as_str()) else {
+            return cx.err(&format!("{p}material"), "missing; expected the name of a material");
+        };
+        let Some(m) = by_name(&materials, name) else {
+            return cx.err(&format!("{p}material"), format!("no material named `{name}`"));
+        };
+        if materials[m as usize].kind != MaterialKind::Diffuse {
+            return cx.err(&format!("{p}material"), format!("`{name}` is not diffuse"));
+        }
+        let w = cx.vec3(r, "weight", &p, None)?;
+        if w.iter().any(|&x| !(0.0..=1.0).contains(&x)) {
+            return cx.err(&format!("{p}weight"), "expected weights between 0 and 1");
+        }
+        extra.surface(m as usize).reflect = w;
+    }
     let mut scene = Scene::assemble(&name, path, tris, materials);
+    scene.textures = extra.textures;
+    scene.surfaces = extra.surfaces;
+    scene.uvs = uvs;
     scene.variant = t.get("variant").and_then(|v| v.as_str()).unwrap_or("").to_string();
     if let Some(th) = cx.table(&t, "thesis")? {
         let triangles = match th.get("triangles").and_then(|v| v.as_integer()) {
@@ -323,12 +350,54 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     Ok(scene)
 }
 
-/// Loads an OBJ (polygons split as fans) with its MTL materials where present.
+/// What an OBJ brings beside triangles and materials.
+#[derive(Default)]
+struct ObjExtras {
+    /// Texture maps, one per file.
+    textures: Vec<Texture>,
+    /// Per material index, its texture and specular part.
+    surfaces: Vec<Surface>,
+    /// Per triangle, its vertices' texture coordinates (empty when the OBJ has none).
+    uvs: Vec<[[f32; 2]; 3]>,
+}
+
+impl ObjExtras {
+    fn surface(&mut self, m: usize) -> &mut Surface {
+        if self.surfaces.len() <= m {
+            self.surfaces.resize(m + 1, Surface::default());
+        }
+        &mut self.surfaces[m]
+    }
+
+    /// The texture read from `file` (relative to the OBJ's folder), read once.
+    fn texture(&mut self, cx: &Cx, dir: &Path, file: &str) -> Result<u32, SceneError> {
+        if let Some(i) = self.textures.iter().position(|t| t.name == file) {
+            return Ok(i as u32);
+        }
+        let path = dir.join(file);
+        let img = image::open(&path)
+            .map_err(|e| SceneError {
+                file: cx.file.into(),
+                key: "obj".into(),
+                msg: format!("{}: {e}", path.display()),
+            })?
+            .to_rgb8();
+        let (width, height) = img.dimensions();
+        let texels = img.pixels().map(|p| p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | 255 << 24).collect();
+        self.textures.push(Texture { name: file.to_string(), width, height, texels });
+        Ok(self.textures.len() as u32 - 1)
+    }
+}
+
+/// Loads an OBJ (polygons split as fans) with its MTL materials where present:
+/// their diffuse texture maps (`map_Kd`) and texture coordinates, and the
+/// specular part (`Ks`) of diffuse ones.
 fn load_obj(
     cx: &Cx,
     path: &PathBuf,
     t: &toml::Table,
     materials: &mut Vec<Material>,
+    extra: &mut ObjExtras,
 ) -> Result<Vec<Triangle>, SceneError> {
     let opts = tobj::LoadOptions { triangulate: true, single_index: false, ..Default::default() };
     if path.exists() && !path.is_file() {
@@ -376,15 +445,18 @@ fn load_obj(
     if !materials.iter().any(|m| m.name == default) {
         return cx.err("default_material", format!("no material named `{default}`"));
     }
-    let mut index = |name: &str, mtl_mat: Option<&tobj::Material>| -> u32 {
+    let obj_dir = path.parent().unwrap_or(Path::new("."));
+    let mut index = |name: &str, mtl_mat: Option<&tobj::Material>| -> Result<u32, SceneError> {
         if let Some(i) = materials.iter().position(|m| m.name == name) {
-            return i as u32;
+            return Ok(i as u32);
         }
         let m = mtl_mat.expect("only MTL materials are added on demand");
         let kd = m.diffuse.unwrap_or([0.75; 3]);
         let ks = m.specular.unwrap_or([0.0; 3]);
         let ke = m.emissive.unwrap_or([0.0; 3]);
-        // MTL: emissive (Ke) makes an emitter; purely specular (Kd = 0, Ks > 0) a mirror tinted by Ks
+        // MTL: emissive (Ke) makes an emitter; purely specular (Kd = 0, Ks > 0) a mirror tinted by Ks;
+        // otherwise diffuse, with its map_Kd as texture and, where its illumination model traces
+        // reflections (illum 3 to 7), its Ks as the weight of a mirror reflection
         let (kind, color) = if ke.iter().any(|&x| x > 0.0) {
             (MaterialKind::Emitter, kd)
         } else if kd.iter().all(|&x| x < 0.01) && ks.iter().any(|&x| x > 0.0) {
@@ -393,9 +465,19 @@ fn load_obj(
             (MaterialKind::Diffuse, kd)
         };
         materials.push(Material { name: name.to_string(), kind, color, emission: ke });
-        (materials.len() - 1) as u32
+        let i = materials.len() - 1;
+        if kind == MaterialKind::Diffuse {
+            let texture = match &m.diffuse_texture {
+                Some(f) => Some(extra.texture(cx, obj_dir, f)?),
+                None => None,
+            };
+            let traced = m.illumination_model.is_some_and(|n| (3..=7).contains(&n));
+            *extra.surface(i) = Surface { texture, reflect: if traced { ks } else { [0.0; 3] } };
+        }
+        Ok(i as u32)
     };
     let mut out = Vec::new();
+    let mut uvs = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
         let mtl_mat = mesh.material_id.and_then(|i| mtl.get(i));
@@ -405,7 +487,7 @@ fn load_obj(
             .cloned()
             .or_else(|| mtl_mat.map(|m| m.name.clone()))
             .unwrap_or_else(|| default.clone());
-        let mi = index(&mat_name, mtl_mat);
+        let mi = index(&mat_name, mtl_mat)?;
         let p = |i: u32| {
             Vec3::new(
                 mesh.positions[3 * i as usize],
@@ -413,9 +495,24 @@ fn load_obj(
                 mesh.positions[3 * i as usize + 2],
             )
         };
-        for f in mesh.indices.chunks_exact(3) {
+        let uv = |i: u32| {
+            let i = 2 * i as usize;
+            mesh.texcoords.get(i..i + 2).map_or([0.0; 2], |c| [c[0], c[1]])
+        };
+        let has_uv = mesh.texcoord_indices.len() == mesh.indices.len();
+        for (n, f) in mesh.indices.chunks_exact(3).enumerate() {
             out.push(Triangle { v: [p(f[0]), p(f[1]), p(f[2])], material: mi });
+            uvs.push(if has_uv {
+                let c = &mesh.texcoord_indices[3 * n..3 * n + 3];
+                [uv(c[0]), uv(c[1]), uv(c[2])]
+            } else {
+                [[0.0; 2]; 3]
+            });
         }
+    }
+    // texture coordinates matter only where a texture is
+    if !extra.textures.is_empty() {
+        extra.uvs = uvs;
     }
     Ok(out)
 }

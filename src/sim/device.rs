@@ -322,6 +322,18 @@ impl Module {
     }
 }
 
+/// The progress hook every new device starts with ([`set_default_progress`]).
+static DEFAULT_PROGRESS: std::sync::RwLock<Option<super::grid::ProgressHook>> = std::sync::RwLock::new(None);
+
+/// Sets the progress hook ([`Device::set_progress`]) of every device made
+/// from now on: for callers whose launches run on devices that code below
+/// them makes (`tables`, through the reproductions).
+pub fn set_default_progress(hook: Option<super::grid::ProgressHook>) {
+    if let Ok(mut h) = DEFAULT_PROGRESS.write() {
+        *h = hook;
+    }
+}
+
 /// A simulated GPU: memory plus a host thread pool.
 pub struct Device {
     mem: DeviceMemory,
@@ -355,7 +367,7 @@ impl Device {
             pool,
             sizes: HashMap::new(),
             printf: Default::default(),
-            progress: None,
+            progress: DEFAULT_PROGRESS.read().ok().and_then(|h| h.clone()),
             textures: Vec::new(),
         }
     }

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::launch_spec::{self, BufferSpec, ElemType, Spec};
 use crate::model::Profile;
 use crate::sim::access_log::AccessLog;
+use crate::sim::printf::PrintfRecord;
 use crate::sim::stepper::Stepper;
 use crate::sim::{Device, DevicePtr, LaunchConfig};
 
@@ -23,6 +24,13 @@ pub struct Session {
     /// The watchdog (warp instructions per launch) over the spec's
     /// `max_instructions`, when given (`--max-instructions`).
     pub max_instructions: Option<u64>,
+    /// The random warp schedule's seed (`--schedule random --seed N`): the
+    /// stepped launch interleaves its warps as `launch --schedule random`
+    /// does with that seed. `None`: the default schedule.
+    pub random_seed: Option<u64>,
+    /// The `printf` output of the stepped launch during the last stepping
+    /// ([`Session::with_stepper`]), in the deterministic order.
+    printf: std::sync::Mutex<Vec<PrintfRecord>>,
 }
 
 /// Errors of the teaching views.
@@ -50,7 +58,14 @@ impl Session {
             .into());
         }
         let kernel = spec.launches[n - 1].kernel.clone();
-        Ok(Session { spec, launch: n - 1, kernel, max_instructions: None })
+        Ok(Session {
+            spec,
+            launch: n - 1,
+            kernel,
+            max_instructions: None,
+            random_seed: None,
+            printf: Default::default(),
+        })
     }
 
     /// The stepped launch's spec.
@@ -83,7 +98,9 @@ impl Session {
         &self,
         f: impl FnOnce(&mut Stepper, &Buffers) -> Result<R, Error>,
     ) -> Result<R, Error> {
-        let mut dev = Device::with_config(self.spec.sim_config(0, self.max_instructions));
+        let mut config = self.spec.sim_config(0, self.max_instructions);
+        config.schedule.random_seed = self.random_seed;
+        let mut dev = Device::with_config(config);
         let prepared = launch_spec::prepare(&self.spec, &mut dev)?;
         let config =
             |l: &launch_spec::LaunchSpec| LaunchConfig { grid: l.grid, block: l.block, dynamic_shared: l.shared };
@@ -96,8 +113,19 @@ impl Session {
         let cfg = config(l);
         let log = AccessLog::new();
         let mut st = dev.stepper_logged(&prepared.module, &l.kernel, cfg, &args, &log)?;
+        // the launches before it printed before it
+        dev.take_printf();
         let buffers = Buffers { dev: &dev, list: &prepared.buffers, order: &self.spec.buffers };
-        f(&mut st, &buffers)
+        let r = f(&mut st, &buffers);
+        *self.printf.lock().unwrap_or_else(|e| e.into_inner()) = dev.take_printf();
+        r
+    }
+
+    /// The `printf` output of the stepped launch's instructions issued in the
+    /// last stepping ([`Session::with_stepper`]: up to where the view or log
+    /// stopped), in the order of `crate::sim::printf` (CTA, warp, call, lane).
+    pub fn printf_output(&self) -> Vec<PrintfRecord> {
+        self.printf.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 }
 

@@ -5,11 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-/// The temporary name of `file` while it is written: `.NAME.warplight-tmp` beside it.
-fn temporary(file: &Path) -> PathBuf {
-    let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    file.with_file_name(format!(".{name}.warplight-tmp"))
-}
+use crate::cli::interrupt::{Temporary, commit};
 
 /// An error unless each file can be made: a file name, in an existing folder.
 pub fn check_paths<'a>(files: impl IntoIterator<Item = &'a Path>) -> Result<(), String> {
@@ -25,31 +21,18 @@ pub fn check_paths<'a>(files: impl IntoIterator<Item = &'a Path>) -> Result<(), 
     Ok(())
 }
 
-/// Writes every `(file, bytes)`, or none of them.
+/// Writes every `(file, bytes)`, or none of them: each under its temporary
+/// name ([`crate::cli::interrupt::temporary_name`]), then all renamed.
 pub fn write_all(files: &[(PathBuf, Vec<u8>)]) -> Result<(), String> {
-    let mut written: Vec<PathBuf> = Vec::new();
-    let clean = |written: &[PathBuf]| {
-        for t in written {
-            let _ = std::fs::remove_file(t);
-        }
-    };
+    let mut written: Vec<(Temporary, &Path)> = Vec::new();
     for (file, bytes) in files {
-        let tmp = temporary(file);
-        if let Err(e) = std::fs::write(&tmp, bytes) {
-            let _ = std::fs::remove_file(&tmp);
-            clean(&written);
-            return Err(format!("{}: {e}", file.display()));
-        }
-        written.push(tmp);
+        // on an error the temporaries written so far are dropped, which removes them
+        let mut t = Temporary::create(file).map_err(|e| format!("{}: {e}", file.display()))?;
+        t.write_all(bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+        written.push((t, file));
     }
-    for (i, (file, _)) in files.iter().enumerate() {
-        if let Err(e) = std::fs::rename(&written[i], file) {
-            // the files renamed before this one are complete dumps of this run; the rest are removed
-            clean(&written[i..]);
-            return Err(format!("{}: {e}", file.display()));
-        }
-    }
-    Ok(())
+    // the files renamed before a failing one are complete dumps of this run; the rest are removed
+    commit(written).map_err(|(f, e)| format!("{}: {e}", f.display()))
 }
 
 #[cfg(test)]
@@ -67,10 +50,10 @@ mod tests {
         std::fs::remove_file(&a).unwrap();
         // the second file cannot be written (its name is a folder): neither is left, nor a temporary
         std::fs::create_dir_all(d.join("dir.bin")).unwrap();
-        std::fs::create_dir_all(temporary(&d.join("dir.bin"))).unwrap();
+        std::fs::create_dir_all(crate::cli::interrupt::temporary_name(&d.join("dir.bin"))).unwrap();
         let r = write_all(&[(a.clone(), vec![1]), (d.join("dir.bin"), vec![2])]);
         assert!(r.is_err());
-        assert!(!a.exists() && !temporary(&a).exists());
+        assert!(!a.exists() && !crate::cli::interrupt::temporary_name(&a).exists());
         assert!(check_paths([d.join("x/y.bin").as_path()]).unwrap_err().contains("does not exist"));
         assert!(check_paths([d.join("dir.bin").as_path()]).unwrap_err().contains("expected a file name"));
         assert!(check_paths([a.as_path()]).is_ok());

@@ -1,14 +1,16 @@
 //! Runs `kernels/lin2017/path.cu` on the emulator: uploads the laid-out
 //! scene once, launches `path_frame` once per frame (one thread per path,
 //! 256-thread CTAs) and keeps the accumulation buffer on the device across
-//! launches; the counters of every launch are summed.
+//! launches; the counters of every launch are summed, and the traversal
+//! events of the `@count` lines read off each launch's profile.
 
+use super::counts::{self, Counts};
 use super::layout::PathScene;
 use super::{FrameParams, Progressive, eps_for, frame_of};
 use crate::host::camera::Camera;
 use crate::host::rt_kernels::upload;
 use crate::sim::device::to_bytes;
-use crate::sim::{Arg, Counters, Device, LaunchConfig, Module, SimConfig, SimError};
+use crate::sim::{Arg, Counters, Device, Fidelity, LaunchConfig, Module, SimConfig, SimError};
 
 /// The kernel's PTX (clang-16), compiled in.
 pub const PTX: &str = include_str!("../../../kernels/lin2017/path.ptx");
@@ -52,6 +54,7 @@ pub fn params_bytes(scene: &PathScene, camera: &Camera, params: &FrameParams, fr
         params.max_bounces as i32,
         scene.lights.len() as i32,
         params.seed as i32,
+        params.traversal.code(),
     ] {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
@@ -65,6 +68,9 @@ pub struct KernelRender {
     pub image: Progressive,
     /// The emulator's counters summed over the frames' launches.
     pub totals: Counters,
+    /// The traversal events read off the `@count` lines, when the fidelity
+    /// counts instructions (`instructions` or above).
+    pub counts: Option<Counts>,
 }
 
 /// Renders `frames` frames of `camera`'s view on `dev` (with `module` loaded
@@ -93,17 +99,25 @@ pub fn render(
     let db = upload(dev, &to_bytes(&flat(&scene.tri_data)), "tri_data")?;
     let mb = upload(dev, &to_bytes(&mats), "materials")?;
     let lb = upload(dev, &to_bytes(&lights), "lights")?;
+    let boxes: Vec<f32> = scene.up.iter().flatten().copied().collect();
+    let bb = upload(dev, &to_bytes(&boxes), "boxes")?;
     let n = params.paths() * 3;
     let accum = dev.alloc_zeroed::<f32>(n);
     let last = dev.alloc_zeroed::<f32>(n);
-    let args: Vec<Arg> = [pp, nb, rb, tb, db, mb, lb, accum, last].into_iter().map(Arg::Ptr).collect();
+    let args: Vec<Arg> = [pp, nb, rb, tb, db, mb, lb, bb, accum, last].into_iter().map(Arg::Ptr).collect();
     let ctas = params.paths().div_ceil(THREADS as usize) as u32;
     let mut out = Progressive::new(params.width, params.height);
     let mut totals = Counters::default();
+    let counted = dev.config().fidelity >= Fidelity::Instructions;
+    let tags = counts::tags();
+    let mut events = Counts::default();
     for f in 0..frames {
         dev.write(pp, &params_bytes(scene, camera, &params, f))?;
         let st = dev.launch(module, KERNEL, LaunchConfig::linear(ctas, THREADS), &args)?;
         totals.merge(&st.totals);
+        if counted {
+            events.add(&Counts::from_tags(&counts::tagged(&module.prog, &st.profile, &tags)));
+        }
         out.frames += 1;
         if keep_frames {
             out.frame_images.push(Progressive::pixels_of(params.width, params.height, &dev.read::<f32>(last, n)));
@@ -111,5 +125,5 @@ pub fn render(
         progress(f + 1);
     }
     out.accum = dev.read::<f32>(accum, n);
-    Ok(KernelRender { image: out, totals })
+    Ok(KernelRender { image: out, totals, counts: counted.then_some(events) })
 }

@@ -14,7 +14,7 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::host::kdtree::{KdTree, Node};
+use crate::host::kdtree::{Aabb, KdTree, Node};
 use crate::host::scene::{MaterialKind, Scene};
 
 /// The leaf's axis value.
@@ -53,6 +53,10 @@ pub fn kind_code(k: MaterialKind) -> u32 {
 pub struct PathScene {
     /// 16-byte nodes.
     pub nodes: Vec<[u32; 4]>,
+    /// Per node, for kd-backtrack (Foley and Sugerman 2005): its box and its
+    /// parent, `[lo.x, lo.y, lo.z, parent (u32 bits), hi.x, hi.y, hi.z, 0]`
+    /// (the root is its own parent).
+    pub up: Vec<[f32; 8]>,
     /// Leaf triangle lists, concatenated.
     pub refs: Vec<u32>,
     /// Per triangle, three rows (x, y, z, w) of the affine transform into unit-triangle space.
@@ -100,21 +104,27 @@ impl PathScene {
             return Err(LayoutError::TooManyNodes(tree.nodes.len()));
         }
         let mut nodes = Vec::with_capacity(tree.nodes.len());
+        let mut up = Vec::with_capacity(tree.nodes.len());
         let mut refs = Vec::with_capacity(tree.tri_refs.len());
-        // depth first, left child first: (tree node, slot of the parent's right field to patch)
-        let mut todo: Vec<(u32, Option<usize>)> = vec![(0, None)];
-        while let Some((ti, patch)) = todo.pop() {
+        // depth first, left child first: (tree node, its parent's slot, whether
+        // it is the right child (the parent's right field to patch), its box)
+        let mut todo: Vec<(u32, usize, bool, Aabb)> = vec![(0, 0, false, tree.bounds)];
+        while let Some((ti, parent, is_right, b)) = todo.pop() {
             let at = nodes.len();
-            if let Some(p) = patch {
-                let parent: &mut [u32; 4] = &mut nodes[p];
-                parent[2] = at as u32;
+            if is_right {
+                let p: &mut [u32; 4] = &mut nodes[parent];
+                p[2] = at as u32;
             }
+            up.push([b.lo.x, b.lo.y, b.lo.z, f32::from_bits(parent as u32), b.hi.x, b.hi.y, b.hi.z, 0.0]);
             match tree.nodes[ti as usize] {
                 Node::Inner { axis, split, left, right } => {
                     // the left child is the next node
                     nodes.push([(axis as u32) << 30 | (at as u32 + 1), split.to_bits(), 0, 0]);
-                    todo.push((right, Some(at)));
-                    todo.push((left, None));
+                    let (mut bl, mut br) = (b, b);
+                    bl.hi[axis as usize] = split;
+                    br.lo[axis as usize] = split;
+                    todo.push((right, at, true, br));
+                    todo.push((left, at, false, bl));
                 }
                 Node::Leaf { first, count } => {
                     if count as usize > MAX_LEAF {
@@ -171,6 +181,7 @@ impl PathScene {
             .collect();
         Ok(PathScene {
             nodes,
+            up,
             refs,
             tris,
             tri_data,

@@ -8,6 +8,8 @@
 //! per pixel per frame). [`stats`] compares renders with a reference by a
 //! per-block Welch t-test under Holm's correction.
 
+pub mod build;
+pub mod counts;
 pub mod kernel;
 pub mod layout;
 pub mod native;
@@ -63,6 +65,56 @@ impl Integrator {
     }
 }
 
+/// The kd-tree traversal (§3.4, Fig. 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum Traversal {
+    /// The 8-byte short stack of Santos et al. (entries {node, tfar}).
+    ShortStack,
+    /// kd-restart (Foley and Sugerman 2005): no stack, a leaf without a hit
+    /// restarts the descent at the root from its exit.
+    Restart,
+    /// kd-backtrack (Foley and Sugerman 2005): no stack, a leaf without a hit
+    /// climbs the parent links to the first node whose box reaches past its exit.
+    Backtrack,
+}
+
+impl Traversal {
+    /// Every traversal, in Fig. 3's row order.
+    pub const ALL: [Traversal; 3] = [Traversal::ShortStack, Traversal::Restart, Traversal::Backtrack];
+
+    /// The kernel's code.
+    pub fn code(self) -> i32 {
+        match self {
+            Traversal::ShortStack => 0,
+            Traversal::Restart => 1,
+            Traversal::Backtrack => 2,
+        }
+    }
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Traversal::ShortStack => "short-stack",
+            Traversal::Restart => "restart",
+            Traversal::Backtrack => "backtrack",
+        }
+    }
+
+    /// As Fig. 3 names its rows.
+    pub fn label(self) -> &'static str {
+        match self {
+            Traversal::ShortStack => "8-byte stack",
+            Traversal::Restart => "Kd-restart",
+            Traversal::Backtrack => "Kd-backtrack",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn parse(s: &str) -> Option<Traversal> {
+        Traversal::ALL.into_iter().find(|t| t.name() == s)
+    }
+}
+
 /// Samples per pixel in one frame (the 2 x 2 subpixels, §4.2).
 pub const SAMPLES_PER_FRAME: u32 = 4;
 
@@ -82,6 +134,8 @@ pub struct FrameParams {
     pub max_bounces: u32,
     /// Seed of the random numbers.
     pub seed: u32,
+    /// The kd-tree traversal.
+    pub traversal: Traversal,
 }
 
 impl FrameParams {
@@ -127,13 +181,22 @@ pub struct Progressive {
     pub accum: Vec<f32>,
     /// Per frame, per pixel: the mean of its 4 subpixel paths (kept when asked).
     pub frame_images: Vec<FrameBuffer>,
+    /// The traversal events, when traced natively (the emulated render's are in `kernel::KernelRender`).
+    pub counts: counts::Counts,
 }
 
 impl Progressive {
     /// An empty accumulation.
     pub fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize * SAMPLES_PER_FRAME as usize * 3;
-        Progressive { width, height, frames: 0, accum: vec![0.0; n], frame_images: Vec::new() }
+        Progressive {
+            width,
+            height,
+            frames: 0,
+            accum: vec![0.0; n],
+            frame_images: Vec::new(),
+            counts: counts::Counts::default(),
+        }
     }
 
     /// The pixel means of one frame's per-path radiance `last`.
@@ -175,7 +238,8 @@ pub fn render_native(
     let mut out = Progressive::new(params.width, params.height);
     let mut last = vec![0.0f32; out.accum.len()];
     for f in 0..frames {
-        tracer.frame(f, &mut out.accum, &mut last);
+        let c = tracer.frame(f, &mut out.accum, &mut last);
+        out.counts.add(&c);
         out.frames += 1;
         if keep_frames {
             out.frame_images.push(Progressive::pixels_of(params.width, params.height, &last));

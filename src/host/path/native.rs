@@ -9,9 +9,10 @@
 
 use rayon::prelude::*;
 
+use super::counts::Counts;
 use super::layout::{LEAF_AXIS, PathScene};
 use super::rng::{azimuth, path_key, rng, tent};
-use super::{FrameParams, Integrator};
+use super::{FrameParams, Integrator, Traversal};
 
 /// Random dimensions of the camera ray.
 pub const DIMS_CAMERA: u32 = 2;
@@ -120,10 +121,90 @@ impl Tracer<'_> {
         true
     }
 
-    /// The nearest hit in [t_min, t_max] (with `any`, the first found).
-    fn trace(&self, o: V3, d: V3, t_min: f32, t_max: f32, any: bool) -> Option<(u32, f32)> {
+    /// kd-restart and kd-backtrack: the kernel's `trace_stackless`.
+    #[allow(clippy::too_many_arguments)]
+    fn trace_stackless(
+        &self,
+        backtrack: bool,
+        o: V3,
+        d: V3,
+        inv: V3,
+        t_min: f32,
+        t_max: f32,
+        mut tnear: f32,
+        t_exit: f32,
+        any: bool,
+        c: &mut Counts,
+    ) -> Option<(u32, f32)> {
         let s = self.scene;
         let eps = self.frame.eps;
+        let t_hit = t_max;
+        let mut tfar = t_exit;
+        let mut found: Option<u32> = None;
+        let mut idx = 0u32;
+        let mut hi;
+        loop {
+            let mut n = s.nodes[idx as usize];
+            while n[0] >> 30 != LEAF_AXIS {
+                c.inner += 1;
+                let axis = n[0] >> 30;
+                let tsplit = (f32::from_bits(n[1]) - o.comp(axis)) * inv.comp(axis);
+                let (mut first, mut second) = (n[0] & 0xff_ffff, n[2]);
+                if (d.comp(axis).to_bits() as i32) < 0 {
+                    std::mem::swap(&mut first, &mut second);
+                }
+                // Fig. 15 as printed: cvt.rmi then cvt.rzi.s32 (saturating, NaN to 0), as `as i32`
+                let f = ((tnear - tsplit).floor() as i32) >> 31;
+                idx = (first & f as u32).wrapping_add(second & !(f as u32));
+                if f < 0 && tsplit < tfar {
+                    tfar = tsplit;
+                }
+                n = s.nodes[idx as usize];
+            }
+            c.leaves += 1;
+            let (count, first) = ((n[0] >> 24) & 63, n[3]);
+            let lo = fmax(tnear - eps, t_min);
+            hi = fmin(t_hit, tfar + eps);
+            for r in 0..count {
+                let t = s.refs[(first + r) as usize];
+                c.tri_tests += 1;
+                if self.affine(t, o, d, lo, &mut hi) {
+                    found = Some(t);
+                    if any {
+                        break;
+                    }
+                }
+            }
+            if found.is_some() {
+                break;
+            }
+            if !(tfar < t_exit) {
+                break;
+            }
+            tnear = tfar;
+            if backtrack {
+                loop {
+                    idx = s.up[idx as usize][3].to_bits();
+                    c.ascents += 1;
+                    let b = &s.up[idx as usize];
+                    tfar = fmin(t_max, box_exit(b, o, inv));
+                    if idx == 0 || tnear < tfar {
+                        break;
+                    }
+                }
+            } else {
+                idx = 0;
+                tfar = t_exit;
+            }
+        }
+        found.map(|t| (t, hi))
+    }
+
+    /// The nearest hit in [t_min, t_max] (with `any`, the first found).
+    fn trace(&self, o: V3, d: V3, t_min: f32, t_max: f32, any: bool, c: &mut Counts) -> Option<(u32, f32)> {
+        let s = self.scene;
+        let eps = self.frame.eps;
+        c.rays += 1;
         let inv = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
         let (t0x, t1x) = ((s.lo[0] - o.x) * inv.x, (s.hi[0] - o.x) * inv.x);
         let (t0y, t1y) = ((s.lo[1] - o.y) * inv.y, (s.hi[1] - o.y) * inv.y);
@@ -134,6 +215,10 @@ impl Tracer<'_> {
         if !(tnear <= tfar) {
             return None;
         }
+        if self.params.traversal != Traversal::ShortStack {
+            let backtrack = self.params.traversal == Traversal::Backtrack;
+            return self.trace_stackless(backtrack, o, d, inv, t_min, t_max, tnear, tfar, any, c);
+        }
         let t_hit = t_max;
         let mut found: Option<u32> = None;
         let mut stack = [(0u32, 0.0f32); STACK_ENTRIES];
@@ -143,6 +228,7 @@ impl Tracer<'_> {
         loop {
             let mut n = s.nodes[idx as usize];
             while n[0] >> 30 != LEAF_AXIS {
+                c.inner += 1;
                 let axis = n[0] >> 30;
                 let tsplit = (f32::from_bits(n[1]) - o.comp(axis)) * inv.comp(axis);
                 let (mut first, mut second) = (n[0] & 0xff_ffff, n[2]);
@@ -152,17 +238,20 @@ impl Tracer<'_> {
                 let f = -((tnear <= tsplit) as i32);
                 idx = (first & f as u32).wrapping_add(second & !(f as u32));
                 if f < 0 && tsplit <= tfar {
+                    c.pushes += 1;
                     stack[size] = (second, tfar);
                     size += 1;
                     tfar = tsplit;
                 }
                 n = s.nodes[idx as usize];
             }
+            c.leaves += 1;
             let (count, first) = ((n[0] >> 24) & 63, n[3]);
             let lo = fmax(tnear - eps, t_min);
             hi = fmin(t_hit, tfar + eps);
             for r in 0..count {
                 let t = s.refs[(first + r) as usize];
+                c.tri_tests += 1;
                 if self.affine(t, o, d, lo, &mut hi) {
                     found = Some(t);
                     if any {
@@ -176,6 +265,7 @@ impl Tracer<'_> {
             if size == 0 {
                 break;
             }
+            c.pops += 1;
             size -= 1;
             tnear = tfar;
             (idx, tfar) = stack[size];
@@ -190,8 +280,13 @@ impl Tracer<'_> {
 
     /// Radiance of path `i` in frame `frame`.
     pub fn path(&self, i: u32, frame: u32) -> [f32; 3] {
+        self.path_counted(i, frame, &mut Counts::default())
+    }
+
+    /// Radiance of path `i` in frame `frame`, adding its traversal events to `c`.
+    pub fn path_counted(&self, i: u32, frame: u32, counts: &mut Counts) -> [f32; 3] {
         let s = self.scene;
-        let c = &self.frame;
+        let cam = &self.frame;
         let p = &self.params;
         let (w, h) = (p.width, p.height);
         let (pixel, sub) = (i >> 2, i & 3);
@@ -200,10 +295,10 @@ impl Tracer<'_> {
         let integrator = p.integrator;
         let px = x as f32 + ((sub & 1) as f32 + 0.5 + tent(rng(key, 0))) * 0.5;
         let py = y as f32 + ((sub >> 1) as f32 + 0.5 + tent(rng(key, 1))) * 0.5;
-        let cx = (px / w as f32 * 2.0 - 1.0) * c.tan_half * c.aspect;
-        let cy = (1.0 - py / h as f32 * 2.0) * c.tan_half;
-        let (fwd, right, up) = (xyz(&c.fwd, 0), xyz(&c.right, 0), xyz(&c.up, 0));
-        let mut o = xyz(&c.pos, 0);
+        let cx = (px / w as f32 * 2.0 - 1.0) * cam.tan_half * cam.aspect;
+        let cy = (1.0 - py / h as f32 * 2.0) * cam.tan_half;
+        let (fwd, right, up) = (xyz(&cam.fwd, 0), xyz(&cam.right, 0), xyz(&cam.up, 0));
+        let mut o = xyz(&cam.pos, 0);
         let mut d = fwd.add(right.scale(cx)).add(up.scale(cy)).normalize();
         let mut l = v3(0.0, 0.0, 0.0);
         let mut beta = v3(1.0, 1.0, 1.0);
@@ -211,7 +306,7 @@ impl Tracer<'_> {
         let mut bsdf_pdf = 0.0f32;
         let mut bounce = 0u32;
         while bounce <= p.max_bounces {
-            let Some((tri, t)) = self.trace(o, d, c.eps, f32::INFINITY, false) else { break };
+            let Some((tri, t)) = self.trace(o, d, cam.eps, f32::INFINITY, false, counts) else { break };
             let td = s.tri_data[tri as usize];
             let n = v3(td[0], td[1], td[2]);
             let mat = &s.mats[td[3].to_bits() as usize];
@@ -254,7 +349,7 @@ impl Tracer<'_> {
                 let ld = s.tri_data[lg[7].to_bits() as usize];
                 let cos_s = ns.dot(wl);
                 let cos_l = -v3(ld[0], ld[1], ld[2]).dot(wl);
-                if cos_s > 0.0 && cos_l > 0.0 && self.trace(hitp, wl, c.eps, dist - c.eps, true).is_none() {
+                if cos_s > 0.0 && cos_l > 0.0 && self.trace(hitp, wl, cam.eps, dist - cam.eps, true, counts).is_none() {
                     let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
                     let light_pdf = dist2 / (cos_l * s.light_area);
                     let mut wgt = 1.0;
@@ -317,15 +412,26 @@ impl Tracer<'_> {
     }
 
     /// Traces frame `frame`: adds each path's radiance to `accum` (3 floats
-    /// a path) and stores it in `last`, as one kernel launch does.
-    pub fn frame(&self, frame: u32, accum: &mut [f32], last: &mut [f32]) {
-        accum.par_chunks_mut(3).zip(last.par_chunks_mut(3)).enumerate().for_each(|(i, (a, l))| {
-            let r = self.path(i as u32, frame);
-            for ((a, l), r) in a.iter_mut().zip(l.iter_mut()).zip(r) {
-                *a += r;
-                *l = r;
-            }
-        });
+    /// a path) and stores it in `last`, as one kernel launch does; returns
+    /// the frame's traversal events.
+    pub fn frame(&self, frame: u32, accum: &mut [f32], last: &mut [f32]) -> Counts {
+        accum
+            .par_chunks_mut(3)
+            .zip(last.par_chunks_mut(3))
+            .enumerate()
+            .map(|(i, (a, l))| {
+                let mut c = Counts::default();
+                let r = self.path_counted(i as u32, frame, &mut c);
+                for ((a, l), r) in a.iter_mut().zip(l.iter_mut()).zip(r) {
+                    *a += r;
+                    *l = r;
+                }
+                c
+            })
+            .reduce(Counts::default, |mut a, b| {
+                a.add(&b);
+                a
+            })
     }
 }
 
@@ -337,6 +443,14 @@ fn fmin(a: f32, b: f32) -> f32 {
 /// PTX max.f32: the non-NaN operand if one is NaN.
 fn fmax(a: f32, b: f32) -> f32 {
     a.max(b)
+}
+
+/// The ray's exit distance from node box `b` (`[lo, parent, hi, 0]`): the kernel's `box_exit`.
+fn box_exit(b: &[f32; 8], o: V3, inv: V3) -> f32 {
+    let (t0x, t1x) = ((b[0] - o.x) * inv.x, (b[4] - o.x) * inv.x);
+    let (t0y, t1y) = ((b[1] - o.y) * inv.y, (b[5] - o.y) * inv.y);
+    let (t0z, t1z) = ((b[2] - o.z) * inv.z, (b[6] - o.z) * inv.z);
+    fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z))
 }
 
 /// Duff et al.'s orthonormal basis around the unit `n`.

@@ -49,6 +49,30 @@ const LD_ST_WORDS: &[&str] = &[
 /// Ordering, scope and `.noftz` words of atomics (no effect in the model).
 const ATOM_IGNORED: &[&str] = &["relaxed", "acquire", "release", "acq_rel", "cta", "gpu", "sys", "noftz"];
 
+/// Fails for a constant barrier id past 15 or a constant thread count that
+/// is not a positive multiple of the warp size up to a CTA's 1024 threads (as
+/// ptxas refuses them); ids and counts in registers are checked when they
+/// execute (a fault).
+fn constant_barrier(pos: crate::ptx::error::Pos, id: &Operand, count: Option<&Operand>) -> LResult<()> {
+    if let Operand::Lit(ast::Literal::Int(v)) = id
+        && *v > 15
+    {
+        return invalid(pos, format!("barrier id {} is out of range (a CTA has barriers 0 to 15)", *v as i64));
+    }
+    if let Some(Operand::Lit(ast::Literal::Int(c))) = count
+        && (*c == 0 || c % 32 != 0 || *c > 1024)
+    {
+        return invalid(
+            pos,
+            format!(
+                "a barrier thread count of {}: it must be a positive multiple of 32 (the warp size), at most 1024 (a CTA's threads)",
+                *c as i64
+            ),
+        );
+    }
+    Ok(())
+}
+
 /// Fails when a modifier word of `d` is not in `allowed`.
 fn only(d: &Decoded, allowed: &[&str], i: &ast::Instruction) -> LResult<()> {
     for w in &d.mods.words {
@@ -248,6 +272,7 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
                     format!("`{}` takes a destination, a barrier id, an optional count and a predicate", d.full),
                 );
             }
+            constant_barrier(pos, &i.operands[1], (n_ops == 4).then(|| &i.operands[2]))?;
         }
         Bar | Barrier => {
             only(d, &["sync", "aligned"], i)?;
@@ -257,6 +282,7 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             if n_ops == 0 || n_ops > 2 {
                 return invalid(pos, format!("`{}` takes a barrier id and an optional thread count", d.full));
             }
+            constant_barrier(pos, &i.operands[0], i.operands.get(1))?;
         }
         Vote => {
             only(d, &["sync", "all", "any", "uni", "ballot"], i)?;

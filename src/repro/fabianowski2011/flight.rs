@@ -34,6 +34,12 @@ pub struct Totals {
     /// Memory transactions of the gt200 profile: global and local segment
     /// transactions plus texture-cache misses (for the timing model).
     pub mem_transactions: u64,
+    /// Shadow rays among the rays.
+    pub shadow_rays: u64,
+    /// Reflection rays among the rays.
+    pub reflection_rays: u64,
+    /// Texels fetched from texture maps.
+    pub texel_fetches: u64,
 }
 
 /// One scene's flight, per variant.
@@ -159,12 +165,15 @@ pub fn frame_timed(
             + m.local_st.sectors
             + m.global_atom.sectors
             + m.texture.misses,
+        shadow_rays: k.trace.shadow,
+        reflection_rays: k.trace.reflection,
+        texel_fetches: k.trace.texel_fetches,
     };
     Ok((totals, timing))
 }
 
 /// The counters' names, in [`Totals`]' field order.
-pub const COUNTERS: [&str; 8] = [
+pub const COUNTERS: [&str; 11] = [
     "rays",
     "inner_nodes",
     "tex_node_fetches",
@@ -173,10 +182,17 @@ pub const COUNTERS: [&str; 8] = [
     "tex_lookups",
     "tex_hits",
     "mem_transactions",
+    "shadow_rays",
+    "reflection_rays",
+    "texel_fetches",
 ];
 
+/// How many of [`COUNTERS`] every result file has; the later ones (ray kinds,
+/// texel fetches) read as 0 from files written before they were counted.
+const REQUIRED: usize = 8;
+
 impl Totals {
-    fn fields(&self) -> [u64; 8] {
+    fn fields(&self) -> [u64; 11] {
         [
             self.rays,
             self.inner_nodes,
@@ -186,10 +202,13 @@ impl Totals {
             self.tex_lookups,
             self.tex_hits,
             self.mem_transactions,
+            self.shadow_rays,
+            self.reflection_rays,
+            self.texel_fetches,
         ]
     }
 
-    fn from_fields(f: [u64; 8]) -> Totals {
+    fn from_fields(f: [u64; 11]) -> Totals {
         Totals {
             rays: f[0],
             inner_nodes: f[1],
@@ -199,6 +218,9 @@ impl Totals {
             tex_lookups: f[5],
             tex_hits: f[6],
             mem_transactions: f[7],
+            shadow_rays: f[8],
+            reflection_rays: f[9],
+            texel_fetches: f[10],
         }
     }
 
@@ -215,9 +237,13 @@ impl Totals {
 
     /// The totals of `variant` over the measured frames, or `None` when not measured.
     pub fn from_results(r: &Results, group: &str, scene: &str, variant: &str) -> Option<Totals> {
-        let mut f = [0u64; 8];
+        let mut f = [0u64; 11];
         for (i, c) in COUNTERS.iter().enumerate() {
-            f[i] = r.sum(group, scene, variant, c)? as u64;
+            f[i] = match r.sum(group, scene, variant, c) {
+                Some(x) => x as u64,
+                None if i >= REQUIRED => 0,
+                None => return None,
+            };
         }
         Some(Totals::from_fields(f))
     }
@@ -287,4 +313,50 @@ pub fn measure_caches(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<
     let tree = ws.tree(Heuristic::Siroh);
     let v: Vec<(Variant, &str)> = Variant::CACHES.iter().map(|v| (*v, v.name())).collect();
     samples(ws, tree, super::CACHES, &v, tick)
+}
+
+/// The table note on materials: per scene, the share of reflection rays and
+/// the texel fetches per primary ray of `variant` of `group`, and which scenes
+/// have neither (no specular materials, no texture maps) where the thesis'
+/// did.
+pub fn materials_note(r: &Results, group: &str, scenes: &[String], variant: &str) -> String {
+    let mut with = Vec::new();
+    let mut without = Vec::new();
+    for s in scenes {
+        let Some(t) = Totals::from_results(r, group, s, variant) else { continue };
+        let px = r.scene(s).map_or(0, |i| i.frames.iter().map(|f| f.len() as u64).sum::<u64>())
+            * u64::from(r.protocol.resolution).pow(2);
+        if t.reflection_rays == 0 && t.texel_fetches == 0 {
+            without.push(s.as_str());
+        } else {
+            with.push(format!(
+                "{s} {:.1} % reflection rays, {:.2} texel fetches per pixel",
+                100.0 * t.reflection_rays as f64 / t.rays.max(1) as f64,
+                t.texel_fetches as f64 / px.max(1) as f64
+            ));
+        }
+    }
+    let mut note = String::from(
+        "Materials (scene files as loaded; Sponza and Sibenik with their MTL materials and diffuse texture maps, one texel \
+         array read through the texture path, nearest texel, docs/scenes.md): ",
+    );
+    if !with.is_empty() {
+        note.push_str(&with.join("; "));
+    }
+    if !without.is_empty() {
+        if !with.is_empty() {
+            note.push_str(". ");
+        }
+        note.push_str(&format!(
+            "No specular materials and no texture maps in {} (no reflection rays, no texture-map traffic{})",
+            without.join(", "),
+            if without.contains(&"conference") {
+                "; Conference has neither in the thesis either (Table A.1: no textures)"
+            } else {
+                ""
+            }
+        ));
+    }
+    note.push('.');
+    note
 }

@@ -220,3 +220,105 @@ pub fn add(a: &FrameBuffer, b: &FrameBuffer) -> FrameBuffer {
     let pixels = a.pixels.iter().zip(&b.pixels).map(|(x, y)| std::array::from_fn(|c| x[c] + y[c])).collect();
     FrameBuffer { width: a.width, height: a.height, pixels }
 }
+
+/// Photons and spread of a `render --method photon-map` of `scene`: Table 5.1's
+/// for its scenes, else [`DEFAULT_PHOTONS`] and [`DEFAULT_SPREAD`].
+pub fn render_parameters(scene: &str) -> (usize, f32) {
+    super::table_5_1::parameters(scene).unwrap_or((DEFAULT_PHOTONS, DEFAULT_SPREAD))
+}
+
+/// Photons of a render of a scene outside Table 5.1 (its "2^17 all others", L2466).
+pub const DEFAULT_PHOTONS: usize = 1 << 17;
+/// Spread s of a render of a scene outside Table 5.1 (the smallest the table uses, the Ring's).
+pub const DEFAULT_SPREAD: f32 = 10.0;
+/// k of the kNN estimator for a scene outside Table 5.1.
+pub const DEFAULT_K: usize = 50;
+
+/// The estimator and kernel named by `render --estimator`: `vkde`, `vkde-epanechnikov`,
+/// `knn` (Table 5.1's k_kNN for its scenes, else [`DEFAULT_K`]) or `knn:K`.
+pub fn parse_estimator(s: &str, scene: &str) -> Option<(Estimator, Shape)> {
+    let table_k =
+        || super::table_5_1::THESIS.row(scene).map_or(DEFAULT_K, |r| r.cells[6].value() as usize).min(knn::K_MAX);
+    match s {
+        "vkde" => Some((Estimator::Vkde, Shape::Uniform)),
+        "vkde-epanechnikov" => Some((Estimator::Vkde, Shape::Epanechnikov)),
+        "knn" => Some((Estimator::Knn(table_k()), Shape::Uniform)),
+        _ => {
+            let k: usize = s.strip_prefix("knn:")?.parse().ok()?;
+            (1..=knn::K_MAX).contains(&k).then_some((Estimator::Knn(k), Shape::Uniform))
+        }
+    }
+}
+
+/// `warplight render --method photon-map`: the direct light of the native ray
+/// caster plus the photon-mapped indirect light of `scene` seen by `cam`,
+/// natively (`--variant native`) or with the photon, construction and
+/// estimation kernels on the emulator (`--variant emulated`; bit for bit the same).
+pub fn run_cli(
+    a: &crate::cli::render::RenderArgs,
+    scene: &Scene,
+    cam: &Camera,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let (estimator, shape) = parse_estimator(&a.estimator, &scene.name).ok_or_else(|| {
+        format!(
+            "unknown estimator `{}`; expected vkde, vkde-epanechnikov, knn or knn:K (1..={})",
+            a.estimator,
+            knn::K_MAX
+        )
+    })?;
+    let emulated = match a.variant.as_str() {
+        "native" => false,
+        "emulated" => true,
+        v => return Err(format!("--method photon-map --variant {v}: expected native or emulated").into()),
+    };
+    let (photons, spread) = render_parameters(&scene.name);
+    let o = Options { photons, spread, h_max: vkde::H_MAX, estimator, shape, emulated };
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = crate::host::kdtree::build(
+        &tris,
+        crate::host::kdtree::BuildParams::thesis(crate::host::kdtree::Heuristic::Siroh),
+    );
+    let t = std::time::Instant::now();
+    let r = render(scene, &tree, cam, &o)?;
+    let caster = Caster::new(scene, &tree);
+    let (direct, _) = crate::host::raycast::render(&caster, cam, glam::Vec3::ZERO);
+    let image = add(&direct, &r.indirect);
+    let out = &a.output;
+    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let tmp = parent.join(format!(
+        ".{}.warplight-tmp.{}",
+        out.file_stem().and_then(|s| s.to_str()).unwrap_or("render"),
+        ext.as_deref().unwrap_or("png")
+    ));
+    let written = if ext.as_deref() == Some("exr") { image.write_exr(&tmp) } else { image.write_png(&tmp, a.exposure) };
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e.into());
+    }
+    std::fs::rename(&tmp, out).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: {e}", out.display())
+    })?;
+    let c = &r.maps.constructed;
+    println!(
+        "{} ({}x{}), photon map: {} photons, s = {}, {} interactions ({} discarded, {} clamped), {:?} {:?}, \
+         {} query points, {:.1} contributions each: {:.3} s{}",
+        scene.name,
+        cam.resolution[0],
+        cam.resolution[1],
+        photons,
+        spread,
+        c.interactions,
+        c.discarded,
+        c.clamped,
+        estimator,
+        shape,
+        r.queries,
+        r.contributions as f64 / r.queries.max(1) as f64,
+        t.elapsed().as_secs_f64(),
+        if emulated { " (emulated)" } else { " (native)" }
+    );
+    println!("  wrote {} (direct light of the ray caster + photon-mapped indirect light)", out.display());
+    Ok(())
+}

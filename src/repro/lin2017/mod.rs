@@ -1,13 +1,14 @@
 //! Seed 003: Lin Daqi (2017): Real Time Path Tracing on GPU.
 //!
-//! Registered so that `warplight tables --list` shows every table of the
-//! seed with its status; none is reproduced yet. A table is reproduced by
-//! giving it measurement groups and a render function, as
-//! `src/repro/fabianowski2011/` does.
+//! Every table of the seed is registered with its status. Reproduced:
+//! [`fig_3`], the data table of Fig. 3 (traversals × constructions), from
+//! the measurement group [`fig_3::TRAVERSALS`].
 
+pub mod fig_3;
 pub mod render;
 
-use crate::repro::registry::{Status, TableDef, Thesis};
+use crate::host::kdtree::Heuristic;
+use crate::repro::registry::{Group, Status, TableDef, Thesis};
 
 /// The seed and its tables.
 pub static THESIS: Thesis = Thesis {
@@ -17,11 +18,23 @@ pub static THESIS: Thesis = Thesis {
     seed_file: "003_0cecf91ec9b1cabd.txt",
     citation: "Lin Daqi (2017): Real Time Path Tracing on GPU",
     tables: &TABLES,
-    groups: &[],
+    groups: &GROUPS,
 };
 
+/// The measurement groups.
+static GROUPS: [Group; 1] = [Group {
+    name: fig_3::TRAVERSALS,
+    what: "the path tracer with 3 kd-tree traversals on SAH and space-median trees, on the emulator",
+    per_frame: false,
+    variants: 6,
+    seconds_per_side: 0.0,
+    seconds_per_triangle: 4e-4,
+    trees: &[] as &[Heuristic],
+    measure: fig_3::measure,
+}];
+
 /// Its tables as printed (captions verbatim from the seed).
-static TABLES: [TableDef; 4] = [
+static TABLES: [TableDef; 5] = [
     TableDef {
         id: "1",
         title: "Speedup of triangle clipping for different models",
@@ -31,6 +44,16 @@ static TABLES: [TableDef; 4] = [
         scenes: &[],
         groups: &[],
         render: None,
+    },
+    TableDef {
+        id: "fig3",
+        title: "Time (seconds) to render 64 samples/pixel \"bunny&ball\" scene in 512x512",
+        lines: "L181-189",
+        status: Status::Modelled,
+        note: "seconds not reproducible (GPU and scene not stated); relative times modelled by emulated warp instructions; traversal work counted per ray",
+        scenes: &[fig_3::SCENE],
+        groups: &[fig_3::TRAVERSALS],
+        render: Some(fig_3::render),
     },
     TableDef {
         id: "2",

@@ -11,7 +11,7 @@ use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::PathScene;
-use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, kernel, render_native};
+use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, kernel, render_native};
 use crate::sim::Device;
 
 /// What a path render produced.
@@ -107,7 +107,14 @@ pub fn run(
         v => return Err(format!("--method path --variant {v}: expected native or emulated").into()),
     };
     let [width, height] = camera.resolution;
-    let params = FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed };
+    let params = FrameParams {
+        width,
+        height,
+        integrator,
+        max_bounces: a.bounces,
+        seed: a.seed,
+        traversal: Traversal::ShortStack,
+    };
     let r = render(scene, camera, params, frames, emulated)?;
     write_image(&r.image, &a.output, a.exposure)?;
     println!(

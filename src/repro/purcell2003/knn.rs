@@ -134,7 +134,8 @@ pub fn lane_iterations(module: &Module, s: &LaunchStats) -> u64 {
     v4 / 3
 }
 
-fn search_arg(map: &Map, p: &Params) -> Arg {
+/// The kernels' `Search` argument for `map` and `p`.
+pub fn search_arg(map: &Map, p: &Params) -> Arg {
     let (grid, slots) = match map {
         Map::Bitonic(m, _) => (m.grid, 1),
         Map::Stencil(m) => (m.grid, m.slots),

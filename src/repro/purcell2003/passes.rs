@@ -5,6 +5,7 @@
 
 use std::collections::BTreeMap;
 
+use super::dataflow::{self, Class};
 use crate::sim::{Arg, Device, DevicePtr, Element, LaunchConfig, LaunchStats, Module, SimConfig, SimError};
 
 /// `kernels/purcell2003/photons.ptx`: emission, bounces, eye rays.
@@ -43,11 +44,19 @@ pub struct PhaseCounts {
     pub lane_atomics: u64,
     /// CTAs run.
     pub ctas: u64,
+    /// Thread instructions of address arithmetic (by data flow: [`dataflow`]).
+    pub addr_instructions: u64,
+    /// Thread instructions of bit packing (by data flow: [`dataflow`]).
+    pub pack_instructions: u64,
 }
 
 impl PhaseCounts {
-    /// Adds one launch's counters.
-    pub fn add(&mut self, module: &Module, s: &LaunchStats) {
+    /// Adds one launch's counters; `classes` are the classes of the module's
+    /// instructions ([`dataflow::classify_program`]).
+    pub fn add(&mut self, module: &Module, classes: &[Vec<Class>], s: &LaunchStats) {
+        let c = dataflow::count(classes, s);
+        self.addr_instructions += c.addr;
+        self.pack_instructions += c.pack;
         self.launches += 1;
         self.warp_instructions += s.totals.warp_instructions;
         self.thread_instructions += s.totals.thread_instructions;
@@ -67,6 +76,23 @@ impl PhaseCounts {
         self.lane_stores += o.lane_stores;
         self.lane_atomics += o.lane_atomics;
         self.ctas += o.ctas;
+        self.addr_instructions += o.addr_instructions;
+        self.pack_instructions += o.pack_instructions;
+    }
+
+    /// The counts of `later` less these (`later` a superset of these launches).
+    pub fn until(&self, later: &PhaseCounts) -> PhaseCounts {
+        PhaseCounts {
+            launches: later.launches - self.launches,
+            warp_instructions: later.warp_instructions - self.warp_instructions,
+            thread_instructions: later.thread_instructions - self.thread_instructions,
+            lane_loads: later.lane_loads - self.lane_loads,
+            lane_stores: later.lane_stores - self.lane_stores,
+            lane_atomics: later.lane_atomics - self.lane_atomics,
+            ctas: later.ctas - self.ctas,
+            addr_instructions: later.addr_instructions - self.addr_instructions,
+            pack_instructions: later.pack_instructions - self.pack_instructions,
+        }
     }
 }
 
@@ -99,6 +125,8 @@ pub struct Passes {
     photons: Module,
     grid: Module,
     knn: Module,
+    /// The instruction classes of each module's functions (photons, grid, knn).
+    classes: [Vec<Vec<Class>>; 3],
     /// Counters per phase name, summed over its launches.
     pub phases: BTreeMap<String, PhaseCounts>,
     /// Counters per kernel name, summed over its launches.
@@ -117,7 +145,8 @@ impl Passes {
         let photons = dev.load_ptx(PHOTONS_PTX, "kernels/purcell2003/photons.ptx")?;
         let grid = dev.load_ptx(GRID_PTX, "kernels/purcell2003/grid.ptx")?;
         let knn = dev.load_ptx(KNN_PTX, "kernels/purcell2003/knn.ptx")?;
-        Ok(Passes { dev, photons, grid, knn, phases: BTreeMap::new(), kernels: BTreeMap::new() })
+        let classes = [&photons, &grid, &knn].map(|m| dataflow::classify_program(&m.prog));
+        Ok(Passes { dev, photons, grid, knn, classes, phases: BTreeMap::new(), kernels: BTreeMap::new() })
     }
 
     /// The module of `k`.
@@ -138,14 +167,14 @@ impl Passes {
         cfg: LaunchConfig,
         args: &[Arg],
     ) -> Result<LaunchStats, SimError> {
-        let m = match k {
-            Kernels::Photons => &self.photons,
-            Kernels::Grid => &self.grid,
-            Kernels::Knn => &self.knn,
+        let (m, classes) = match k {
+            Kernels::Photons => (&self.photons, &self.classes[0]),
+            Kernels::Grid => (&self.grid, &self.classes[1]),
+            Kernels::Knn => (&self.knn, &self.classes[2]),
         };
         let s = self.dev.launch(m, kernel, cfg, args)?;
-        self.phases.entry(phase.to_string()).or_default().add(m, &s);
-        self.kernels.entry(kernel.to_string()).or_default().add(m, &s);
+        self.phases.entry(phase.to_string()).or_default().add(m, classes, &s);
+        self.kernels.entry(kernel.to_string()).or_default().add(m, classes, &s);
         Ok(s)
     }
 

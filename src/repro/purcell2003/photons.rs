@@ -28,6 +28,11 @@ pub struct Geometry {
     pub point: Vec3,
     /// Power of one emitted photon when `n` are emitted: the light's power / `n` (set by [`Geometry::power_per_photon`]).
     pub light_power: [f32; 3],
+    /// The point light's emission cone (a projection map): unit axis and the
+    /// cosine of its half-angle, the smallest cone about the direction to the
+    /// scene's bounding sphere that holds the sphere; (0, 0, 1, -1), the whole
+    /// sphere, for an area light or a point light inside the sphere.
+    pub cone: [f32; 4],
     /// Scene bounds.
     pub lo: Vec3,
     /// Scene bounds.
@@ -87,7 +92,17 @@ impl Geometry {
             }
         }
         let (lo, hi) = scene.bounds();
-        Geometry { tris, mats, lights: area, point, light_power: power, lo, hi }
+        let mut cone = [0.0, 0.0, 1.0, -1.0];
+        if area.is_empty() {
+            let (c, radius) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+            let to = c - point;
+            let dist = to.length();
+            if dist > radius {
+                let a = to / dist;
+                cone = [a.x, a.y, a.z, (1.0 - (radius / dist).powi(2)).sqrt()];
+            }
+        }
+        Geometry { tris, mats, lights: area, point, light_power: power, cone, lo, hi }
     }
 
     /// Triangles.
@@ -95,9 +110,12 @@ impl Geometry {
         self.tris.len() / 12
     }
 
-    /// Power carried by each of `n` emitted photons.
+    /// Power carried by each of `n` emitted photons: the light's power into
+    /// the emission cone (its solid angle's share of the sphere, (1 - cos) / 2)
+    /// over `n`.
     pub fn power_per_photon(&self, n: usize) -> [f32; 3] {
-        self.light_power.map(|p| p / n.max(1) as f32)
+        let share = (1.0 - self.cone[3]) * 0.5;
+        self.light_power.map(|p| p * share / n.max(1) as f32)
     }
 
     /// The `Scene` structure of the kernels.
@@ -107,6 +125,7 @@ impl Geometry {
         Bytes::default()
             .i32s(&[self.num_tris() as i32, self.lights.len() as i32])
             .f32s(&[eps, 0.0, self.point.x, self.point.y, self.point.z, 0.0, pw[0], pw[1], pw[2], 0.0])
+            .f32s(&self.cone)
             .arg()
     }
 }
@@ -132,6 +151,13 @@ impl PhotonArrays {
     /// Slots of the bounce frames (1..frames), where stored photons are.
     pub fn stored_slots(&self) -> (usize, usize) {
         (self.n, self.n * (self.frames - 1))
+    }
+
+    /// Photons stored (valid slots of the bounce frames), read back.
+    pub fn count_stored(&self, passes: &Passes) -> usize {
+        let (first, count) = self.stored_slots();
+        let pos = passes.dev.read::<f32>(self.pos, 4 * (first + count));
+        (first..first + count).filter(|&s| pos[4 * s + 3] != 0.0).count()
     }
 }
 

@@ -10,7 +10,7 @@ use super::grid::Grid;
 use super::knn::{self, Map, Params, RADIANCE_ESTIMATE};
 use super::passes::{Passes, PhaseCounts};
 use super::photons::{self, Geometry, PhotonArrays, Queries, TRACE_PHOTONS, TRACE_RAYS};
-use super::scenes::{EYE_DEPTH, Fixture, ITERS_PER_PASS, SEED, fixture};
+use super::scenes::{EYE_DEPTH, Fixture, ITERS_PER_PASS, PILOT_SEED, SEED, emitted_for, fixture};
 use super::stencil;
 use crate::host::scene::Scene;
 use crate::repro::registry::{MeasureError, Tick, Workspace};
@@ -56,7 +56,12 @@ pub fn prepare(scene: &Scene, width: u32) -> Result<Prepared, MeasureError> {
     let f = *fixture(&scene.name).ok_or_else(|| format!("seed 004 has no scene {}", scene.name))?;
     let geo = Geometry::of(scene);
     let mut passes = Passes::new(Some(WATCHDOG))?;
-    let photons = photons::trace(&mut passes, &geo, f.emitted, f.bounces, SEED)?;
+    // calibration: a pilot run's share of stored photons sets the emitted count
+    let pilot = photons::trace(&mut passes, &geo, f.pilot, f.bounces, PILOT_SEED)?;
+    let pilot_stored = pilot.count_stored(&passes);
+    passes.take_phase(TRACE_PHOTONS);
+    let emitted = emitted_for(f.stated_photons, f.pilot, pilot_stored);
+    let photons = photons::trace(&mut passes, &geo, emitted, f.bounces, SEED)?;
     let queries = photons::eye_rays(&mut passes, &geo, &camera(scene, &f, width), EYE_DEPTH)?;
     let grid = Grid::new(geo.lo, geo.hi, f.grid);
     Ok(Prepared { passes, fixture: f, photons, queries, grid })
@@ -82,9 +87,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     let trace = pr.passes.take_phase(TRACE_PHOTONS);
     let rays = pr.passes.take_phase(TRACE_RAYS);
     let npix = (pr.queries.width * pr.queries.height) as usize;
-    let (first, count) = pr.photons.stored_slots();
-    let pos = pr.passes.dev.read::<f32>(pr.photons.pos, 4 * (first + count));
-    let stored = (first..first + count).filter(|&s| pos[4 * s + 3] != 0.0).count();
+    let stored = pr.photons.count_stored(&pr.passes);
     let p = params(&pr.fixture);
     let mut out = Vec::new();
     for method in METHODS {
@@ -124,7 +127,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
         c.insert("pixels".into(), npix as f64);
         c.insert("width".into(), w as f64);
         c.insert("height".into(), h as f64);
-        c.insert("emitted".into(), pr.fixture.emitted as f64);
+        c.insert("emitted".into(), pr.photons.n as f64);
         c.insert("stored".into(), stored as f64);
         c.insert("found_k".into(), est.states.iter().filter(|s| s.n as u32 >= p.k).count() as f64);
         out.push(Sample {

@@ -12,13 +12,14 @@ use std::collections::BTreeMap;
 
 use super::bitonic::{self, BUILD_MAP};
 use super::knn::{self, Map, Params};
+use super::knn_2003;
 use super::passes::{Kernels, Passes, PhaseCounts};
 use super::pipeline::{self, Prepared};
 use super::stencil;
 use crate::repro::compare::{Printed as P, Tolerance};
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
-use crate::repro::table::{Column, Published, PublishedRow as Row, Table, Unit};
+use crate::repro::table::{Check, Column, Published, PublishedRow as Row, Table, Unit};
 use crate::sim::{Arg, DevicePtr, SimError};
 
 /// Measurement group: per-iteration costs of the kernels.
@@ -28,54 +29,48 @@ pub const KERNELS: &str = "purcell/kernels";
 pub const SCENE: &str = "cornell-box";
 
 /// Our rows: (label in the results, row label, the printed row it compares with).
-pub const ROWS: [(&str, &str); 6] = [
+pub const ROWS: [(&str, &str); 8] = [
     ("bitonic-sort", "Bitonic Sort"),
     ("bitonic-sort-2003", "Bitonic Sort (2003-faithful)"),
     ("binary-search", "Binary Search"),
     ("re-bitonic", "Rad. Estimate (bitonic map)"),
+    ("re-bitonic-2003", "Rad. Estimate (bitonic map, 2003-faithful)"),
     ("stencil-routing", "Stencil Routing"),
     ("re-stencil", "Rad. Estimate (stencil map)"),
+    ("re-stencil-2003", "Rad. Estimate (stencil map, 2003-faithful)"),
 ];
 
 /// Table 2 as printed (004:L190–197): Inst, TEX, Addr, Pack. The two
 /// "Rad. Estimate" rows are unlabelled; the first follows Bitonic Sort and
 /// Binary Search, the second Stencil Routing (the order of Table 1). The
-/// 2003-faithful bitonic row compares with the printed Bitonic Sort row.
+/// 2003-faithful rows compare with the printed row of their kernel.
 pub const THESIS: Published = Published {
     rows: &[
         Row { scene: "Bitonic Sort", cells: &[P("52"), P("2"), P("13"), P("0")] },
         Row { scene: "Bitonic Sort (2003-faithful)", cells: &[P("52"), P("2"), P("13"), P("0")] },
         Row { scene: "Binary Search", cells: &[P("18"), P("1"), P("13"), P("0")] },
         Row { scene: "Rad. Estimate (bitonic map)", cells: &[P("202"), P("6"), P("47"), P("41")] },
+        Row { scene: "Rad. Estimate (bitonic map, 2003-faithful)", cells: &[P("202"), P("6"), P("47"), P("41")] },
         Row { scene: "Stencil Routing", cells: &[P("42"), P("0"), P("25"), P("0")] },
         Row { scene: "Rad. Estimate (stencil map)", cells: &[P("193"), P("5"), P("20"), P("41")] },
+        Row { scene: "Rad. Estimate (stencil map, 2003-faithful)", cells: &[P("193"), P("5"), P("20"), P("41")] },
     ],
     average: &[],
     std_dev: &[],
 };
 
-fn sample(variant: &str, inst: f64, tex: f64, iterations: f64) -> Sample {
-    let mut c = BTreeMap::new();
-    c.insert("inst_per_iteration".into(), inst);
-    c.insert("tex_per_iteration".into(), tex);
-    c.insert("iterations".into(), iterations);
-    Sample { group: KERNELS.into(), scene: SCENE.into(), frame: None, variant: variant.into(), counters: c }
-}
+/// The counters of a row: Inst, TEX, Addr and Pack per iteration, in [`COUNTERS`]' order.
+pub const COUNTERS: [&str; 4] = ["inst_per_iteration", "tex_per_iteration", "addr_per_iteration", "pack_per_iteration"];
 
-fn per(c: &PhaseCounts, iterations: f64) -> (f64, f64) {
-    (c.thread_instructions as f64 / iterations, c.lane_loads as f64 / iterations)
-}
-
-fn diff(a: &PhaseCounts, b: &PhaseCounts) -> PhaseCounts {
-    PhaseCounts {
-        launches: b.launches - a.launches,
-        warp_instructions: b.warp_instructions - a.warp_instructions,
-        thread_instructions: b.thread_instructions - a.thread_instructions,
-        lane_loads: b.lane_loads - a.lane_loads,
-        lane_stores: b.lane_stores - a.lane_stores,
-        lane_atomics: b.lane_atomics - a.lane_atomics,
-        ctas: b.ctas - a.ctas,
+/// A row's sample: `c`'s counts over `iterations`.
+fn sample(variant: &str, c: &PhaseCounts, iterations: f64) -> Sample {
+    let per = [c.thread_instructions, c.lane_loads, c.addr_instructions, c.pack_instructions];
+    let mut m = BTreeMap::new();
+    for (name, v) in COUNTERS.iter().zip(per) {
+        m.insert(name.to_string(), v as f64 / iterations);
     }
+    m.insert("iterations".into(), iterations);
+    Sample { group: KERNELS.into(), scene: SCENE.into(), frame: None, variant: variant.into(), counters: m }
 }
 
 /// Copies `words` u32s of `src` into a new buffer.
@@ -86,29 +81,40 @@ fn copy(p: &mut Passes, src: DevicePtr, words: usize) -> Result<DevicePtr, SimEr
 
 /// The estimate's cost of one lookup: from a state after one pass, one
 /// launch of 1 lookup and one of 3; the difference over the difference in
-/// lane-iterations (both from the emulator's counters).
+/// lane-iterations (both from the emulator's counters). `faithful`: the
+/// 2003-faithful kernel (float addressing, packed state).
 fn estimate_per_lookup(
     p: &mut Passes,
     map: &Map,
     pr_q: &super::photons::Queries,
     f: &Params,
-) -> Result<(f64, f64, f64), SimError> {
+    faithful: bool,
+) -> Result<(PhaseCounts, f64), MeasureError> {
     let npix = (pr_q.width * pr_q.height) as usize;
-    let state = knn::start_states(p, pr_q)?;
-    knn::pass(p, "warm", map, pr_q, f, state)?;
-    let words = knn::STATE_WORDS * npix;
-    let s1 = copy(p, state, words)?;
-    let s3 = copy(p, state, words)?;
-    let one = knn::pass(p, "one", map, pr_q, &Params { iters: 1, ..*f }, s1)?;
-    let three = knn::pass(p, "three", map, pr_q, &Params { iters: 3, ..*f }, s3)?;
+    let one = Params { iters: 1, ..*f };
+    let three = Params { iters: 3, ..*f };
+    let (a, b) = if faithful {
+        let grid = match map {
+            Map::Bitonic(m, _) => m.grid,
+            Map::Stencil(m) => m.grid,
+        };
+        let tex = knn_2003::textures(p, map)?;
+        let state = knn_2003::start_states(p, pr_q, &grid)?;
+        knn_2003::pass(p, "warm", map, &tex, pr_q, f, state)?;
+        let (s1, s3) = (copy(p, state, 4 * npix)?, copy(p, state, 4 * npix)?);
+        (knn_2003::pass(p, "one", map, &tex, pr_q, &one, s1)?, knn_2003::pass(p, "three", map, &tex, pr_q, &three, s3)?)
+    } else {
+        let state = knn::start_states(p, pr_q)?;
+        knn::pass(p, "warm", map, pr_q, f, state)?;
+        let words = knn::STATE_WORDS * npix;
+        let (s1, s3) = (copy(p, state, words)?, copy(p, state, words)?);
+        (knn::pass(p, "one", map, pr_q, &one, s1)?, knn::pass(p, "three", map, pr_q, &three, s3)?)
+    };
     let m = p.module(Kernels::Knn);
-    let lanes = (knn::lane_iterations(m, &three) - knn::lane_iterations(m, &one)) as f64;
-    let d = diff(&p.phase("one"), &p.phase("three"));
-    p.take_phase("one");
-    p.take_phase("three");
+    let lanes = (knn::lane_iterations(m, &b) - knn::lane_iterations(m, &a)) as f64;
+    let d = p.take_phase("one").until(&p.take_phase("three"));
     p.take_phase("warm");
-    let (i, t) = per(&d, lanes);
-    Ok((i, t, lanes))
+    Ok((d, lanes))
 }
 
 /// Measurement group [`KERNELS`] (on [`SCENE`] only).
@@ -142,8 +148,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     bitonic::sort(p, "sort", a, b, n)?;
     let s = p.take_phase("sort");
     let it = (s.launches * n as u64) as f64;
-    let (i, t) = per(&s, it);
-    out.push(sample("bitonic-sort", i, t, it));
+    out.push(sample("bitonic-sort", &s, it));
     // the 2003-faithful sort of the same keys: float4 (photon, key, 0, 0)
     let texels: Vec<f32> = elems.chunks_exact(2).flat_map(|e| [e[1] as f32, e[0] as f32, 0.0, 0.0]).collect();
     let width = 1usize << n.trailing_zeros().div_ceil(2);
@@ -152,29 +157,30 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     bitonic::sort_2003(p, "sort 2003", a, b, n, width)?;
     let s = p.take_phase("sort 2003");
     let it = (s.launches * n as u64) as f64;
-    let (i, t) = per(&s, it);
-    out.push(sample("bitonic-sort-2003", i, t, it));
+    out.push(sample("bitonic-sort-2003", &s, it));
     // the search: over n elements (log2 n + 1 steps) and over the first n/2 (one step fewer)
     let cells = grid.cells();
     let first = p.dev.alloc_zeroed::<u32>(cells + 1);
     bitonic::search(p, "search n", map.sorted, n, cells, first)?;
     bitonic::search(p, "search n/2", map.sorted, n / 2, cells, first)?;
-    let d = diff(&p.take_phase("search n/2"), &p.take_phase("search n"));
-    let (i, t) = per(&d, (cells + 1) as f64);
-    out.push(sample("binary-search", i, t, (cells + 1) as f64));
+    let d = p.take_phase("search n/2").until(&p.take_phase("search n"));
+    out.push(sample("binary-search", &d, (cells + 1) as f64));
     let f = pipeline::params(&fixture);
-    let (i, t, l) = estimate_per_lookup(p, &Map::Bitonic(&map, &photons), &queries, &f)?;
-    out.push(sample("re-bitonic", i, t, l));
+    for (variant, faithful) in [("re-bitonic", false), ("re-bitonic-2003", true)] {
+        let (d, l) = estimate_per_lookup(p, &Map::Bitonic(&map, &photons), &queries, &f, faithful)?;
+        out.push(sample(variant, &d, l));
+    }
     // map B
     tick(Tick { frame: None, variant: "stencil" });
     let smap = stencil::build(p, grid, &photons, fixture.slots)?;
     p.take_phase(BUILD_MAP);
     let route = p.kernel("stencil_route");
     let slots = (photons.n * (photons.frames - 1)) as f64;
-    let (i, t) = per(&route, slots);
-    out.push(sample("stencil-routing", i, t, slots));
-    let (i, t, l) = estimate_per_lookup(p, &Map::Stencil(&smap), &queries, &f)?;
-    out.push(sample("re-stencil", i, t, l));
+    out.push(sample("stencil-routing", &route, slots));
+    for (variant, faithful) in [("re-stencil", false), ("re-stencil-2003", true)] {
+        let (d, l) = estimate_per_lookup(p, &Map::Stencil(&smap), &queries, &f, faithful)?;
+        out.push(sample(variant, &d, l));
+    }
     Ok(out)
 }
 
@@ -184,30 +190,68 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     let columns = vec![
         Column::measured("Inst", Unit::Number(1), Tolerance::COUNT).uncompared(isa),
         Column::measured("TEX", Unit::Number(2), Tolerance::Relative(0.0)),
-        Column::not_reproducible(
-            "Addr",
-            Unit::Count,
-            "not measured yet: needs a classifier of PTX instructions by data flow (feeding a load address)",
-        ),
-        Column::not_reproducible(
-            "Pack",
-            Unit::Count,
-            "not measured yet: no packed-state (128-bit output) variant of the estimate",
-        ),
+        Column::measured("Addr", Unit::Number(1), Tolerance::COUNT).uncompared(isa),
+        Column::measured("Pack", Unit::Number(1), Tolerance::COUNT).uncompared(isa),
     ];
+    let get = |v: &str, c: &str| r.sum(KERNELS, SCENE, v, c);
     let ours: Vec<(String, Vec<f64>)> = ROWS
         .iter()
         .filter_map(|(v, label)| {
-            let inst = r.sum(KERNELS, SCENE, v, "inst_per_iteration")?;
-            let tex = r.sum(KERNELS, SCENE, v, "tex_per_iteration")?;
-            Some((label.to_string(), vec![inst, tex, f64::NAN, f64::NAN]))
+            let cells: Option<Vec<f64>> = COUNTERS.iter().map(|c| get(v, c)).collect();
+            Some((label.to_string(), cells?))
         })
         .collect();
     let mut t = Table::compare(&e.address(), &e.heading(), columns, &THESIS, &ours);
+    let cell = |v: &str, c: usize| get(v, COUNTERS[c]).unwrap_or(f64::NAN);
+    for (natural, faithful, what) in [
+        ("bitonic-sort", "bitonic-sort-2003", "bitonic sort"),
+        ("re-bitonic", "re-bitonic-2003", "estimate on the bitonic map"),
+        ("re-stencil", "re-stencil-2003", "estimate on the stencil map"),
+    ] {
+        let (a, b) = (cell(natural, 2), cell(faithful, 2));
+        t.checks.push(Check {
+            claim: format!(
+                "{what}: 2-D texture addressing without integers costs address arithmetic (004:L199-202): \
+                 more Addr in the 2003-faithful kernel than in the natural one"
+            ),
+            evidence: format!("Addr {b:.1} vs {a:.1} per iteration"),
+            holds: b > a,
+        });
+    }
+    for (natural, faithful, what) in
+        [("re-bitonic", "re-bitonic-2003", "bitonic map"), ("re-stencil", "re-stencil-2003", "stencil map")]
+    {
+        let (a, b) = (cell(natural, 3), cell(faithful, 3));
+        t.checks.push(Check {
+            claim: format!(
+                "estimate on the {what}: the Pack column comes from the 128-bit output (004:L203): no packing without it, \
+                 packing with the state in one float4"
+            ),
+            evidence: format!("Pack {a:.1} (natural) vs {b:.1} (2003-faithful) per lookup"),
+            holds: a == 0.0 && b > 0.0,
+        });
+        let share = (cell(faithful, 2) + b) / cell(faithful, 0);
+        t.checks.push(Check {
+            claim: format!(
+                "estimate on the {what}, 2003-faithful: a third to a half of the instructions are overhead, \
+                 address arithmetic and packing (004:L231; the printed rows: 43.6% and 31.6%)"
+            ),
+            evidence: format!("(Addr + Pack) / Inst = {:.1}%", 100.0 * share),
+            holds: (1.0 / 3.0..=0.5).contains(&share),
+        });
+    }
     t.notes.push(
         "Per iteration: one compare-exchange (sort), one search step, one photon slot (routing), one photon lookup (estimate). \
          Ours: thread instructions and lane-level global loads from the emulator's counters on the Cornell box's map; \
          the estimate's and the search's as the difference of two launches differing by known iterations."
+            .into(),
+    );
+    t.notes.push(
+        "Addr and Pack: the executed thread instructions of each class, the class read off the PTX by data flow \
+         (src/repro/purcell2003/dataflow.rs): Addr feeds memory addresses only; Pack is a bit-level instruction \
+         (shift, and/or, bit field, half conversion, vector mov) that is not Addr. 2003-faithful rows: every array a 2-D \
+         float texture addressed by convert1dto2d in float arithmetic; the estimate's state packed into one float4 \
+         around every lookup (kernels/purcell2003/knn.cu)."
             .into(),
     );
     t.notes.push(

@@ -1,0 +1,94 @@
+//! Thesis 003's path tracer, paths per second emulated against native: one
+//! frame (4 paths per pixel, next-event estimation, at most 16 bounces) of
+//! the Lambertian Cornell box and of Fig. 3's bunny&ball at 32 x 32, the
+//! kernel `path_frame` at fidelity `functional` (and `instructions`, which
+//! the Fig. 3 table runs at) against the native mirror, both on all host
+//! threads. The ratios are measured in one run (the machines are shared and
+//! noisy) and printed before criterion's own timings.
+
+use std::path::Path;
+use std::time::Instant;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use warplight::host::camera::Camera;
+use warplight::host::path::build::{self, Construction};
+use warplight::host::path::layout::PathScene;
+use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::scene_file;
+use warplight::sim::{Device, Fidelity};
+
+const SIDE: u32 = 32;
+
+fn setup(name: &str) -> (PathScene, Camera) {
+    let s = scene_file::load(Path::new(&format!("scenes/{name}.toml"))).expect("scene");
+    let tris: Vec<[glam::Vec3; 3]> = s.triangles.iter().map(|t| t.v).collect();
+    let tree = build::build(&tris, &build::Params::fig3(Construction::Sah, tris.len()));
+    let ps = PathScene::new(&s, &tree).expect("layout");
+    (ps, Camera { resolution: [SIDE, SIDE], ..s.camera })
+}
+
+fn params() -> FrameParams {
+    FrameParams {
+        width: SIDE,
+        height: SIDE,
+        integrator: Integrator::Nee,
+        max_bounces: 16,
+        seed: 0,
+        traversal: Traversal::ShortStack,
+    }
+}
+
+fn native(ps: &PathScene, cam: &Camera) -> f32 {
+    render_native(ps, cam, params(), 1, false, |_| {}).accum[0]
+}
+
+fn emulated(ps: &PathScene, cam: &Camera, level: Fidelity) -> f32 {
+    let p = params();
+    let mut cfg = kernel::sim_config(&p);
+    cfg.fidelity = level;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev).expect("kernel");
+    kernel::render(&mut dev, &module, ps, cam, p, 1, false, |_| {}).expect("render").image.accum[0]
+}
+
+/// Best of `n` timings of `f`.
+fn best(n: usize, mut f: impl FnMut() -> f32) -> f64 {
+    (0..n)
+        .map(|_| {
+            let t0 = Instant::now();
+            std::hint::black_box(f());
+            t0.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn report() {
+    let paths = params().paths() as f64;
+    for name in ["cornell-lambert", "bunny-ball"] {
+        let (ps, cam) = setup(name);
+        let tn = best(5, || native(&ps, &cam));
+        let tf = best(2, || emulated(&ps, &cam, Fidelity::Functional));
+        let ti = best(2, || emulated(&ps, &cam, Fidelity::Instructions));
+        eprintln!("\n{name}, {SIDE} x {SIDE}, 1 frame ({paths} paths), NEE (best of several runs):");
+        eprintln!("  native                  {:>10.0} paths/s", paths / tn);
+        eprintln!("  emulated, functional    {:>10.0} paths/s   native / emulated {:>7.1} x", paths / tf, tf / tn);
+        eprintln!("  emulated, instructions  {:>10.0} paths/s   native / emulated {:>7.1} x", paths / ti, ti / tn);
+    }
+    eprintln!();
+}
+
+fn bench(c: &mut Criterion) {
+    report();
+    for name in ["cornell-lambert", "bunny-ball"] {
+        let (ps, cam) = setup(name);
+        let mut g = c.benchmark_group(format!("path_{name}_{SIDE}"));
+        g.sample_size(10);
+        g.throughput(criterion::Throughput::Elements(params().paths() as u64));
+        g.bench_function("native", |b| b.iter(|| native(&ps, &cam)));
+        g.bench_function("emulated_functional", |b| b.iter(|| emulated(&ps, &cam, Fidelity::Functional)));
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,115 @@
+//! Thesis 003's kd-tree traversals (Fig. 3): the 8-byte short stack,
+//! kd-restart and kd-backtrack in `kernels/lin2017/path.cu` on trees of
+//! thesis 003's constructions (`host::path::build`). Emulated and native
+//! frames agree bit for bit for every traversal; the counts the emulator
+//! reads off the kernel's `@count` lines equal the native mirror's, event for
+//! event; the stackless traversals visit the same leaves; all three find
+//! the same hits.
+
+use warplight::host::camera::Camera;
+use warplight::host::path::build::{self, Construction};
+use warplight::host::path::counts::{self, Counts};
+use warplight::host::path::layout::PathScene;
+use warplight::host::path::{FrameParams, Integrator, Progressive, Traversal, kernel, render_native};
+use warplight::host::scene::Scene;
+use warplight::host::scene_file;
+use warplight::sim::{Device, Fidelity};
+
+fn scene(name: &str) -> Scene {
+    scene_file::load(&scene_file::resolve(name)).unwrap_or_else(|e| panic!("scenes/{name}.toml: {e}"))
+}
+
+fn layout(scene: &Scene, c: Construction) -> PathScene {
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build::build(&tris, &build::Params::fig3(c, tris.len()));
+    PathScene::new(scene, &tree).expect("layout")
+}
+
+fn params(w: u32, h: u32, traversal: Traversal) -> FrameParams {
+    FrameParams { width: w, height: h, integrator: Integrator::Nee, max_bounces: 16, seed: 5, traversal }
+}
+
+fn emulate(ps: &PathScene, cam: &Camera, p: FrameParams) -> (Progressive, Counts) {
+    let mut cfg = kernel::sim_config(&p);
+    cfg.fidelity = Fidelity::Instructions;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev).expect("load PTX");
+    let r = kernel::render(&mut dev, &module, ps, cam, p, 1, false, |_| {}).expect("launch");
+    (r.image, r.counts.expect("counted at fidelity instructions"))
+}
+
+#[test]
+fn every_tag_names_an_instruction_of_its_line() {
+    let tags = counts::tags();
+    let names: Vec<&str> = tags.iter().map(|t| t.name.as_str()).collect();
+    for n in ["rays", "inner", "leaves", "tri_tests", "push", "pop", "ascents"] {
+        assert!(names.contains(&n), "no @count tag {n}");
+    }
+    // each tag's opcode appears in the PTX on its line (a recompile that
+    // moved or renamed the instruction would silently count nothing)
+    let ptx = kernel::PTX;
+    for t in &tags {
+        let mut on_line = false;
+        let mut found = false;
+        for l in ptx.lines().map(str::trim) {
+            if let Some(loc) = l.strip_prefix(".loc") {
+                let w: Vec<&str> = loc.split_whitespace().collect();
+                on_line = w.len() >= 2 && w[0] == "1" && w[1] == t.line.to_string();
+            } else if on_line && l.split_whitespace().next() == Some(t.opcode.as_str()) {
+                found = true;
+            }
+        }
+        assert!(found, "@count {} {}: no such instruction on line {}", t.name, t.opcode, t.line);
+    }
+}
+
+#[test]
+fn emulated_traversals_equal_native_bit_for_bit_and_count_for_count() {
+    let s = scene("cornell-lambert");
+    let cam = Camera { resolution: [8, 6], ..s.camera };
+    for c in Construction::ALL {
+        let ps = layout(&s, c);
+        for t in Traversal::ALL {
+            let p = params(8, 6, t);
+            let native = render_native(&ps, &cam, p, 1, false, |_| {});
+            let (emu, counted) = emulate(&ps, &cam, p);
+            let diff = native.accum.iter().zip(&emu.accum).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+            assert_eq!(diff, 0, "{c:?} {t:?}: {diff} values differ");
+            assert_eq!(counted, native.counts, "{c:?} {t:?}: emulator's tagged counts vs native");
+            assert!(native.accum.iter().sum::<f32>() > 0.0, "{c:?} {t:?}: black");
+            let k = native.counts;
+            assert!(k.rays > 0 && k.inner > 0 && k.leaves > 0 && k.tri_tests > 0, "{c:?} {t:?}: {k:?}");
+            match t {
+                Traversal::ShortStack => assert!(k.pushes > 0 && k.ascents == 0, "{k:?}"),
+                Traversal::Restart => assert!(k.pushes == 0 && k.pops == 0 && k.ascents == 0, "{k:?}"),
+                Traversal::Backtrack => assert!(k.pushes == 0 && k.ascents > 0, "{k:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn stackless_traversals_visit_the_same_leaves_and_every_traversal_finds_the_same_hits() {
+    // the bunny&ball of Fig. 3 (70,735 triangles), both trees, natively
+    let s = scene("bunny-ball");
+    let (w, h) = (24, 24);
+    let cam = Camera { resolution: [w, h], ..s.camera };
+    for c in Construction::ALL {
+        let ps = layout(&s, c);
+        let runs: Vec<(Traversal, Progressive)> =
+            Traversal::ALL.iter().map(|&t| (t, render_native(&ps, &cam, params(w, h, t), 1, false, |_| {}))).collect();
+        let (restart, backtrack) = (&runs[1].1.counts, &runs[2].1.counts);
+        // the same leaves in the same order: the same leaf visits and triangle tests
+        assert_eq!((restart.leaves, restart.tri_tests), (backtrack.leaves, backtrack.tri_tests), "{c:?}");
+        // kd-backtrack resumes below the root: fewer inner-node steps
+        assert!(backtrack.inner < restart.inner, "{c:?}: {backtrack:?} vs {restart:?}");
+        // the short stack re-descends nothing: fewest inner steps
+        assert!(runs[0].1.counts.inner < backtrack.inner, "{c:?}");
+        // the same hits, hence the same image, with all three
+        for (t, r) in &runs[1..] {
+            let diff = r.accum.iter().zip(&runs[0].1.accum).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+            assert_eq!(diff, 0, "{c:?} {t:?}: {diff} values differ from the short stack's");
+        }
+        assert_eq!(runs[0].1.counts.rays, restart.rays, "{c:?}: the same rays traced");
+    }
+}
