@@ -81,7 +81,10 @@ fn writes(k: &Kind) -> Vec<Var> {
         | Kind::Redux { d, .. } => vec![r(d)],
         Kind::Match { d, p, .. } => std::iter::once(r(d)).chain(p.map(Var::P)).collect(),
         Kind::Carry { d, cc, .. } => vec![r(d), Var::R(*cc)],
-        Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } => ds.iter().map(r).collect(),
+        Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } | Kind::Tex { ds, .. } | Kind::Suld { ds, .. } => {
+            ds.iter().map(r).collect()
+        }
+        Kind::Txq { d, .. } => vec![r(d)],
         Kind::Atom { d, .. } => d.iter().map(r).collect(),
         Kind::Vote { d, p, .. } | Kind::BarRed { d, p, .. } => {
             d.iter().map(r).chain(std::iter::once(Var::P(*p))).collect()
@@ -89,8 +92,10 @@ fn writes(k: &Kind) -> Vec<Var> {
         Kind::Setp { p, q, .. } => std::iter::once(Var::P(*p)).chain(q.map(Var::P)).collect(),
         Kind::PredLogic { d, .. } => vec![Var::P(*d)],
         Kind::St { .. }
+        | Kind::Sust { .. }
         | Kind::Bra { .. }
         | Kind::Call { .. }
+        | Kind::CallIndirect { .. }
         | Kind::Ret
         | Kind::Exit
         | Kind::Bar { .. }
@@ -121,6 +126,15 @@ fn uses(inst: &crate::ptx::ir::Inst) -> Vec<(Var, Use)> {
             v.extend([b, c].into_iter().filter_map(reg).map(|x| (x, Use::Sink)));
             let u = if is_memory(*space) { Use::Address } else { Use::Sink };
             v.extend(reg(&addr.base).map(|x| (x, u)));
+        }
+        // a texture or surface access: its handle and coordinates address memory
+        Kind::Tex { handle, coords, .. } | Kind::Suld { handle, coords, .. } => {
+            v.extend(std::iter::once(handle).chain(coords.iter()).filter_map(reg).map(|x| (x, Use::Address)));
+        }
+        Kind::Txq { handle, .. } => v.extend(reg(handle).map(|x| (x, Use::Address))),
+        Kind::Sust { vals, handle, coords, .. } => {
+            v.extend(vals.iter().filter_map(reg).map(|x| (x, Use::Sink)));
+            v.extend(std::iter::once(handle).chain(coords.iter()).filter_map(reg).map(|x| (x, Use::Address)));
         }
         k => {
             // every other instruction: its data sources flow into its results
