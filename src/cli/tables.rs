@@ -366,29 +366,6 @@ impl UnitProgress {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Devices made while the progress is on move its bar within the unit:
-    /// 480 CTAs, 240 resident at a time, half of them retired after the first round.
-    #[test]
-    fn the_emulators_hook_moves_the_bar_within_a_unit() {
-        let u = UnitProgress::with_bar(2, 0, indicatif::ProgressBar::hidden());
-        u.bar.set_length(2 * STEPS);
-        let ptx = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n ret;\n}\n";
-        let mut dev = crate::sim::Device::new();
-        let m = dev.load_ptx(ptx, "k.ptx").unwrap();
-        dev.launch(&m, "k", crate::sim::LaunchConfig::linear(480, 32), &[]).unwrap();
-        // other tests' devices, made in this process while the hook is set, may move it further
-        assert!((STEPS / 2..2 * STEPS).contains(&u.bar.position()), "{}", u.bar.position());
-        u.unit_done("one".into());
-        assert!(u.bar.position() >= STEPS);
-        assert_eq!(u.bar.message(), "1/2 runs, last one");
-        u.finish();
-    }
-}
-
 fn merge(files: &[PathBuf], partial: bool) -> Result<Results, Box<dyn std::error::Error>> {
     let mut shards = Vec::new();
     for f in files {
@@ -470,4 +447,27 @@ fn check_baseline(f: &std::path::Path, r: &Results, tables: &[Table]) -> Result<
     }
     eprintln!("baseline {}: no cell dropped out of tolerance", f.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Devices made while the progress is on move its bar within the unit:
+    /// 480 CTAs, 240 resident at a time, half of them retired after the first round.
+    #[test]
+    fn the_emulators_hook_moves_the_bar_within_a_unit() {
+        let u = UnitProgress::with_bar(2, 0, indicatif::ProgressBar::hidden());
+        u.bar.set_length(2 * STEPS);
+        let ptx = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n ret;\n}\n";
+        let mut dev = crate::sim::Device::new();
+        let m = dev.load_ptx(ptx, "k.ptx").unwrap();
+        dev.launch(&m, "k", crate::sim::LaunchConfig::linear(480, 32), &[]).unwrap();
+        // other tests' devices, made in this process while the hook is set, may move it further
+        assert!((STEPS / 2..2 * STEPS).contains(&u.bar.position()), "{}", u.bar.position());
+        u.unit_done("one".into());
+        assert!(u.bar.position() >= STEPS);
+        assert_eq!(u.bar.message(), "1/2 runs, last one");
+        u.finish();
+    }
 }
