@@ -12,7 +12,7 @@ use warplight::sim::cfg::Cfg;
 use warplight::sim::regalloc::{Allocation, Liveness};
 use warplight::sim::{Arg, Device, LaunchConfig, Module, SimConfig};
 
-/// Frame rows of `trace_stack` after compaction. It declares 684 data
+/// Frame rows of `trace_stack` after compaction. It declares 686 data
 /// registers (`%f<410>`, `%r<170>`, `%rd<100>`, `%SP`, `%SPL` and the
 /// parameter temporaries); at most this many are live at once (or pinned).
 /// A change to the allocator or the kernel's PTX that moves this figure
