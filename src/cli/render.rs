@@ -152,6 +152,18 @@ fn pixel_progress(dev: &mut Device, kernel: &str, pixels: u64) -> Option<indicat
     Some(pb)
 }
 
+/// Writes `fb` to `out` as OpenEXR (`.exr`) or PNG: encoded in memory, then
+/// written beside the output under a temporary name and renamed, so that
+/// neither a failure nor a signal leaves a partial image.
+pub(crate) fn write_image(
+    fb: &crate::host::image::FrameBuffer,
+    out: &std::path::Path,
+    exposure: f32,
+) -> Result<(), String> {
+    let exr = out.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    super::write_atomically(out, &encode(fb, exr, exposure)?)
+}
+
 /// The image as the bytes of a PNG (sRGB, `exposure` stops) or an OpenEXR
 /// file (linear 32-bit float RGB).
 fn encode(fb: &crate::host::image::FrameBuffer, exr: bool, exposure: f32) -> Result<Vec<u8>, String> {
@@ -269,10 +281,7 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let render_s = t1.elapsed().as_secs_f64();
-    // encoded in memory, then written beside the output under a temporary name and renamed:
-    // never a partial image, also on a signal
-    let bytes = encode(&fb, ext.as_deref() == Some("exr"), a.exposure)?;
-    super::write_atomically(&a.output, &bytes)?;
+    write_image(&fb, &a.output, a.exposure)?;
     let ts = tree.stats();
     println!(
         "{} frame {} ({}x{}), {} triangles, {} tree: {} inner nodes, {} references, depth {} (built in {:.3} s)",

@@ -284,22 +284,7 @@ pub fn run_cli(
     let (direct, _) = crate::host::raycast::render(&caster, cam, glam::Vec3::ZERO);
     let image = add(&direct, &r.indirect);
     let out = &a.output;
-    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-    let tmp = parent.join(format!(
-        ".{}.warplight-tmp.{}",
-        out.file_stem().and_then(|s| s.to_str()).unwrap_or("render"),
-        ext.as_deref().unwrap_or("png")
-    ));
-    let written = if ext.as_deref() == Some("exr") { image.write_exr(&tmp) } else { image.write_png(&tmp, a.exposure) };
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e.into());
-    }
-    std::fs::rename(&tmp, out).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", out.display())
-    })?;
+    crate::cli::render::write_image(&image, out, a.exposure)?;
     let c = &r.maps.constructed;
     println!(
         "{} ({}x{}), photon map: {} photons, s = {}, {} interactions ({} discarded, {} clamped), {:?} {:?}, \

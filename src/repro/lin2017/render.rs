@@ -3,7 +3,6 @@
 //! written as EXR (linear) or PNG, with a progress bar on a terminal.
 
 use std::io::IsTerminal;
-use std::path::Path;
 use std::time::Instant;
 
 use crate::cli::render::RenderArgs;
@@ -116,7 +115,7 @@ pub fn run(
         traversal: Traversal::ShortStack,
     };
     let r = render(scene, camera, params, frames, emulated)?;
-    write_image(&r.image, &a.output, a.exposure)?;
+    crate::cli::render::write_image(&r.image, &a.output, a.exposure)?;
     println!(
         "{} ({}x{}), path tracer {}, {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
         scene.name,
@@ -134,26 +133,5 @@ pub fn run(
         println!("  emulated path_frame: {w} warp instructions, {t} thread instructions");
     }
     println!("  wrote {}", a.output.display());
-    Ok(())
-}
-
-/// Writes `img` as EXR or PNG (by extension) under a temporary name, then renames it.
-fn write_image(img: &FrameBuffer, out: &Path, exposure: f32) -> Result<(), Box<dyn std::error::Error>> {
-    let ext = out.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let tmp = parent.join(format!(
-        ".{}.warplight-tmp.{}",
-        out.file_stem().and_then(|s| s.to_str()).unwrap_or("render"),
-        ext.as_deref().unwrap_or("png")
-    ));
-    let written = if ext.as_deref() == Some("exr") { img.write_exr(&tmp) } else { img.write_png(&tmp, exposure) };
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e.into());
-    }
-    std::fs::rename(&tmp, out).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: {e}", out.display())
-    })?;
     Ok(())
 }
