@@ -45,6 +45,24 @@ fn kill(sig: &str, pid: u32) {
     assert!(ok, "kill {sig} {pid}");
 }
 
+/// Waits (at most 10 s) until every thread of process `pid` is stopped (state
+/// `T` in `/proc/PID/task/*/stat`) or the process has ended.
+fn wait_stopped(pid: u32) {
+    let t0 = Instant::now();
+    let state = |stat: &str| stat.rsplit_once(')').and_then(|(_, r)| r.trim_start().chars().next());
+    while t0.elapsed() < Duration::from_secs(10) {
+        let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else { return };
+        let all = tasks.flatten().all(|t| {
+            let stat = std::fs::read_to_string(t.path().join("stat")).unwrap_or_default();
+            matches!(state(&stat), Some('T' | 't' | 'Z' | 'X') | None)
+        });
+        if all {
+            return;
+        }
+        std::thread::yield_now();
+    }
+}
+
 /// Waits at most 30 s for `child`'s exit code (None: killed by a signal).
 fn wait(child: &mut Child) -> Option<i32> {
     let t0 = Instant::now();
@@ -101,6 +119,8 @@ fn a_signal_while_the_output_is_written_leaves_neither_it_nor_the_temporary_file
         let t0 = Instant::now();
         while !tmp.exists() && child.try_wait().unwrap().is_none() && t0.elapsed() < Duration::from_secs(60) {}
         kill("-STOP", child.id());
+        // kill returns before the stop takes effect: sample only once every thread is stopped
+        wait_stopped(child.id());
         let caught = tmp.exists() && !out.exists();
         kill("-TERM", child.id());
         kill("-CONT", child.id());

@@ -14,7 +14,8 @@
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock};
 
 /// The temporary files that exist now (created, not yet renamed or removed).
 static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
@@ -22,6 +23,18 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 fn pending() -> MutexGuard<'static, Vec<PathBuf>> {
     // a panic elsewhere while the list was held leaves it consistent (each change is one push or retain)
     PENDING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The number of the first signal received (0: none), set by the signal
+/// handler itself, synchronously, before the handler thread wakes: [`commit`]
+/// checks it under the lock, so an output whose signal arrived before its
+/// rename is never published even when the handler thread has not run yet.
+static RECEIVED: OnceLock<Arc<AtomicUsize>> = OnceLock::new();
+
+/// The signal received so far, if any.
+fn received() -> Option<i32> {
+    let n = RECEIVED.get()?.load(Ordering::SeqCst);
+    (n != 0).then_some(n as i32)
 }
 
 /// The exit status of a process ended by `signal`, as shells report it.
@@ -34,6 +47,11 @@ pub fn exit_status(signal: i32) -> i32 {
 /// handler cannot be installed, the signals keep their default action.
 pub fn install() {
     use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let flag = RECEIVED.get_or_init(|| Arc::new(AtomicUsize::new(0)));
+    for sig in [SIGINT, SIGTERM, SIGHUP] {
+        // the action is one atomic store (async-signal-safe); without it, commit relies on the thread alone
+        let _ = signal_hook::flag::register_usize(sig, Arc::clone(flag), sig as usize);
+    }
     let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
         return;
     };
@@ -122,6 +140,12 @@ impl Drop for Temporary {
 /// output that failed is returned with the error.
 pub fn commit(files: Vec<(Temporary, &Path)>) -> Result<(), (PathBuf, std::io::Error)> {
     let mut held = pending();
+    if let Some(sig) = received() {
+        // the signal came before the rename: the handler thread is about to
+        // remove the temporaries and exit; do it here, holding the lock
+        remove_all(&held);
+        std::process::exit(exit_status(sig));
+    }
     let mut failed = None;
     for (mut t, output) in files {
         t.file = None;
