@@ -3,32 +3,17 @@
 // libdevice, as `warplight compile` makes them), loaded by the driver.
 // Usage: mathlib_host INPUTS.bin OUT_DIR [NAME=FILE.ptx ...]
 // Writes OUT_DIR/nvcc.f32.bin, nvcc.f64.bin and NAME.f32.bin, NAME.f64.bin.
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
-#include <cuda.h>
-#include <cuda_runtime.h>
+#include "host_harness.h"
 #include "mathlib.cu"
 
 static const int N = 2048, F32_ROWS = 45, F64_ROWS = 5;
 
-#define CK(x) do { cudaError_t e = (x); if (e != cudaSuccess) { fprintf(stderr, "%s: %s\n", #x, cudaGetErrorString(e)); exit(1); } } while (0)
-#define CD(x) do { CUresult e = (x); if (e != CUDA_SUCCESS) { const char *s; cuGetErrorString(e, &s); fprintf(stderr, "%s: %s\n", #x, s); exit(1); } } while (0)
-
-static void save(const std::string &path, const void *p, size_t bytes) {
-  FILE *f = fopen(path.c_str(), "wb");
-  if (!f || fwrite(p, 1, bytes, f) != bytes) { fprintf(stderr, "cannot write %s\n", path.c_str()); exit(1); }
-  fclose(f);
-}
-
 int main(int argc, char **argv) {
   if (argc < 3) { fprintf(stderr, "usage: mathlib_host INPUTS.bin OUT_DIR [NAME=FILE.ptx ...]\n"); return 2; }
   std::vector<float> in(2 * N);
-  FILE *f = fopen(argv[1], "rb");
-  if (!f || fread(in.data(), 4, 2 * N, f) != (size_t)(2 * N)) { fprintf(stderr, "cannot read %s\n", argv[1]); return 1; }
-  fclose(f);
+  read_inputs(argv[1], in.data(), 4, 2 * N);
   std::string out = argv[2];
   float *x, *y, *o;
   double *od;
@@ -50,31 +35,9 @@ int main(int argc, char **argv) {
   mathlib<<<N / 128, 128>>>(x, y, o, od, N);
   CK(cudaGetLastError());
   fetch("nvcc");
-  for (int a = 3; a < argc; a++) {
-    std::string arg = argv[a];
-    size_t eq = arg.find('=');
-    std::string name = arg.substr(0, eq), path = arg.substr(eq + 1);
-    FILE *pf = fopen(path.c_str(), "rb");
-    if (!pf) { fprintf(stderr, "cannot read %s\n", path.c_str()); return 1; }
-    std::string ptx;
-    char buf[65536];
-    size_t k;
-    while ((k = fread(buf, 1, sizeof buf, pf)) > 0) ptx.append(buf, k);
-    fclose(pf);
-    CUmodule m;
-    char log[8192] = {0};
-    CUjit_option opts[] = {CU_JIT_ERROR_LOG_BUFFER, CU_JIT_ERROR_LOG_BUFFER_SIZE_BYTES};
-    void *vals[] = {log, (void *)(size_t)sizeof log};
-    CUresult r = cuModuleLoadDataEx(&m, ptx.c_str(), 2, opts, vals);
-    if (r != CUDA_SUCCESS) { fprintf(stderr, "%s: JIT failed: %s\n", path.c_str(), log); return 1; }
-    CUfunction fn;
-    CD(cuModuleGetFunction(&fn, m, "mathlib"));
-    int n = N;
-    void *params[] = {&x, &y, &o, &od, &n};
-    CD(cuLaunchKernel(fn, N / 128, 1, 1, 128, 1, 1, 0, 0, params, 0));
-    fetch(name);
-    printf("%s: ran %s\n", name.c_str(), path.c_str());
-  }
+  int n = N;
+  void *params[] = {&x, &y, &o, &od, &n};
+  run_ptx_files(argc, argv, 3, "mathlib", params, N / 128, 128, fetch);
   printf("nvcc: ran the nvcc build\n");
   return 0;
 }
