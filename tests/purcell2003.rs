@@ -45,7 +45,7 @@ fn photons_are_emitted_by_the_counter_based_rng_and_traced_one_launch_per_bounce
     let geo = Geometry::of(&scene);
     let mut p = Passes::new(None).unwrap();
     let (n, bounces) = (256, 3);
-    let ph = photons::trace(&mut p, &geo, n, bounces, 7).unwrap();
+    let ph = photons::trace(&mut p, &geo, n, bounces, 7, true).unwrap();
     // one emission pass and one pass per bounce, counted by the emulator
     assert_eq!(p.phase(TRACE_PHOTONS).launches, 1 + bounces as u64);
     let pos = read4(&p, ph.pos, n * (bounces + 1));
@@ -89,7 +89,7 @@ fn photons_are_emitted_by_the_counter_based_rng_and_traced_one_launch_per_bounce
     assert!(down > n / 4 && down < n * 3 / 4, "{down} of {n} hit the floor");
     // deterministic: the same bytes on a second device run
     let mut q = Passes::new(None).unwrap();
-    let ph2 = photons::trace(&mut q, &geo, n, bounces, 7).unwrap();
+    let ph2 = photons::trace(&mut q, &geo, n, bounces, 7, true).unwrap();
     assert_eq!(read4(&q, ph2.pos, n * (bounces + 1)), pos);
 }
 
@@ -179,7 +179,7 @@ fn map_a_sorts_photons_by_cell_and_the_binary_search_finds_each_cells_first_phot
     let scene = floor_scene(0.8);
     let geo = Geometry::of(&scene);
     let mut p = Passes::new(None).unwrap();
-    let ph = photons::trace(&mut p, &geo, 300, 2, 3).unwrap();
+    let ph = photons::trace(&mut p, &geo, 300, 2, 3, true).unwrap();
     let grid = Grid::new(Vec3::new(-2.0, -0.1, -2.0), Vec3::new(2.0, 0.1, 2.0), [8, 1, 8]);
     let map = bitonic::build(&mut p, grid, &ph).unwrap();
     let (first_slot, count) = ph.stored_slots();

@@ -70,6 +70,7 @@ struct Scene {
   float light[4];    // point light position (num_lights == 0)
   float power[4];    // power per emitted photon (rgb)
   float cone[4];     // point light: axis and cosine of the half-angle of the emission cone
+  float radiance[4]; // area light: emitted radiance (rgb); point light: intensity (rgb)
 };
 
 struct Hit { float t; int tri; };
@@ -168,9 +169,12 @@ extern "C" __global__ void emit(Scene sc, const float *tris, const int *lights, 
   out[i] = make_float4(d.x, d.y, d.z, 0.0f);
 }
 
-// Pass b >= 1: one bounce. Reads frame b - 1, writes frame b.
+// Pass b >= 1: one bounce. Reads frame b - 1, writes frame b. A photon that
+// lands on a diffuse surface is stored, except, when `direct` is 0, one that
+// comes straight from the light (b == 1): the shadow rays give direct light
+// (004:L140), so the map holds indirect light and caustics only.
 extern "C" __global__ void bounce(Scene sc, const float *tris, const float4 *mats, float4 *pos, float4 *pw,
-                                  float4 *dir, float4 *out, int n, int b, unsigned seed) {
+                                  float4 *dir, float4 *out, int n, int b, unsigned seed, int direct) {
   int i = WL_TID;
   if (i >= n) return;
   int prev = (b - 1) * n + i, cur = b * n + i;
@@ -191,7 +195,7 @@ extern "C" __global__ void bounce(Scene sc, const float *tris, const float4 *mat
       np = make_float4(x.x, x.y, x.z, 0.0f);
       nd = make_float4(d.x, d.y, d.z, 0.0f);
       if (kind == 0) {
-        np.w = 1.0f;  // stored at a diffuse surface
+        np.w = (direct != 0 || b > 1) ? 1.0f : 0.0f;  // stored at a diffuse surface
         float q = fmaxf(c.x, fmaxf(c.y, c.z));
         if (rng_unit(seed, i, b, 0) < q) {
           if (dot(nrm, d) > 0.0f) nrm = mul(nrm, -1.0f);
@@ -251,4 +255,64 @@ extern "C" __global__ void eye_rays(Scene sc, const float *tris, const float4 *m
   query[i] = q;
   normal[i] = nq;
   albedo[i] = a;
+}
+
+// Direct illumination (004:L140, L174-176): `samples` shadow rays per pixel
+// from its query point (query, normal, albedo as eye_rays writes them) to the
+// light. An area light (emissive triangles lights[]) is sampled as emit
+// samples it (a uniformly chosen triangle, a uniform point on it); a point
+// light is its position. Sample s of pixel i uses the random numbers of pass
+// 16 + s. direct[i] = albedo / pi * the mean over the samples of the light's
+// contribution: area light, radiance * cos_x * cos_l / d^2 * (lights *
+// triangle area) when nothing lies between; point light, intensity * cos_x /
+// d^2. Pixels without a query point get 0.
+extern "C" __global__ void shadow_rays(Scene sc, const float *tris, const int *lights, const float4 *query,
+                                       const float4 *normal, const float4 *albedo, int npix, int samples,
+                                       unsigned seed, float4 *direct) {
+  int i = WL_TID;
+  if (i >= npix) return;
+  float4 q4 = query[i];
+  V3 acc = v3(0.0f, 0.0f, 0.0f);
+  if (q4.w != 0.0f) {
+    float4 n4 = normal[i];
+    V3 x = v3(q4.x, q4.y, q4.z), n = v3(n4.x, n4.y, n4.z);
+    for (int s = 0; s < samples; ++s) {
+      unsigned pass = 16u + (unsigned)s;
+      V3 l = v3(sc.light[0], sc.light[1], sc.light[2]);
+      float weight = 1.0f;  // point light: intensity / d^2
+      V3 nl = v3(0.0f, 0.0f, 0.0f);
+      if (sc.num_lights > 0) {
+        int k = imin((int)(rng_unit(seed, i, pass, 0) * sc.num_lights), sc.num_lights - 1);
+        int ti = lights[k];
+        const float *t = tris + 12 * ti;
+        float a = rng_unit(seed, i, pass, 1), bb = rng_unit(seed, i, pass, 2);
+        if (a + bb > 1.0f) { a = 1.0f - a; bb = 1.0f - bb; }
+        V3 e1 = v3(t[3], t[4], t[5]), e2 = v3(t[6], t[7], t[8]);
+        l = add(v3(t[0], t[1], t[2]), add(mul(e1, a), mul(e2, bb)));
+        V3 c = cross(e1, e2);
+        float len = sqrtf(dot(c, c));
+        nl = mul(c, 1.0f / len);
+        weight = 0.5f * len * (float)sc.num_lights;
+      }
+      V3 to = sub(l, x);
+      float d2 = dot(to, to), dist = sqrtf(d2);
+      V3 wi = mul(to, 1.0f / dist);
+      float cx = dot(n, wi);
+      if (cx <= 0.0f) continue;
+      float cl = 1.0f;
+      if (sc.num_lights > 0) {
+        cl = fabsf(dot(nl, wi));
+      }
+      Hit h = intersect(tris, sc.num_tris, x, wi, sc.eps);
+      if (h.tri >= 0 && h.t < dist - sc.eps) continue;  // occluded (the light itself lies at dist)
+      float g = cx * cl * weight / d2;
+      acc.x += sc.radiance[0] * g;
+      acc.y += sc.radiance[1] * g;
+      acc.z += sc.radiance[2] * g;
+    }
+    float4 a4 = albedo[i];
+    float f = 1.0f / (3.14159265358979f * (float)samples);
+    acc = v3(acc.x * a4.x * f, acc.y * a4.y * f, acc.z * a4.z * f);
+  }
+  direct[i] = make_float4(acc.x, acc.y, acc.z, 0.0f);
 }

@@ -58,8 +58,9 @@ pub struct RenderArgs {
     #[arg(long)]
     pub json: Option<PathBuf>,
     /// Method: `raycast` (thesis 000's Whitted ray caster), `path` (thesis 003's
-    /// path tracer) or `photon-map` (thesis 000 ch. 5; `--estimator`); the last two
-    /// take `--variant native` or `emulated`.
+    /// path tracer), `photon-map` (thesis 000 ch. 5; `--estimator`) or `purcell`
+    /// (seed 004's GPU photon map on both grid maps: OUT-bitonic.png, OUT-stencil.png;
+    /// `--json` the convergence chart); the last three take `--variant native` or `emulated`.
     #[arg(long, default_value = "raycast")]
     pub method: String,
     /// Path tracer: pt, nee, mis (balance heuristic) or mis-power.
@@ -187,11 +188,11 @@ fn encode(fb: &crate::host::image::FrameBuffer, exr: bool, exposure: f32) -> Res
 
 /// Renders one frame.
 fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    if !matches!(a.method.as_str(), "raycast" | "path" | "photon-map") {
-        return Err(format!("unknown method `{}`; expected raycast, path or photon-map", a.method).into());
+    if !matches!(a.method.as_str(), "raycast" | "path" | "photon-map" | "purcell") {
+        return Err(format!("unknown method `{}`; expected raycast, path, photon-map or purcell", a.method).into());
     }
     let kernel_variant = match a.variant.as_str() {
-        _ if a.method == "path" || a.method == "photon-map" => None,
+        _ if a.method == "path" || a.method == "photon-map" || a.method == "purcell" => None,
         "native" => None,
         v => Some(Variant::parse(v).ok_or_else(|| {
             let names: Vec<&str> = Variant::EVERY.iter().map(|v| v.name()).collect();
@@ -239,6 +240,9 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     if a.method == "photon-map" {
         return crate::repro::fabianowski2011::photon_image::run_cli(&a, &scene, &cam);
+    }
+    if a.method == "purcell" {
+        return crate::repro::purcell2003::image::run_cli(&a, &scene, &cam);
     }
     crate::limits::check_memory(
         || format!("a render of {width} x {height} pixels"),

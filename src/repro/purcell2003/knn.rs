@@ -171,28 +171,43 @@ pub fn pass(
     p: &Params,
     state: crate::sim::DevicePtr,
 ) -> Result<LaunchStats, SimError> {
-    let mut args = vec![
-        search_arg(map, p),
+    let lists = match map {
+        Map::Bitonic(m, _) => vec![Arg::Ptr(m.first), Arg::Ptr(m.sorted), Arg::I32(m.n as i32)],
+        Map::Stencil(m) => vec![Arg::Ptr(m.stored)],
+    };
+    launch_pass(passes, phase, map.kernel(), map, vec![search_arg(map, p)], q, state, lists)
+}
+
+/// Launches the estimate kernel `kernel` (natural or 2003-faithful) over
+/// `q`'s tiles. Its arguments: `head` (the search, and the 2003 texture
+/// width), the query points, the state buffer, the image size, `lists` (map
+/// A: first photons, sorted list, its length; map B: stored counts), then
+/// the photon data of `map` (map A: position, power, direction; map B: the
+/// redistribution factors and the cells' blocks).
+#[allow(clippy::too_many_arguments)]
+pub fn launch_pass(
+    passes: &mut Passes,
+    phase: &str,
+    kernel: &str,
+    map: &Map,
+    mut args: Vec<Arg>,
+    q: &Queries,
+    state: crate::sim::DevicePtr,
+    lists: Vec<Arg>,
+) -> Result<LaunchStats, SimError> {
+    args.extend([
         Arg::Ptr(q.query),
         Arg::Ptr(q.normal),
         Arg::Ptr(state),
         Arg::I32(q.width as i32),
         Arg::I32(q.height as i32),
-    ];
+    ]);
+    args.extend(lists);
     match map {
-        Map::Bitonic(m, ph) => args.extend([
-            Arg::Ptr(m.first),
-            Arg::Ptr(m.sorted),
-            Arg::I32(m.n as i32),
-            Arg::Ptr(ph.pos),
-            Arg::Ptr(ph.pow),
-            Arg::Ptr(ph.dir),
-        ]),
-        Map::Stencil(m) => {
-            args.extend([Arg::Ptr(m.stored), Arg::Ptr(m.scale), Arg::Ptr(m.pos), Arg::Ptr(m.pow), Arg::Ptr(m.dir)])
-        }
+        Map::Bitonic(_, ph) => args.extend([Arg::Ptr(ph.pos), Arg::Ptr(ph.pow), Arg::Ptr(ph.dir)]),
+        Map::Stencil(m) => args.extend([Arg::Ptr(m.scale), Arg::Ptr(m.pos), Arg::Ptr(m.pow), Arg::Ptr(m.dir)]),
     }
-    passes.launch(phase, Kernels::Knn, map.kernel(), tiles(q.width, q.height), &args)
+    passes.launch(phase, Kernels::Knn, kernel, tiles(q.width, q.height), &args)
 }
 
 /// Reads the state buffer.
@@ -210,16 +225,51 @@ pub fn estimate(
     p: &Params,
     max_passes: u64,
 ) -> Result<Estimate, SimError> {
+    estimate_with(passes, map, q, p, max_passes, &mut |_, _| {})
+}
+
+/// [`estimate`], showing the running states after every pass to
+/// `after_pass` (the pass number from 1, the states): the progressive
+/// display (004:L142).
+pub fn estimate_with(
+    passes: &mut Passes,
+    map: &Map,
+    q: &Queries,
+    p: &Params,
+    max_passes: u64,
+    after_pass: &mut dyn FnMut(u64, &[State]),
+) -> Result<Estimate, SimError> {
     let npix = (q.width * q.height) as usize;
     let state = start_states(passes, q)?;
+    run_passes(
+        passes,
+        max_passes,
+        &mut |ps| pass(ps, RADIANCE_ESTIMATE, map, q, p, state),
+        &|ps| states(ps, state, npix),
+        after_pass,
+    )
+}
+
+/// The host loop of an estimate (natural or 2003-faithful): launches
+/// `launch` until every pixel of `read`'s states has finished (at most
+/// `max_passes` launches), reading the finished flags after each pass (the
+/// occlusion query's answer) and counting lane-iterations.
+pub fn run_passes<E: From<SimError>>(
+    passes: &mut Passes,
+    max_passes: u64,
+    launch: &mut dyn FnMut(&mut Passes) -> Result<LaunchStats, E>,
+    read: &dyn Fn(&Passes) -> Vec<State>,
+    after_pass: &mut dyn FnMut(u64, &[State]),
+) -> Result<Estimate, E> {
     let mut n = 0;
     let mut lanes = 0;
-    let mut st = states(passes, state, npix);
+    let mut st = read(passes);
     while n < max_passes && st.iter().any(|s| !s.done) {
-        let s = pass(passes, RADIANCE_ESTIMATE, map, q, p, state)?;
+        let s = launch(passes)?;
         lanes += lane_iterations(passes.module(Kernels::Knn), &s);
         n += 1;
-        st = states(passes, state, npix);
+        st = read(passes);
+        after_pass(n, &st);
     }
     let finished = st.iter().all(|s| s.done);
     Ok(Estimate { states: st, passes: n, lane_iterations: lanes, finished })
@@ -228,7 +278,12 @@ pub fn estimate(
 /// Radiance towards the eye at each pixel: albedo / π · Σ power / (π r²),
 /// r the search radius, or r_max where fewer than k photons lie within it.
 pub fn radiance(e: &Estimate, albedo: &[f32], p: &Params) -> Vec<[f32; 3]> {
-    e.states
+    radiance_of(&e.states, albedo, p)
+}
+
+/// [`radiance`] of final states `states` (`albedo`: 4 floats per pixel).
+pub fn radiance_of(states: &[State], albedo: &[f32], p: &Params) -> Vec<[f32; 3]> {
+    states
         .iter()
         .enumerate()
         .map(|(i, s)| {

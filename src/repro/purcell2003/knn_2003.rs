@@ -8,7 +8,7 @@
 
 use super::grid::Grid;
 use super::knn::{self, Estimate, Map, Params, State};
-use super::passes::{Kernels, Passes};
+use super::passes::Passes;
 use super::photons::Queries;
 use crate::sim::{Arg, DevicePtr, LaunchStats, SimError};
 
@@ -158,29 +158,12 @@ pub fn pass(
     p: &Params,
     state: DevicePtr,
 ) -> Result<LaunchStats, SimError> {
-    let mut args = vec![
-        knn::search_arg(map, p),
-        Arg::F32(TEXTURE_WIDTH as f32),
-        Arg::Ptr(q.query),
-        Arg::Ptr(q.normal),
-        Arg::Ptr(state),
-        Arg::I32(q.width as i32),
-        Arg::I32(q.height as i32),
-    ];
-    match map {
-        Map::Bitonic(_, ph) => args.extend([
-            Arg::Ptr(tex.per_cell),
-            Arg::Ptr(tex.sorted),
-            Arg::F32(tex.sorted_n as f32),
-            Arg::Ptr(ph.pos),
-            Arg::Ptr(ph.pow),
-            Arg::Ptr(ph.dir),
-        ]),
-        Map::Stencil(m) => {
-            args.extend([Arg::Ptr(tex.per_cell), Arg::Ptr(m.scale), Arg::Ptr(m.pos), Arg::Ptr(m.pow), Arg::Ptr(m.dir)])
-        }
-    }
-    passes.launch(phase, Kernels::Knn, kernel(map), knn::tiles(q.width, q.height), &args)
+    let lists = match map {
+        Map::Bitonic(..) => vec![Arg::Ptr(tex.per_cell), Arg::Ptr(tex.sorted), Arg::F32(tex.sorted_n as f32)],
+        Map::Stencil(_) => vec![Arg::Ptr(tex.per_cell)],
+    };
+    let head = vec![knn::search_arg(map, p), Arg::F32(TEXTURE_WIDTH as f32)];
+    knn::launch_pass(passes, phase, kernel(map), map, head, q, state, lists)
 }
 
 /// Reads the packed state buffer back.
@@ -208,15 +191,11 @@ pub fn estimate(
     let grid = grid_of(map);
     let tex = textures(passes, map)?;
     let state = start_states(passes, q, &grid)?;
-    let mut n = 0;
-    let mut lanes = 0;
-    let mut st = states(passes, state, q, &grid);
-    while n < max_passes && st.iter().any(|s| !s.done) {
-        let s = pass(passes, knn::RADIANCE_ESTIMATE, map, &tex, q, p, state)?;
-        lanes += knn::lane_iterations(passes.module(Kernels::Knn), &s);
-        n += 1;
-        st = states(passes, state, q, &grid);
-    }
-    let finished = st.iter().all(|s| s.done);
-    Ok(Estimate { states: st, passes: n, lane_iterations: lanes, finished })
+    knn::run_passes(
+        passes,
+        max_passes,
+        &mut |ps| Ok(pass(ps, knn::RADIANCE_ESTIMATE, map, &tex, q, p, state)?),
+        &|ps| states(ps, state, q, &grid),
+        &mut |_, _| {},
+    )
 }

@@ -7,14 +7,18 @@
 //! - [`stencil`]: grid photon map B (stencil routing, Fig. 5);
 //! - [`knn`]: the kNN-grid radiance estimate (Fig. 6) with the 16 x 16 tile early-out;
 //! - [`knn_2003`]: the same estimate with 2-D float addressing and packed state;
+//! - [`native`]: the per-pixel passes in Rust, bit for bit as the kernels;
+//! - [`image`]: Fig. 7's images (direct light + either map's estimate), emulated and native;
 //! - [`dataflow`]: Table 2's instruction classes (TEX, Addr, Pack) read off the PTX;
 //! - [`pipeline`], [`table_1`], [`table_2`]: the measurement groups and tables.
 
 pub mod bitonic;
 pub mod dataflow;
 pub mod grid;
+pub mod image;
 pub mod knn;
 pub mod knn_2003;
+pub mod native;
 pub mod passes;
 pub mod photons;
 pub mod pipeline;

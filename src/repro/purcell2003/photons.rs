@@ -33,6 +33,9 @@ pub struct Geometry {
     /// scene's bounding sphere that holds the sphere; (0, 0, 1, -1), the whole
     /// sphere, for an area light or a point light inside the sphere.
     pub cone: [f32; 4],
+    /// What the shadow rays see of the light: an area light's emitted
+    /// radiance (its first triangle's material), a point light's intensity.
+    pub radiance: [f32; 3],
     /// Scene bounds.
     pub lo: Vec3,
     /// Scene bounds.
@@ -70,17 +73,20 @@ impl Geometry {
                 _ => None,
             })
             .unwrap_or_default();
-        let (mut point, mut power) = (Vec3::ZERO, [0.0f32; 3]);
+        let (mut point, mut power, mut radiance) = (Vec3::ZERO, [0.0f32; 3], [0.0f32; 3]);
         if area.is_empty() {
             if let Some((p, i)) = scene.lights.iter().find_map(|l| match l {
                 Light::Point { position, intensity } => Some((*position, *intensity)),
                 _ => None,
             }) {
                 point = Vec3::from(p);
+                radiance = i;
                 // flux of an isotropic point light: 4 pi I
                 power = i.map(|x| x * 4.0 * std::f32::consts::PI);
             }
         } else {
+            let first = &scene.materials[scene.triangles[area[0] as usize].material as usize];
+            radiance = first.emission.map(|e| e.max(0.0));
             // flux of a Lambertian emitter: pi * emission * area
             for &t in &area {
                 let tr = &scene.triangles[t as usize];
@@ -102,7 +108,7 @@ impl Geometry {
                 cone = [a.x, a.y, a.z, (1.0 - (radius / dist).powi(2)).sqrt()];
             }
         }
-        Geometry { tris, mats, lights: area, point, light_power: power, cone, lo, hi }
+        Geometry { tris, mats, lights: area, point, light_power: power, cone, radiance, lo, hi }
     }
 
     /// Triangles.
@@ -118,14 +124,20 @@ impl Geometry {
         self.light_power.map(|p| p * share / n.max(1) as f32)
     }
 
+    /// The rays' offset from their origin surface (scene-relative).
+    pub fn eps(&self) -> f32 {
+        (self.hi - self.lo).length().max(1e-3) * 1e-4
+    }
+
     /// The `Scene` structure of the kernels.
     fn scene_arg(&self, n: usize) -> Arg {
-        let eps = (self.hi - self.lo).length().max(1e-3) * 1e-4;
+        let eps = self.eps();
         let pw = self.power_per_photon(n);
         Bytes::default()
             .i32s(&[self.num_tris() as i32, self.lights.len() as i32])
             .f32s(&[eps, 0.0, self.point.x, self.point.y, self.point.z, 0.0, pw[0], pw[1], pw[2], 0.0])
             .f32s(&self.cone)
+            .f32s(&[self.radiance[0], self.radiance[1], self.radiance[2], 0.0])
             .arg()
     }
 }
@@ -162,13 +174,16 @@ impl PhotonArrays {
 }
 
 /// Traces `n` photons through `bounces` bounces: one emission pass and one
-/// pass per bounce, in phase [`TRACE_PHOTONS`].
+/// pass per bounce, in phase [`TRACE_PHOTONS`]. `direct`: whether photons
+/// that land on a diffuse surface straight from the light are stored (the
+/// pipeline leaves them out: its shadow rays give direct light).
 pub fn trace(
     passes: &mut Passes,
     geo: &Geometry,
     n: usize,
     bounces: usize,
     seed: u32,
+    direct: bool,
 ) -> Result<PhotonArrays, SimError> {
     let frames = bounces + 1;
     let tris = passes.upload(&geo.tris)?;
@@ -218,6 +233,7 @@ pub fn trace(
                 Arg::I32(n as i32),
                 Arg::I32(b as i32),
                 Arg::U32(seed),
+                Arg::I32(i32::from(direct)),
             ],
         )?;
     }
@@ -240,13 +256,12 @@ pub struct Queries {
     pub albedo: DevicePtr,
 }
 
-/// Eye rays through `camera`'s pixels (one per pixel), followed through up to
-/// `depth` specular hits, in phase [`TRACE_RAYS`].
-pub fn eye_rays(passes: &mut Passes, geo: &Geometry, camera: &Camera, depth: u32) -> Result<Queries, SimError> {
+/// The kernel `eye_rays`' camera: position, forward, right, up, tan(fov_y / 2), aspect.
+pub fn camera_array(camera: &Camera) -> [f32; 14] {
     let (r, u, f) = camera.frame();
     let [w, h] = camera.resolution;
     let tan = (camera.fov_y.to_radians() * 0.5).tan();
-    let cam = [
+    [
         camera.position[0],
         camera.position[1],
         camera.position[2],
@@ -261,7 +276,14 @@ pub fn eye_rays(passes: &mut Passes, geo: &Geometry, camera: &Camera, depth: u32
         u.z,
         tan,
         w as f32 / h as f32,
-    ];
+    ]
+}
+
+/// Eye rays through `camera`'s pixels (one per pixel), followed through up to
+/// `depth` specular hits, in phase [`TRACE_RAYS`].
+pub fn eye_rays(passes: &mut Passes, geo: &Geometry, camera: &Camera, depth: u32) -> Result<Queries, SimError> {
+    let [w, h] = camera.resolution;
+    let cam = camera_array(camera);
     let tris = passes.upload(&geo.tris)?;
     let mats = passes.upload(&geo.mats)?;
     let camp = passes.upload(&cam)?;
@@ -288,6 +310,41 @@ pub fn eye_rays(passes: &mut Passes, geo: &Geometry, camera: &Camera, depth: u32
         ],
     )?;
     Ok(Queries { width: w, height: h, query, normal, albedo })
+}
+
+/// Direct illumination at the query points `q`: `samples` shadow rays per
+/// pixel to the light (kernel `shadow_rays`), in phase [`TRACE_RAYS`]; the
+/// buffer of per-pixel radiance (r, g, b, 0).
+pub fn shadow_rays(
+    passes: &mut Passes,
+    geo: &Geometry,
+    q: &Queries,
+    samples: u32,
+    seed: u32,
+) -> Result<DevicePtr, SimError> {
+    let tris = passes.upload(&geo.tris)?;
+    let lights = passes.upload(&geo.lights)?;
+    let npix = (q.width * q.height) as usize;
+    let direct = passes.dev.alloc_zeroed::<f32>(4 * npix);
+    passes.launch_1d(
+        TRACE_RAYS,
+        Kernels::Photons,
+        "shadow_rays",
+        npix,
+        &[
+            geo.scene_arg(1),
+            Arg::Ptr(tris),
+            Arg::Ptr(lights),
+            Arg::Ptr(q.query),
+            Arg::Ptr(q.normal),
+            Arg::Ptr(q.albedo),
+            Arg::I32(npix as i32),
+            Arg::I32(samples as i32),
+            Arg::U32(seed),
+            Arg::Ptr(direct),
+        ],
+    )?;
+    Ok(direct)
 }
 
 /// The kernels' random number for (seed, item, pass, dimension), in [0, 1)

@@ -41,6 +41,8 @@ pub struct Prepared {
     pub queries: Queries,
     /// The grid.
     pub grid: Grid,
+    /// Direct light per pixel from the shadow rays (r, g, b, 0).
+    pub direct: crate::sim::DevicePtr,
 }
 
 /// The image of `scene` for an image `width` pixels wide (the paper's aspect).
@@ -51,20 +53,35 @@ pub fn camera(scene: &Scene, f: &Fixture, width: u32) -> crate::host::camera::Ca
     c
 }
 
-/// Traces the photons and the eye rays of `scene` (`width` pixels wide).
+/// The fixture of `scene`, or an error naming it.
+pub fn fixture_of(scene: &Scene) -> Result<Fixture, MeasureError> {
+    Ok(*fixture(&scene.name).ok_or_else(|| format!("seed 004 has no scene {}", scene.name))?)
+}
+
+/// Traces the photons, the eye rays and the shadow rays of `scene` (`width`
+/// pixels wide) with its fixture.
 pub fn prepare(scene: &Scene, width: u32) -> Result<Prepared, MeasureError> {
-    let f = *fixture(&scene.name).ok_or_else(|| format!("seed 004 has no scene {}", scene.name))?;
+    prepare_with(scene, &fixture_of(scene)?, width)
+}
+
+/// [`prepare`] with the settings `f` (the scene's fixture, or a reduced one:
+/// [`Fixture::reduced`]). The map holds indirect light and caustics: photons
+/// that land straight from the light are not stored, the shadow rays
+/// (`f.shadow_samples` per pixel) giving direct light.
+pub fn prepare_with(scene: &Scene, f: &Fixture, width: u32) -> Result<Prepared, MeasureError> {
+    let f = *f;
     let geo = Geometry::of(scene);
     let mut passes = Passes::new(Some(WATCHDOG))?;
     // calibration: a pilot run's share of stored photons sets the emitted count
-    let pilot = photons::trace(&mut passes, &geo, f.pilot, f.bounces, PILOT_SEED)?;
+    let pilot = photons::trace(&mut passes, &geo, f.pilot, f.bounces, PILOT_SEED, false)?;
     let pilot_stored = pilot.count_stored(&passes);
     passes.take_phase(TRACE_PHOTONS);
     let emitted = emitted_for(f.stated_photons, f.pilot, pilot_stored);
-    let photons = photons::trace(&mut passes, &geo, emitted, f.bounces, SEED)?;
+    let photons = photons::trace(&mut passes, &geo, emitted, f.bounces, SEED, false)?;
     let queries = photons::eye_rays(&mut passes, &geo, &camera(scene, &f, width), EYE_DEPTH)?;
+    let direct = photons::shadow_rays(&mut passes, &geo, &queries, f.shadow_samples, SEED)?;
     let grid = Grid::new(geo.lo, geo.hi, f.grid);
-    Ok(Prepared { passes, fixture: f, photons, queries, grid })
+    Ok(Prepared { passes, fixture: f, photons, queries, grid, direct })
 }
 
 /// The radiance estimate's parameters for fixture `f`, drawn as tiles.
@@ -83,7 +100,13 @@ fn put(c: &mut BTreeMap<String, f64>, prefix: &str, p: &PhaseCounts) {
 
 /// Measurement group [`PIPELINE`]: both maps on the workspace's scene.
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
-    let mut pr = prepare(ws.scene, ws.resolution)?;
+    let f = fixture_of(ws.scene)?;
+    measure_with(ws, &f, tick)
+}
+
+/// [`measure`] with the settings `f`.
+pub fn measure_with(ws: &mut Workspace, f: &Fixture, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    let mut pr = prepare_with(ws.scene, f, ws.resolution)?;
     let trace = pr.passes.take_phase(TRACE_PHOTONS);
     let rays = pr.passes.take_phase(TRACE_RAYS);
     let npix = (pr.queries.width * pr.queries.height) as usize;
@@ -129,6 +152,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
         c.insert("height".into(), h as f64);
         c.insert("emitted".into(), pr.photons.n as f64);
         c.insert("stored".into(), stored as f64);
+        c.insert("shadow_samples".into(), pr.fixture.shadow_samples as f64);
         c.insert("found_k".into(), est.states.iter().filter(|s| s.n as u32 >= p.k).count() as f64);
         out.push(Sample {
             group: PIPELINE.into(),

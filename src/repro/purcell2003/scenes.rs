@@ -28,8 +28,23 @@ pub struct Fixture {
     pub slots: usize,
     /// Image width and height as stated.
     pub paper_resolution: [u32; 2],
-    /// Shadow samples per pixel as stated (not run: no shadow-ray passes here).
+    /// Shadow samples per pixel as stated (the shadow-ray pass's samples).
     pub shadow_samples: u32,
+}
+
+impl Fixture {
+    /// The fixture with `div` times fewer photons (stored, pilot) and photons
+    /// sought (at least 4), for runs of seconds (the tests' subset); the
+    /// other settings as they are.
+    pub fn reduced(&self, div: u32) -> Fixture {
+        let d = div.max(1);
+        Fixture {
+            stated_photons: (self.stated_photons / d).max(1),
+            pilot: (self.pilot / d as usize).max(1),
+            k: (self.k / d).max(4),
+            ..*self
+        }
+    }
 }
 
 /// Photon lookups per radiance-estimate pass (unstated).

@@ -15,6 +15,7 @@ use super::knn::{self, Map, Params};
 use super::knn_2003;
 use super::passes::{Kernels, Passes, PhaseCounts};
 use super::pipeline::{self, Prepared};
+use super::scenes::Fixture;
 use super::stencil;
 use crate::repro::compare::{Printed as P, Tolerance};
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
@@ -119,7 +120,13 @@ fn estimate_per_lookup(
 
 /// Measurement group [`KERNELS`] (on [`SCENE`] only).
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
-    let Prepared { mut passes, fixture, photons, queries, grid } = pipeline::prepare(ws.scene, ws.resolution)?;
+    let f = pipeline::fixture_of(ws.scene)?;
+    measure_with(ws, &f, tick)
+}
+
+/// [`measure`] with the settings `f`.
+pub fn measure_with(ws: &mut Workspace, f: &Fixture, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    let Prepared { mut passes, fixture, photons, queries, grid, .. } = pipeline::prepare_with(ws.scene, f, ws.resolution)?;
     let p = &mut passes;
     let mut out = Vec::new();
     // map A: cell keys, then the sort and the search measured on their own
