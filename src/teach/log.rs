@@ -1,11 +1,13 @@
 //! The text log of `warplight step` (its non-interactive mode, for scripts,
 //! tests and lessons): each issued warp instruction with its active mask and
-//! what it did to the warp's control flow, and at breakpoints the SIMT stack
-//! and watched registers lane by lane.
+//! what it did to the warp's control flow, each `printf` line at the step
+//! that printed it, and at breakpoints the SIMT stack and watched registers
+//! lane by lane.
 
 use std::io::Write;
 
 use super::breakpoints::Breakpoints;
+use super::printed::{self, Printed};
 use super::session::{Error, Session};
 use super::track;
 use crate::sim::stepper::Stepper;
@@ -27,10 +29,16 @@ pub struct LogOptions {
 
 /// Steps the session's launch and writes the log to `out`.
 pub fn run(session: &Session, o: &LogOptions, out: &mut dyn Write) -> Result<(), Error> {
-    session.with_stepper(|st| log(session, st, o, out))
+    session.with_stepping(|st, _, printed| log(session, st, printed, o, out))
 }
 
-fn log(session: &Session, st: &mut Stepper, o: &LogOptions, out: &mut dyn Write) -> Result<(), Error> {
+fn log(
+    session: &Session,
+    st: &mut Stepper,
+    printed: &Printed,
+    o: &LogOptions,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
     let prog = &st.module().prog;
     let l = session.launch_spec();
     writeln!(
@@ -47,6 +55,7 @@ fn log(session: &Session, st: &mut Stepper, o: &LogOptions, out: &mut dyn Write)
     while steps < o.max_steps {
         let Some(ev) = st.step()? else { break };
         steps += 1;
+        let recs = printed.take();
         let selected = o.only.is_none_or(|(s, w)| s == ev.cta_slot && w == ev.warp);
         let Some(w) = st.warp(ev.cta_slot, ev.warp) else { continue };
         let fx = tracker.observe(&ev, &w);
@@ -63,6 +72,12 @@ fn log(session: &Session, st: &mut Stepper, o: &LogOptions, out: &mut dyn Write)
                 ev.source_line.map(|l| format!("  src line {l}")).unwrap_or_default(),
                 if fx.word().is_empty() { String::new() } else { format!("  [{}]", fx.word()) }
             )?;
+        }
+        // the step's printf output, at the step (with or without --trace)
+        if selected {
+            for line in printed::labelled(&recs) {
+                writeln!(out, "{steps:>7}  {line}")?;
+            }
         }
         let Some(hit) = o.breaks.hit(&ev, &w) else { continue };
         if !selected {

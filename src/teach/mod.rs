@@ -2,11 +2,13 @@
 //! `warplight step` ([`tui`]), its text log ([`log`]), and the HTML timeline
 //! of `warplight trace` ([`trace`]). They share a replayable launch
 //! ([`session`]), source-file lookup ([`sources`]) and the per-step notes on
-//! divergence and reconvergence ([`track`]), and which line of the user's
-//! source an instruction belongs to ([`user_lines`]).
+//! divergence and reconvergence ([`track`]), each step's `printf` output
+//! ([`printed`]), and which line of the user's source an instruction belongs
+//! to ([`user_lines`]).
 
 pub mod breakpoints;
 pub mod log;
+pub mod printed;
 pub mod session;
 pub mod sources;
 pub mod trace;

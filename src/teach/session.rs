@@ -13,6 +13,8 @@ use crate::sim::printf::PrintfRecord;
 use crate::sim::stepper::Stepper;
 use crate::sim::{Device, DevicePtr, LaunchConfig};
 
+use super::printed::Printed;
+
 /// A launch spec, ready to be stepped.
 pub struct Session {
     /// The spec.
@@ -90,13 +92,22 @@ impl Session {
     /// Runs `f` on a fresh stepper at the start of the launch (fresh buffers),
     /// recording memory accesses.
     pub fn with_stepper<R>(&self, f: impl FnOnce(&mut Stepper) -> Result<R, Error>) -> Result<R, Error> {
-        self.with_stepper_and_buffers(|st, _| f(st))
+        self.with_stepping(|st, _, _| f(st))
     }
 
     /// As [`Session::with_stepper`], with the spec's buffers readable while stepping.
     pub fn with_stepper_and_buffers<R>(
         &self,
         f: impl FnOnce(&mut Stepper, &Buffers) -> Result<R, Error>,
+    ) -> Result<R, Error> {
+        self.with_stepping(|st, bufs, _| f(st, bufs))
+    }
+
+    /// As [`Session::with_stepper_and_buffers`], with each step's `printf`
+    /// output handed out by [`Printed::take`] after the step.
+    pub fn with_stepping<R>(
+        &self,
+        f: impl FnOnce(&mut Stepper, &Buffers, &Printed) -> Result<R, Error>,
     ) -> Result<R, Error> {
         let mut config = self.spec.sim_config(0, self.max_instructions);
         config.schedule.random_seed = self.random_seed;
@@ -116,8 +127,9 @@ impl Session {
         // the launches before it printed before it
         dev.take_printf();
         let buffers = Buffers { dev: &dev, list: &prepared.buffers, order: &self.spec.buffers };
-        let r = f(&mut st, &buffers);
-        *self.printf.lock().unwrap_or_else(|e| e.into_inner()) = dev.take_printf();
+        let printed = Printed::new(&dev);
+        let r = f(&mut st, &buffers, &printed);
+        *self.printf.lock().unwrap_or_else(|e| e.into_inner()) = printed.finish();
         r
     }
 

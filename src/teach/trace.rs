@@ -1,10 +1,11 @@
 //! `warplight trace`: a launch recorded step by step into one self-contained
 //! HTML page (no network; data, script and style inline) — a timeline per
 //! warp the reader can scrub, with the active mask of each instruction as a
-//! 32-cell strip, divergence and reconvergence marked, the SIMT stack, and the
+//! 32-cell strip, divergence and reconvergence marked, the SIMT stack, the
 //! memory transactions, sectors or banks of each memory instruction under a
-//! device profile. Its size is bounded: choose CTAs, warps and a step range,
-//! and at most `max_events` instructions are kept.
+//! device profile, and the `printf` output at the instruction that printed
+//! it. Its size is bounded: choose CTAs, warps and a step range, and at most
+//! `max_events` instructions are kept.
 
 use serde::Serialize;
 
@@ -88,6 +89,10 @@ pub struct TraceEvent {
     pub stack: Vec<(u32, u32, u32, u32)>,
     /// Its memory accesses.
     pub mem: Vec<TraceMem>,
+    /// Its `printf` output: (lane, text) in lane order; absent from the page's
+    /// data when it printed nothing.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub out: Vec<(u32, String)>,
 }
 
 /// A source file for the page.
@@ -131,7 +136,7 @@ pub fn record(session: &Session, o: &TraceOptions) -> Result<Trace, Error> {
 
 /// As [`record`], calling `tick(steps)` every 4096 warp instructions (for a progress display).
 pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64)) -> Result<Trace, Error> {
-    session.with_stepper(|st| {
+    session.with_stepping(|st, _, printed| {
         let prog = &st.module().prog;
         let l = session.launch_spec();
         let grid = l.grid;
@@ -164,6 +169,7 @@ pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64
                 break;
             };
             step += 1;
+            let out = printed.take();
             if step.is_multiple_of(4096) {
                 tick(step);
             }
@@ -235,6 +241,7 @@ pub fn record_with(session: &Session, o: &TraceOptions, mut tick: impl FnMut(u64
                 fx: fx.word().to_string(),
                 stack,
                 mem,
+                out: out.into_iter().map(|r| (r.lane, r.text)).collect(),
             });
         }
         t.total_steps = step;

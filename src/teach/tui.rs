@@ -4,8 +4,10 @@
 //! of four panels — the SIMT reconvergence stack (with the CTA's warps),
 //! per-lane register values, the last memory instruction's per-lane addresses
 //! with the transactions, sectors or banks they form under the chosen device
-//! profile, or memory contents (the CTA's shared variables and the spec's
-//! buffers by name). Fits an 80×24 terminal.
+//! profile, memory contents (the CTA's shared variables and the spec's
+//! buffers by name), or the kernel's `printf` output so far, each line with
+//! the step that printed it (the message line tells when a step printed).
+//! Fits an 80×24 terminal.
 //!
 //! The source pane stays on the user's file: lines of library headers and the
 //! compiler's line 0 show the user's line they belong to (see
@@ -29,6 +31,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Clear, Paragraph};
 
 use super::breakpoints::Breakpoints;
+use super::printed::{self, Printed};
 use super::session::{Buffers, Error, Session};
 use super::sources;
 use super::track::{Effect, Tracker};
@@ -84,12 +87,12 @@ pub fn drive<B: Backend>(
     let mut app = App::new(session, o)?;
     let mut target = 0u64;
     loop {
-        let exit = session.with_stepper_and_buffers(|st, bufs| {
-            app.replay(st, target)?;
+        let exit = session.with_stepping(|st, bufs, out| {
+            app.replay(st, out, target)?;
             loop {
                 terminal.draw(|f| app.draw(f, st, bufs))?;
                 let Some(key) = next_key()? else { return Ok(Exit::Quit) };
-                match app.handle(key, st)? {
+                match app.handle(key, st, out)? {
                     Exit::Stay => {}
                     other => return Ok(other),
                 }
@@ -121,6 +124,8 @@ pub enum Panel {
     Memory,
     /// Memory contents: shared variables and the spec's buffers.
     Data,
+    /// The `printf` output so far, by step.
+    Output,
 }
 
 /// The code pane shown below [`WIDE`] columns.
@@ -170,6 +175,10 @@ pub struct App {
     /// The region of the memory-contents panel and its first row.
     data_region: usize,
     data_first: usize,
+    /// The `printf` output up to the current step: (step, labelled line).
+    printed: Vec<(u64, String)>,
+    /// Lines the output panel is scrolled back from its end.
+    out_back: usize,
     /// [`user_lines::attribute`] of the program.
     user: Vec<Vec<Option<SrcLoc>>>,
     /// Each warp's last user source line.
@@ -208,6 +217,8 @@ impl App {
             hscroll: 0,
             data_region: 0,
             data_first: 0,
+            printed: Vec::new(),
+            out_back: 0,
             user,
             last_user: HashMap::new(),
             last: HashMap::new(),
@@ -222,8 +233,9 @@ impl App {
     }
 
     /// Brings a fresh stepper to `target` steps, rebuilding the per-warp notes.
-    fn replay(&mut self, st: &mut Stepper, target: u64) -> Result<(), Error> {
+    fn replay(&mut self, st: &mut Stepper, out: &Printed, target: u64) -> Result<(), Error> {
         self.steps = 0;
+        self.printed.clear();
         self.fault = None;
         self.fault_line = None;
         self.last.clear();
@@ -231,7 +243,7 @@ impl App {
         self.last_user.clear();
         self.tracker = Tracker::default();
         while self.steps < target {
-            if self.step_one(st)?.is_none() {
+            if self.step_one(st, out)?.is_none() {
                 break;
             }
         }
@@ -239,9 +251,11 @@ impl App {
     }
 
     /// Issues one warp instruction (any warp, in scheduling order).
-    fn step_one(&mut self, st: &mut Stepper) -> Result<Option<(StepEvent, WarpView)>, Error> {
+    fn step_one(&mut self, st: &mut Stepper, out: &Printed) -> Result<Option<(StepEvent, WarpView)>, Error> {
         let Some(ev) = st.step()? else { return Ok(None) };
         self.steps += 1;
+        let step = self.steps;
+        self.printed.extend(printed::labelled(&out.take()).into_iter().map(|l| (step, l)));
         let key = (ev.cta_slot, ev.warp);
         let w = st.warp(ev.cta_slot, ev.warp).ok_or("stepped warp vanished")?;
         let fx = self.tracker.observe(&ev, &w);
@@ -259,10 +273,11 @@ impl App {
     fn run_until(
         &mut self,
         st: &mut Stepper,
+        out: &Printed,
         mut stop: impl FnMut(&Self, &Stepper, &StepEvent, &WarpView) -> bool,
     ) -> Result<Option<StepEvent>, Error> {
         for _ in 0..self.o.max_steps {
-            match self.step_one(st)? {
+            match self.step_one(st, out)? {
                 None => {
                     self.message = format!("the grid finished after {} warp instructions", self.steps);
                     return Ok(None);
@@ -313,23 +328,23 @@ impl App {
         )
     }
 
-    fn handle(&mut self, key: KeyEvent, st: &mut Stepper) -> Result<Exit, Error> {
+    fn handle(&mut self, key: KeyEvent, st: &mut Stepper, out: &Printed) -> Result<Exit, Error> {
         if self.help {
             self.help = false;
             return Ok(Exit::Stay);
         }
         if let Some(p) = self.prompt.take() {
-            return self.handle_prompt(p, key, st);
+            return self.handle_prompt(p, key, st, out);
         }
         let ctrl = key.modifiers.contains(KeyModifiers::CONTROL);
         match key.code {
             KeyCode::Char('q') | KeyCode::Esc => return Ok(Exit::Quit),
             KeyCode::Char('c') if ctrl => return Ok(Exit::Quit),
             KeyCode::Char('?') | KeyCode::F(1) => self.help = true,
-            KeyCode::Char('s') | KeyCode::Char(' ') | KeyCode::Down => self.act(st, Action::Instruction)?,
-            KeyCode::Char('n') => self.act(st, Action::SourceLine)?,
-            KeyCode::Char('c') => self.act(st, Action::Continue)?,
-            KeyCode::Char('a') => self.act(st, Action::Barrier)?,
+            KeyCode::Char('s') | KeyCode::Char(' ') | KeyCode::Down => self.act(st, out, Action::Instruction)?,
+            KeyCode::Char('n') => self.act(st, out, Action::SourceLine)?,
+            KeyCode::Char('c') => self.act(st, out, Action::Continue)?,
+            KeyCode::Char('a') => self.act(st, out, Action::Barrier)?,
             KeyCode::Char('g') => self.prompt = Some(Prompt::Goto(String::new())),
             KeyCode::Char('b') => self.prompt = Some(Prompt::Break(String::new())),
             KeyCode::Char('u') | KeyCode::Backspace | KeyCode::Left => {
@@ -352,6 +367,10 @@ impl App {
             KeyCode::Char('2') => self.panel = Panel::Registers,
             KeyCode::Char('3') | KeyCode::Char('m') => self.panel = Panel::Memory,
             KeyCode::Char('4') => self.panel = Panel::Data,
+            KeyCode::Char('5') => {
+                self.panel = Panel::Output;
+                self.out_back = 0;
+            }
             KeyCode::Char('v') => {
                 self.code = match self.code {
                     CodePane::Source => CodePane::Ptx,
@@ -373,6 +392,10 @@ impl App {
                 }
             }
             KeyCode::Char('j') | KeyCode::PageDown if self.panel == Panel::Data => self.data_first += 1,
+            KeyCode::Char('j') | KeyCode::PageDown if self.panel == Panel::Output => {
+                self.out_back = self.out_back.saturating_sub(1)
+            }
+            KeyCode::Char('k') | KeyCode::PageUp | KeyCode::Up if self.panel == Panel::Output => self.out_back += 1,
             KeyCode::Char('k') | KeyCode::PageUp | KeyCode::Up if self.panel == Panel::Data => {
                 self.data_first = self.data_first.saturating_sub(1)
             }
@@ -383,7 +406,7 @@ impl App {
         Ok(Exit::Stay)
     }
 
-    fn handle_prompt(&mut self, p: Prompt, key: KeyEvent, st: &mut Stepper) -> Result<Exit, Error> {
+    fn handle_prompt(&mut self, p: Prompt, key: KeyEvent, st: &mut Stepper, out: &Printed) -> Result<Exit, Error> {
         let (mut text, goto) = match p {
             Prompt::Goto(t) => (t, true),
             Prompt::Break(t) => (t, false),
@@ -408,7 +431,7 @@ impl App {
                 if !has_inst {
                     self.message = format!("PTX line {line} holds no instruction");
                 } else if goto {
-                    self.act(st, Action::Goto(line))?;
+                    self.act(st, out, Action::Goto(line))?;
                 } else {
                     let on = self.o.breaks.toggle_ptx(line);
                     self.message = format!("breakpoint at PTX line {line} {}", if on { "set" } else { "cleared" });
@@ -421,7 +444,24 @@ impl App {
         Ok(Exit::Stay)
     }
 
-    fn act(&mut self, st: &mut Stepper, a: Action) -> Result<(), Error> {
+    fn act(&mut self, st: &mut Stepper, out: &Printed, a: Action) -> Result<(), Error> {
+        let printed_before = self.printed.len();
+        self.act_on(st, out, a)?;
+        // what the action printed, on the message line (the panel 5 lists it)
+        let n = self.printed.len() - printed_before;
+        if n > 0 {
+            self.out_back = 0;
+            let last = &self.printed[self.printed.len() - 1].1;
+            self.message = if n == 1 {
+                format!("{}; printf: {last}", self.message)
+            } else {
+                format!("{}; printf: {n} lines, the last {last} (5 lists them)", self.message)
+            };
+        }
+        Ok(())
+    }
+
+    fn act_on(&mut self, st: &mut Stepper, out: &Printed, a: Action) -> Result<(), Error> {
         if self.fault.is_some() {
             self.message = "the launch faulted: u steps back, q quits".into();
             return Ok(());
@@ -443,10 +483,10 @@ impl App {
         let start_line = self.shown_line(st, sel, &w0);
         let is_sel = move |ev: &StepEvent| (ev.cta_slot, ev.warp) == sel;
         let result = match a {
-            Action::Instruction => self.run_until(st, |_, _, ev, _| is_sel(ev)),
+            Action::Instruction => self.run_until(st, out, |_, _, ev, _| is_sel(ev)),
             // the next source line, or a change of the warp's lanes (divergence,
             // reconvergence, a switch to the waiting path), whichever comes first
-            Action::SourceLine => self.run_until(st, |app, st, ev, w| {
+            Action::SourceLine => self.run_until(st, out, |app, st, ev, w| {
                 if !is_sel(ev) {
                     return false;
                 }
@@ -454,9 +494,9 @@ impl App {
                 let line = app.shown_line(st, sel, w);
                 w.next_pc.is_none() || fx.diverged || fx.reconverged || fx.switched || line != start_line
             }),
-            Action::Goto(l) => self.run_until(st, |_, _, ev, w| is_sel(ev) && w.next_ptx_line == Some(l)),
-            Action::Barrier => self.run_until(st, |_, _, ev, _| is_sel(ev) && ev.opcode.starts_with("bar")),
-            Action::Continue => self.run_until(st, |app, _, ev, w| app.o.breaks.hit(ev, w).is_some()),
+            Action::Goto(l) => self.run_until(st, out, |_, _, ev, w| is_sel(ev) && w.next_ptx_line == Some(l)),
+            Action::Barrier => self.run_until(st, out, |_, _, ev, _| is_sel(ev) && ev.opcode.starts_with("bar")),
+            Action::Continue => self.run_until(st, out, |app, _, ev, w| app.o.breaks.hit(ev, w).is_some()),
         };
         if self.steps > start {
             self.history.push(start);
@@ -548,6 +588,7 @@ impl App {
             Panel::Registers => self.draw_registers(f, lower, st, w.as_ref()),
             Panel::Memory => self.draw_memory(f, lower, st),
             Panel::Data => self.draw_data(f, lower, st, bufs),
+            Panel::Output => self.draw_output(f, lower),
         }
         if let Some(fault) = &self.fault {
             f.render_widget(Clear, lower);
@@ -566,7 +607,7 @@ impl App {
         };
         f.render_widget(Paragraph::new(m).style(Style::new().fg(Color::Yellow)), msg);
         f.render_widget(
-            Paragraph::new("s step n line c cont g goto b brk a bar u back w warp v pane 1-4 panel ? help q")
+            Paragraph::new("s step n line c cont g goto b brk a bar u back w warp v pane 1-5 panel ? help q")
                 .style(Style::new().add_modifier(Modifier::DIM)),
             keys,
         );
@@ -830,6 +871,27 @@ impl App {
         self.format_value(u32::from_le_bytes(w) as u64, 32)
     }
 
+    /// The `printf` output so far, one line a lane's line with the step that
+    /// printed it; the last step's lines in green. Scrolled to the end unless
+    /// `k` moved it back.
+    fn draw_output(&self, f: &mut Frame, area: Rect) {
+        let rows = area.height.saturating_sub(2) as usize;
+        let end = self.printed.len().saturating_sub(self.out_back.min(self.printed.len().saturating_sub(rows)));
+        let first = end.saturating_sub(rows);
+        let mut lines: Vec<Line> = self.printed[first..end]
+            .iter()
+            .map(|(step, l)| {
+                let text = format!("{step:>6} {}", l.replace('\t', "    "));
+                if *step == self.steps { Line::styled(text, Style::new().fg(Color::Green)) } else { Line::raw(text) }
+            })
+            .collect();
+        if lines.is_empty() {
+            lines.push(Line::raw("nothing printed yet (printf output appears here at the step that prints it)"));
+        }
+        let title = format!(" 5 printf output: {} lines to step {} (j/k) ", self.printed.len(), self.steps);
+        f.render_widget(Paragraph::new(lines).block(Block::default().borders(Borders::ALL).title(title)), area);
+    }
+
     fn draw_memory(&self, f: &mut Frame, area: Rect, st: &Stepper) {
         let mut lines = Vec::new();
         match self.last_mem.get(&self.sel) {
@@ -1042,7 +1104,8 @@ a         continue until the selected warp reaches a barrier
 u, <-     step back (undo the last action by replaying)
 w W Tab   next / previous warp of the CTA;  ] [  next / previous CTA
 v         source or PTX (narrow terminals);  > <  scroll code sideways
-1 2 3 4   panel: SIMT stack, registers, last memory access, memory
+1 ... 5   panel: SIMT stack, registers, last memory access, memory,
+          printf output (each line with the step that printed it)
 x         decimal (signed), hex or float;  j k  scroll;  l  more lanes
 o         memory panel: next shared variable or buffer
 q, Esc    quit
