@@ -86,7 +86,8 @@ type Res = Result<(), Box<dyn std::error::Error>>;
 
 /// Runs the command.
 pub fn run(a: LaunchArgs) -> Res {
-    let spec = Spec::load(&a.spec)?;
+    // `examples/…` from any directory, as `step`, `trace` and `run` find them
+    let spec = Spec::load(&crate::host::scene_file::data_file(&a.spec))?;
     run_spec(spec, &a.options)
 }
 

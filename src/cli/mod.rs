@@ -9,9 +9,11 @@ pub mod render;
 pub mod run;
 pub mod scene_info;
 pub mod step;
+pub mod step_session;
 pub mod table_format;
 pub mod tables;
 pub mod trace;
+pub mod validate;
 
 use clap::{Parser, Subcommand};
 
@@ -139,10 +141,7 @@ pub fn main() -> i32 {
         Command::Launch(a) => launch::run(a),
         Command::Kernels { ptx } => ptx_info::kernels(&ptx),
         Command::Check { ptx } => ptx_info::check(&ptx),
-        Command::Validate { fixture, ptx, markdown } => {
-            use crate::host::scene_file::data_file;
-            validate(&data_file(&fixture), &data_file(&ptx), markdown)
-        }
+        Command::Validate { fixture, ptx, markdown } => validate::run(&fixture, &ptx, markdown),
         Command::Scene { what: SceneCommand::Info { name } } => scene_info::info(&name),
         Command::Tables(a) => tables::run(a),
         Command::Compile(a) => compile::run(a),
@@ -172,34 +171,4 @@ pub fn write_atomically(file: &std::path::Path, bytes: &[u8]) -> Result<(), Stri
     // on failure the temporary file goes too (dropped): nothing half-written is left
     tmp.write_all(bytes).map_err(err)?;
     interrupt::commit(vec![(tmp, file)]).map_err(|(_, e)| err(e))
-}
-
-fn validate(fixture: &std::path::Path, ptx: &std::path::Path, md: bool) -> Result<(), Box<dyn std::error::Error>> {
-    use crate::model::validation::{Expect, compare, markdown};
-    let rows = compare(fixture, ptx)?;
-    if md {
-        print!("{}", include_str!("validation_header.md"));
-        print!("{}", markdown(&rows));
-        return Ok(());
-    }
-    let exact = rows.iter().filter(|r| r.expect == Expect::Exact).count();
-    let equal = rows.iter().filter(|r| r.expect == Expect::Exact && r.measured == r.emulated).count();
-    for r in rows.iter().filter(|r| r.measured != r.emulated) {
-        println!(
-            "{:>3} {:<13} ({:>4}, {}) {:<62} H100 {:>8}  warplight {:>8}{}",
-            r.launch,
-            r.kernel,
-            r.args.0,
-            r.args.1,
-            r.metric,
-            r.measured,
-            r.emulated,
-            if r.expect == Expect::Exact { "  DIFFERS" } else { "" }
-        );
-    }
-    println!("{equal} of {exact} exactly compared metrics equal; {} shown side by side", rows.len() - exact);
-    if equal != exact {
-        return Err("the hopper profile differs from the H100".into());
-    }
-    Ok(())
 }

@@ -4,9 +4,8 @@
 //! is not a terminal.
 
 use std::io::IsTerminal;
-use std::path::PathBuf;
 
-use crate::model::Profile;
+use super::step_session::SessionArgs;
 use crate::teach::breakpoints::Breakpoints;
 use crate::teach::session::Session;
 use crate::teach::{log, tui};
@@ -16,16 +15,14 @@ use crate::teach::{log, tui};
 #[command(after_help = "Interactive keys (press ? in the view for all of them):\n  \
     s/space step the warp   n step a source line   c continue to a breakpoint   g go to a PTX line\n  \
     b toggle a breakpoint   a continue to a barrier   u/backspace step back\n  \
-    w/W next/previous warp  ]/[ next/previous CTA  1/2/3 stack, registers, memory   q quit\n\n\
+    w/W next/previous warp  ]/[ next/previous CTA  1-5 panels (5: printf output)   q quit\n\n\
     Examples:\n  warplight step examples/if_else.toml\n  \
     warplight step examples/if_else.toml --log --break 45 --watch %r10\n  \
     warplight step examples/lessons/banks.toml --device gt200")]
 pub struct StepArgs {
-    /// The launch spec (TOML).
-    pub spec: PathBuf,
-    /// Which of the spec's launches is stepped, from 1; those before it run first.
-    #[arg(long, default_value_t = 1)]
-    pub launch: usize,
+    /// The spec, the launch, the watchdog, the profile, checking and schedule.
+    #[command(flatten)]
+    pub session: SessionArgs,
     /// Stop at this PTX line (repeatable): print the warp's state before it executes.
     #[arg(long = "break", value_name = "PTX_LINE")]
     pub breaks: Vec<u32>,
@@ -51,18 +48,6 @@ pub struct StepArgs {
     /// continue (interactive view).
     #[arg(long, default_value_t = 100_000)]
     pub max_steps: u64,
-    /// The watchdog: stop a launch as a runaway after this many warp instructions
-    /// (default: the spec's `max_instructions`, else 2^32). See docs/limits.md.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    pub max_instructions: Option<u64>,
-    /// Device profile for the memory panel's transactions, sectors and banks:
-    /// gt200, maxwell or hopper (default: the spec's `device`, else hopper).
-    #[arg(long)]
-    pub device: Option<String>,
-    /// Checking (`--check`, `--uninit`; the reports come before the view) and
-    /// the warp schedule of the stepped launch (`--schedule random --seed N`).
-    #[command(flatten)]
-    pub checks: crate::check::cli::CheckArgs,
 }
 
 /// Parses `SLOT:WARP`.
@@ -74,23 +59,10 @@ pub fn parse_warp(w: &str) -> Result<(usize, u32), String> {
     ))
 }
 
-/// The profile of `--device`, else of the spec's `device`, else hopper.
-pub fn profile(session: &Session, device: Option<&str>) -> Result<Profile, Box<dyn std::error::Error>> {
-    match device {
-        Some(d) => Ok(Profile::parse(d).ok_or_else(|| format!("--device {d}: expected gt200, maxwell or hopper"))?),
-        None => session.spec_profile(),
-    }
-}
-
 /// Runs the command.
 pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
-    // `examples/…` from any directory: the checkout's or $WARPLIGHT_HOME's copy when not here
-    let mut session = Session::load_launch(&crate::host::scene_file::data_file(&a.spec), a.launch)?;
-    session.max_instructions = a.max_instructions;
-    session.random_seed = a.checks.random_seed();
-    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
     let only = a.warp.as_deref().map(parse_warp).transpose()?;
-    let profile = profile(&session, a.device.as_deref())?;
+    let (session, profile) = a.session.open()?;
     let breaks = session.with_stepper(|st| Ok(Breakpoints::new(&st.module().prog, &a.breaks, &a.src_breaks)?))?;
     let interactive = !a.log && !a.trace && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
     if interactive {

@@ -4,7 +4,7 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use crate::teach::session::Session;
+use super::step_session::SessionArgs;
 use crate::teach::trace::{self, TraceOptions};
 
 /// Options of `warplight trace`.
@@ -15,11 +15,9 @@ Examples:\n  warplight trace examples/if_else.toml -o if_else.html\n  \
 warplight trace examples/reduce.toml --cta 0 --warp 0 --warp 1 -o reduce.html\n  \
 warplight trace examples/lessons/coalescing.toml --launch 3 --device gt200 --cta 0 -o stride32.html")]
 pub struct TraceArgs {
-    /// The launch spec (TOML).
-    pub spec: PathBuf,
-    /// Which of the spec's launches is recorded, from 1; those before it run first.
-    #[arg(long, default_value_t = 1)]
-    pub launch: usize,
+    /// The spec, the launch, the watchdog, the profile, checking and schedule.
+    #[command(flatten)]
+    pub session: SessionArgs,
     /// The HTML file to write (written only when the recording succeeded).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -38,18 +36,6 @@ pub struct TraceArgs {
     /// Most instructions kept; the page says when the recording was cut.
     #[arg(long, default_value_t = 20_000)]
     pub max_events: usize,
-    /// The watchdog: stop a launch as a runaway after this many warp instructions
-    /// (default: the spec's `max_instructions`, else 2^32). See docs/limits.md.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
-    pub max_instructions: Option<u64>,
-    /// Device profile for the memory transactions, sectors and banks: gt200, maxwell or hopper
-    /// (default: the spec's `device`, else hopper).
-    #[arg(long)]
-    pub device: Option<String>,
-    /// Checking (`--check`, `--uninit`; the reports go to stderr) and the
-    /// warp schedule of the recorded launch (`--schedule random --seed N`).
-    #[command(flatten)]
-    pub checks: crate::check::cli::CheckArgs,
 }
 
 /// Runs the command.
@@ -57,12 +43,7 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
     if a.from > a.to {
         return Err(format!("--from {} is after --to {}", a.from, a.to).into());
     }
-    // `examples/…` from any directory: the checkout's or $WARPLIGHT_HOME's copy when not here
-    let mut session = Session::load_launch(&crate::host::scene_file::data_file(&a.spec), a.launch)?;
-    let profile = crate::cli::step::profile(&session, a.device.as_deref())?;
-    session.max_instructions = a.max_instructions;
-    session.random_seed = a.checks.random_seed();
-    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
+    let (session, profile) = a.session.open()?;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
     let spinner = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new_spinner();

@@ -3,10 +3,10 @@
 //! `tests/fixtures/h100_micro.json`; this runs the same launches on the
 //! hopper profile and lines the two up, metric by metric.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::{Model, Profile};
-use crate::sim::{Arg, Device, LaunchConfig};
+use crate::sim::{Arg, Device, LaunchConfig, SimError};
 
 /// How a metric is expected to compare.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -79,29 +79,89 @@ fn expectation(metric: &str, kernel: &str) -> Expect {
     if exact_mem.contains(&metric) { Expect::Exact } else { Expect::SideBySide }
 }
 
+/// Why [`compare`] could not run. Every message names the file at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum ValidationError {
+    /// The fixture or the PTX file could not be read.
+    #[error("{}: {source}", file.display())]
+    Read {
+        /// The file.
+        file: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The fixture is not JSON.
+    #[error("{}: not JSON: {source}", file.display())]
+    Json {
+        /// The fixture.
+        file: PathBuf,
+        /// Where and why.
+        source: serde_json::Error,
+    },
+    /// The fixture lacks something a comparison needs.
+    #[error("{}: {what}", file.display())]
+    Fixture {
+        /// The fixture.
+        file: PathBuf,
+        /// What is missing, and where.
+        what: String,
+    },
+    /// The PTX does not load (the message names the file and line).
+    #[error(transparent)]
+    Ptx(SimError),
+    /// A launch of the fixture failed on the emulator.
+    #[error("{}: launch {launch} (`{kernel}`): {source}", fixture.display())]
+    Launch {
+        /// The fixture.
+        fixture: PathBuf,
+        /// The launch's `id` in the fixture.
+        launch: usize,
+        /// Its kernel.
+        kernel: String,
+        /// Why (names the PTX file where it is about the PTX).
+        source: SimError,
+    },
+}
+
 /// Runs every launch of the fixture at `fixture` on the hopper profile using the
 /// PTX at `ptx`, and returns the comparison rows.
-pub fn compare(fixture: &Path, ptx: &Path) -> Result<Vec<Row>, Box<dyn std::error::Error>> {
-    let fx: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(fixture)?)?;
-    let src = std::fs::read_to_string(ptx)?;
+pub fn compare(fixture: &Path, ptx: &Path) -> Result<Vec<Row>, ValidationError> {
+    let read = |file: &Path| {
+        std::fs::read_to_string(file).map_err(|source| ValidationError::Read { file: file.to_path_buf(), source })
+    };
+    let missing = |what: String| ValidationError::Fixture { file: fixture.to_path_buf(), what };
+    let fx: serde_json::Value = serde_json::from_str(&read(fixture)?)
+        .map_err(|source| ValidationError::Json { file: fixture.to_path_buf(), source })?;
+    let src = read(ptx)?;
     let mut rows = Vec::new();
-    for l in fx["launches"].as_array().ok_or("fixture without launches")? {
+    let launches = fx["launches"].as_array().ok_or_else(|| missing("no `launches` array".into()))?;
+    for (i, l) in launches.iter().enumerate() {
         let id = l["id"].as_u64().unwrap_or(0) as usize;
-        let kernel = l["kernel"].as_str().ok_or("launch without kernel")?.to_string();
+        let kernel = l["kernel"].as_str().ok_or_else(|| missing(format!("launches[{i}] has no `kernel`")))?.to_string();
         let (a, b) = (l["a"].as_i64().unwrap_or(0), l["b"].as_i64().unwrap_or(0));
         let (grid, block) = (l["grid"].as_u64().unwrap_or(64) as u32, l["block"].as_u64().unwrap_or(256) as u32);
         let mut dev = Device::new();
-        let m = dev.load_ptx(&src, &ptx.display().to_string())?;
+        let m = dev.load_ptx(&src, &ptx.display().to_string()).map_err(ValidationError::Ptx)?;
         let n = 1usize << 20;
         let out = dev.alloc_zeroed::<f32>(n);
         let inb = dev.alloc_zeroed::<f32>(n);
         let model = Model::new(Profile::Hopper, &m.prog);
         let args = [Arg::Ptr(out), Arg::Ptr(inb), Arg::I32(a as i32), Arg::I32(b as i32)];
-        let core = dev.launch_observed(&m, &kernel, LaunchConfig::linear(grid, block), &args, Some(&model))?;
+        let core = dev.launch_observed(&m, &kernel, LaunchConfig::linear(grid, block), &args, Some(&model)).map_err(
+            |source| ValidationError::Launch {
+                fixture: fixture.to_path_buf(),
+                launch: id,
+                kernel: kernel.clone(),
+                source,
+            },
+        )?;
         let stats = model.finish();
         let ours: std::collections::HashMap<&str, u64> = stats.profiler_names(&core.totals).into_iter().collect();
-        let mut metrics: Vec<(&String, &serde_json::Value)> =
-            l["metrics"].as_object().ok_or("launch without metrics")?.iter().collect();
+        let mut metrics: Vec<(&String, &serde_json::Value)> = l["metrics"]
+            .as_object()
+            .ok_or_else(|| missing(format!("launches[{i}] has no `metrics`")))?
+            .iter()
+            .collect();
         metrics.sort_by_key(|(k, _)| k.as_str());
         for (name, v) in metrics {
             let measured = v.as_u64().unwrap_or(0);
