@@ -17,15 +17,23 @@ pub mod lbvh;
 pub mod photon_image;
 pub mod photons;
 pub mod pm_layout;
+pub mod sah;
+pub mod scene_bvh;
+pub mod spills;
 pub mod table_4_1;
 pub mod table_4_2;
 pub mod table_4_3;
 pub mod table_4_4;
 pub mod table_5_1;
+pub mod table_6_1;
+pub mod table_6_2;
+pub mod table_6_3;
 pub mod table_6_4;
+pub mod table_6_5;
 pub mod timing;
 pub mod traversal;
 pub mod vkde;
+pub mod vvh;
 
 use flight::{SceneRun, Totals};
 
@@ -72,7 +80,7 @@ pub static THESIS: Thesis = Thesis {
 const HEURISTIC_TREES: [Heuristic; 3] = [Heuristic::Sah, Heuristic::Numerical, Heuristic::Siroh];
 
 /// The measurement groups.
-static GROUPS: [Group; 9] = [
+static GROUPS: [Group; 11] = [
     Group {
         name: TRAVERSAL,
         what: "5 traversal kernels on the emulator",
@@ -162,6 +170,26 @@ static GROUPS: [Group; 9] = [
         seconds_per_triangle: 2e-5,
         trees: &[Heuristic::Siroh],
         measure: table_6_4::measure,
+    },
+    Group {
+        name: table_6_5::SCENE_BVH,
+        what: "ray traversal of the SAH scene BVH in the complete and compact layouts on the emulator",
+        per_frame: true,
+        variants: 2,
+        seconds_per_side: 0.05,
+        seconds_per_triangle: 2e-5,
+        trees: &[Heuristic::Siroh],
+        measure: table_6_5::measure,
+    },
+    Group {
+        name: vvh::PM_BUILDERS,
+        what: "VVH and LBVH photon maps with n_auto and leaf thresholds 1-128, native walks at each frame's queries",
+        per_frame: true,
+        variants: 18,
+        seconds_per_side: NATIVE,
+        seconds_per_triangle: 2e-4,
+        trees: &[Heuristic::Siroh],
+        measure: vvh::measure,
     },
 ];
 
@@ -291,31 +319,31 @@ static TABLES: [TableDef; N] = [
         id: "6.1",
         title: "Rendering frame rates with different minimal photon map leaf size thresholds",
         lines: "L2629-2659",
-        status: Status::Missing,
-        note: "modelled when reproduced: all FPS (class T); conversion lost Ring row and shifted labels; emulate n_T/n_I per threshold instead",
-        scenes: &[],
-        groups: &[],
-        render: None,
+        status: Status::Partly,
+        note: "n_auto measured (§6.1.3 as printed); all frame rates not reproduced (GTX 280); n_T/n_I per threshold measured by native walks of VVH and LBVH photon maps instead; rows reconciled (Ring row lost, labels shifted)",
+        scenes: &table_5_1::SCENES,
+        groups: &[vvh::PM_BUILDERS],
+        render: Some(table_6_1::render),
     },
     TableDef {
         id: "6.2",
         title: "Photon map node counts, relative to the VVH, and construction timings with LBVH",
         lines: "L2667-2681",
-        status: Status::Missing,
-        note: "measured when reproduced: node counts class C (VVH needs serial host builder); LBVH ms need timing model; interactions differ from 5.1",
-        scenes: &[],
-        groups: &[],
-        render: None,
+        status: Status::Partly,
+        note: "interactions and VVH/LBVH node counts measured (serial VVH builder, LBVH with dual merge, n_auto); LBVH ms not reproduced (GTX 280); interactions differ from 5.1 in the thesis",
+        scenes: &table_5_1::SCENES,
+        groups: &[vvh::PM_BUILDERS],
+        render: Some(table_6_2::render),
     },
     TableDef {
         id: "6.3",
         title: "Photon map node traversals, interaction retrievals per query point and rendering frame rates with LBVH construction, relative to the VVH",
         lines: "L2683-2697",
-        status: Status::Missing,
-        note: "measured when reproduced: n_T, n_I class C (strongest ch. 6 count target); FPS columns class T",
-        scenes: &[],
-        groups: &[],
-        render: None,
+        status: Status::Partly,
+        note: "n_T and n_I per query point measured (native walks of VVH and LBVH photon maps with n_auto, bit for bit pmgather.cu); FPS not reproduced (GTX 280)",
+        scenes: &table_5_1::SCENES,
+        groups: &[vvh::PM_BUILDERS],
+        render: Some(table_6_3::render),
     },
     TableDef {
         id: "6.4",
@@ -331,11 +359,11 @@ static TABLES: [TableDef; N] = [
         id: "6.5",
         title: "Global memory accesses during node traversal, instructions per ray and frame rates with compact BVH (C), relative to complete BVH (B)",
         lines: "L2829-2853",
-        status: Status::Missing,
-        note: "measured when reproduced: nodes/accesses/bytes class C, instructions class S, FPS class T; (b) needs 64-register cap and spill modelling",
-        scenes: &[],
-        groups: &[],
-        render: None,
+        status: Status::Partly,
+        note: "(b): node and stack accesses and bytes counted on the emulator (SAH scene BVH in [AL09]'s complete and the compact pairs, Alg. 6.1; the byte model checked on the memory model's counters), instructions of the traversal kernel alone, register cap 64 by a spill model of the PTX; FPS not reproduced; (a) not reproduced (older code base's baseline not built)",
+        scenes: &table_6_5::SCENES,
+        groups: &[table_6_5::SCENE_BVH],
+        render: Some(table_6_5::render),
     },
     TableDef {
         id: "6.6",

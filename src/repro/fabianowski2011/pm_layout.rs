@@ -211,37 +211,7 @@ impl Layouts {
             }
             out.complete[slot] = w;
         }
-        // C: breadth first over the inner nodes, one pair for each one's children
-        let mut todo = std::collections::VecDeque::from([(0u32, 0usize)]);
-        out.compact.push([0; 8]);
-        while let Some((i, pair)) = todo.pop_front() {
-            let n = t.nodes[i as usize];
-            let PmKind::Inner(kids) = n.kind else { continue };
-            let (l, r) = (t.nodes[kids[0] as usize], t.nodes[kids[1] as usize]);
-            let mut w = [0u32; 8];
-            let (mut lmask, mut umask) = (0u32, 0u32);
-            for c in 0..3 {
-                let (m, a) = plane(n.lo[c], l.lo[c], r.lo[c]);
-                let (mm, b) = plane(n.hi[c], l.hi[c], r.hi[c]);
-                w[c] = m.to_bits();
-                w[3 + c] = mm.to_bits();
-                lmask |= a << (2 - c);
-                umask |= b << (2 - c);
-            }
-            for (side, kid) in kids.into_iter().enumerate() {
-                let word = match t.nodes[kid as usize].kind {
-                    PmKind::Leaf { first, .. } => first | REF_LEAF,
-                    PmKind::Inner(_) => {
-                        let p = out.compact.len();
-                        out.compact.push([0; 8]);
-                        todo.push_back((kid, p));
-                        p as u32
-                    }
-                };
-                w[6 + side] = word | ([lmask, umask][side] << 29);
-            }
-            out.compact[pair] = w;
-        }
+        out.compact = compact_pairs(&t);
         out
     }
 
@@ -256,6 +226,46 @@ impl Layouts {
         }
         v
     }
+}
+
+/// The compact layout of `t` (its root inner): breadth first over the inner
+/// nodes, one 32-byte pair for each one's children; pair 0 holds the root's.
+/// Per axis and side the stored plane is the left child's if it differs from
+/// the parent's (mask 1), else the right child's if it differs (mask 0), else
+/// the parent's, assigned to the left (L2720). A leaf child's word holds its
+/// first position with [`REF_LEAF`].
+pub fn compact_pairs(t: &PmTree) -> Vec<[u32; 8]> {
+    let mut out = vec![[0u32; 8]];
+    let mut todo = std::collections::VecDeque::from([(0u32, 0usize)]);
+    while let Some((i, pair)) = todo.pop_front() {
+        let n = t.nodes[i as usize];
+        let PmKind::Inner(kids) = n.kind else { continue };
+        let (l, r) = (t.nodes[kids[0] as usize], t.nodes[kids[1] as usize]);
+        let mut w = [0u32; 8];
+        let (mut lmask, mut umask) = (0u32, 0u32);
+        for c in 0..3 {
+            let (m, a) = plane(n.lo[c], l.lo[c], r.lo[c]);
+            let (mm, b) = plane(n.hi[c], l.hi[c], r.hi[c]);
+            w[c] = m.to_bits();
+            w[3 + c] = mm.to_bits();
+            lmask |= a << (2 - c);
+            umask |= b << (2 - c);
+        }
+        for (side, kid) in kids.into_iter().enumerate() {
+            let word = match t.nodes[kid as usize].kind {
+                PmKind::Leaf { first, .. } => first | REF_LEAF,
+                PmKind::Inner(_) => {
+                    let p = out.len();
+                    out.push([0; 8]);
+                    todo.push_back((kid, p));
+                    p as u32
+                }
+            };
+            w[6 + side] = word | ([lmask, umask][side] << 29);
+        }
+        out[pair] = w;
+    }
+    out
 }
 
 /// Which layout a traversal reads.

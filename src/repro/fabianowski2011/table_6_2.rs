@@ -1,0 +1,69 @@
+//! Thesis 000 Table 6.2 (seed 000, L2667–2681): photon map node counts,
+//! relative to the VVH, and construction timings with LBVH.
+//!
+//! Interactions and node counts (inner nodes and leaves, both built with
+//! n_auto) are measured by [`super::vvh`]; the LBVH construction times are a
+//! GTX 280's and not reproduced. The scenarios Scene 6 with 2^18 photons and
+//! Conference with 2^19 (§6.1.4) are not run.
+
+use super::vvh::{self, Builder, PM_BUILDERS};
+use crate::repro::compare::{Printed as P, Tolerance, mean_sd};
+use crate::repro::registry::Entry;
+use crate::repro::results::Results;
+use crate::repro::table::{Check, Column, Published, PublishedRow as Row, Table, Unit};
+
+/// Table 6.2 as printed: Interactions, Nodes VVH, Nodes LBVH, LBVH construction (ms).
+pub const THESIS: Published = Published {
+    rows: &[
+        Row { scene: "scene6", cells: &[P("160298"), P("23313"), P("−5.8%"), P("10.68")] },
+        Row { scene: "scene6 (2^18, s=28)", cells: &[P("319997"), P("24839"), P("−7.0%"), P("19.27")] },
+        Row { scene: "sponza", cells: &[P("292551"), P("166635"), P("+2.8%"), P("18.13")] },
+        Row { scene: "sibenik", cells: &[P("413316"), P("236247"), P("+3.3%"), P("26.02")] },
+        Row { scene: "fairy", cells: &[P("8911"), P("5345"), P("+5.2%"), P("2.67")] },
+        Row { scene: "conference", cells: &[P("97911"), P("36557"), P("−1.4%"), P("7.31")] },
+        Row { scene: "conference (2^19, s=50)", cells: &[P("390223"), P("39411"), P("−4.3%"), P("24.53")] },
+        Row { scene: "passage", cells: &[P("70256"), P("5477"), P("−7.7%"), P("6.06")] },
+        Row { scene: "ring", cells: &[P("74101"), P("31081"), P("−1.1%"), P("6.28")] },
+    ],
+    average: &[P(""), P(""), P("−1.8%"), P("")],
+    std_dev: &[P(""), P(""), P("4.7%"), P("")],
+};
+
+/// The table.
+pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
+    let scenes = super::scenes_of(r, PM_BUILDERS);
+    let ms_why = "LBVH construction times of the GTX 280 (CUDA kernels and radix sorts); no timing model is applied";
+    let columns = vec![
+        Column::measured("Interactions", Unit::Number(0), Tolerance::COUNT),
+        Column::measured("Nodes VVH", Unit::Number(0), Tolerance::COUNT),
+        Column::measured("Nodes LBVH", Unit::Change, Tolerance::RATIO),
+        Column::not_reproducible("LBVH ms", Unit::Number(2), ms_why),
+    ];
+    let auto = |b| vvh::variant(b, None);
+    let ours: Vec<(String, Vec<f64>)> = scenes
+        .iter()
+        .filter_map(|s| {
+            let v = vvh::measured(r, s, &auto(Builder::Vvh))?;
+            let l = vvh::measured(r, s, &auto(Builder::Lbvh))?;
+            Some((s.clone(), vec![v.interactions, v.nodes, (l.nodes / v.nodes - 1.0) * 100.0, f64::NAN]))
+        })
+        .collect();
+    let mut t = Table::compare(&e.address(), &e.heading(), columns, &THESIS, &ours);
+    if !ours.is_empty() {
+        let rel: Vec<f64> = ours.iter().map(|(_, v)| v[2]).collect();
+        let (m, sd) = mean_sd(&rel);
+        t.checks.push(Check {
+            claim: "LBVH node counts within a few percent of the VVH's (average −1.8%, SD 4.7%)".into(),
+            evidence: format!("ours: {m:+.1}% on average, SD {sd:.1}%"),
+            holds: m.abs() <= 15.0,
+        });
+    }
+    t.notes.push(super::run_note(r, &scenes, "VVH and LBVH photon maps with n_auto (native builds)"));
+    t.notes.push(vvh::HOW.into());
+    t.notes.push(
+        "Nodes count inner nodes and leaves. The thesis' interaction counts differ from its own Table 5.1 (extract \
+         erratum 9); ours are those of our Table 5.1 run. The 2^18 and 2^19 scenarios of §6.1.4 are not run."
+            .into(),
+    );
+    vec![t]
+}

@@ -1,0 +1,170 @@
+//! The VVH photon map beside the LBVH (thesis 000 §6.1, Tables 6.1–6.3): one
+//! measurement group builds both over Table 5.1's kernels, with n_auto and
+//! with the fixed leaf-size thresholds 1, 2, 4, …, 128 of Table 6.1, and
+//! gathers through each (the complete layout, [`super::pm_layout::gather`],
+//! bit for bit `pmgather.cu`'s walk, `tests/photon_bvh.rs`) at the query points
+//! of each frame: n_T (nodes tested) and n_I (interactions retrieved) per
+//! query point, node counts per tree.
+//!
+//! The VVH is [`super::sah::Params::vvh`]: eq. 6.2 with eq. 6.3's volume
+//! probabilities, C_T = 0, C_I = 1, a leaf at n_P ≤ threshold, depth at most
+//! 64 (L2619, L2625), built serially on the host as the thesis does.
+
+use super::lbvh;
+use super::photon_image::{self, Estimator, Options};
+use super::pm_layout::{self, Layout, Layouts, PmTree};
+use super::sah;
+use super::table_5_1::parameters;
+use super::vkde::{self, Kernel, Shape};
+use crate::host::kdtree::Heuristic;
+use crate::host::raycast::Caster;
+use crate::repro::registry::{MeasureError, Tick, Workspace};
+use crate::repro::results::Sample;
+
+/// Group: VVH and LBVH photon maps, gathered natively over the flight.
+pub const PM_BUILDERS: &str = "fabianowski/pm-builders";
+
+/// Table 6.1's fixed leaf-size thresholds.
+pub const THRESHOLDS: [u32; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
+
+/// Which builder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Builder {
+    /// The serial VVH (§6.1.1).
+    Vvh,
+    /// The LBVH with the dual merge (§6.1.2).
+    Lbvh,
+}
+
+impl Builder {
+    /// Both, in Table 6.1's order.
+    pub const ALL: [Builder; 2] = [Builder::Vvh, Builder::Lbvh];
+
+    /// Short name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Builder::Vvh => "vvh",
+            Builder::Lbvh => "lbvh",
+        }
+    }
+}
+
+/// The variant name of `builder` at leaf threshold `threshold` (`None`: n_auto).
+pub fn variant(builder: Builder, threshold: Option<u32>) -> String {
+    match threshold {
+        None => format!("{}-auto", builder.name()),
+        Some(t) => format!("{}-{t}", builder.name()),
+    }
+}
+
+/// The VVH over `kernels` with leaf threshold `threshold`.
+pub fn build_vvh(kernels: &[Kernel], threshold: u32) -> PmTree {
+    let boxes: Vec<sah::Bounds> = kernels.iter().map(|k| [k.lo, k.hi]).collect();
+    sah::build(&boxes, &sah::Params::vvh(threshold as usize))
+}
+
+/// The tree of `builder` over `kernels` at `threshold`.
+pub fn build(builder: Builder, kernels: &[Kernel], threshold: u32) -> PmTree {
+    match builder {
+        Builder::Vvh => build_vvh(kernels, threshold),
+        Builder::Lbvh => lbvh::build(kernels, threshold).tree(),
+    }
+}
+
+/// Measurement group [`PM_BUILDERS`].
+pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    let (photons, spread) = parameters(&ws.scene.name)
+        .ok_or_else(|| format!("{}: not a scene of Table 5.1 (its parameters are per scene)", ws.scene.name))?;
+    let o = Options {
+        photons,
+        spread,
+        h_max: vkde::H_MAX,
+        estimator: Estimator::Vkde,
+        shape: Shape::Uniform,
+        emulated: false,
+    };
+    ws.build(Heuristic::Siroh);
+    let tree = ws.tree(Heuristic::Siroh);
+    let maps = photon_image::photon_maps(ws.scene, tree, &o, None)?;
+    let kernels = &maps.constructed.kernels;
+    let n_auto = lbvh::n_auto(kernels, ws.scene);
+    let mut maps_built = Vec::new();
+    for b in Builder::ALL {
+        for t in std::iter::once(None).chain(THRESHOLDS.map(Some)) {
+            let started = std::time::Instant::now();
+            let pm = build(b, kernels, t.unwrap_or(n_auto));
+            let seconds = started.elapsed().as_secs_f64();
+            let stats = pm.stats();
+            maps_built.push((variant(b, t), Layouts::new(&pm, kernels), stats, seconds));
+        }
+    }
+    let caster = Caster::new(ws.scene, tree);
+    let mut out = Vec::new();
+    for f in ws.frames.clone() {
+        let cam = super::flight::camera(ws.scene, f, ws.resolution);
+        let q = photon_image::queries(&caster, &cam);
+        let queries = q.iter().flatten().count() as f64;
+        for (name, layouts, stats, seconds) in &maps_built {
+            tick(Tick { frame: Some(f), variant: name });
+            let (_, walk) = pm_layout::gather_all(layouts, Layout::Complete, &q, Shape::Uniform);
+            let c = [
+                ("queries", queries),
+                ("n_t", walk.nodes as f64),
+                ("n_i", walk.retrieved as f64),
+                ("nodes", (stats.inner + stats.leaves) as f64),
+                ("leaves", stats.leaves as f64),
+                ("depth", stats.depth as f64),
+                ("interactions", kernels.len() as f64),
+                ("n_auto", n_auto as f64),
+                ("build_seconds", *seconds),
+            ];
+            out.push(Sample {
+                group: PM_BUILDERS.into(),
+                scene: ws.scene.name.clone(),
+                frame: Some(f),
+                variant: name.clone(),
+                counters: c.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// One variant's values for one scene: per query point n_T and n_I, and per
+/// frame the tree's nodes, the interactions and n_auto.
+#[derive(Debug, Clone, Copy)]
+pub struct Measured {
+    /// Nodes tested per query point.
+    pub n_t: f64,
+    /// Interactions retrieved per query point.
+    pub n_i: f64,
+    /// Nodes of the tree (inner and leaves).
+    pub nodes: f64,
+    /// Stored interactions (kernels).
+    pub interactions: f64,
+    /// n_auto.
+    pub n_auto: f64,
+}
+
+/// The values of `variant` of `scene` in `r`.
+pub fn measured(r: &crate::repro::results::Results, scene: &str, variant: &str) -> Option<Measured> {
+    let g = |c: &str| r.sum(PM_BUILDERS, scene, variant, c);
+    let frames =
+        r.samples.iter().filter(|s| s.group == PM_BUILDERS && s.scene == scene && s.variant == variant).count() as f64;
+    let q = g("queries")?;
+    Some(Measured {
+        n_t: g("n_t")? / q,
+        n_i: g("n_i")? / q,
+        nodes: g("nodes")? / frames,
+        interactions: g("interactions")? / frames,
+        n_auto: g("n_auto")? / frames,
+    })
+}
+
+/// The note naming how the photon maps of Tables 6.1–6.3 are made.
+pub const HOW: &str = "Photon maps over Table 5.1's kernels (native photon tracing and construction, its emissions and \
+     spread s per scene): the VVH of src/repro/fabianowski2011/sah.rs (eq. 6.2 with eq. 6.3's volume ratios, C_T = 0, \
+     C_I = 1, a leaf at n_P <= threshold, depth <= 64, object partitions swept over the kernels' AABB centroids) and \
+     the LBVH with the dual merge (bit for bit lbvh.cu's); n_T and n_I counted by the native walk of the complete \
+     layout (bit for bit pmgather.cu's) at the primary and reflection hits of each frame. n_auto follows §6.1.3 as \
+     printed, and ours is far above the thesis' (see Table 6.4's note), so our leaves are larger.";
