@@ -43,3 +43,49 @@ fn emulated_frames_equal_native_frames_bit_for_bit() {
         assert!(sum > 0.0, "{integrator:?}: a black image");
     }
 }
+
+fn warplight(args: &[&str]) -> (bool, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
+
+#[test]
+fn render_takes_each_traversal_and_names_a_wrong_one() {
+    let dir = std::env::temp_dir().join(format!("warplight-lin2017-traversal-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    for t in ["stack", "restart", "backtrack"] {
+        let out = dir.join(format!("{t}.exr"));
+        let (ok, stdout, stderr) = warplight(&[
+            "render",
+            "--method",
+            "path",
+            "--scene",
+            "cornell-lambert",
+            "--resolution",
+            "8x6",
+            "--spp",
+            "4",
+            "--traversal",
+            t,
+            "-o",
+            out.to_str().expect("utf-8 path"),
+        ]);
+        assert!(ok, "--traversal {t}: {stderr}");
+        let name = if t == "stack" { "short-stack" } else { t };
+        assert!(stdout.contains(&format!("({name} traversal)")), "--traversal {t}: {stdout}");
+        assert!(out.exists(), "--traversal {t}: no image");
+    }
+    let (ok, _, stderr) = warplight(&[
+        "render",
+        "--method",
+        "path",
+        "--scene",
+        "cornell-lambert",
+        "--resolution",
+        "8x6",
+        "--traversal",
+        "bvh",
+    ]);
+    assert!(!ok && stderr.contains("unknown traversal `bvh`"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}

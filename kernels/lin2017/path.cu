@@ -310,18 +310,20 @@ static __device__ __forceinline__ void basis(V3 n, V3 *b1, V3 *b2) {
   *b2 = v3(b, sign + n.y * n.y * a, -n.y);
 }
 
-extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
-                                      const float4 *tris, const float4 *tri_data, const float4 *mats,
-                                      const float4 *lights, const float4 *boxes, float *accum, float *last) {
-  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes};
-  const Params *p = params;
-  int i = (int)WL_TID;
-  if (i >= p->num_paths) return;
+// One path's state between bounces (the per-path struct of 003:L534: next
+// ray, mask, pixel, activeness, and what the estimators carry across a bounce).
+struct Path {
+  V3 o, d;                // the next ray
+  V3 L, beta;             // radiance gathered, the mask (path throughput)
+  int bounce;             // bounces taken
+  bool count_emission;    // camera rays and specular bounces see emitters
+  float bsdf_pdf;         // solid-angle pdf of the last diffuse bounce (mis)
+};
+
+// Path i's camera ray: tent-jittered in subpixel (sub & 1, sub >> 1) of the 2 x 2 grid.
+static __device__ __forceinline__ Path camera_path(const Params *p, int i, unsigned key) {
   int pixel = i >> 2, sub = i & 3;
   int x = pixel % p->width, y = pixel / p->width;
-  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
-  int integrator = p->integrator;
-  // the camera ray: tent-jittered in subpixel (sub & 1, sub >> 1) of the 2 x 2 grid
   float px = (float)x + ((float)(sub & 1) + 0.5f + tent(rng(key, 0))) * 0.5f;
   float py = (float)y + ((float)(sub >> 1) + 0.5f + tent(rng(key, 1))) * 0.5f;
   float cx = (px / (float)p->width * 2.0f - 1.0f) * p->tan_half * p->aspect;
@@ -329,115 +331,135 @@ extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, 
   V3 fwd = v3(p->cam_fwd[0], p->cam_fwd[1], p->cam_fwd[2]);
   V3 right = v3(p->cam_right[0], p->cam_right[1], p->cam_right[2]);
   V3 up = v3(p->cam_up[0], p->cam_up[1], p->cam_up[2]);
-  V3 o = v3(p->cam_pos[0], p->cam_pos[1], p->cam_pos[2]);
-  V3 d = normalize3(add3(add3(fwd, scale3(right, cx)), scale3(up, cy)));
-  V3 L = v3(0.0f, 0.0f, 0.0f), beta = v3(1.0f, 1.0f, 1.0f);
-  bool count_emission = true;   // camera rays and specular bounces see emitters
-  float bsdf_pdf = 0.0f;        // solid-angle pdf of the last diffuse bounce (mis)
-  for (int bounce = 0; bounce <= p->max_bounces; bounce++) {
-    float t;
-    int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
-    if (tri < 0) break;
-    float4 td = s.tri_data[tri];
-    V3 n = v3(td.x, td.y, td.z);
-    float4 m0 = s.mats[2 * __float_as_int(td.w)];
-    int kind = __float_as_int(m0.w);
-    float cos_d = dot3(d, n);
-    if (kind == KIND_EMITTER) {
-      if (cos_d < 0.0f) {   // the front face emits
-        float4 m1 = s.mats[2 * __float_as_int(td.w) + 1];
-        float w = 1.0f;
-        if (!count_emission) {
-          if (integrator == INTEGRATOR_NEE) {
-            w = 0.0f;
-          } else if (integrator != INTEGRATOR_PT) {
-            float light_pdf = t * t / (-cos_d * p->light_area);
-            w = mis_weight(integrator, bsdf_pdf, light_pdf);
-          }
-        }
-        L = add3(L, scale3(mul3(beta, v3(m1.x, m1.y, m1.z)), w));
-      }
-      break;
-    }
-    V3 hitp = add3(o, scale3(d, t));
-    V3 ns = cos_d < 0.0f ? n : v3(-n.x, -n.y, -n.z);   // faces the ray
-    V3 color = v3(m0.x, m0.y, m0.z);
-    unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
-    if (kind == KIND_DIFFUSE && integrator != INTEGRATOR_PT && bounce < p->max_bounces) {
-      // next event estimation: a light triangle by area, a point on it uniformly
-      float yl = rng(key, dim);
-      int l = 0;
-      while (l + 1 < p->num_lights && !(yl < s.lights[3 * l].w)) l++;
-      float4 la = s.lights[3 * l], lb = s.lights[3 * l + 1], lc = s.lights[3 * l + 2];
-      float su = sqrtf(rng(key, dim + 1));
-      float yv = rng(key, dim + 2);
-      float bu = su * (1.0f - yv), bv = su * yv;
-      V3 q = add3(add3(v3(la.x, la.y, la.z), scale3(v3(lb.x, lb.y, lb.z), bu)), scale3(v3(lc.x, lc.y, lc.z), bv));
-      V3 wl = sub3(q, hitp);
-      float dist2 = dot3(wl, wl);
-      float dist = sqrtf(dist2);
-      wl = scale3(wl, 1.0f / dist);
-      int ltri = __float_as_int(lb.w);
-      float4 ld = s.tri_data[ltri];
-      float cos_s = dot3(ns, wl);
-      float cos_l = -dot3(v3(ld.x, ld.y, ld.z), wl);
-      if (cos_s > 0.0f && cos_l > 0.0f) {
-        float ts;
-        if (trace(s, hitp, wl, p->eps, dist - p->eps, true, &ts) < 0) {
-          float4 le = s.mats[2 * __float_as_int(ld.w) + 1];
-          float light_pdf = dist2 / (cos_l * p->light_area);
-          float w = 1.0f;
-          if (integrator != INTEGRATOR_NEE) w = mis_weight(integrator, light_pdf, cos_s * INV_PI);
-          float g = cos_s * INV_PI / light_pdf * w;
-          L = add3(L, scale3(mul3(mul3(beta, color), v3(le.x, le.y, le.z)), g));
+  Path P;
+  P.o = v3(p->cam_pos[0], p->cam_pos[1], p->cam_pos[2]);
+  P.d = normalize3(add3(add3(fwd, scale3(right, cx)), scale3(up, cy)));
+  P.L = v3(0.0f, 0.0f, 0.0f);
+  P.beta = v3(1.0f, 1.0f, 1.0f);
+  P.bounce = 0;
+  P.count_emission = true;
+  P.bsdf_pdf = 0.0f;
+  return P;
+}
+
+// One level of the inner loop (003:L119) for one path: trace its ray, gather
+// emission and the light sample, pick the next direction, Russian roulette.
+// False when the path ends (missed, hit an emitter, the longest path, or
+// terminated); P then holds its final radiance.
+static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned key) {
+  const Params *p = s.p;
+  int integrator = p->integrator;
+  int bounce = P.bounce;
+  V3 o = P.o, d = P.d;
+  float t;
+  int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
+  if (tri < 0) return false;
+  float4 td = s.tri_data[tri];
+  V3 n = v3(td.x, td.y, td.z);
+  float4 m0 = s.mats[2 * __float_as_int(td.w)];
+  int kind = __float_as_int(m0.w);
+  float cos_d = dot3(d, n);
+  if (kind == KIND_EMITTER) {
+    if (cos_d < 0.0f) {   // the front face emits
+      float4 m1 = s.mats[2 * __float_as_int(td.w) + 1];
+      float w = 1.0f;
+      if (!P.count_emission) {
+        if (integrator == INTEGRATOR_NEE) {
+          w = 0.0f;
+        } else if (integrator != INTEGRATOR_PT) {
+          float light_pdf = t * t / (-cos_d * p->light_area);
+          w = mis_weight(integrator, P.bsdf_pdf, light_pdf);
         }
       }
+      P.L = add3(P.L, scale3(mul3(P.beta, v3(m1.x, m1.y, m1.z)), w));
     }
-    if (bounce == p->max_bounces) break;
-    // the next direction
-    if (kind == KIND_DIFFUSE) {
-      float y1 = rng(key, dim + 3);
-      float r = sqrtf(y1), c, sn;
-      azimuth(rng(key, dim + 4), &c, &sn);
-      float lz = sqrtf(fmaxf(1.0f - y1, 0.0f));
-      V3 b1, b2;
-      basis(ns, &b1, &b2);
-      d = add3(add3(scale3(b1, r * c), scale3(b2, r * sn)), scale3(ns, lz));
-      bsdf_pdf = lz * INV_PI;
-      count_emission = false;
-    } else {
-      float cos_i = -dot3(d, ns);   // > 0: ns faces the ray
-      V3 next = add3(d, scale3(ns, 2.0f * cos_i));
-      if (kind == KIND_GLASS) {
-        // the Fresnel switch (Schlick): reflect with probability R, else refract
-        float ior = s.mats[2 * __float_as_int(td.w) + 1].w;
-        bool into = cos_d < 0.0f;
-        float eta = into ? 1.0f / ior : ior;
-        float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
-        if (k > 0.0f) {   // else total internal reflection
-          float cos_t = sqrtf(k);
-          V3 tdir = add3(scale3(d, eta), scale3(ns, eta * cos_i - cos_t));
-          float r0 = (1.0f - ior) / (1.0f + ior);
-          r0 = r0 * r0;
-          float c = 1.0f - (into ? cos_i : cos_t);
-          float c2 = c * c;
-          float fr = r0 + (1.0f - r0) * (c2 * c2 * c);
-          if (!(rng(key, dim + 6) < fr)) next = tdir;
-        }
-      }
-      d = next;
-      count_emission = true;
-    }
-    // Russian roulette on the bounce's mask f cos / p = color
-    float q = fmaxf(fmaxf(color.x, color.y), color.z);
-    if (q < 1.0f) {
-      if (!(rng(key, dim + 5) < q)) break;
-      beta = v3(beta.x * (color.x / q), beta.y * (color.y / q), beta.z * (color.z / q));
-    } else {
-      beta = mul3(beta, color);
-    }
-    o = hitp;
+    return false;
   }
+  V3 hitp = add3(o, scale3(d, t));
+  V3 ns = cos_d < 0.0f ? n : v3(-n.x, -n.y, -n.z);   // faces the ray
+  V3 color = v3(m0.x, m0.y, m0.z);
+  unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
+  if (kind == KIND_DIFFUSE && integrator != INTEGRATOR_PT && bounce < p->max_bounces) {
+    // next event estimation: a light triangle by area, a point on it uniformly
+    float yl = rng(key, dim);
+    int l = 0;
+    while (l + 1 < p->num_lights && !(yl < s.lights[3 * l].w)) l++;
+    float4 la = s.lights[3 * l], lb = s.lights[3 * l + 1], lc = s.lights[3 * l + 2];
+    float su = sqrtf(rng(key, dim + 1));
+    float yv = rng(key, dim + 2);
+    float bu = su * (1.0f - yv), bv = su * yv;
+    V3 q = add3(add3(v3(la.x, la.y, la.z), scale3(v3(lb.x, lb.y, lb.z), bu)), scale3(v3(lc.x, lc.y, lc.z), bv));
+    V3 wl = sub3(q, hitp);
+    float dist2 = dot3(wl, wl);
+    float dist = sqrtf(dist2);
+    wl = scale3(wl, 1.0f / dist);
+    int ltri = __float_as_int(lb.w);
+    float4 ld = s.tri_data[ltri];
+    float cos_s = dot3(ns, wl);
+    float cos_l = -dot3(v3(ld.x, ld.y, ld.z), wl);
+    if (cos_s > 0.0f && cos_l > 0.0f) {
+      float ts;
+      if (trace(s, hitp, wl, p->eps, dist - p->eps, true, &ts) < 0) {
+        float4 le = s.mats[2 * __float_as_int(ld.w) + 1];
+        float light_pdf = dist2 / (cos_l * p->light_area);
+        float w = 1.0f;
+        if (integrator != INTEGRATOR_NEE) w = mis_weight(integrator, light_pdf, cos_s * INV_PI);
+        float g = cos_s * INV_PI / light_pdf * w;
+        P.L = add3(P.L, scale3(mul3(mul3(P.beta, color), v3(le.x, le.y, le.z)), g));
+      }
+    }
+  }
+  if (bounce == p->max_bounces) return false;
+  // the next direction
+  if (kind == KIND_DIFFUSE) {
+    float y1 = rng(key, dim + 3);
+    float r = sqrtf(y1), c, sn;
+    azimuth(rng(key, dim + 4), &c, &sn);
+    float lz = sqrtf(fmaxf(1.0f - y1, 0.0f));
+    V3 b1, b2;
+    basis(ns, &b1, &b2);
+    d = add3(add3(scale3(b1, r * c), scale3(b2, r * sn)), scale3(ns, lz));
+    P.bsdf_pdf = lz * INV_PI;
+    P.count_emission = false;
+  } else {
+    float cos_i = -dot3(d, ns);   // > 0: ns faces the ray
+    V3 next = add3(d, scale3(ns, 2.0f * cos_i));
+    if (kind == KIND_GLASS) {
+      // the Fresnel switch (Schlick): reflect with probability R, else refract
+      float ior = s.mats[2 * __float_as_int(td.w) + 1].w;
+      bool into = cos_d < 0.0f;
+      float eta = into ? 1.0f / ior : ior;
+      float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+      if (k > 0.0f) {   // else total internal reflection
+        float cos_t = sqrtf(k);
+        V3 tdir = add3(scale3(d, eta), scale3(ns, eta * cos_i - cos_t));
+        float r0 = (1.0f - ior) / (1.0f + ior);
+        r0 = r0 * r0;
+        float c = 1.0f - (into ? cos_i : cos_t);
+        float c2 = c * c;
+        float fr = r0 + (1.0f - r0) * (c2 * c2 * c);
+        if (!(rng(key, dim + 6) < fr)) next = tdir;
+      }
+    }
+    d = next;
+    P.count_emission = true;
+  }
+  // Russian roulette on the bounce's mask f cos / p = color
+  float q = fmaxf(fmaxf(color.x, color.y), color.z);
+  if (q < 1.0f) {
+    if (!(rng(key, dim + 5) < q)) return false;
+    P.beta = v3(P.beta.x * (color.x / q), P.beta.y * (color.y / q), P.beta.z * (color.z / q));
+  } else {
+    P.beta = mul3(P.beta, color);
+  }
+  P.o = hitp;
+  P.d = d;
+  P.bounce = bounce + 1;
+  return true;
+}
+
+// Adds path i's radiance to its slot of the accumulation buffer and stores it in `last`.
+static __device__ __forceinline__ void finish(float *accum, float *last, int i, V3 L) {
   float *a = accum + 3 * i;
   a[0] += L.x;
   a[1] += L.y;
@@ -446,4 +468,80 @@ extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, 
   l[0] = L.x;
   l[1] = L.y;
   l[2] = L.z;
+}
+
+// The megakernel: one launch per frame, each thread runs its path to the end.
+extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                      const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                      const float4 *lights, const float4 *boxes, float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes};
+  const Params *p = params;
+  int i = (int)WL_TID;
+  if (i >= p->num_paths) return;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  Path P = camera_path(p, i, key);
+  while (step(s, P, key)) {
+  }
+  finish(accum, last, i, P.L);
+}
+
+// ---- The wavefront form (Fig. 1's inner loop, §6.3): one launch per level ----
+//
+// The per-path state lives in global memory between launches, 4 float4 (64
+// bytes) per path: [o, path index], [d, bounce], [beta, bsdf_pdf],
+// [L, flags] with flags bit 0 = count emission, bit 1 = active
+// (PATH_ACTIVE; kernels/lin2017/compact.cu reads it). path_init writes every
+// path's camera ray; path_level advances the first n states by one level. The
+// host launches path_level over all paths each level ("normal") or compacts
+// the active states between levels (kernels/lin2017/compact.cu) and
+// launches over those alone. Path i's random numbers depend on i and its
+// bounce only, so both forms trace exactly the megakernel's paths.
+#define PATH_COUNT_EMISSION 1u
+#define PATH_ACTIVE 2u
+
+static __device__ __forceinline__ void store_path(float4 *st, int i, const Path &P, unsigned flags) {
+  st[0] = make_float4(P.o.x, P.o.y, P.o.z, __int_as_float(i));
+  st[1] = make_float4(P.d.x, P.d.y, P.d.z, __int_as_float(P.bounce));
+  st[2] = make_float4(P.beta.x, P.beta.y, P.beta.z, P.bsdf_pdf);
+  st[3] = make_float4(P.L.x, P.L.y, P.L.z, __uint_as_float(flags | (P.count_emission ? PATH_COUNT_EMISSION : 0u)));
+}
+
+extern "C" __global__ void path_init(const Params *params, float4 *states) {
+  const Params *p = params;
+  int i = (int)WL_TID;
+  if (i >= p->num_paths) return;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  store_path(states + 4 * i, i, camera_path(p, i, key), PATH_ACTIVE);
+}
+
+extern "C" __global__ void path_level(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                      const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                      const float4 *lights, const float4 *boxes, float4 *states, unsigned n,
+                                      float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes};
+  const Params *p = params;
+  unsigned j = WL_TID;
+  if (j >= n) return;
+  float4 *st = states + 4 * j;
+  float4 e = st[3];
+  unsigned flags = __float_as_uint(e.w);
+  if (!(flags & PATH_ACTIVE)) return;
+  float4 a = st[0];   // @count live ld.global.v4.u32
+  float4 b = st[1], c = st[2];
+  int i = __float_as_int(a.w);
+  Path P;
+  P.o = v3(a.x, a.y, a.z);
+  P.d = v3(b.x, b.y, b.z);
+  P.bounce = __float_as_int(b.w);
+  P.beta = v3(c.x, c.y, c.z);
+  P.bsdf_pdf = c.w;
+  P.L = v3(e.x, e.y, e.z);
+  P.count_emission = (flags & PATH_COUNT_EMISSION) != 0u;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  if (step(s, P, key)) {
+    store_path(st, i, P, PATH_ACTIVE);
+  } else {
+    finish(accum, last, i, P.L);
+    st[3].w = __uint_as_float(0u);
+  }
 }

@@ -75,6 +75,9 @@ pub struct RenderArgs {
     /// Path tracer: seed of the random numbers.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
+    /// Path tracer: the kd-tree traversal, stack (the 8-byte short stack), restart or backtrack.
+    #[arg(long, default_value = "stack")]
+    pub traversal: String,
     /// Photon map (thesis 000 ch. 5): vkde, vkde-epanechnikov, knn (Table 5.1's k) or knn:K.
     #[arg(long, default_value = "vkde")]
     pub estimator: String,

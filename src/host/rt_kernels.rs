@@ -183,9 +183,24 @@ pub fn count_tags(source: &str) -> Vec<CountTag> {
 /// summed over every PTX instruction on a tagged line of `raytrace.cu` whose
 /// opcode is the tag's: the events the kernel performed.
 pub fn line_counts(prog: &Program, stats: &LaunchStats, tags: &[CountTag]) -> std::collections::BTreeMap<String, u64> {
+    tagged_counts(prog, &stats.profile, SOURCE_FILE, tags, |c| c.pred_on)
+}
+
+/// Per tag name, `select` of the per-instruction counters summed over every
+/// PTX instruction that `.loc` places on a tagged line of the kernel source
+/// `source_file` (a suffix of the PTX's `.file` path) and whose opcode is the
+/// tag's; instructions no lane executed with its guard true are skipped.
+/// `select = |c| c.pred_on` gives the events the kernel performed.
+pub fn tagged_counts(
+    prog: &Program,
+    profile: &crate::sim::counters::InstProfile,
+    source_file: &str,
+    tags: &[CountTag],
+    select: impl Fn(&crate::sim::counters::InstCounts) -> u64,
+) -> std::collections::BTreeMap<String, u64> {
     let mut out: std::collections::BTreeMap<String, u64> = tags.iter().map(|t| (t.name.clone(), 0)).collect();
-    let Some(file) = prog.files.iter().position(|f| f.ends_with(SOURCE_FILE)) else { return out };
-    for (f, counts) in stats.profile.per_fn.iter().enumerate() {
+    let Some(file) = prog.files.iter().position(|f| f.ends_with(source_file)) else { return out };
+    for (f, counts) in profile.per_fn.iter().enumerate() {
         for (pc, c) in counts.iter().enumerate() {
             let info = &prog.functions[f].info[pc];
             let Some(src) = info.src else { continue };
@@ -193,7 +208,7 @@ pub fn line_counts(prog: &Program, stats: &LaunchStats, tags: &[CountTag]) -> st
                 continue;
             }
             for t in tags.iter().filter(|t| t.line == src.line && t.opcode == info.opcode) {
-                *out.entry(t.name.clone()).or_default() += c.pred_on;
+                *out.entry(t.name.clone()).or_default() += select(c);
             }
         }
     }

@@ -12,14 +12,14 @@
 
 use std::collections::BTreeMap;
 
-use crate::host::rt_kernels::{CountTag, count_tags};
+use crate::host::rt_kernels::{CountTag, count_tags, tagged_counts};
 use crate::ptx::ir::Program;
 use crate::sim::counters::InstProfile;
 
 /// The kernel's CUDA source, whose `@count` tags name the lines counted.
 pub const SOURCE: &str = include_str!("../../../kernels/lin2017/path.cu");
 /// The source's path as the PTX's `.file` directive names it (suffix).
-const SOURCE_FILE: &str = "kernels/lin2017/path.cu";
+pub const SOURCE_FILE: &str = "kernels/lin2017/path.cu";
 
 /// Traversal events, summed over rays.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
@@ -76,19 +76,5 @@ pub fn tags() -> Vec<CountTag> {
 /// in `profile`, over every PTX instruction on a tagged line of `path.cu`
 /// whose opcode is the tag's.
 pub fn tagged(prog: &Program, profile: &InstProfile, tags: &[CountTag]) -> BTreeMap<String, u64> {
-    let mut out: BTreeMap<String, u64> = tags.iter().map(|t| (t.name.clone(), 0)).collect();
-    let Some(file) = prog.files.iter().position(|f| f.ends_with(SOURCE_FILE)) else { return out };
-    for (f, counts) in profile.per_fn.iter().enumerate() {
-        for (pc, c) in counts.iter().enumerate() {
-            let info = &prog.functions[f].info[pc];
-            let Some(src) = info.src else { continue };
-            if src.file as usize != file || c.pred_on == 0 {
-                continue;
-            }
-            for t in tags.iter().filter(|t| t.line == src.line && t.opcode == info.opcode) {
-                *out.entry(t.name.clone()).or_default() += c.pred_on;
-            }
-        }
-    }
-    out
+    tagged_counts(prog, profile, SOURCE_FILE, tags, |c| c.pred_on)
 }

@@ -10,7 +10,7 @@ use super::{FrameParams, Progressive, eps_for, frame_of};
 use crate::host::camera::Camera;
 use crate::host::rt_kernels::upload;
 use crate::sim::device::to_bytes;
-use crate::sim::{Arg, Counters, Device, Fidelity, LaunchConfig, Module, SimConfig, SimError};
+use crate::sim::{Arg, Counters, Device, DevicePtr, Fidelity, LaunchConfig, Module, SimConfig, SimError};
 
 /// The kernel's PTX (clang-16), compiled in.
 pub const PTX: &str = include_str!("../../../kernels/lin2017/path.ptx");
@@ -61,6 +61,47 @@ pub fn params_bytes(scene: &PathScene, camera: &Camera, params: &FrameParams, fr
     bytes
 }
 
+/// The scene's buffers on the device, in the kernels' argument order.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneBuffers {
+    /// The parameter block (`Params`), rewritten per frame.
+    pub params: DevicePtr,
+    /// Nodes, references, triangle rows, triangle data, materials, lights, node boxes.
+    pub data: [DevicePtr; 7],
+}
+
+impl SceneBuffers {
+    /// The kernels' first eight arguments: the parameter block, then the scene's data.
+    pub fn scene_args(&self) -> [DevicePtr; 8] {
+        let d = self.data;
+        [self.params, d[0], d[1], d[2], d[3], d[4], d[5], d[6]]
+    }
+}
+
+/// The rows of `v`, one after the other.
+fn flat<const N: usize>(v: &[[f32; N]]) -> Vec<f32> {
+    v.iter().flatten().copied().collect()
+}
+
+/// Uploads the laid-out scene and frame 0's parameter block.
+pub fn upload_scene(
+    dev: &mut Device,
+    scene: &PathScene,
+    camera: &Camera,
+    params: &FrameParams,
+) -> Result<SceneBuffers, SimError> {
+    let nodes: Vec<u32> = scene.nodes.iter().flatten().copied().collect();
+    let pp = upload(dev, &params_bytes(scene, camera, params, 0), "params")?;
+    let nb = upload(dev, &to_bytes(&nodes), "nodes")?;
+    let rb = upload(dev, &to_bytes(&scene.refs), "refs")?;
+    let tb = upload(dev, &to_bytes(&flat(&scene.tris)), "tris")?;
+    let db = upload(dev, &to_bytes(&flat(&scene.tri_data)), "tri_data")?;
+    let mb = upload(dev, &to_bytes(&flat(&scene.mats)), "materials")?;
+    let lb = upload(dev, &to_bytes(&flat(&scene.lights)), "lights")?;
+    let bb = upload(dev, &to_bytes(&flat(&scene.up)), "boxes")?;
+    Ok(SceneBuffers { params: pp, data: [nb, rb, tb, db, mb, lb, bb] })
+}
+
 /// An emulated progressive render.
 #[derive(Debug, Clone)]
 pub struct KernelRender {
@@ -87,24 +128,12 @@ pub fn render(
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Result<KernelRender, SimError> {
-    let flat = |v: &[[f32; 4]]| -> Vec<f32> { v.iter().flatten().copied().collect() };
-    let nodes: Vec<u32> = scene.nodes.iter().flatten().copied().collect();
-    let tris: Vec<f32> = scene.tris.iter().flatten().copied().collect();
-    let mats: Vec<f32> = scene.mats.iter().flatten().copied().collect();
-    let lights: Vec<f32> = scene.lights.iter().flatten().copied().collect();
-    let pp = upload(dev, &params_bytes(scene, camera, &params, 0), "params")?;
-    let nb = upload(dev, &to_bytes(&nodes), "nodes")?;
-    let rb = upload(dev, &to_bytes(&scene.refs), "refs")?;
-    let tb = upload(dev, &to_bytes(&tris), "tris")?;
-    let db = upload(dev, &to_bytes(&flat(&scene.tri_data)), "tri_data")?;
-    let mb = upload(dev, &to_bytes(&mats), "materials")?;
-    let lb = upload(dev, &to_bytes(&lights), "lights")?;
-    let boxes: Vec<f32> = scene.up.iter().flatten().copied().collect();
-    let bb = upload(dev, &to_bytes(&boxes), "boxes")?;
+    let bufs = upload_scene(dev, scene, camera, &params)?;
+    let pp = bufs.params;
     let n = params.paths() * 3;
     let accum = dev.alloc_zeroed::<f32>(n);
     let last = dev.alloc_zeroed::<f32>(n);
-    let args: Vec<Arg> = [pp, nb, rb, tb, db, mb, lb, bb, accum, last].into_iter().map(Arg::Ptr).collect();
+    let args: Vec<Arg> = bufs.scene_args().into_iter().chain([accum, last]).map(Arg::Ptr).collect();
     let ctas = params.paths().div_ceil(THREADS as usize) as u32;
     let mut out = Progressive::new(params.width, params.height);
     let mut totals = Counters::default();

@@ -15,6 +15,7 @@ pub mod layout;
 pub mod native;
 pub mod rng;
 pub mod stats;
+pub mod wavefront;
 
 use super::camera::Camera;
 use super::image::FrameBuffer;
@@ -109,9 +110,12 @@ impl Traversal {
         }
     }
 
-    /// Parses a command-line name.
+    /// Parses a command-line name (`stack` is the short stack).
     pub fn parse(s: &str) -> Option<Traversal> {
-        Traversal::ALL.into_iter().find(|t| t.name() == s)
+        match s {
+            "stack" => Some(Traversal::ShortStack),
+            _ => Traversal::ALL.into_iter().find(|t| t.name() == s),
+        }
     }
 }
 

@@ -9,6 +9,7 @@ use crate::cli::render::RenderArgs;
 use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
+use crate::host::path::build::{self as path_build, Construction};
 use crate::host::path::layout::PathScene;
 use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, kernel, render_native};
 use crate::sim::Device;
@@ -57,7 +58,13 @@ pub fn render(
     emulated: Option<crate::sim::Fidelity>,
 ) -> Result<PathRender, Box<dyn std::error::Error>> {
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+    // the stackless traversals cannot return to a split plane they crossed:
+    // they need thesis 003's SAH tree, which keeps a triangle lying in a split
+    // plane on both sides (docs/reproduction-lin2017.md, Fig. 3)
+    let tree = match params.traversal {
+        Traversal::ShortStack => build(&tris, BuildParams::thesis(Heuristic::Sah)),
+        _ => path_build::build(&tris, &path_build::Params::fig3(Construction::Sah, tris.len())),
+    };
     let ps = PathScene::new(scene, &tree)?;
     let what = format!(
         "{} {} {}x{}",
@@ -99,6 +106,8 @@ pub fn run(
     let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
         format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic) or mis-power", a.integrator)
     })?;
+    let traversal = Traversal::parse(&a.traversal)
+        .ok_or_else(|| format!("unknown traversal `{}`; expected stack, restart or backtrack", a.traversal))?;
     let frames = frames_for(a.spp)?;
     let emulated = match a.variant.as_str() {
         "native" => None,
@@ -106,22 +115,16 @@ pub fn run(
         v => return Err(format!("--method path --variant {v}: expected native or emulated").into()),
     };
     let [width, height] = camera.resolution;
-    let params = FrameParams {
-        width,
-        height,
-        integrator,
-        max_bounces: a.bounces,
-        seed: a.seed,
-        traversal: Traversal::ShortStack,
-    };
+    let params = FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal };
     let r = render(scene, camera, params, frames, emulated)?;
     crate::cli::render::write_image(&r.image, &a.output, a.exposure)?;
     println!(
-        "{} ({}x{}), path tracer {}, {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
+        "{} ({}x{}), path tracer {} ({} traversal), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
         scene.name,
         width,
         height,
         integrator.name(),
+        traversal.name(),
         a.spp,
         frames,
         a.bounces,

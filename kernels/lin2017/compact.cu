@@ -1,0 +1,79 @@
+// Thesis 003 (Lin 2017), §6.3: thread compaction between two levels of the
+// inner loop (003:L501-536). The thesis calls thrust::remove_if on the array
+// of per-path states with the predicate !active (003:L534); this is the same
+// stream compaction written out as its three kernels, flag - scan - scatter:
+//
+//   compact_flag      flags[j] = state j is active (bit PATH_ACTIVE of its last word)
+//   compact_scan      per CTA of COMPACT_THREADS: the exclusive scan of the
+//                     flags (Hillis-Steele in shared memory) and the CTA's total
+//   compact_scan_sums one CTA: the exclusive scan of the CTA totals, and the
+//                     grand total (the active paths) in sums[blocks]
+//   compact_scatter   the active states, in order, to their scanned places
+//
+// A state is 4 float4 (64 bytes, kernels/lin2017/path.cu's layout). The
+// compaction is stable: the active states keep their order.
+#include "../prelude.h"
+
+#define COMPACT_THREADS 256
+#define PATH_ACTIVE 2u   // as kernels/lin2017/path.cu
+
+extern "C" __global__ void compact_flag(const float4 *states, unsigned n, unsigned *flags) {
+  unsigned j = WL_TID;
+  if (j >= n) return;
+  flags[j] = (__float_as_uint(states[4 * j + 3].w) & PATH_ACTIVE) != 0u ? 1u : 0u;
+}
+
+// An exclusive scan of v over the CTA (COMPACT_THREADS threads, all
+// present); returns the CTA's total through *total.
+static __device__ __forceinline__ unsigned cta_scan(unsigned *buf, unsigned v, unsigned *total) {
+  unsigned t = threadIdx.x;
+  buf[t] = v;
+  __syncthreads();
+  for (unsigned off = 1; off < COMPACT_THREADS; off <<= 1) {
+    unsigned x = t >= off ? buf[t - off] : 0u;
+    __syncthreads();
+    buf[t] += x;
+    __syncthreads();
+  }
+  unsigned inclusive = buf[t];
+  *total = buf[COMPACT_THREADS - 1];
+  __syncthreads();
+  return inclusive - v;
+}
+
+extern "C" __global__ void compact_scan(const unsigned *flags, unsigned n, unsigned *offsets, unsigned *sums) {
+  __shared__ unsigned buf[COMPACT_THREADS];
+  unsigned j = WL_TID;
+  unsigned v = j < n ? flags[j] : 0u;
+  unsigned total;
+  unsigned ex = cta_scan(buf, v, &total);
+  if (j < n) offsets[j] = ex;
+  if (threadIdx.x == 0) sums[blockIdx.x] = total;
+}
+
+extern "C" __global__ void compact_scan_sums(unsigned *sums, unsigned blocks) {
+  __shared__ unsigned buf[COMPACT_THREADS];
+  unsigned carry = 0;
+  for (unsigned base = 0; base < blocks; base += COMPACT_THREADS) {
+    unsigned k = base + threadIdx.x;
+    unsigned v = k < blocks ? sums[k] : 0u;
+    unsigned total;
+    unsigned ex = cta_scan(buf, v, &total);
+    if (k < blocks) sums[k] = carry + ex;
+    carry += total;
+  }
+  if (threadIdx.x == 0) sums[blocks] = carry;
+}
+
+extern "C" __global__ void compact_scatter(const float4 *in, const unsigned *flags, const unsigned *offsets,
+                                           const unsigned *sums, unsigned n, float4 *out) {
+  unsigned j = WL_TID;
+  if (j >= n || flags[j] == 0u) return;
+  unsigned k = sums[blockIdx.x] + offsets[j];
+  const float4 *src = in + 4 * j;
+  float4 *dst = out + 4 * k;
+  dst[0] = src[0];
+  dst[1] = src[1];
+  dst[2] = src[2];
+  dst[3] = src[3];
+}
