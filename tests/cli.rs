@@ -441,3 +441,77 @@ fn fmad_flag_spec_key_and_profile_decide_contraction() {
     assert_eq!(value(&["launch", a, "--json", "--print", "x", "--device", "maxwell"]), fused);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `warplight ARGS` run in `dir`: (success, stdout, stderr).
+fn warplight_in(dir: &std::path::Path, args: &[&str]) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).current_dir(dir).output().unwrap();
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
+
+#[test]
+fn launch_finds_example_specs_from_any_directory() {
+    let dir = tempdir();
+    let (ok, out, err) = warplight_in(&dir, &["launch", "examples/reduce.toml", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["launches"][0]["counters"]["ctas"], 8);
+    // a file of this directory comes first; a name found nowhere is named in the error
+    std::fs::create_dir_all(dir.join("examples")).unwrap();
+    std::fs::write(dir.join("examples/reduce.toml"), "ptx = 1\n").unwrap();
+    let (ok, _, err) = warplight_in(&dir, &["launch", "examples/reduce.toml"]);
+    assert!(!ok && err.contains("examples/reduce.toml"), "the local file, not the checkout's: {err}");
+    let (ok, _, err) = warplight_in(&dir, &["launch", "examples/nothing.toml"]);
+    assert!(!ok && err.contains("examples/nothing.toml"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn validate_names_the_file_in_every_error() {
+    let dir = tempdir();
+    let file = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    };
+    let launch = r#"{"launches": [{"id": 3, "kernel": "KERNEL", "grid": 1, "block": 32, "metrics": {}}]}"#;
+    let good = file("good.json", &launch.replace("KERNEL", "ld_stride"));
+    let bad_ptx = file("bad.ptx", ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n foo;\n}\n");
+    let cases: [(Vec<String>, String, &str); 7] = [
+        (
+            vec![dir.join("none.json").display().to_string()],
+            dir.join("none.json").display().to_string(),
+            "No such file",
+        ),
+        (vec![file("x.json", "x")], dir.join("x.json").display().to_string(), "not JSON"),
+        (vec![file("e.json", "{}")], dir.join("e.json").display().to_string(), "no `launches` array"),
+        (
+            vec![file("k.json", r#"{"launches": [{"id": 1}]}"#)],
+            dir.join("k.json").display().to_string(),
+            "launches[0] has no `kernel`",
+        ),
+        (
+            vec![file("n.json", &launch.replace("KERNEL", "nope"))],
+            dir.join("n.json").display().to_string(),
+            "launch 3 (`nope`): no kernel `nope`",
+        ),
+        (
+            vec![good.clone(), dir.join("none.ptx").display().to_string()],
+            dir.join("none.ptx").display().to_string(),
+            "No such file",
+        ),
+        (vec![good.clone(), bad_ptx.clone()], format!("{bad_ptx}:6:2"), "unsupported instruction `foo`"),
+    ];
+    for (files, named, why) in cases {
+        let mut args = vec!["validate".to_string(), "--fixture".into(), files[0].clone()];
+        if let Some(ptx) = files.get(1) {
+            args.extend(["--ptx".into(), ptx.clone()]);
+        }
+        let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        let (ok, _, err) = warplight(&args);
+        assert!(!ok && err.starts_with(&format!("error: {named}")) && err.contains(why), "{args:?}: {err}");
+    }
+    // from another directory the checkout's fixture and PTX are found
+    let (ok, _, err) = warplight_in(&dir, &["validate", "--fixture", &good]);
+    assert!(ok, "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,13 +1,22 @@
 //! Device `printf` (`vprintf` calls) in the emulator, on clang's and nvcc's
 //! PTX of one kernel (`tests/fixtures/printf/printf.cu`, committed in both
-//! dialects), and a student's kernel with `expf` and `printf` run with one
-//! command from another directory (issue 18's "done when").
+//! dialects), a student's kernel with `expf` and `printf` run with one
+//! command from another directory (issue 18's "done when"), and each line at
+//! the step that printed it in the step log, the terminal view and the trace.
 
 mod common;
 
+use std::path::Path;
 use std::process::Command;
 
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use warplight::model::Profile;
 use warplight::sim::{Arg, Device, LaunchConfig};
+use warplight::teach::breakpoints::Breakpoints;
+use warplight::teach::session::Session;
+use warplight::teach::{log, trace, tui};
 
 /// What `printf.cu` prints for thread `t` of CTA `c` (as glibc formats it).
 fn expected_line(c: u32, t: u32) -> String {
@@ -166,6 +175,156 @@ fn a_students_kernel_with_expf_and_printf_runs_with_one_command_from_any_directo
     assert_eq!(j["printf"][3]["lane"], 3);
     assert_eq!(j["printf"][3]["text"].as_str().unwrap(), want.lines().nth(3).unwrap().to_string() + "\n");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The printf kernel as a spec: 2 CTAs of 40 threads (warp 1 has 8 lanes).
+const SPEC_FILE: &str = "tests/fixtures/printf/printf.toml";
+
+fn printf_session() -> Session {
+    Session::load(Path::new(SPEC_FILE)).unwrap_or_else(|e| panic!("{SPEC_FILE}: {e}"))
+}
+
+/// What lane `lane` of warp `warp` of CTA `c` prints at a call: the first
+/// call's line, or for the second call (thread 0 after the barrier) `done`.
+fn labelled(c: u32, warp: u32, lane: u32, done: bool) -> String {
+    let text = if done { format!("cta {c} done\n") } else { expected_line(c, warp * 32 + lane) };
+    format!("cta {c} warp {warp} lane {lane:>2}> {}", text.trim_end_matches('\n'))
+}
+
+/// The step log: the lines a step printed follow it, with its step number;
+/// the whole launch's output still follows the log.
+#[test]
+fn the_step_log_shows_each_printf_line_at_its_step() {
+    let s = printf_session();
+    let o = log::LogOptions { trace: true, max_steps: 1_000_000, ..Default::default() };
+    let mut out = Vec::new();
+    log::run(&s, &o, &mut out).unwrap();
+    let out = String::from_utf8(out).unwrap();
+    let lines: Vec<&str> = out.lines().collect();
+    // each call of a warp: its trace line, then one line a lane, in lane order, same step
+    let calls: Vec<usize> =
+        (0..lines.len()).filter(|&i| lines[i].contains(": call") && lines[i].contains(" mask ")).collect();
+    assert_eq!(calls.len(), 6, "2 CTAs x (2 warps' first calls + thread 0's second)\n{out}");
+    let mut seen = Vec::new();
+    for &i in &calls {
+        let step = lines[i].split_whitespace().next().unwrap();
+        let printed: Vec<&str> = lines[i + 1..]
+            .iter()
+            .take_while(|l| l.split_whitespace().next() == Some(step) && l.contains("> "))
+            .copied()
+            .collect();
+        let (c, w): (u32, u32) = {
+            let f: Vec<&str> = lines[i].split(['[', ',', ']']).collect();
+            (
+                f[1].trim().parse().unwrap(),
+                lines[i].split("warp").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap(),
+            )
+        };
+        let done = seen.contains(&(c, w));
+        seen.push((c, w));
+        let want: Vec<String> = if done {
+            vec![labelled(c, 0, 0, true)]
+        } else {
+            (0..if w == 0 { 32 } else { 8 }).map(|l| labelled(c, w, l, false)).collect()
+        };
+        let got: Vec<String> = printed.iter().map(|l| l.split_once(step).unwrap().1.trim_start().to_string()).collect();
+        assert_eq!(got, want, "step {step}\n{out}");
+    }
+    // without --trace the printed lines still show, at their steps; --warp keeps one warp's
+    let o = log::LogOptions { max_steps: 1_000_000, only: Some((0, 1)), ..Default::default() };
+    let mut out = Vec::new();
+    log::run(&s, &o, &mut out).unwrap();
+    let out = String::from_utf8(out).unwrap();
+    let printed: Vec<&str> = out.lines().filter(|l| l.contains("> ")).collect();
+    assert_eq!(printed.len(), 8, "{out}");
+    assert!(printed.iter().all(|l| l.contains(" cta 0 warp 1 lane ")), "{out}");
+    // the whole launch's output, in CTA, warp, call, lane order, for after the log
+    assert_eq!(s.printf_output().len(), 82);
+}
+
+/// The terminal view: the step that printed says so on the message line, and
+/// panel 5 lists the output with the step of each line; stepping back takes
+/// it away again.
+#[test]
+fn the_terminal_view_shows_each_printf_line_at_its_step() {
+    let s = printf_session();
+    // the PTX line of the first printf call
+    let t = trace::record(&s, &trace_all()).unwrap();
+    let call = t.events.iter().find(|e| !e.out.is_empty()).unwrap();
+    let script = format!("5g{}\n", call.line);
+    let (before, _) = view(&s, &script);
+    assert!(before.contains("nothing printed yet"), "{before}");
+    let (after, app) = view(&s, &format!("{script}s"));
+    assert!(app.message.contains("printf: 32 lines, the last cta 0 warp 0 lane 31>"), "{}", app.message);
+    // the panel's last 8 rows: lanes 24 to 31 of warp 0, at the step that printed them
+    for lane in 24..32 {
+        let want = format!("{:>6} {}", app.steps, labelled(0, 0, lane, false));
+        assert!(after.lines().any(|r| r.trim_start_matches('│').starts_with(&want[..60])), "{want}\n{after}");
+    }
+    assert!(after.contains(&format!("5 printf output: 32 lines to step {}", app.steps)), "{after}");
+    // k scrolls back through the output; u steps back before the call
+    let (scrolled, _) = view(&s, &format!("{script}skkk"));
+    assert!(scrolled.contains(&labelled(0, 0, 21, false)[..40]), "{scrolled}");
+    let (back, app) = view(&s, &format!("{script}su"));
+    assert!(back.contains("nothing printed yet") && app.message.contains("stepped back"), "{back}");
+}
+
+/// The trace: each recorded instruction carries its lanes' output, and the
+/// page holds it.
+#[test]
+fn the_trace_records_each_printf_line_at_its_instruction() {
+    let s = printf_session();
+    let mut o = trace_all();
+    o.ctas = vec![1];
+    let t = trace::record(&s, &o).unwrap();
+    let printing: Vec<&trace::TraceEvent> = t.events.iter().filter(|e| !e.out.is_empty()).collect();
+    assert_eq!(printing.len(), 3, "warp 0's and warp 1's calls, thread 0's second call");
+    for e in &printing {
+        assert!(e.op.starts_with("call"), "{}", e.op);
+        let w = t.warps[e.w].warp;
+        let done = e.out.len() == 1;
+        let want: Vec<(u32, String)> = if done {
+            vec![(0, "cta 1 done\n".to_string())]
+        } else {
+            (0..e.mask.count_ones()).map(|l| (l, expected_line(1, w * 32 + l))).collect()
+        };
+        assert_eq!(e.out, want, "step {}", e.step);
+    }
+    // the instructions that printed nothing carry no output in the page's data
+    let page = trace::html(&t).unwrap();
+    assert_eq!(page.matches("\"out\":").count(), 3);
+    assert!(page.contains("\"out\":[[0,\"cta 1 t  0: d=20 "), "the data holds the text");
+    assert!(page.contains("id=\"out\""), "the page has the output pane");
+}
+
+fn trace_all() -> trace::TraceOptions {
+    trace::TraceOptions {
+        ctas: vec![],
+        warps: vec![],
+        from: 1,
+        to: u64::MAX,
+        max_events: 100_000,
+        profile: Profile::Hopper,
+    }
+}
+
+/// The terminal view (80x24) after `script` (characters, `\n` for Enter): the screen and the view's state.
+fn view(s: &Session, script: &str) -> (String, tui::App) {
+    let o = tui::TuiOptions {
+        breaks: Breakpoints::default(),
+        watches: vec![],
+        start: (0, 0),
+        profile: Profile::Hopper,
+        max_steps: 100_000,
+    };
+    let mut keys = script
+        .chars()
+        .map(|c| KeyEvent::new(if c == '\n' { KeyCode::Enter } else { KeyCode::Char(c) }, KeyModifiers::NONE));
+    let mut term = Terminal::new(TestBackend::new(80, 24)).unwrap();
+    let app = tui::drive(&mut term, s, o, || Ok(keys.next())).unwrap();
+    let buf = term.backend().buffer();
+    let rows: Vec<String> = (0..24).map(|y| (0..80).map(|x| buf[(x, y)].symbol().to_string()).collect()).collect();
+    (rows.join("\n"), app)
 }
 
 const STUDENT: &str = r#"#include <cstdio>
