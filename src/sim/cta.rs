@@ -182,8 +182,13 @@ impl Cta {
             if self.rng.is_some() {
                 break;
             }
-            for k in 1..=n {
-                let i = (self.cur + k) % n;
+            // the warps after the current one, wrapping around (no division)
+            let mut i = self.cur;
+            for _ in 0..n {
+                i += 1;
+                if i == n {
+                    i = 0;
+                }
                 if self.warps[i].state == WarpState::Ready {
                     self.cur = i;
                     self.slice_left = self.slice;

@@ -1,15 +1,21 @@
 //! The executable form of a module, decoded once when it is loaded: for every
 //! instruction, what the executor would otherwise work out on every issue —
-//! its counter class and, for arithmetic, the 32-lane function that the
-//! `(operation, type, rounding)` triple selects. The executor looks the
-//! instruction's [`Op`] up by PC and dispatches on it. Operands come from a
-//! copy of the IR instructions whose registers are renamed to frame slots
-//! ([`regalloc`](super::regalloc): a frame holds the live maximum of rows,
-//! not one per virtual register).
+//! its guard, its counter class and, for the frequent forms, the operation
+//! with its operands resolved to frame slots and constants (an [`Exec`]):
+//! arithmetic as the 32-lane function that the `(operation, type, rounding)`
+//! triple selects, `mov`, `selp`, `setp`, `bra`, `ld` and `st`. The executor
+//! looks the instruction's [`Op`] (32 bytes, no `Vec`: a test guards the
+//! size) up by PC and dispatches on it; the other forms ([`Exec::Ir`]) are
+//! interpreted from a copy of the IR instructions whose registers are renamed
+//! to frame slots ([`regalloc`](super::regalloc): a frame holds the live
+//! maximum of rows, not one per virtual register).
 
 use std::collections::HashMap;
 
-use crate::ptx::ir::{ArithOp, FloatMode, Inst, InstClass, Kind, Program, RegId, Rounding, Src};
+use crate::ptx::ir::{
+    Address, ArithOp, Cmp, Dst, FloatMode, Inst, InstClass, Kind, MemSpace, PRED_FALSE, PRED_TRUE, PredId, PredSrc,
+    Program, RegId, Rounding, Src,
+};
 use crate::ptx::types::Ty;
 
 use super::alu;
@@ -25,18 +31,166 @@ pub type Lanes = [u64; 32];
 /// `f(a, b, c, out)` writes every lane of `out`.
 pub type LaneFn = fn(&Lanes, &Lanes, &Lanes, &mut Lanes);
 
-/// One decoded instruction (16 bytes: guarded by a test).
+/// A source operand of a compact instruction: a frame slot (below
+/// [`CONST`]), or row `o - CONST` of the function's constant table
+/// ([`FnCode::consts`]: an immediate broadcast to 32 lanes, so that reading
+/// it borrows a row as reading a register does).
+pub type Opnd = u16;
+
+/// The first constant operand.
+pub const CONST: Opnd = 0x8000;
+
+/// A destination of a compact instruction: a frame slot ([`Dest::SINK`]
+/// discards the value) and the register's width in bits (results are
+/// truncated to it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Dest {
+    /// Frame slot.
+    pub slot: u16,
+    /// Declared width.
+    pub bits: u8,
+}
+
+impl Dest {
+    /// The `_` sink.
+    pub const SINK: u16 = u16::MAX;
+
+    /// All-ones in the register's width.
+    #[inline(always)]
+    pub fn mask(self) -> u64 {
+        width_mask(self.bits)
+    }
+
+    /// The compact form of `d`, when its mask is a width's.
+    fn of(d: Dst) -> Option<Dest> {
+        let bits = (64 - d.mask.leading_zeros()) as u8;
+        if width_mask(bits) != d.mask {
+            return None;
+        }
+        let slot = if d.reg == Dst::SINK { Dest::SINK } else { Some(d.reg).filter(|&s| s < CONST)? };
+        Some(Dest { slot, bits })
+    }
+}
+
+#[inline(always)]
+fn width_mask(bits: u8) -> u64 {
+    if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 }
+}
+
+/// What an instruction does, with operands resolved (24 bytes).
+#[derive(Debug, Clone, Copy)]
+pub enum Exec {
+    /// Interpreted from the IR instruction ([`FnCode::insts`]).
+    Ir,
+    /// An `add`/`sub` contracted with a `mul` that no lane function
+    /// covers: interpreted from [`FnCode::fused`].
+    Fused,
+    /// `d = f(a, b, c)`: arithmetic, and `add`/`sub` contracted with a `mul`
+    /// (an FMA with the signs folded in). `c` is `a` when `f` does not read it.
+    Lanes {
+        /// The 32-lane function.
+        f: LaneFn,
+        /// Destination.
+        d: Dest,
+        /// Sources.
+        a: Opnd,
+        /// Sources.
+        b: Opnd,
+        /// Sources.
+        c: Opnd,
+    },
+    /// `mov d, a`.
+    Mov {
+        /// Destination.
+        d: Dest,
+        /// Source.
+        a: Opnd,
+    },
+    /// `selp d, a, b, p`.
+    Selp {
+        /// Destination.
+        d: Dest,
+        /// Where `p` holds.
+        a: Opnd,
+        /// Where it does not.
+        b: Opnd,
+        /// The selector.
+        p: PredSrc,
+    },
+    /// `setp.cmp.ty p|q, a, b` (no combining predicate, not a half pair);
+    /// `q` is [`PRED_FALSE`] (never written) when absent.
+    Setp {
+        /// Comparison.
+        cmp: Cmp,
+        /// Operand type.
+        ty: Ty,
+        /// `.ftz`.
+        ftz: bool,
+        /// Where the comparison goes.
+        p: PredId,
+        /// Where its negation goes.
+        q: PredId,
+        /// Sources.
+        a: Opnd,
+        /// Sources.
+        b: Opnd,
+    },
+    /// `bra target`.
+    Bra {
+        /// Instruction index.
+        target: u32,
+    },
+    /// `ld.space.ty {ds}, [base + offset]`: `n` elements, into destinations
+    /// of one width.
+    Ld {
+        /// Space as written.
+        space: MemSpace,
+        /// Element type.
+        ty: Ty,
+        /// Elements (1, 2 or 4).
+        n: u8,
+        /// `.nc`.
+        nc: bool,
+        /// 64-bit base.
+        wide: bool,
+        /// Width of the destinations.
+        bits: u8,
+        /// Address base.
+        base: Opnd,
+        /// Byte offset.
+        offset: i32,
+        /// Destination slots ([`Dest::SINK`] discards).
+        ds: [u16; 4],
+    },
+    /// `st.space.ty [base + offset], {vals}`.
+    St {
+        /// Space as written.
+        space: MemSpace,
+        /// Element type.
+        ty: Ty,
+        /// Elements (1, 2 or 4).
+        n: u8,
+        /// 64-bit base.
+        wide: bool,
+        /// Address base.
+        base: Opnd,
+        /// Byte offset.
+        offset: i32,
+        /// Values.
+        vals: [Opnd; 4],
+    },
+}
+
+/// One decoded instruction (32 bytes: guarded by a test).
 #[derive(Debug, Clone, Copy)]
 pub struct Op {
-    /// For arithmetic: the resolved 32-lane function; `None`: interpreted
-    /// from the IR instruction.
-    pub lanes: Option<LaneFn>,
-    /// Whether `lanes` reads operand `c`.
-    pub reads_c: bool,
+    /// What it does.
+    pub exec: Exec,
+    /// Its guard; an unguarded instruction has the always-true predicate
+    /// ([`PRED_TRUE`]), so the executor evaluates every guard alike.
+    pub guard: PredSrc,
     /// Its class, for the class counters.
     pub class: InstClass,
-    /// An `add`/`sub` that executes fused with a `mul` ([`FnCode::fused`]).
-    pub fused: bool,
 }
 
 /// A function's decoded instructions, parallel to its IR instructions.
@@ -45,8 +199,11 @@ pub struct FnCode {
     /// One per instruction.
     pub ops: Vec<Op>,
     /// The IR instructions with every data register renamed to its frame
-    /// slot ([`FnCode::alloc`]): what the executor reads operands from.
+    /// slot ([`FnCode::alloc`]): what the executor interprets [`Exec::Ir`]
+    /// instructions from.
     pub insts: Vec<Inst>,
+    /// The constants compact instructions read ([`Opnd`]).
+    pub consts: Vec<Lanes>,
     /// The `add`/`sub` instructions ptxas would contract with a `mul`, by
     /// index ([`contract`]), operands renamed to slots; empty when
     /// contraction is off.
@@ -66,6 +223,34 @@ impl FnCode {
     #[inline]
     pub fn slot(&self, r: RegId) -> usize {
         self.alloc.slot[r as usize] as usize
+    }
+}
+
+/// Builds a function's constant table while its instructions are compacted.
+#[derive(Default)]
+struct Consts {
+    rows: Vec<Lanes>,
+    index: HashMap<u64, Opnd>,
+}
+
+impl Consts {
+    /// The compact operand of `s` (renamed): a slot or a constant row;
+    /// `None` for special registers and addresses of variables, which are
+    /// interpreted.
+    fn opnd(&mut self, s: Src) -> Option<Opnd> {
+        match s {
+            Src::Reg(r) => Some(r).filter(|&r| r < CONST),
+            Src::Imm(v) => {
+                if let Some(&o) = self.index.get(&v) {
+                    return Some(o);
+                }
+                let o = CONST.checked_add(u16::try_from(self.rows.len()).ok().filter(|&n| n < 0x7FFF)?)?;
+                self.rows.push([v; 32]);
+                self.index.insert(v, o);
+                Some(o)
+            }
+            _ => None,
+        }
     }
 }
 
@@ -123,30 +308,104 @@ impl Code {
                     rename(&mut fz.b);
                     rename(&mut fz.c);
                 }
-                let ops = f
-                    .insts
+                let mut consts = Consts::default();
+                let ops = insts
                     .iter()
                     .zip(&f.info)
                     .enumerate()
                     .map(|(k, (i, info))| {
-                        let is_fused = fused.contains_key(&(k as u32));
-                        let r = match i.kind {
-                            Kind::Arith { op, ty, mode, .. } if !is_fused => resolve_arith(op, ty, mode, opts.sfu),
-                            _ => None,
-                        };
-                        Op {
-                            lanes: r.map(|r| r.0),
-                            reads_c: r.is_some_and(|r| r.1),
-                            class: info.class,
-                            fused: is_fused,
-                        }
+                        let fz = fused.get(&(k as u32));
+                        let exec = compact_form(i, fz, opts.sfu, &mut consts).unwrap_or(if fz.is_some() {
+                            Exec::Fused
+                        } else {
+                            Exec::Ir
+                        });
+                        let guard = i.guard.unwrap_or(PredSrc { reg: PRED_TRUE, neg: false });
+                        Op { exec, guard, class: info.class }
                     })
                     .collect();
-                FnCode { ops, insts, fused, alloc }
+                let consts = consts.rows;
+                FnCode { ops, insts, consts, fused, alloc }
             })
             .collect();
         Code { funcs }
     }
+}
+
+/// The compact form of instruction `i` (registers renamed; `fz`: its
+/// contraction with a `mul`, if any), or `None` when it is interpreted.
+fn compact_form(i: &Inst, fz: Option<&Fused>, sfu: SfuModel, consts: &mut Consts) -> Option<Exec> {
+    Some(match &i.kind {
+        Kind::Arith { ty, mode, d, .. } if fz.is_some() => {
+            let fz = fz.expect("fused");
+            // fma(±a, b, ±c) with the add's modifiers: a lane function for
+            // the IEEE default on f32 (`arith::fused` computes the rest)
+            if *ty != Ty::F32 || mode.ftz || mode.sat {
+                return None;
+            }
+            let f: LaneFn = match (fz.neg_product, fz.neg_c) {
+                (false, false) => ffma,
+                (true, false) => ffma_neg_ab,
+                (false, true) => ffma_neg_c,
+                (true, true) => ffma_neg_ab_c,
+            };
+            Exec::Lanes { f, d: Dest::of(*d)?, a: consts.opnd(fz.a)?, b: consts.opnd(fz.b)?, c: consts.opnd(fz.c)? }
+        }
+        Kind::Arith { op, ty, mode, d, a, b, c } => {
+            let (f, reads_c) = resolve_arith(*op, *ty, *mode, sfu)?;
+            let (d, a, b) = (Dest::of(*d)?, consts.opnd(*a)?, consts.opnd(*b)?);
+            Exec::Lanes { f, d, a, b, c: if reads_c { consts.opnd(*c)? } else { a } }
+        }
+        Kind::Mov { d, a } => Exec::Mov { d: Dest::of(*d)?, a: consts.opnd(*a)? },
+        Kind::Selp { d, a, b, p } => Exec::Selp { d: Dest::of(*d)?, a: consts.opnd(*a)?, b: consts.opnd(*b)?, p: *p },
+        Kind::Setp { cmp, ty, p, q, a, b, comb: None, ftz } if !matches!(ty, Ty::F16x2 | Ty::BF16x2) => Exec::Setp {
+            cmp: *cmp,
+            ty: *ty,
+            ftz: *ftz,
+            p: *p,
+            q: q.unwrap_or(PRED_FALSE),
+            a: consts.opnd(*a)?,
+            b: consts.opnd(*b)?,
+        },
+        Kind::Bra { target, .. } => Exec::Bra { target: *target },
+        Kind::Ld { space, ty, ds, addr, nc, .. } if matches!(ds.len(), 1 | 2 | 4) => {
+            let (base, offset) = address(addr, consts)?;
+            let d0 = Dest::of(ds[0])?;
+            let mut slots = [Dest::SINK; 4];
+            for (s, d) in slots.iter_mut().zip(ds) {
+                let d = Dest::of(*d)?;
+                if d.bits != d0.bits {
+                    return None;
+                }
+                *s = d.slot;
+            }
+            Exec::Ld {
+                space: *space,
+                ty: *ty,
+                n: ds.len() as u8,
+                nc: *nc,
+                wide: addr.wide,
+                bits: d0.bits,
+                base,
+                offset,
+                ds: slots,
+            }
+        }
+        Kind::St { space, ty, vals, addr, .. } if matches!(vals.len(), 1 | 2 | 4) => {
+            let (base, offset) = address(addr, consts)?;
+            let mut vs = [0; 4];
+            for (o, v) in vs.iter_mut().zip(vals) {
+                *o = consts.opnd(*v)?;
+            }
+            Exec::St { space: *space, ty: *ty, n: vals.len() as u8, wide: addr.wide, base, offset, vals: vs }
+        }
+        _ => return None,
+    })
+}
+
+/// An address's base operand and its offset, when the offset fits 32 bits.
+fn address(a: &Address, consts: &mut Consts) -> Option<(Opnd, i32)> {
+    Some((consts.opnd(a.base)?, i32::try_from(a.offset).ok()?))
 }
 
 #[inline(always)]
@@ -247,6 +506,12 @@ lanefn2!(fabs, |x, _y| canon32(f32of(x).abs()));
 lanefn2!(frcp, |x, _y| canon32(1.0 / f32of(x)));
 lanefn2!(fsqrt, |x, _y| canon32(f32of(x).sqrt()));
 lanefn3!(ffma, |x, y, z| canon32(f32of(x).mul_add(f32of(y), f32of(z))));
+// an `add`/`sub` contracted with a `mul`: fma with the product's and the
+// addend's signs flipped as `arith::fused` flips them
+const SIGN32: u64 = 1 << 31;
+lanefn3!(ffma_neg_ab, |x, y, z| canon32(f32of(x ^ SIGN32).mul_add(f32of(y), f32of(z))));
+lanefn3!(ffma_neg_c, |x, y, z| canon32(f32of(x).mul_add(f32of(y), f32of(z ^ SIGN32))));
+lanefn3!(ffma_neg_ab_c, |x, y, z| canon32(f32of(x ^ SIGN32).mul_add(f32of(y), f32of(z ^ SIGN32))));
 lanefn2!(mufu_rcp, |x, _y| sfu::rcp(x as u32, false) as u64);
 lanefn2!(mufu_rcp_ftz, |x, _y| sfu::rcp(x as u32, true) as u64);
 lanefn2!(mufu_rsq, |x, _y| sfu::rsq(x as u32, false, false) as u64);
@@ -337,8 +602,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_decoded_instruction_is_16_bytes() {
-        assert_eq!(std::mem::size_of::<Op>(), 16);
+    fn a_decoded_instruction_is_32_bytes() {
+        assert_eq!(std::mem::size_of::<Exec>(), 24);
+        assert_eq!(std::mem::size_of::<Op>(), 32);
     }
 
     /// Every resolved function computes what `alu::arith` computes, on
@@ -428,5 +694,119 @@ mod tests {
             }
         }
         assert!(resolved > 40, "only {resolved} forms resolved");
+    }
+
+    /// The lane functions of an `add`/`sub` contracted with a `mul` compute
+    /// what the interpreted contraction (`arith::fused`) computes: the f32
+    /// fma of `alu::arith` with the product's and the addend's signs flipped.
+    #[test]
+    fn contracted_lane_functions_agree_with_the_fma_semantics() {
+        let f = |x: f32| x.to_bits() as u64;
+        let vals = [
+            f(1.5),
+            f(-2.25),
+            f(0.0),
+            f(-0.0),
+            f(f32::NAN),
+            f(f32::INFINITY),
+            f(f32::NEG_INFINITY),
+            f(1e-40),
+            f(3.0e38),
+            f(1.0 / 3.0),
+            f(-7.0),
+        ];
+        let sign = 1u64 << 31;
+        let forms: [(LaneFn, bool, bool); 4] =
+            [(ffma, false, false), (ffma_neg_ab, true, false), (ffma_neg_c, false, true), (ffma_neg_ab_c, true, true)];
+        for (func, na, nc) in forms {
+            for (i, &x) in vals.iter().enumerate() {
+                let a: Lanes = [x; 32];
+                let b: Lanes = std::array::from_fn(|l| vals[l % vals.len()]);
+                let c: Lanes = std::array::from_fn(|l| vals[(l * 3 + i) % vals.len()]);
+                let mut out = [0; 32];
+                func(&a, &b, &c, &mut out);
+                for l in 0..32 {
+                    let (x, z) = (a[l] ^ if na { sign } else { 0 }, c[l] ^ if nc { sign } else { 0 });
+                    let want = alu::arith(ArithOp::Mad, Ty::F32, FloatMode::default(), x, b[l], z);
+                    assert_eq!(out[l], want, "neg_ab={na} neg_c={nc} a={:#x} b={:#x} c={:#x}", a[l], b[l], c[l]);
+                }
+            }
+        }
+    }
+
+    fn decode_body(body: &str) -> (Program, Code) {
+        let src = format!(
+            ".version 7.8\n.target sm_90\n.address_size 64\n.entry k(.param .u64 out)\n{{\n.reg .pred %p<3>;\n.reg .b32 %r<8>;\n.reg .f32 %f<8>;\n.reg .b64 %rd<4>;\n{body}\n}}\n"
+        );
+        let p = crate::ptx::load(&src, "t.ptx").unwrap();
+        let code = Code::decode(&p, FloatOptions::default());
+        (p, code)
+    }
+
+    /// The frequent forms get compact instructions with operands resolved to
+    /// frame slots and constant rows; the others stay interpreted.
+    #[test]
+    fn frequent_forms_are_compact_with_resolved_operands() {
+        let (_, code) = decode_body(
+            "ld.param.u64 %rd1, [out];\n\
+             cvta.to.global.u64 %rd2, %rd1;\n\
+             mov.u32 %r1, %tid.x;\n\
+             mul.wide.u32 %rd3, %r1, 4;\n\
+             add.s64 %rd2, %rd2, %rd3;\n\
+             ld.global.f32 %f1, [%rd2+8];\n\
+             add.rn.f32 %f2, %f1, 0f3F800000;\n\
+             setp.lt.f32 %p1, %f2, %f1;\n\
+             selp.f32 %f3, %f2, %f1, %p1;\n\
+             @%p1 bra DONE;\n\
+             mov.f32 %f3, 0f40000000;\n\
+             DONE:\n\
+             st.global.f32 [%rd2], %f3;\n\
+             ret;",
+        );
+        let fc = &code.funcs[0];
+        let ops = &fc.ops;
+        assert!(matches!(ops[0].exec, Exec::Ld { space: MemSpace::KernelParam, n: 1, .. }));
+        assert!(matches!(ops[1].exec, Exec::Ir), "cvta is interpreted");
+        assert!(matches!(ops[2].exec, Exec::Ir), "a special-register source is interpreted");
+        let Exec::Lanes { b, .. } = ops[3].exec else { panic!("mul.wide: {:?}", ops[3].exec) };
+        assert!(b >= CONST && fc.consts[(b - CONST) as usize] == [4; 32], "the immediate is a constant row");
+        let Exec::Ld { space: MemSpace::Global, offset: 8, wide: true, bits: 32, n: 1, .. } = ops[5].exec else {
+            panic!("ld: {:?}", ops[5].exec)
+        };
+        let Exec::Lanes { d, a, b, c, .. } = ops[6].exec else { panic!("add.rn.f32: {:?}", ops[6].exec) };
+        assert!(d.slot < CONST && a < CONST && b >= CONST && c == a && d.bits == 32);
+        assert_eq!(fc.consts[(b - CONST) as usize], [0x3F80_0000; 32]);
+        assert!(matches!(ops[7].exec, Exec::Setp { q: PRED_FALSE, .. }));
+        assert!(matches!(ops[8].exec, Exec::Selp { .. }));
+        assert!(matches!(ops[9].exec, Exec::Bra { target: 11 }));
+        assert!(ops[9].guard.reg > PRED_TRUE && !ops[9].guard.neg);
+        assert_eq!(ops[8].guard, PredSrc { reg: PRED_TRUE, neg: false }, "unguarded: always true");
+        assert!(matches!(ops[10].exec, Exec::Mov { .. }));
+        assert!(matches!(ops[11].exec, Exec::St { space: MemSpace::Global, n: 1, .. }));
+        assert!(matches!(ops[12].exec, Exec::Ir));
+        // one row per distinct immediate
+        let (_, code) = decode_body("mov.u32 %r1, 5;\nadd.s32 %r2, %r1, 5;\nadd.s32 %r3, %r2, 6;\nret;");
+        assert_eq!(code.funcs[0].consts.len(), 2);
+    }
+
+    /// A `mul` feeding an `add` (contraction on) executes as one fma lane
+    /// function with the signs folded in.
+    #[test]
+    fn a_contracted_add_is_a_compact_fma() {
+        let (_, code) = decode_body(
+            "ld.param.u64 %rd1, [out];\n\
+             ld.global.f32 %f1, [%rd1];\n\
+             ld.global.f32 %f2, [%rd1+4];\n\
+             mul.f32 %f3, %f1, %f2;\n\
+             sub.f32 %f4, %f1, %f3;\n\
+             st.global.f32 [%rd1], %f4;\n\
+             ret;",
+        );
+        let Exec::Lanes { f, .. } = code.funcs[0].ops[4].exec else { panic!("{:?}", code.funcs[0].ops[4].exec) };
+        // fma(-2, 3, 1) = -5; the other sign foldings give 7, 5 and -7
+        let (a, b, c) = ([2f32.to_bits() as u64; 32], [3f32.to_bits() as u64; 32], [1f32.to_bits() as u64; 32]);
+        let mut out = [0; 32];
+        f(&a, &b, &c, &mut out);
+        assert_eq!(out, [(-5f32).to_bits() as u64; 32], "c - a*b is fma(-a, b, c)");
     }
 }

@@ -2,9 +2,8 @@
 //! predicate logic, and the lane exchanges `vote` and `shfl`.
 
 use super::super::contract::Fused;
-use super::super::decode::LaneFn;
 use super::super::warp::Warp;
-use super::{CtaMut, Ctx, Lanes, combine, map1, map3, operand, pred_bits, read, set_pred, write};
+use super::{CtaMut, Ctx, Lanes, combine, lane_masks, map1, map3, operand, pred_bits, read, select, set_pred, write};
 use crate::ptx::ir::{
     ArithOp, BoolOp, CarryOp, Dst, FloatMode, Kind, PredId, PredSrc, ReduxOp, RegId, ShflMode, Src, VoteMode,
 };
@@ -39,34 +38,6 @@ pub(super) fn unpack(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, ds: &[Dst], a: Src, 
         let part = map1(&v, |x| (x >> (k as u32 * part_bits)) & pm);
         write(fr, *d, &part, exec);
     }
-}
-
-/// Arithmetic whose 32-lane function was resolved when the module was decoded.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub(super) fn resolved(
-    ctx: &Ctx,
-    w: &mut Warp,
-    cta: &CtaMut,
-    f: LaneFn,
-    reads_c: bool,
-    d: Dst,
-    a: Src,
-    b: Src,
-    c: Src,
-    exec: u32,
-) {
-    let mut r = [0u64; 32];
-    {
-        let (va, vb) = (operand(ctx, w, cta, a), operand(ctx, w, cta, b));
-        if reads_c {
-            let vc = operand(ctx, w, cta, c);
-            f(&va, &vb, &vc, &mut r);
-        } else {
-            f(&va, &vb, &va, &mut r);
-        }
-    }
-    write(w.frames.last_mut().expect("frame"), d, &r, exec);
 }
 
 /// Arithmetic evaluated lane by lane (`alu::arith`): the forms that
@@ -212,13 +183,7 @@ pub(super) fn selp(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, d: Dst, a: Src, b: Src
         let (oa, ob) = (operand(ctx, w, cta, a), operand(ctx, w, cta, b));
         // the lanes borrowed once, so that the loop is over two plain arrays
         let (va, vb): (&Lanes, &Lanes) = (&oa, &ob);
-        let pv = pred_bits(w.frame(), p);
-        for l in 0..32 {
-            // branch-free: the predicate bit as an all-ones or all-zeros mask
-            let m = ((pv >> l) & 1) as u64;
-            let m = m.wrapping_neg();
-            r[l] = (va[l] & m) | (vb[l] & !m);
-        }
+        select(&lane_masks(pred_bits(w.frame(), p)), va, vb, &mut r);
     }
     write(w.frames.last_mut().expect("frame"), d, &r, exec);
 }

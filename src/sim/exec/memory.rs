@@ -100,6 +100,13 @@ fn bytes_store(buf: &mut [u8], off: u64, size: u32, v: u64) -> Option<()> {
     Some(())
 }
 
+/// Whether `addr` is a multiple of `size`: a mask test for the sizes
+/// accesses have (powers of two), not a division.
+#[inline(always)]
+fn aligned(addr: u64, size: u32) -> bool {
+    if size.is_power_of_two() { addr & (size as u64 - 1) == 0 } else { addr.is_multiple_of(size as u64) }
+}
+
 /// One lane's access. `store = Some(v)` writes; returns the loaded value otherwise.
 #[allow(clippy::too_many_arguments)]
 #[inline]
@@ -115,7 +122,7 @@ pub(super) fn access(
 ) -> Result<u64, Box<ExecFault>> {
     let a = r.addr();
     let oob = || fault(FaultKind::OutOfBounds { space: r.space(), addr: a, size }, Some(lane));
-    if !a.is_multiple_of(align as u64) {
+    if !aligned(a, align) {
         return Err(fault(FaultKind::Misaligned { space: r.space(), addr: a, size: align }, Some(lane)));
     }
     match r {
@@ -280,7 +287,7 @@ fn vector_access(
             for (k, v) in vals.iter_mut().enumerate() {
                 let ak = a.wrapping_add((k as u32 * size) as u64);
                 let oob = || fault(FaultKind::OutOfBounds { space: MemSpace::Global, addr: ak, size }, Some(l));
-                if !ak.is_multiple_of(size as u64) {
+                if !aligned(ak, size) {
                     return Err(fault(FaultKind::Misaligned { space: MemSpace::Global, addr: ak, size }, Some(l)));
                 }
                 let (al, off) = find_global(ctx, &mut last, ak, size).ok_or_else(oob)?;
@@ -315,7 +322,7 @@ fn vector_access(
 
 /// Vector accesses must be aligned to their whole size.
 fn check_vector_align(r: Resolved, lane: usize, total: u32) -> Result<(), Box<ExecFault>> {
-    if !r.addr().is_multiple_of(total as u64) {
+    if !aligned(r.addr(), total) {
         return Err(fault(FaultKind::Misaligned { space: r.space(), addr: r.addr(), size: total }, Some(lane)));
     }
     Ok(())
@@ -357,7 +364,6 @@ pub(super) fn load(
     exec: u32,
 ) -> Result<(), Box<ExecFault>> {
     let addrs = addresses(ctx, w, cta, addr);
-    let mut touched = Touched::new();
     // a scalar load needs one lane array, not four
     let mut one = [[0u64; 32]; 1];
     let mut four;
@@ -367,15 +373,35 @@ pub(super) fn load(
         four = [[0u64; 32]; 4];
         &mut four[..ds.len()]
     };
-    let first = vector_access(ctx, w, cta.shared, space, ty, &addrs, exec, vals, false, &mut touched)?;
-    if let Some(r) = first {
-        count_space(&mut cta.counters.loads, r);
-    }
-    emit(cta, w, func, pc, MemOp::Load, nc, ty.bytes(), ds.len() as u32, &touched);
+    load_into(ctx, w, cta, (func, pc), space, ty, &addrs, nc, exec, vals)?;
     let fr = w.frames.last_mut().expect("frame");
     for (v, d) in vals.iter().zip(ds) {
         write(fr, *d, v, exec);
     }
+    Ok(())
+}
+
+/// Loads `vals.len()` elements of `ty` per active lane at `addrs` into
+/// `vals`, counts the instruction and tells the observer.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn load_into(
+    ctx: &Ctx,
+    w: &mut Warp,
+    cta: &mut CtaMut,
+    (func, pc): (u32, u32),
+    space: MemSpace,
+    ty: Ty,
+    addrs: &Lanes,
+    nc: bool,
+    exec: u32,
+    vals: &mut [Lanes],
+) -> Result<(), Box<ExecFault>> {
+    let mut touched = Touched::new();
+    let first = vector_access(ctx, w, cta.shared, space, ty, addrs, exec, vals, false, &mut touched)?;
+    if let Some(r) = first {
+        count_space(&mut cta.counters.loads, r);
+    }
+    emit(cta, w, func, pc, MemOp::Load, nc, ty.bytes(), vals.len() as u32, &touched);
     Ok(())
 }
 
@@ -397,13 +423,29 @@ pub(super) fn store(
     for (k, v) in srcs.iter().enumerate() {
         vs[k] = read(ctx, w, cta, *v);
     }
+    store_from(ctx, w, cta, (func, pc), space, ty, &addrs, exec, &mut vs[..srcs.len()])
+}
+
+/// Stores `vals.len()` elements of `ty` per active lane at `addrs`, counts
+/// the instruction and tells the observer.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn store_from(
+    ctx: &Ctx,
+    w: &mut Warp,
+    cta: &mut CtaMut,
+    (func, pc): (u32, u32),
+    space: MemSpace,
+    ty: Ty,
+    addrs: &Lanes,
+    exec: u32,
+    vals: &mut [Lanes],
+) -> Result<(), Box<ExecFault>> {
     let mut touched = Touched::new();
-    let vals = &mut vs[..srcs.len()];
-    let first = vector_access(ctx, w, cta.shared, space, ty, &addrs, exec, vals, true, &mut touched)?;
+    let first = vector_access(ctx, w, cta.shared, space, ty, addrs, exec, vals, true, &mut touched)?;
     if let Some(r) = first {
         count_space(&mut cta.counters.stores, r);
     }
-    emit(cta, w, func, pc, MemOp::Store, false, ty.bytes(), srcs.len() as u32, &touched);
+    emit(cta, w, func, pc, MemOp::Store, false, ty.bytes(), vals.len() as u32, &touched);
     Ok(())
 }
 

@@ -19,7 +19,7 @@ pub use call::call_chain;
 
 use super::cfg::Cfg;
 use super::counters::{Counters, InstProfile};
-use super::decode::Code;
+use super::decode::{CONST, Code, Dest, Exec, Opnd};
 use super::fault::FaultKind;
 use super::memory::DeviceMemory;
 use super::observer::{MemObserver, ObserverFactory};
@@ -121,17 +121,85 @@ fn write(frame: &mut Frame, d: Dst, v: &Lanes, mask: u32) {
     if d.reg == Dst::SINK {
         return;
     }
-    let r = &mut frame.regs[d.reg as usize];
-    if mask == u32::MAX {
+    store_row(&mut frame.regs[d.reg as usize], d.mask, v, mask);
+}
+
+/// All-ones or all-zeros lane masks of four lanes, for each 4-bit group of
+/// a lane bitmask.
+static NIBBLE_MASKS: [[u64; 4]; 16] = {
+    let mut t = [[0u64; 4]; 16];
+    let mut n = 0;
+    while n < 16 {
+        let mut l = 0;
+        while l < 4 {
+            if n >> l & 1 != 0 {
+                t[n][l] = u64::MAX;
+            }
+            l += 1;
+        }
+        n += 1;
+    }
+    t
+};
+
+/// Lane `l` all ones where bit `l` of `bits` is set, else zero: selecting by
+/// a lane bitmask through it is branch-free and vectorises (a loop testing
+/// each bit compiles to a branch per lane, mispredicted when warps diverge).
+#[inline(always)]
+fn lane_masks(bits: u32) -> Lanes {
+    let mut m = [0u64; 32];
+    for k in 0..8 {
+        m[k * 4..k * 4 + 4].copy_from_slice(&NIBBLE_MASKS[(bits >> (4 * k) & 0xF) as usize]);
+    }
+    m
+}
+
+/// `a` where the lane's mask is set, else `b`.
+#[inline(always)]
+fn select(m: &Lanes, a: &Lanes, b: &Lanes, out: &mut Lanes) {
+    for l in 0..32 {
+        out[l] = (a[l] & m[l]) | (b[l] & !m[l]);
+    }
+}
+
+/// Writes `v & width` into the lanes of `row` that `exec` names.
+#[inline(always)]
+fn store_row(row: &mut Lanes, width: u64, v: &Lanes, exec: u32) {
+    if exec == u32::MAX {
         for l in 0..32 {
-            r[l] = v[l] & d.mask;
+            row[l] = v[l] & width;
         }
     } else {
+        let e = lane_masks(exec);
         for l in 0..32 {
-            if mask >> l & 1 != 0 {
-                r[l] = v[l] & d.mask;
-            }
+            row[l] = (v[l] & width & e[l]) | (row[l] & !e[l]);
         }
+    }
+}
+
+/// Writes a compact instruction's result.
+#[inline(always)]
+fn put(regs: &mut [Lanes], d: Dest, v: &Lanes, exec: u32) {
+    if d.slot != Dest::SINK {
+        store_row(&mut regs[d.slot as usize], d.mask(), v, exec);
+    }
+}
+
+/// A compact instruction's operand: a register row or a constant row.
+#[inline(always)]
+fn opnd<'a>(regs: &'a [Lanes], consts: &'a [Lanes], o: Opnd) -> &'a Lanes {
+    if o < CONST { &regs[o as usize] } else { &consts[(o - CONST) as usize] }
+}
+
+/// A compact memory instruction's addresses: base plus offset (32-bit bases
+/// wrap, then zero-extend).
+#[inline(always)]
+fn compact_addresses(regs: &[Lanes], consts: &[Lanes], base: Opnd, offset: i32, wide: bool) -> Lanes {
+    let b = opnd(regs, consts, base);
+    if wide {
+        map1(b, |x| x.wrapping_add(offset as i64 as u64))
+    } else {
+        map1(b, |x| (x as u32).wrapping_add(offset as u32) as u64)
     }
 }
 
@@ -262,16 +330,13 @@ fn advance(w: &mut Warp, pc: u32) {
 fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, Box<ExecFault>> {
     let pc = top.pc;
     let code = &ctx.code.funcs[func as usize];
-    // operands in frame slots (`FnCode::insts`), not the IR's register numbers
-    let (Some(inst), Some(op)) = (code.insts.get(pc as usize), code.ops.get(pc as usize)) else {
+    let Some(op) = code.ops.get(pc as usize) else {
         let name = &ctx.prog.functions[func as usize].name;
         return Err(fault(FaultKind::Unsupported(format!("execution ran past the end of `{name}`")), None));
     };
     let mask = top.mask;
-    let exec = match inst.guard {
-        None => mask,
-        Some(p) => mask & pred_bits(w.frame(), p),
-    };
+    // an unguarded instruction's guard is the always-true predicate
+    let exec = mask & pred_bits(w.frame(), op.guard);
     // counting
     let c = &mut *cta.counters;
     c.warp_instructions += 1;
@@ -285,6 +350,93 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         ic.pred_on += exec.count_ones() as u64;
     }
 
+    match op.exec {
+        // control transfers move the stack themselves (and run with no lane active too)
+        Exec::Bra { target } => return Ok(control::branch(ctx, w, cta, func, pc, target, exec)),
+        Exec::Ir => return exec_ir(ctx, w, cta, func, pc, &code.insts[pc as usize], exec),
+        _ => {}
+    }
+    advance(w, pc);
+    if exec == 0 {
+        // Predicated off for every lane: issued, no effect.
+        return Ok(Effect::Continue);
+    }
+    let consts = &code.consts[..];
+    match op.exec {
+        Exec::Lanes { f, d, a, b, c } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let mut r = [0u64; 32];
+            f(opnd(&fr.regs, consts, a), opnd(&fr.regs, consts, b), opnd(&fr.regs, consts, c), &mut r);
+            put(&mut fr.regs, d, &r, exec);
+        }
+        Exec::Mov { d, a } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let r = *opnd(&fr.regs, consts, a);
+            put(&mut fr.regs, d, &r, exec);
+        }
+        Exec::Selp { d, a, b, p } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let m = lane_masks(pred_bits(fr, p));
+            let mut r = [0u64; 32];
+            select(&m, opnd(&fr.regs, consts, a), opnd(&fr.regs, consts, b), &mut r);
+            put(&mut fr.regs, d, &r, exec);
+        }
+        Exec::Setp { cmp, ty, ftz, p, q, a, b } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let t = super::alu::compare_lanes(cmp, ty, ftz, opnd(&fr.regs, consts, a), opnd(&fr.regs, consts, b));
+            set_pred(fr, p, t, exec);
+            // `q` is PRED_FALSE, never written, when absent
+            set_pred(fr, q, !t, exec);
+        }
+        Exec::Fused => {
+            let (Kind::Arith { ty, mode, d, .. }, Some(fz)) = (&code.insts[pc as usize].kind, code.fused.get(&pc))
+            else {
+                unreachable!("a contracted instruction is an arithmetic one with its contraction")
+            };
+            arith::fused(ctx, w, cta, (*ty, *mode), *d, fz, exec);
+        }
+        Exec::Ld { space, ty, n, nc, wide, bits, base, offset, ds } => {
+            let addrs = compact_addresses(&w.frame().regs, consts, base, offset, wide);
+            // a scalar load needs one lane array, not four
+            let mut one = [[0u64; 32]; 1];
+            let mut four;
+            let vals: &mut [Lanes] = if n == 1 {
+                &mut one
+            } else {
+                four = [[0u64; 32]; 4];
+                &mut four[..n as usize]
+            };
+            memory::load_into(ctx, w, cta, (func, pc), space, ty, &addrs, nc, exec, vals)?;
+            let fr = w.frames.last_mut().expect("frame");
+            for (v, &slot) in vals.iter().zip(&ds) {
+                put(&mut fr.regs, Dest { slot, bits }, v, exec);
+            }
+        }
+        Exec::St { space, ty, n, wide, base, offset, vals } => {
+            let fr = w.frame();
+            let addrs = compact_addresses(&fr.regs, consts, base, offset, wide);
+            let mut vs = [[0u64; 32]; 4];
+            for (v, &o) in vs.iter_mut().zip(&vals[..n as usize]) {
+                *v = *opnd(&fr.regs, consts, o);
+            }
+            memory::store_from(ctx, w, cta, (func, pc), space, ty, &addrs, exec, &mut vs[..n as usize])?;
+        }
+        Exec::Bra { .. } | Exec::Ir => unreachable!("handled above"),
+    }
+    Ok(Effect::Continue)
+}
+
+/// Executes an instruction without a compact form, from its IR (registers
+/// renamed to frame slots), once counted.
+fn exec_ir(
+    ctx: &Ctx,
+    w: &mut Warp,
+    cta: &mut CtaMut,
+    func: u32,
+    pc: u32,
+    inst: &Inst,
+    exec: u32,
+) -> Result<Effect, Box<ExecFault>> {
     // Control transfers move the stack themselves (and run with no lane active too).
     match &inst.kind {
         Kind::Bra { target, .. } => return Ok(control::branch(ctx, w, cta, func, pc, *target, exec)),
@@ -313,19 +465,6 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
     advance(w, pc);
     if exec == 0 {
         // Predicated off for every lane: issued, no effect.
-        return Ok(Effect::Continue);
-    }
-
-    if op.fused
-        && let Kind::Arith { ty, mode, d, .. } = inst.kind
-        && let Some(fz) = code.fused.get(&pc)
-    {
-        arith::fused(ctx, w, cta, (ty, mode), d, fz, exec);
-        return Ok(Effect::Continue);
-    }
-
-    if let (Some(lanes), Kind::Arith { d, a, b, c, .. }) = (op.lanes, &inst.kind) {
-        arith::resolved(ctx, w, cta, lanes, op.reads_c, *d, *a, *b, *c, exec);
         return Ok(Effect::Continue);
     }
 
