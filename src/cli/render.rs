@@ -258,8 +258,7 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         Some(v) => {
             let mut config = rt_kernels::sim_config(&cam);
             config.fidelity = a.fidelity;
-            config.fmad = crate::sim::contract::for_profile(profile, a.fmad);
-            config.sfu = crate::sim::sfu::SfuModel::for_profile(profile);
+            profile.configure(&mut config, a.fmad);
             let mut dev = Device::with_config(config);
             let module = rt_kernels::load(&mut dev)?;
             let pb = pixel_progress(&mut dev, v.kernel(), width as u64 * height as u64);

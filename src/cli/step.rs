@@ -88,9 +88,10 @@ pub fn run(a: StepArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut session = Session::load_launch(&crate::host::scene_file::data_file(&a.spec), a.launch)?;
     session.max_instructions = a.max_instructions;
     session.random_seed = a.checks.random_seed();
-    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
-    let only = a.warp.as_deref().map(parse_warp).transpose()?;
     let profile = profile(&session, a.device.as_deref())?;
+    session.device = Some(profile);
+    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions, profile)?;
+    let only = a.warp.as_deref().map(parse_warp).transpose()?;
     let breaks = session.with_stepper(|st| Ok(Breakpoints::new(&st.module().prog, &a.breaks, &a.src_breaks)?))?;
     let interactive = !a.log && !a.trace && std::io::stdout().is_terminal() && std::io::stdin().is_terminal();
     if interactive {

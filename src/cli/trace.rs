@@ -62,7 +62,8 @@ pub fn run(a: TraceArgs) -> Result<(), Box<dyn std::error::Error>> {
     let profile = crate::cli::step::profile(&session, a.device.as_deref())?;
     session.max_instructions = a.max_instructions;
     session.random_seed = a.checks.random_seed();
-    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions)?;
+    session.device = Some(profile);
+    crate::check::cli::check_before_stepping(&session.spec, session.launch, &a.checks, a.max_instructions, profile)?;
     let o = TraceOptions { ctas: a.ctas, warps: a.warps, from: a.from, to: a.to, max_events: a.max_events, profile };
     let spinner = std::io::stderr().is_terminal().then(|| {
         let pb = indicatif::ProgressBar::new_spinner();

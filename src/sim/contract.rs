@@ -52,14 +52,6 @@ pub fn set_default(on: bool) {
     DEFAULT.store(on, Ordering::Relaxed)
 }
 
-/// Whether ptxas contracts for a GPU of `profile`: sm_50 and later (maxwell,
-/// hopper) have FFMA; GT200's FMAD truncates the product, which is not
-/// modelled, so the gt200 profile executes every instruction as written.
-/// `flag` (`--fmad`, the spec's `fmad`) decides when given.
-pub fn for_profile(profile: crate::model::Profile, flag: Option<bool>) -> bool {
-    flag.unwrap_or(profile != crate::model::Profile::Gt200)
-}
-
 /// An `add`/`sub` that executes as fma(±a, b, ±c).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Fused {
