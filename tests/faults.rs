@@ -179,6 +179,47 @@ fn recursion_past_the_local_limit_overflows() {
     assert!(matches!(f.kind, FaultKind::LocalStackOverflow { limit: 4096, .. }), "{f}");
 }
 
+/// `f(a) = a + 1` called through a function-pointer table with the call
+/// site's return declaration `RET` and prototype `PROTO`.
+const INDIRECT: &str = ".version 7.8\n.target sm_90\n.address_size 64\n\
+    .func (.param .b32 r) f(.param .b32 a)\n{\n.reg .b32 %r<3>;\nld.param.b32 %r1, [a];\nadd.s32 %r2, %r1, 1;\n\
+    st.param.b32 [r], %r2;\nret;\n}\n\
+    .global .align 8 .u64 tab[1] = {f};\n\
+    .visible .entry k(.param .u64 out)\n{\n.reg .b64 %rd<4>;\n.reg .b32 %r<2>;\n\
+    ld.param.u64 %rd2, [out];\ncvta.to.global.u64 %rd3, %rd2;\nmov.u64 %rd2, tab;\nld.global.u64 %rd1, [%rd2];\nmov.b32 %r1, 0;\n\
+    {\n.param .b32 param0;\nst.param.b32 [param0], 41;\nRET\nprototype_0 : .callprototype PROTO;\nCALL\n}\n\
+    st.global.b32 [%rd3], %r1;\nret;\n}\n";
+
+/// `out[0]` after the launch, or its error.
+fn indirect(ret: &str, proto: &str, call: &str) -> (Result<warplight::sim::LaunchStats, SimError>, u32) {
+    let src = INDIRECT.replace("RET", ret).replace("PROTO", proto).replace("CALL", call);
+    let mut dev = warplight::sim::Device::new();
+    let m = dev.load_ptx(&src, "indirect.ptx").unwrap_or_else(|e| panic!("{e}"));
+    let out = dev.alloc_zeroed::<u32>(1);
+    let r = dev.launch(&m, "k", LaunchConfig::linear(1, 1), &[Arg::Ptr(out)]);
+    (r, dev.read::<u32>(out, 1)[0])
+}
+
+/// An indirect call whose call site declares other return values than the
+/// called function returns (count or size) faults; copying back what fits
+/// left the rest of a 64-bit value unset, or nothing at all.
+#[test]
+fn indirect_calls_check_the_return_values() {
+    let call = "call (retval0), %rd1, (param0), prototype_0;\nld.param.b32 %r1, [retval0];";
+    let (ok, v) = indirect(".param .b32 retval0;", "(.param .b32 _) _ (.param .b32 _)", call);
+    ok.unwrap();
+    assert_eq!(v, 42);
+    let (wide, _) = indirect(".param .b64 retval0;", "(.param .b64 _) _ (.param .b32 _)", call);
+    let f = fault_of(wide);
+    assert_eq!(f.lane, Some(0));
+    let FaultKind::Unsupported(msg) = &f.kind else { panic!("{f}") };
+    assert!(msg.contains("expecting 1 return value(s) [8-byte]; it returns 1 [4-byte]"), "{msg}");
+    let (none, _) = indirect("", "_ (.param .b32 _)", "call %rd1, (param0), prototype_0;");
+    let f = fault_of(none);
+    let FaultKind::Unsupported(msg) = &f.kind else { panic!("{f}") };
+    assert!(msg.contains("`f` expecting 0 return value(s) []; it returns 1 [4-byte]"), "{msg}");
+}
+
 fn surface(elem_bytes: u32, dims: [u32; 3], row_pitch: u64, data: warplight::sim::DevicePtr) -> SurfaceDesc {
     SurfaceDesc { data, elem_bytes, dims, row_pitch }
 }
