@@ -163,7 +163,9 @@ const PARTIAL_DEFS: &str = ".version 7.8\n.target sm_90\n.address_size 64\n\
 /// condition code). Lanes 0..15 are worked by hand; all lanes agree.
 #[test]
 fn definitions_that_do_not_kill_keep_their_registers_live() {
-    let cases: [(&str, &str, fn(u32) -> u32); 4] = [
+    // (kernel, the definitions, the value of lane t)
+    type Case = (&'static str, &'static str, fn(u32) -> u32);
+    let cases: [Case; 4] = [
         ("guarded", "@%p1 mov.u32 %r4, 5;", |t| if t < 8 { 5 } else { 0 }),
         // lanes 0..15 hold t & 3: four each of 0, 1, 2, 3
         ("redux", "redux.sync.add.u32 %r4, %r2, %r5;", |t| if t < 16 { 24 } else { 0 }),
