@@ -30,7 +30,7 @@ struct Case {
 
 fn case(path: &'static str) -> Case {
     let spec = Spec::load(Path::new(path)).expect("spec");
-    let mut config = spec.sim_config(1, None);
+    let mut config = spec.sim_config(1, None, warplight::model::Profile::Hopper, None);
     if config.fidelity < Fidelity::Memory {
         config.fidelity = Fidelity::Memory;
     }

@@ -621,11 +621,22 @@ impl Spec {
         })
     }
 
-    /// The simulator settings for this spec: `threads` host threads, the
-    /// spec's limits, and `max_instructions` (a command-line flag) over the
-    /// spec's `max_instructions`.
-    pub fn sim_config(&self, threads: usize, max_instructions: Option<u64>) -> SimConfig {
+    /// The simulator settings for this spec on a GPU of `profile`: `threads`
+    /// host threads, the spec's limits, `max_instructions` (a command-line
+    /// flag) over the spec's `max_instructions`, and the device's arithmetic
+    /// ([`Profile::configure`]): FMA contraction from `fmad` (a command-line
+    /// flag) over the spec's `fmad` over the profile's default, and the
+    /// profile's SFU model. `launch`, `step`, `trace` and `--check` all run
+    /// on these settings.
+    pub fn sim_config(
+        &self,
+        threads: usize,
+        max_instructions: Option<u64>,
+        profile: Profile,
+        fmad: Option<bool>,
+    ) -> SimConfig {
         let mut c = SimConfig { threads, ..SimConfig::default() };
+        profile.configure(&mut c, fmad.or(self.fmad));
         if let Some(n) = max_instructions.or(self.max_instructions) {
             c.schedule.max_warp_instructions = n;
         }
@@ -960,15 +971,15 @@ init = [1, 2, 3]
         let base = "ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\n";
         let s = parse(base).unwrap();
         assert_eq!((s.max_instructions, s.max_call_depth), (None, None));
-        let c = s.sim_config(3, None);
+        let c = s.sim_config(3, None, Profile::Hopper, None);
         assert_eq!(c.threads, 3);
         assert_eq!(c.schedule.max_warp_instructions, crate::sim::device::DEFAULT_MAX_WARP_INSTRUCTIONS);
         assert_eq!(c.max_call_depth, crate::sim::device::DEFAULT_MAX_CALL_DEPTH);
-        assert_eq!(s.sim_config(0, Some(7)).schedule.max_warp_instructions, 7);
+        assert_eq!(s.sim_config(0, Some(7), Profile::Hopper, None).schedule.max_warp_instructions, 7);
         let s = parse(&format!("max_instructions = 1000\nmax_call_depth = 9\n{base}")).unwrap();
-        assert_eq!(s.sim_config(0, None).schedule.max_warp_instructions, 1000);
-        assert_eq!(s.sim_config(0, Some(7)).schedule.max_warp_instructions, 7);
-        assert_eq!(s.sim_config(0, None).max_call_depth, 9);
+        assert_eq!(s.sim_config(0, None, Profile::Hopper, None).schedule.max_warp_instructions, 1000);
+        assert_eq!(s.sim_config(0, Some(7), Profile::Hopper, None).schedule.max_warp_instructions, 7);
+        assert_eq!(s.sim_config(0, None, Profile::Hopper, None).max_call_depth, 9);
         assert_eq!(parse(&format!("fmad = false\n{base}")).unwrap().fmad, Some(false));
         assert_eq!(s.fmad, None);
         for bad in ["max_instructions = 0", "max_call_depth = 4294967296", "max_call_depth = 1.5"] {

@@ -38,7 +38,7 @@ fn args(tools: &str, uninit: &[&str], seed: Option<u64>) -> CheckArgs {
 /// Runs a spec checked; returns the reports and buffer `out`'s (or `read`'s) values.
 fn run(spec: &Path, a: &CheckArgs, threads: usize, read: &str) -> (Vec<Report>, Vec<i32>) {
     let spec = Spec::load(spec).unwrap();
-    let mut config = spec.sim_config(threads, None);
+    let mut config = spec.sim_config(threads, None, warplight::model::Profile::Hopper, None);
     a.configure(&mut config).unwrap();
     let mut dev = Device::with_config(config);
     let p = launch_spec::prepare(&spec, &mut dev).unwrap();

@@ -223,7 +223,12 @@ fn mutated_specs_and_scenes_never_panic() {
                     return;
                 }
             };
-            let mut dev = warplight::sim::Device::with_config(spec.sim_config(1, Some(200_000)));
+            let mut dev = warplight::sim::Device::with_config(spec.sim_config(
+                1,
+                Some(200_000),
+                warplight::model::Profile::Hopper,
+                None,
+            ));
             let _ = warplight::launch_spec::prepare(&spec, &mut dev);
         });
         assert!(r.is_ok(), "spec {} mutated to:\n{m}", path.display());

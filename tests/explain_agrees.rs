@@ -48,11 +48,11 @@ fn the_view_shows_the_counters_for_every_lesson() {
         let spec = Spec::load(path).unwrap();
         for profile in [Profile::Gt200, Profile::Maxwell, Profile::Hopper] {
             // the counters, from normal launches
-            let mut dev = Device::with_config(spec.sim_config(0, None));
+            let mut dev = Device::with_config(spec.sim_config(0, None, profile, None));
             let prepared = launch_spec::prepare(&spec, &mut dev).unwrap();
             let results = launch_spec::run(&spec, &mut dev, &prepared, profile).unwrap();
             // the view, from stepping the same launches in order on a second device
-            let mut sdev = Device::with_config(spec.sim_config(0, None));
+            let mut sdev = Device::with_config(spec.sim_config(0, None, profile, None));
             let sprep = launch_spec::prepare(&spec, &mut sdev).unwrap();
             for (i, l) in spec.launches.iter().enumerate() {
                 let args = launch_spec::arguments(&spec, &sprep, l).unwrap();

@@ -462,3 +462,25 @@ fn a_huge_register_range_is_an_error_not_an_abort() {
     let p = ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n.reg .pred %p<70000>;\nret;\n}\n";
     assert!(warplight::ptx::load(p, "p.ptx").is_err());
 }
+
+/// A function address in the initializer of a zero-length array (the last
+/// `.global` or `.const` variable) is an error naming the line; the loader
+/// wrote the address into no bytes at all and panicked.
+#[test]
+fn a_function_address_in_a_zero_length_array_is_an_error_not_a_panic() {
+    for space in ["global", "const"] {
+        let ptx = module(&format!(
+            ".func f()\n{{\nret;\n}}\n.{space} .u64 t[0] = {{f}};\n.visible .entry k()\n{{\nret;\n}}\n"
+        ));
+        let e = warplight::ptx::load(&ptx, "zero.ptx").unwrap_err();
+        assert_eq!(e.pos.line, 8, "{e}");
+        let msg = e.to_string();
+        assert!(msg.starts_with("zero.ptx:8:") && msg.contains("more elements than the array"), "{msg}");
+        // one element holds it
+        let ok = ptx.replace("t[0]", "t[1]");
+        assert!(warplight::ptx::load(&ok, "one.ptx").is_ok(), "{space}");
+    }
+    // a zero-length array with no initializer, or an empty one, still loads
+    let ptx = module(".global .u64 t[0];\n.const .u32 c[0] = {};\n.visible .entry k()\n{\nret;\n}\n");
+    warplight::ptx::load(&ptx, "empty.ptx").unwrap();
+}

@@ -5,9 +5,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use proptest::prelude::*;
-use warplight::ptx::ir::{ArithOp, FloatMode, Rounding};
+use warplight::ptx::ir::{ArithOp, CarryOp, FloatMode, Rounding};
 use warplight::ptx::types::Ty;
-use warplight::sim::alu::{arith, cvt};
+use warplight::sim::alu::{arith, carry, cvt};
 
 fn mode(r: Rounding) -> FloatMode {
     FloatMode { rnd: Some(r), ..FloatMode::default() }
@@ -106,5 +106,42 @@ proptest! {
         prop_assert_eq!(wide as i64, ai as i64 * bi as i64);
         prop_assert_eq!(arith(ArithOp::Popc, Ty::B32, m, a as u64, 0, 0) as u32, a.count_ones());
         prop_assert_eq!(arith(ArithOp::Brev, Ty::B32, m, a as u64, 0, 0) as u32, a.reverse_bits());
+    }
+}
+
+/// `mad.hi.cc`/`madc.hi` on signed types take the high half of the signed
+/// product (worked by hand): -2 × 3 = -6 has the high word 0xFFFF_FFFF, where
+/// the unsigned product 0xFFFF_FFFE × 3 = 0x2_FFFF_FFFA has 2.
+#[test]
+fn signed_mad_hi_carry_takes_the_signed_high_half() {
+    let m2 = (-2i32) as u32 as u64;
+    assert_eq!(carry(CarryOp::MadHi, Ty::S32, m2, 3, 0, 0), (0xFFFF_FFFF, 0));
+    assert_eq!(carry(CarryOp::MadHi, Ty::U32, m2, 3, 0, 0), (2, 0), "unsigned unchanged");
+    // 0xFFFF_FFFF + 1 wraps to 0 with a carry out
+    assert_eq!(carry(CarryOp::MadHi, Ty::S32, m2, 3, 1, 0), (0, 1));
+    assert_eq!(carry(CarryOp::MadHi, Ty::S32, m2, 3, 0, 1), (0, 1), "carry in");
+    // (-1)(-1) = 1: high word 0; unsigned 2^128 - 2^65 + 1, high word 2^64 - 2,
+    // which + 5 + 1 wraps to 4 with a carry out
+    let m1 = u64::MAX;
+    assert_eq!(carry(CarryOp::MadHi, Ty::S64, m1, m1, 5, 1), (6, 0));
+    assert_eq!(carry(CarryOp::MadHi, Ty::U64, m1, m1, 5, 1), (4, 1));
+    // i64::MIN × 2 = -2^64: high word -1; + carry in = 0 with a carry out
+    assert_eq!(carry(CarryOp::MadHi, Ty::S64, i64::MIN as u64, 2, 0, 1), (0, 1));
+    // the low half is the same for both
+    assert_eq!(carry(CarryOp::MadLo, Ty::S32, m2, 3, 0, 0), ((-6i32) as u32 as u64, 0));
+}
+
+proptest! {
+    #[test]
+    fn signed_mad_hi_carry_matches_i128(a in any::<i64>(), b in any::<i64>(), c in any::<u64>(), cin in 0u64..2) {
+        // 32 bits: i64 product of the sign-extended words
+        let (a32, b32, c32) = (a as i32, b as i32, c as u32);
+        let hi = ((a32 as i64 * b32 as i64) >> 32) as u32 as u64;
+        let sum = hi + c32 as u64 + cin;
+        prop_assert_eq!(carry(CarryOp::MadHi, Ty::S32, a as u64, b as u64, c, cin), (sum & 0xFFFF_FFFF, sum >> 32));
+        // 64 bits: i128 product
+        let hi = ((a as i128 * b as i128) >> 64) as u64 as u128;
+        let sum = hi + c as u128 + cin as u128;
+        prop_assert_eq!(carry(CarryOp::MadHi, Ty::S64, a as u64, b as u64, c, cin), (sum as u64, (sum >> 64) as u64));
     }
 }

@@ -99,6 +99,7 @@ fn tables_4_1_and_4_2_print_thesis_as_printed_verdicts_and_scores() {
     let (ok, out, _) = warplight(&["tables", "4.2", "--scenes", "scene6", "--resolution", "16", "--format", "json"]);
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert!(ok && v["format"] == 1 && v["samples"].as_array().unwrap().len() == 4, "{out}");
+    assert_eq!(v["fmad"], true, "the run's FMA contraction is recorded");
 }
 
 #[test]
@@ -366,4 +367,36 @@ fn scene6_count_verdicts_are_the_baselines() {
         checked += want.len();
     }
     assert!(checked > 60, "{checked} cells");
+}
+
+/// `tables --fmad` is recorded in the results, and shards measured with and
+/// without FMA contraction do not merge; files written before it was
+/// recorded read as contraction on.
+#[test]
+fn shards_with_different_fmad_do_not_merge() {
+    use warplight::repro::protocol::{FrameRange, Protocol};
+    use warplight::repro::results::{Results, SceneInfo};
+    let shard = |frames: FrameRange, fmad: bool| {
+        let mut r = Results::new("c", Protocol::quick(), vec!["t:1".into()], vec!["g".into()]);
+        r.fmad = fmad;
+        r.scenes.push(SceneInfo {
+            name: "s".into(),
+            triangles: 1,
+            thesis_triangles: None,
+            flight_frames: 3,
+            frames: vec![frames],
+        });
+        r
+    };
+    let (a, b) = (FrameRange { start: 0, end: 1 }, FrameRange { start: 1, end: 3 });
+    let merged = Results::merge(&[("a".into(), shard(a, false)), ("b".into(), shard(b, false))], false).unwrap();
+    assert!(!merged.fmad);
+    let e = Results::merge(&[("a".into(), shard(a, true)), ("b".into(), shard(b, false))], false).unwrap_err();
+    assert_eq!(e.to_string(), "b does not belong with a: FMA contraction off against on (tables --fmad)");
+    // written and read back; without the key, on
+    let mut v = serde_json::to_value(shard(a, false)).unwrap();
+    assert_eq!(v["fmad"], false);
+    v.as_object_mut().unwrap().remove("fmad");
+    let old: Results = serde_json::from_value(v).unwrap();
+    assert!(old.fmad);
 }

@@ -384,3 +384,79 @@ fn trace_shows_the_users_line_for_generated_and_library_code() {
     assert!(!shfl.is_empty() && shfl.iter().all(|e| e.src_inherited), "shuffles are inlined library code");
     assert!(t.events.iter().any(|e| !e.src_inherited), "the kernel's own lines are its own");
 }
+
+/// `a·a − 1` for a = 1 + 2^-12 (unrounded `mul` then `sub`: ptxas contracts
+/// them into one FMA) and `rcp.approx` of `x`, stored to `out[0..2]`.
+const ARITH_PTX: &str = ".version 7.8\n.target sm_90\n.address_size 64\n\
+    .visible .entry k(.param .u64 in, .param .u64 out)\n{\n.reg .b64 %rd<3>;\n.reg .f32 %f<6>;\n\
+    ld.param.u64 %rd1, [in];\nld.param.u64 %rd2, [out];\ncvta.to.global.u64 %rd1, %rd1;\ncvta.to.global.u64 %rd2, %rd2;\n\
+    ld.global.f32 %f1, [%rd1];\nld.global.f32 %f2, [%rd1+4];\nmul.f32 %f3, %f1, %f1;\nsub.f32 %f4, %f3, 0f3F800000;\n\
+    rcp.approx.f32 %f5, %f2;\nst.global.f32 [%rd2], %f4;\nst.global.f32 [%rd2+4], %f5;\nret;\n}\n";
+
+/// `out` after stepping the spec's launch to its end.
+fn stepped_out(s: &Session) -> Vec<u32> {
+    s.with_stepper_and_buffers(|st, b| {
+        while !st.finished() {
+            st.step()?;
+        }
+        let (_, bytes) = b.read("out", 0, 2).expect("buffer out");
+        Ok(bytes.chunks(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect())
+    })
+    .expect("steps")
+}
+
+/// `step` (and `trace`, `--check`, which build their device the same way)
+/// computes as `launch` does: the spec's `fmad` and the device profile's FMA
+/// contraction and SFU model (stepping used hopper's whatever the device).
+#[test]
+fn stepping_computes_with_the_fmad_and_sfu_of_launch() {
+    // an input where the H200's MUFU table differs from the correctly rounded reciprocal
+    let x = (2..1000)
+        .map(|i| 1.0 + i as f32 / 1024.0)
+        .find(|x| warplight::sim::sfu::rcp(x.to_bits(), false) != (1.0 / x).to_bits())
+        .expect("an input where the models differ");
+    let a = 1.0 + 2f32.powi(-12);
+    // a·a = 1 + 2^-11 + 2^-24: rounded (a tie, to even) 1 + 2^-11; fused, exact
+    let (fused, rounded) = ((2f32.powi(-11) + 2f32.powi(-24)).to_bits(), 2f32.powi(-11).to_bits());
+    let (mufu, exact) = (warplight::sim::sfu::rcp(x.to_bits(), false), (1.0 / x).to_bits());
+    let dir = std::env::temp_dir().join(format!("warplight-teach-arith-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("k.ptx"), ARITH_PTX).unwrap();
+    let cases = [
+        ("", None, [fused, mufu]),
+        ("fmad = false\n", None, [rounded, mufu]),
+        ("device = \"gt200\"\n", None, [rounded, exact]),
+        ("device = \"gt200\"\nfmad = true\n", None, [fused, exact]),
+        // `step --device gt200` over the spec's hopper
+        ("", Some(Profile::Gt200), [rounded, exact]),
+    ];
+    for (i, (keys, device, want)) in cases.into_iter().enumerate() {
+        let spec = dir.join(format!("s{i}.toml"));
+        std::fs::write(
+            &spec,
+            format!(
+                "{keys}ptx = \"k.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 1\nargs = [\"in\", \"out\"]\n\
+                 [[buffer]]\nname = \"in\"\ntype = \"f32\"\nlen = 2\ninit = [{:?}, {:?}]\n\
+                 [[buffer]]\nname = \"out\"\ntype = \"f32\"\nlen = 2\n",
+                a as f64, x as f64
+            ),
+        )
+        .unwrap();
+        let mut s = Session::load(&spec).unwrap();
+        s.device = device;
+        assert_eq!(stepped_out(&s), want, "step, spec {i} ({keys:?}, {device:?})");
+        // launch, on the same device
+        let dump = dir.join(format!("out{i}.bin"));
+        let mut args = vec!["launch".to_string(), spec.display().to_string(), "--dump".into()];
+        args.push(format!("out={}", dump.display()));
+        if let Some(d) = device {
+            args.extend(["--device".to_string(), d.to_string()]);
+        }
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(&args).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let bytes = std::fs::read(&dump).unwrap();
+        let launched: Vec<u32> = bytes.chunks(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect();
+        assert_eq!(launched, want, "launch, spec {i}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

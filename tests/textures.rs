@@ -69,6 +69,7 @@ fn texture(dev: &mut Device, t: &Value) -> u64 {
         read: if t["read"] == "normalized" { ReadMode::NormalizedFloat } else { ReadMode::ElementType },
         normalized: t["normalized"].as_bool().unwrap(),
     })
+    .unwrap()
 }
 
 fn run(dev: &mut Device, d: Dialect, file: &str, kernel: &str, n: usize, args: &[Arg]) {
@@ -160,7 +161,8 @@ fn surfaces_equal_the_h200() {
         let mut dev = Device::new();
         let data = dev.alloc_from(&u32s(&c["surface"]["texels"]));
         let dims = u32s(&c["surface"]["dims"]);
-        let s = dev.create_surface(SurfaceDesc { data, elem_bytes: 4, dims: [dims[0], dims[1], 0], row_pitch: 0 });
+        let s =
+            dev.create_surface(SurfaceDesc { data, elem_bytes: 4, dims: [dims[0], dims[1], 0], row_pitch: 0 }).unwrap();
         let n = c["x"].as_array().unwrap().len();
         let (x, y) = (floats(&mut dev, &c["x"]), floats(&mut dev, &c["y"]));
         let (z, cl) = (dev.alloc_zeroed::<u32>(n), dev.alloc_zeroed::<u32>(n));
@@ -178,7 +180,9 @@ fn surfaces_equal_the_h200() {
             let c = case(&f, name);
             let mut dev = Device::new();
             let data = dev.alloc_from(&u32s(&c["surface"]["texels"]));
-            let s = dev.create_surface(SurfaceDesc { data, elem_bytes: 4, dims: [dims[0], dims[1], 0], row_pitch: 0 });
+            let s = dev
+                .create_surface(SurfaceDesc { data, elem_bytes: 4, dims: [dims[0], dims[1], 0], row_pitch: 0 })
+                .unwrap();
             let (x, y, v) = (floats(&mut dev, &c["x"]), floats(&mut dev, &c["y"]), floats(&mut dev, &c["v"]));
             let clamp = c["clamp"].as_i64().unwrap() as i32;
             run(

@@ -117,13 +117,15 @@ pub fn json(reports: &[(usize, super::Report)]) -> serde_json::Value {
 
 /// `--check` for `step` and `trace`: runs the spec's launches up to and
 /// including `launch` (index) checked, under the schedule asked for (the one
-/// the stepped launch runs under too, [`CheckArgs::random_seed`]), and prints
-/// the stepped launch's reports to stderr before the view opens.
+/// the stepped launch runs under too, [`CheckArgs::random_seed`]) on the
+/// stepped device `profile`'s arithmetic, and prints the stepped launch's
+/// reports to stderr before the view opens.
 pub fn check_before_stepping(
     spec: &crate::launch_spec::Spec,
     launch: usize,
     a: &CheckArgs,
     max_instructions: Option<u64>,
+    profile: crate::model::Profile,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let tools = a.tools()?;
     if !tools.any() {
@@ -131,11 +133,10 @@ pub fn check_before_stepping(
     }
     let mut spec = spec.clone();
     spec.launches.truncate(launch + 1);
-    let mut config = spec.sim_config(0, max_instructions);
+    let mut config = spec.sim_config(0, max_instructions, profile, None);
     a.configure(&mut config)?;
     let mut dev = crate::sim::Device::with_config(config);
     let p = crate::launch_spec::prepare(&spec, &mut dev)?;
-    let profile = crate::model::Profile::Hopper;
     let r = super::spec::run(&spec, &mut dev, &p, profile, &a.options(&p)?);
     let reports: Vec<(usize, super::Report)> = r.reports.into_iter().filter(|(i, _)| *i == launch).collect();
     print_reports(&reports, 1, tools, true);

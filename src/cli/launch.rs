@@ -115,11 +115,9 @@ pub fn run_spec(spec: Spec, a: &LaunchOptions) -> Res {
     if let Some(why) = capped {
         eprintln!("warning: --threads {}: {why}", a.threads);
     }
-    let mut config = spec.sim_config(threads, a.max_instructions);
+    let mut config = spec.sim_config(threads, a.max_instructions, profile, a.fmad);
     config.fidelity = a.fidelity;
     a.checks.configure(&mut config)?;
-    config.fmad = crate::sim::contract::for_profile(profile, a.fmad.or(spec.fmad));
-    config.sfu = crate::sim::sfu::SfuModel::for_profile(profile);
     let mut dev = Device::with_config(config);
     let prepared = launch_spec::prepare(&spec, &mut dev)?;
     let prog = &prepared.module.prog;

@@ -239,10 +239,10 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let [width, height] = cam.resolution;
     if a.method == "path" {
-        return crate::repro::lin2017::render::run(&a, &scene, &cam);
+        return run_path(&a, &scene, &cam);
     }
     if a.method == "photon-map" {
-        return crate::repro::fabianowski2011::photon_image::run_cli(&a, &scene, &cam);
+        return run_photon_map(&a, &scene, &cam);
     }
     if a.method == "purcell" {
         return crate::repro::purcell2003::image::run_cli(&a, &scene, &cam);
@@ -265,8 +265,7 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         Some(v) => {
             let mut config = rt_kernels::sim_config(&cam);
             config.fidelity = a.fidelity;
-            config.fmad = crate::sim::contract::for_profile(profile, a.fmad);
-            config.sfu = crate::sim::sfu::SfuModel::for_profile(profile);
+            profile.configure(&mut config, a.fmad);
             let mut dev = Device::with_config(config);
             let module = rt_kernels::load(&mut dev)?;
             let pb = pixel_progress(&mut dev, v.kernel(), width as u64 * height as u64);
@@ -364,5 +363,109 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
         });
         super::write_atomically(j, serde_json::to_string_pretty(&v)?.as_bytes())?;
     }
+    Ok(())
+}
+
+/// `warplight render --method path` (thesis 003's path tracer,
+/// [`crate::repro::lin2017::render`]) with the command's options.
+fn run_path(
+    a: &RenderArgs,
+    scene: &crate::host::scene::Scene,
+    camera: &crate::host::camera::Camera,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use crate::host::path::{FrameParams, Integrator, Traversal};
+    let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
+        format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic) or mis-power", a.integrator)
+    })?;
+    let traversal = Traversal::parse(&a.traversal)
+        .ok_or_else(|| format!("unknown traversal `{}`; expected stack, restart or backtrack", a.traversal))?;
+    let frames = crate::repro::lin2017::render::frames_for(a.spp)?;
+    let emulated = match a.variant.as_str() {
+        "native" => None,
+        "emulated" => Some(a.fidelity),
+        v => return Err(format!("--method path --variant {v}: expected native or emulated").into()),
+    };
+    let [width, height] = camera.resolution;
+    let params = FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal };
+    let r = crate::repro::lin2017::render::render(scene, camera, params, frames, emulated)?;
+    write_image(&r.image, &a.output, a.exposure)?;
+    println!(
+        "{} ({}x{}), path tracer {} ({} traversal), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
+        scene.name,
+        width,
+        height,
+        integrator.name(),
+        traversal.name(),
+        a.spp,
+        frames,
+        a.bounces,
+        r.seconds,
+        params.paths() as f64 * frames as f64 / r.seconds.max(1e-9) / 1e6,
+        if emulated.is_some() { " (emulated)" } else { " (native)" }
+    );
+    if let Some((w, t)) = r.instructions {
+        println!("  emulated path_frame: {w} warp instructions, {t} thread instructions");
+    }
+    println!("  wrote {}", a.output.display());
+    Ok(())
+}
+
+/// `warplight render --method photon-map`: the direct light of the native ray
+/// caster plus the photon-mapped indirect light of `scene` seen by `cam`,
+/// natively (`--variant native`) or with the photon, construction and
+/// estimation kernels on the emulator (`--variant emulated`; bit for bit the same).
+fn run_photon_map(
+    a: &RenderArgs,
+    scene: &crate::host::scene::Scene,
+    cam: &crate::host::camera::Camera,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use crate::repro::fabianowski2011::photon_image::{Options, add, parse_estimator, render_parameters};
+    use crate::repro::fabianowski2011::{knn, photon_image, vkde};
+    let (estimator, shape) = parse_estimator(&a.estimator, &scene.name).ok_or_else(|| {
+        format!(
+            "unknown estimator `{}`; expected vkde, vkde-epanechnikov, knn or knn:K (1..={})",
+            a.estimator,
+            knn::K_MAX
+        )
+    })?;
+    let emulated = match a.variant.as_str() {
+        "native" => false,
+        "emulated" => true,
+        v => return Err(format!("--method photon-map --variant {v}: expected native or emulated").into()),
+    };
+    let (photons, spread) = render_parameters(&scene.name);
+    let o = Options { photons, spread, h_max: vkde::H_MAX, estimator, shape, emulated };
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = crate::host::kdtree::build(
+        &tris,
+        crate::host::kdtree::BuildParams::thesis(crate::host::kdtree::Heuristic::Siroh),
+    );
+    let t = std::time::Instant::now();
+    let r = photon_image::render(scene, &tree, cam, &o)?;
+    let caster = Caster::new(scene, &tree);
+    let (direct, _) = crate::host::raycast::render(&caster, cam, glam::Vec3::ZERO);
+    let image = add(&direct, &r.indirect);
+    let out = &a.output;
+    write_image(&image, out, a.exposure)?;
+    let c = &r.maps.constructed;
+    println!(
+        "{} ({}x{}), photon map: {} photons, s = {}, {} interactions ({} discarded, {} clamped), {:?} {:?}, \
+         {} query points, {:.1} contributions each: {:.3} s{}",
+        scene.name,
+        cam.resolution[0],
+        cam.resolution[1],
+        photons,
+        spread,
+        c.interactions,
+        c.discarded,
+        c.clamped,
+        estimator,
+        shape,
+        r.queries,
+        r.contributions as f64 / r.queries.max(1) as f64,
+        t.elapsed().as_secs_f64(),
+        if emulated { " (emulated)" } else { " (native)" }
+    );
+    println!("  wrote {} (direct light of the ray caster + photon-mapped indirect light)", out.display());
     Ok(())
 }

@@ -39,7 +39,14 @@ impl SessionArgs {
         session.max_instructions = self.max_instructions;
         session.random_seed = self.checks.random_seed();
         let profile = profile(&session, self.device.as_deref())?;
-        crate::check::cli::check_before_stepping(&session.spec, session.launch, &self.checks, self.max_instructions)?;
+        session.device = Some(profile);
+        crate::check::cli::check_before_stepping(
+            &session.spec,
+            session.launch,
+            &self.checks,
+            self.max_instructions,
+            profile,
+        )?;
         Ok((session, profile))
     }
 }

@@ -3,6 +3,9 @@
 
 use std::fmt;
 
+use crate::sim::SimConfig;
+use crate::sim::sfu::SfuModel;
+
 /// A modelled GPU generation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum Profile {
@@ -52,6 +55,30 @@ pub struct Params {
 impl Profile {
     /// All profiles.
     pub const ALL: [Profile; 3] = [Profile::Gt200, Profile::Maxwell, Profile::Hopper];
+
+    /// Whether ptxas contracts for a GPU of this profile: sm_50 and later
+    /// (maxwell, hopper) have FFMA; GT200's FMAD truncates the product, which
+    /// is not modelled, so the gt200 profile executes every instruction as
+    /// written. `flag` (`--fmad`, the spec's `fmad`) decides when given.
+    pub fn fmad(self, flag: Option<bool>) -> bool {
+        flag.unwrap_or(self != Profile::Gt200)
+    }
+
+    /// The special-function unit model of this profile's GPU: the H200's
+    /// tables for hopper; the maxwell and gt200 profiles (not measured)
+    /// compute correctly rounded.
+    pub fn sfu(self) -> SfuModel {
+        if self == Profile::Hopper { SfuModel::Sm90 } else { SfuModel::CorrectlyRounded }
+    }
+
+    /// Sets what of the simulator's arithmetic depends on the device: FMA
+    /// contraction ([`Profile::fmad`] of `fmad`) and the SFU model
+    /// ([`Profile::sfu`]). Every command that runs a kernel on a profile goes
+    /// through here.
+    pub fn configure(self, c: &mut SimConfig, fmad: Option<bool>) {
+        c.fmad = self.fmad(fmad);
+        c.sfu = self.sfu();
+    }
 
     /// Parses `gt200`, `maxwell` or `hopper`.
     pub fn parse(s: &str) -> Option<Profile> {

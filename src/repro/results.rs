@@ -57,6 +57,11 @@ pub struct Results {
     pub commit: String,
     /// The protocol.
     pub protocol: Protocol,
+    /// Whether the emulated kernels ran with ptxas's FMA contraction
+    /// (`tables --fmad`; on in files written before it was recorded, the
+    /// only setting then). Shards merge only with the same.
+    #[serde(default = "contraction_on")]
+    pub fmad: bool,
     /// The tables asked for (addresses, `fabianowski:4.5`).
     pub tables: Vec<String>,
     /// The measurement groups run.
@@ -68,6 +73,10 @@ pub struct Results {
     pub unavailable: Vec<String>,
     /// Samples, sorted by group, scene, frame, variant.
     pub samples: Vec<Sample>,
+}
+
+fn contraction_on() -> bool {
+    true
 }
 
 /// Why shards cannot be merged, or a results file cannot be read.
@@ -129,12 +138,14 @@ pub enum MergeError {
 }
 
 impl Results {
-    /// An empty result for a run.
+    /// An empty result for a run, with FMA contraction on (the run sets
+    /// [`Results::fmad`] as it ran).
     pub fn new(commit: &str, protocol: Protocol, tables: Vec<String>, groups: Vec<String>) -> Results {
         Results {
             format: FORMAT,
             commit: commit.into(),
             protocol,
+            fmad: true,
             tables,
             groups,
             scenes: Vec::new(),
@@ -205,7 +216,8 @@ impl Results {
         Ok(r)
     }
 
-    /// Merges shards: same commit, protocol, tables and groups; disjoint frames.
+    /// Merges shards: same commit, protocol, FMA contraction, tables and
+    /// groups; disjoint frames.
     /// With `partial == false`, every scene must cover the protocol's frames.
     pub fn merge(shards: &[(String, Results)], partial: bool) -> Result<Results, MergeError> {
         let Some((first_name, first)) = shards.first() else { return Err(MergeError::Empty) };
@@ -223,6 +235,14 @@ impl Results {
                     "protocol {} against {}",
                     r.protocol.describe(),
                     first.protocol.describe()
+                )));
+            }
+            if r.fmad != first.fmad {
+                let on = |f: bool| if f { "on" } else { "off" };
+                return Err(mismatch(format!(
+                    "FMA contraction {} against {} (tables --fmad)",
+                    on(r.fmad),
+                    on(first.fmad)
                 )));
             }
             if r.tables != first.tables || r.groups != first.groups {

@@ -197,6 +197,8 @@ pub fn execute(
     let addr: Vec<String> = plan.entries.iter().map(|e| e.address()).collect();
     let groups: Vec<String> = plan.groups.iter().map(|(g, _)| g.name.to_string()).collect();
     let mut r = Results::new(commit, plan.protocol.clone(), addr, groups);
+    // the emulated kernels' contraction, as `tables --fmad` set it for the process
+    r.fmad = crate::sim::contract::default_on();
     r.unavailable = unavailable.iter().map(|u| u.why.clone()).collect();
     for s in scenes {
         let frames = plan.frames_of(s);

@@ -562,7 +562,17 @@ pub fn carry(op: CarryOp, ty: Ty, a: u64, b: u64, c: u64, cin: u64) -> (u64, u64
             return (r as u64, (a < b + cin) as u64);
         }
         CarryOp::MadLo => ((a * b) & mask) + c + cin,
-        CarryOp::MadHi => ((a * b) >> w) + c + cin,
+        CarryOp::MadHi => {
+            // the high half of the signed product for .s32/.s64 (sign-extended
+            // operands); the addition and its carry are the same for both
+            let hi = if ty.is_signed() {
+                let (sa, sb) = (ty.extend(a as u64) as i64 as i128, ty.extend(b as u64) as i64 as i128);
+                ((sa * sb) >> w) as u128 & mask
+            } else {
+                (a * b) >> w
+            };
+            hi + c + cin
+        }
     };
     ((wide & mask) as u64, (wide >> w) as u64 & 1)
 }

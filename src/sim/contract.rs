@@ -52,14 +52,6 @@ pub fn set_default(on: bool) {
     DEFAULT.store(on, Ordering::Relaxed)
 }
 
-/// Whether ptxas contracts for a GPU of `profile`: sm_50 and later (maxwell,
-/// hopper) have FFMA; GT200's FMAD truncates the product, which is not
-/// modelled, so the gt200 profile executes every instruction as written.
-/// `flag` (`--fmad`, the spec's `fmad`) decides when given.
-pub fn for_profile(profile: crate::model::Profile, flag: Option<bool>) -> bool {
-    flag.unwrap_or(profile != crate::model::Profile::Gt200)
-}
-
 /// An `add`/`sub` that executes as fma(±a, b, ±c).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Fused {
@@ -92,7 +84,14 @@ fn writes(k: &Kind) -> Vec<RegId> {
         | Kind::Shfl { d: x, .. }
         | Kind::Redux { d: x, .. }
         | Kind::Match { d: x, .. } => vec![d(x)],
-        Kind::Carry { d: x, cc, .. } => vec![d(x), *cc],
+        // the condition code only with `.cc` (`addc` without it reads it only)
+        Kind::Carry { d: x, cc, cout, .. } => {
+            if *cout {
+                vec![d(x), *cc]
+            } else {
+                vec![d(x)]
+            }
+        }
         Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } | Kind::Tex { ds, .. } | Kind::Suld { ds, .. } => {
             ds.iter().map(d).collect()
         }
@@ -359,6 +358,15 @@ mod tests {
         let mut v: Vec<u32> = contract(&prog.functions[0]).into_keys().collect();
         v.sort_unstable();
         v
+    }
+
+    #[test]
+    fn carries_write_the_condition_code_only_with_cc() {
+        let src = ".version 8.0\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n.reg .b32 %r<8>;\n\
+                   add.cc.u32 %r1, %r2, %r3;\naddc.u32 %r4, %r2, %r3;\naddc.cc.u32 %r5, %r2, %r3;\nret;\n}\n";
+        let prog = crate::ptx::load(src, "c.ptx").unwrap();
+        let w: Vec<usize> = prog.functions[0].insts[..3].iter().map(|i| writes(&i.kind).len()).collect();
+        assert_eq!(w, [2, 1, 2], "add.cc, addc, addc.cc");
     }
 
     #[test]

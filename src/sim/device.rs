@@ -90,6 +90,15 @@ pub enum SimError {
     /// A device pointer that is not the start of an allocation, or an access past its end.
     #[error("bad device memory access: {0}")]
     BadPointer(String),
+    /// A texture or surface descriptor that cannot be created: a bad channel
+    /// count or element size, or texels outside every allocation.
+    #[error("bad {what} object: {msg}")]
+    BadObject {
+        /// `texture` or `surface`.
+        what: &'static str,
+        /// What is wrong.
+        msg: String,
+    },
     /// The kernel faulted.
     #[error("{0}")]
     Fault(Box<Fault>),
@@ -436,16 +445,30 @@ impl Device {
 
     /// Creates a texture object (`cudaCreateTextureObject`) over texels already
     /// in device memory; the handle is what a kernel's `cudaTextureObject_t`
-    /// parameter takes ([`Arg::U64`]).
-    pub fn create_texture(&mut self, desc: super::texture::TextureDesc) -> u64 {
+    /// parameter takes ([`Arg::U64`]). An error when the descriptor is
+    /// invalid ([`super::texture::TextureDesc::validate`]).
+    pub fn create_texture(&mut self, desc: super::texture::TextureDesc) -> Result<u64, SimError> {
+        desc.validate(|a, n| self.mem.find(a, n).is_some())
+            .map_err(|msg| SimError::BadObject { what: "texture", msg })?;
         self.textures.push(super::texture::Object::Texture(desc));
-        super::texture::handle_of(self.textures.len() - 1)
+        Ok(super::texture::handle_of(self.textures.len() - 1))
     }
 
     /// Creates a surface object (`cudaCreateSurfaceObject`); the handle is a
-    /// `cudaSurfaceObject_t` argument ([`Arg::U64`]).
-    pub fn create_surface(&mut self, desc: super::texture::SurfaceDesc) -> u64 {
+    /// `cudaSurfaceObject_t` argument ([`Arg::U64`]). An error when the
+    /// descriptor is invalid ([`super::texture::SurfaceDesc::validate`]).
+    pub fn create_surface(&mut self, desc: super::texture::SurfaceDesc) -> Result<u64, SimError> {
+        desc.validate(|a, n| self.mem.find(a, n).is_some())
+            .map_err(|msg| SimError::BadObject { what: "surface", msg })?;
         self.textures.push(super::texture::Object::Surface(desc));
+        Ok(super::texture::handle_of(self.textures.len() - 1))
+    }
+
+    /// Registers an object without [`Device::create_texture`]'s checks: how
+    /// tests reach a descriptor outside every allocation.
+    #[cfg(test)]
+    pub(crate) fn create_object_unchecked(&mut self, obj: super::texture::Object) -> u64 {
+        self.textures.push(obj);
         super::texture::handle_of(self.textures.len() - 1)
     }
 

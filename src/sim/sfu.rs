@@ -29,14 +29,6 @@ pub enum SfuModel {
     Sm90,
 }
 
-impl SfuModel {
-    /// The model of `profile`'s GPU: the H200's tables for hopper; the
-    /// maxwell and gt200 profiles (not measured) compute correctly rounded.
-    pub fn for_profile(profile: crate::model::Profile) -> SfuModel {
-        if profile == crate::model::Profile::Hopper { SfuModel::Sm90 } else { SfuModel::CorrectlyRounded }
-    }
-}
-
 /// The canonical NaN the unit returns.
 const QNAN: u32 = 0x7FFF_FFFF;
 const TINY: f32 = 1.175_494_4e-38; // 2^-126

@@ -268,9 +268,13 @@ pub fn gather(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, x: f32, y: f32, c
 }
 
 /// The byte address of a surface access of `size` bytes at byte x and rows
-/// y, z; `None` when out of range (after `.clamp` clamps it).
+/// y, z; `None` when out of range (after `.clamp` clamps it), and always when
+/// the access is wider than a row (no position holds it, clamped or not).
 pub fn surface_addr(s: &SurfaceDesc, coords: [i32; 3], dims: usize, size: u32, clamp: bool) -> Option<u64> {
     let row = s.elem_bytes as i64 * s.dims[0].max(1) as i64;
+    if row < size as i64 || size == 0 {
+        return None;
+    }
     let pitch = if s.row_pitch == 0 { row as u64 } else { s.row_pitch };
     let mut x = coords[0] as i64;
     let mut yz = [0i64; 2];
@@ -293,6 +297,51 @@ fn size_dim(dims: [u32; 3], d: usize) -> i64 {
     size(dims, d)
 }
 
+/// The bytes a resource of `dims` elements of `elem` bytes spans from its
+/// first element, rows `row_pitch` apart (0: packed); an error when a row
+/// pitch is shorter than a row or the span passes 2^64.
+fn span(elem: u64, dims: [u32; 3], row_pitch: u64) -> Result<u64, String> {
+    let row = elem.checked_mul(dims[0].max(1) as u64).ok_or("its rows pass 2^64 bytes")?;
+    if row_pitch != 0 && row_pitch < row {
+        return Err(format!("row pitch {row_pitch} is shorter than a row ({row} bytes)"));
+    }
+    let pitch = if row_pitch == 0 { row } else { row_pitch };
+    let rows = dims[1].max(1) as u64 * dims[2].max(1) as u64;
+    pitch.checked_mul(rows - 1).and_then(|b| b.checked_add(row)).ok_or_else(|| "it spans past 2^64 bytes".to_string())
+}
+
+impl TextureDesc {
+    /// Checks the descriptor as `cudaCreateTextureObject` would: 1, 2 or 4
+    /// channels, and the texels (`dims`, `row_pitch`) within one allocation
+    /// from `data` (`fits(addr, bytes)`). The error says what is wrong.
+    pub fn validate(&self, fits: impl Fn(u64, u64) -> bool) -> Result<(), String> {
+        if ![1, 2, 4].contains(&self.channels) {
+            return Err(format!("{} channels (1, 2 or 4)", self.channels));
+        }
+        let bytes = span(self.format.bytes() as u64 * self.channels as u64, self.dims, self.row_pitch)?;
+        if !fits(self.data.0, bytes) {
+            return Err(format!("its {bytes} bytes from {:#x} are not within one allocation", self.data.0));
+        }
+        Ok(())
+    }
+}
+
+impl SurfaceDesc {
+    /// Checks the descriptor as `cudaCreateSurfaceObject` would: elements of
+    /// at least one byte, and all of them (`dims`, `row_pitch`) within one
+    /// allocation from `data` (`fits(addr, bytes)`).
+    pub fn validate(&self, fits: impl Fn(u64, u64) -> bool) -> Result<(), String> {
+        if self.elem_bytes == 0 {
+            return Err("elements of 0 bytes".into());
+        }
+        let bytes = span(self.elem_bytes as u64, self.dims, self.row_pitch)?;
+        if !fits(self.data.0, bytes) {
+            return Err(format!("its {bytes} bytes from {:#x} are not within one allocation", self.data.0));
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -306,6 +355,18 @@ mod tests {
         assert_eq!(address(4, 4, AddressMode::Mirror), Some(3));
         assert_eq!(address(-1, 4, AddressMode::Mirror), Some(0));
         assert_eq!(address(8, 4, AddressMode::Mirror), Some(0));
+    }
+
+    #[test]
+    fn surface_accesses_wider_than_a_row_have_no_address() {
+        let s = SurfaceDesc { data: DevicePtr(0x1000), elem_bytes: 4, dims: [1, 2, 0], row_pitch: 0 };
+        // a 4-byte row: an 8-byte access fits nowhere, clamped or not
+        assert_eq!(surface_addr(&s, [0, 0, 0], 2, 8, true), None);
+        assert_eq!(surface_addr(&s, [0, 1, 0], 2, 8, false), None);
+        // a 4-byte one clamps to x = 0 of row 1
+        assert_eq!(surface_addr(&s, [9, 1, 0], 2, 4, true), Some(0x1004));
+        let z = SurfaceDesc { elem_bytes: 0, ..s };
+        assert_eq!(surface_addr(&z, [0, 0, 0], 2, 4, true), None);
     }
 
     #[test]

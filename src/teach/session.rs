@@ -30,6 +30,10 @@ pub struct Session {
     /// stepped launch interleaves its warps as `launch --schedule random`
     /// does with that seed. `None`: the default schedule.
     pub random_seed: Option<u64>,
+    /// The device profile over the spec's `device` (`--device`), when given:
+    /// stepping runs with its arithmetic (FMA contraction, SFU model), as
+    /// `launch` on that device does.
+    pub device: Option<Profile>,
     /// The `printf` output of the stepped launch during the last stepping
     /// ([`Session::with_stepper`]), in the deterministic order.
     printf: std::sync::Mutex<Vec<PrintfRecord>>,
@@ -66,6 +70,7 @@ impl Session {
             kernel,
             max_instructions: None,
             random_seed: None,
+            device: None,
             printf: Default::default(),
         })
     }
@@ -109,7 +114,11 @@ impl Session {
         &self,
         f: impl FnOnce(&mut Stepper, &Buffers, &Printed) -> Result<R, Error>,
     ) -> Result<R, Error> {
-        let mut config = self.spec.sim_config(0, self.max_instructions);
+        let profile = match self.device {
+            Some(p) => p,
+            None => self.spec_profile()?,
+        };
+        let mut config = self.spec.sim_config(0, self.max_instructions, profile, None);
         config.schedule.random_seed = self.random_seed;
         let mut dev = Device::with_config(config);
         let prepared = launch_spec::prepare(&self.spec, &mut dev)?;

@@ -93,7 +93,8 @@ pub(super) fn init_bytes(v: &ast::VarDecl) -> LResult<Vec<u8>> {
             let bits = lit_bits(*l, v.ty, v.pos)?;
             out.extend_from_slice(&bits.to_le_bytes()[..eb]);
         }
-        if out.len() > size && size > 0 {
+        // a zero-length array takes no element either (`t[0] = {f}`)
+        if out.len() > size {
             return invalid(v.pos, format!("initializer of `{}` has more elements than the array", v.name));
         }
     }

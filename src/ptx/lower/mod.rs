@@ -252,7 +252,11 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
                 Some(g) => &mut prog.globals[g].init,
                 None => &mut prog.const_bank,
             };
-            dst[at..at + 8].copy_from_slice(&bytes);
+            // init_bytes refused initializers longer than the variable; checked again, never indexed blindly
+            let Some(slot) = dst.get_mut(at..at + 8) else {
+                return invalid(v.pos, format!("function address `{name}` past the end of `{}`", v.name));
+            };
+            slot.copy_from_slice(&bytes);
         }
     }
     let sigs: Vec<Signature> = defs.iter().map(|f| signature(f)).collect::<LResult<_>>()?;

@@ -141,11 +141,7 @@ pub fn frame_timed(
     // watchdog's budget grows with the pixels
     let cam = camera(scene, f, res);
     // the GT200: no FFMA contraction, correctly rounded special functions
-    let config = SimConfig {
-        fmad: false,
-        sfu: crate::sim::sfu::SfuModel::for_profile(Profile::Gt200),
-        ..rt_kernels::sim_config(&cam)
-    };
+    let config = SimConfig { fmad: false, sfu: Profile::Gt200.sfu(), ..rt_kernels::sim_config(&cam) };
     let mut dev = Device::with_config(config);
     let module = rt_kernels::load(&mut dev)?;
     let k = rt_kernels::render(&mut dev, &module, scene, tree, &cam, scene.flight.light_offset(f), v, Profile::Gt200)?;

@@ -5,13 +5,12 @@
 use std::io::IsTerminal;
 use std::time::Instant;
 
-use crate::cli::render::RenderArgs;
 use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::build::{self as path_build, Construction};
 use crate::host::path::layout::PathScene;
-use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, kernel, render_native};
+use crate::host::path::{FrameParams, SAMPLES_PER_FRAME, Traversal, kernel, render_native};
 use crate::sim::Device;
 
 /// What a path render produced.
@@ -95,46 +94,4 @@ pub fn render(
         pb.finish_and_clear();
     }
     Ok(PathRender { image, frames, seconds: t0.elapsed().as_secs_f64(), instructions })
-}
-
-/// Runs `warplight render --method path` with the command's options.
-pub fn run(
-    a: &RenderArgs,
-    scene: &crate::host::scene::Scene,
-    camera: &Camera,
-) -> Result<(), Box<dyn std::error::Error>> {
-    let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
-        format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic) or mis-power", a.integrator)
-    })?;
-    let traversal = Traversal::parse(&a.traversal)
-        .ok_or_else(|| format!("unknown traversal `{}`; expected stack, restart or backtrack", a.traversal))?;
-    let frames = frames_for(a.spp)?;
-    let emulated = match a.variant.as_str() {
-        "native" => None,
-        "emulated" => Some(a.fidelity),
-        v => return Err(format!("--method path --variant {v}: expected native or emulated").into()),
-    };
-    let [width, height] = camera.resolution;
-    let params = FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal };
-    let r = render(scene, camera, params, frames, emulated)?;
-    crate::cli::render::write_image(&r.image, &a.output, a.exposure)?;
-    println!(
-        "{} ({}x{}), path tracer {} ({} traversal), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
-        scene.name,
-        width,
-        height,
-        integrator.name(),
-        traversal.name(),
-        a.spp,
-        frames,
-        a.bounces,
-        r.seconds,
-        params.paths() as f64 * frames as f64 / r.seconds.max(1e-9) / 1e6,
-        if emulated.is_some() { " (emulated)" } else { " (native)" }
-    );
-    if let Some((w, t)) = r.instructions {
-        println!("  emulated path_frame: {w} warp instructions, {t} thread instructions");
-    }
-    println!("  wrote {}", a.output.display());
-    Ok(())
 }

@@ -107,6 +107,25 @@ pub(super) fn call_indirect(
             Some(first),
         ));
     }
+    // the return values as the call site declares them: the callee's, or a fault
+    // (copying back fewer or truncated values would leave registers unset)
+    if let Kind::CallIndirect { rets, .. } = &ctx.prog.functions[w.frame().func as usize].insts[pc as usize].kind
+        && (rets.len() != cf.returns.len() || rets.iter().zip(&cf.returns).any(|(&(_, size), r)| size != r.size))
+    {
+        let show =
+            |sizes: &mut dyn Iterator<Item = u32>| sizes.map(|b| format!("{b}-byte")).collect::<Vec<_>>().join(", ");
+        return Err(fault(
+            FaultKind::Unsupported(format!(
+                "indirect call of `{}` expecting {} return value(s) [{}]; it returns {} [{}]",
+                cf.name,
+                rets.len(),
+                show(&mut rets.iter().map(|r| r.1)),
+                cf.returns.len(),
+                show(&mut cf.returns.iter().map(|r| r.size))
+            )),
+            Some(first),
+        ));
+    }
     let rest = exec & !group;
     if rest != 0 {
         // the others call again from the same instruction; the group rejoins after it

@@ -3,6 +3,8 @@
 //! the device ([`crate::sim::texture`]); texels are read from and written to
 //! device memory.
 
+use std::cell::Cell;
+
 use super::{CtaMut, Ctx, ExecFault, Lanes, fault, read, write};
 use crate::ptx::ir::*;
 use crate::ptx::types::Ty;
@@ -10,9 +12,22 @@ use crate::sim::fault::FaultKind;
 use crate::sim::texture::{self, Object, SurfaceDesc, TextureDesc};
 use crate::sim::warp::Warp;
 
-/// Loads `size` bytes of device memory at `addr` (0 outside every allocation).
-fn load(ctx: &Ctx, addr: u64, size: u32) -> u64 {
-    ctx.mem.find(addr, size as u64).map(|(a, off)| a.load(off, size)).unwrap_or(0)
+/// Loads `size` bytes of device memory at `addr`; outside every allocation
+/// it reads 0 and records the address in `miss` (the first one), for the
+/// caller to fault on ([`out_of_bounds`]).
+fn load(ctx: &Ctx, addr: u64, size: u32, miss: &Cell<Option<(u64, u32)>>) -> u64 {
+    ctx.mem.find(addr, size as u64).map(|(a, off)| a.load(off, size)).unwrap_or_else(|| {
+        if miss.get().is_none() {
+            miss.set(Some((addr, size)));
+        }
+        0
+    })
+}
+
+/// A texel or surface element outside every allocation: the fault of a
+/// global access out of bounds (what memcheck reports).
+fn out_of_bounds(addr: u64, size: u32, lane: usize) -> Box<ExecFault> {
+    fault(FaultKind::OutOfBounds { space: MemSpace::Global, addr, size }, Some(lane))
 }
 
 fn bad_handle(what: &str, h: u64, lane: usize) -> Box<ExecFault> {
@@ -55,7 +70,8 @@ pub(super) fn tex(
     cta.counters.textures.requests += (0..8).filter(|q| exec >> (4 * q) & 0xF != 0).count() as u64;
     let h = read(ctx, w, cta, handle);
     let cs: Vec<Lanes> = coords.iter().map(|c| read(ctx, w, cta, *c)).collect();
-    let rd = |a: u64, n: u32| load(ctx, a, n);
+    let miss = Cell::new(None);
+    let rd = |a: u64, n: u32| load(ctx, a, n, &miss);
     let mut out = [[0u64; 32]; 4];
     for l in lanes(exec) {
         let t = tex_of(ctx, h[l], l)?;
@@ -75,6 +91,9 @@ pub(super) fn tex(
             }
             texture::fetch_int(t, &rd, x, dims)
         };
+        if let Some((a, n)) = miss.get() {
+            return Err(out_of_bounds(a, n, l));
+        }
         for c in 0..4 {
             out[c][l] = v[c] as u64;
         }
@@ -121,7 +140,8 @@ pub(super) fn txq(
 }
 
 /// The byte address of lane `l`'s surface access, `None` to skip it (`.zero`
-/// out of range); `.trap` out of range faults.
+/// out of range); `.trap` out of range faults, as does `.clamp` for an access
+/// wider than a row.
 fn surf_addr(
     s: &SurfaceDesc,
     cs: &[Lanes],
@@ -135,6 +155,14 @@ fn surf_addr(
         x[d] = cs[d][l] as u32 as i32;
     }
     let a = texture::surface_addr(s, x, geom.dims(), size, clamp == SurfClamp::Clamp);
+    // clamped, only an access wider than a row has no address
+    if a.is_none() && clamp == SurfClamp::Clamp {
+        let row = s.elem_bytes as u64 * s.dims[0].max(1) as u64;
+        return Err(fault(
+            FaultKind::Unsupported(format!("{size}-byte surface access is wider than a row ({row} bytes) with .clamp")),
+            Some(l),
+        ));
+    }
     if a.is_none() && clamp == SurfClamp::Trap {
         return Err(fault(
             FaultKind::Unsupported(format!("surface access out of range at ({}, {}, {}) with .trap", x[0], x[1], x[2])),
@@ -167,7 +195,9 @@ pub(super) fn suld(
         let s = surf_of(ctx, h[l], l)?;
         if let Some(a) = surf_addr(s, &cs, geom, eb * ds.len() as u32, clamp, l)? {
             for (k, o) in out.iter_mut().enumerate() {
-                o[l] = load(ctx, a + (k as u32 * eb) as u64, eb);
+                let at = a + (k as u32 * eb) as u64;
+                let (al, off) = ctx.mem.find(at, eb as u64).ok_or_else(|| out_of_bounds(at, eb, l))?;
+                o[l] = al.load(off, eb);
             }
         }
     }
@@ -197,17 +227,80 @@ pub(super) fn sust(
     let cs: Vec<Lanes> = coords.iter().map(|c| read(ctx, w, cta, *c)).collect();
     let vs: Vec<Lanes> = vals.iter().map(|v| read(ctx, w, cta, *v)).collect();
     let eb = ty.bytes();
-    // lanes storing to one element: the lowest lane's value stays (the H200's order)
-    for l in lanes(exec).collect::<Vec<_>>().into_iter().rev() {
+    // every lane's elements first, in lane order: outside every allocation
+    // the lowest such lane faults, before anything is stored
+    let mut at = Vec::new();
+    for l in lanes(exec) {
         let s = surf_of(ctx, h[l], l)?;
         if let Some(a) = surf_addr(s, &cs, geom, eb * vals.len() as u32, clamp, l)? {
-            for (k, v) in vs.iter().enumerate() {
-                let at = a + (k as u32 * eb) as u64;
-                if let Some((al, off)) = ctx.mem.find(at, eb as u64) {
-                    al.store(off, eb, v[l]);
-                }
+            for k in 0..vals.len() {
+                let ak = a + (k as u32 * eb) as u64;
+                ctx.mem.find(ak, eb as u64).ok_or_else(|| out_of_bounds(ak, eb, l))?;
+                at.push((l, k, ak));
             }
         }
     }
+    // lanes storing to one element: the lowest lane's value stays (the H200's order)
+    for &(l, k, ak) in at.iter().rev() {
+        if let Some((al, off)) = ctx.mem.find(ak, eb as u64) {
+            al.store(off, eb, vs[k][l]);
+        }
+    }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::ptx::ir::MemSpace;
+    use crate::sim::fault::FaultKind;
+    use crate::sim::texture::{AddressMode, FilterMode, Object, ReadMode, SurfaceDesc, TexelFormat, TextureDesc};
+    use crate::sim::{Arg, Device, DevicePtr, LaunchConfig, SimError};
+
+    /// Lane 0 fetches texel 2 of a 1-D texture, loads and stores the element
+    /// at byte 4 of row 1 of a surface (`.trap`: in range of its extent).
+    const PTX: &str = ".version 7.8\n.target sm_90\n.address_size 64\n\
+        .visible .entry fetch(.param .u64 h)\n{\n.reg .b64 %rd<2>;\n.reg .b32 %r<2>;\n.reg .f32 %f<5>;\n\
+        ld.param.u64 %rd1, [h];\nmov.b32 %r1, 2;\ntex.1d.v4.f32.s32 {%f1, %f2, %f3, %f4}, [%rd1, {%r1}];\nret;\n}\n\
+        .visible .entry load(.param .u64 h)\n{\n.reg .b64 %rd<2>;\n.reg .b32 %r<4>;\n\
+        ld.param.u64 %rd1, [h];\nmov.b32 %r1, 4;\nmov.b32 %r2, 1;\nsuld.b.2d.b32.trap {%r3}, [%rd1, {%r1, %r2}];\nret;\n}\n\
+        .visible .entry store(.param .u64 h)\n{\n.reg .b64 %rd<2>;\n.reg .b32 %r<4>;\n\
+        ld.param.u64 %rd1, [h];\nmov.b32 %r1, 4;\nmov.b32 %r2, 1;\nmov.b32 %r3, 7;\n\
+        sust.b.2d.b32.trap [%rd1, {%r1, %r2}], {%r3};\nret;\n}\n";
+
+    /// A texel or surface element outside every allocation faults as a global
+    /// access out of bounds does (it read 0 and dropped the store).
+    #[test]
+    fn texels_and_surface_elements_outside_every_allocation_fault() {
+        let mut dev = Device::new();
+        let m = dev.load_ptx(PTX, "oob.ptx").unwrap();
+        let nowhere = 0xdead_0000_0000u64;
+        assert!(dev.memory().find(nowhere, 64).is_none());
+        let tex = dev.create_object_unchecked(Object::Texture(TextureDesc {
+            data: DevicePtr(nowhere),
+            format: TexelFormat::F32,
+            channels: 1,
+            dims: [4, 0, 0],
+            row_pitch: 0,
+            linear: true,
+            addr: [AddressMode::Clamp; 3],
+            filter: FilterMode::Point,
+            read: ReadMode::ElementType,
+            normalized: false,
+        }));
+        let surf = dev.create_object_unchecked(Object::Surface(SurfaceDesc {
+            data: DevicePtr(nowhere),
+            elem_bytes: 4,
+            dims: [2, 2, 0],
+            row_pitch: 0,
+        }));
+        // texel 2: 8 bytes in; surface byte 4 of row 1 (8-byte rows): 12 bytes in
+        for (kernel, h, addr) in
+            [("fetch", tex, nowhere + 8), ("load", surf, nowhere + 12), ("store", surf, nowhere + 12)]
+        {
+            let r = dev.launch(&m, kernel, LaunchConfig::linear(1, 1), &[Arg::U64(h)]);
+            let Err(SimError::Fault(f)) = r else { panic!("{kernel}: expected a fault, got {r:?}") };
+            assert_eq!(f.kind, FaultKind::OutOfBounds { space: MemSpace::Global, addr, size: 4 }, "{kernel}");
+            assert_eq!(f.lane, Some(0), "{kernel}");
+        }
+    }
 }
