@@ -262,3 +262,26 @@ fn the_ray_tracing_kernel_reports_nothing() {
         assert!(c.reports.is_empty(), "{v:?}: {:#?}", c.reports);
     }
 }
+
+/// `__syncwarp()` (`bar.warp.sync`) orders the lanes of a warp: lanes that
+/// swap values through shared memory across it do not race; the same kernel
+/// without it races between lanes of one warp (kernels/tests/planted_warp_race.cu).
+#[test]
+fn syncwarp_orders_the_lanes_of_a_warp() {
+    let dir = Path::new("tests/fixtures/sanitizer");
+    let (r, synced) = run(&dir.join("planted_warp_race_synced.toml"), &args("all", &[], None), 2, "out");
+    assert!(r.is_empty(), "across __syncwarp: {r:#?}");
+    // out[64c + t] = s[t ^ 1] = v(t ^ 1) + (t ^ 1), v(u) = s[u ^ 1] = 3 (u ^ 1) + c
+    let want: Vec<i32> = (0..128).map(|i| (3 * (i % 64) + i / 64 + ((i % 64) ^ 1))).collect();
+    assert_eq!(synced, want);
+    let (r, nosync) = run(&dir.join("planted_warp_race_nosync.toml"), &args("all", &[], None), 2, "out");
+    assert_eq!(nosync, want, "lockstep execution hides the race");
+    let race = |p: &[&str]| ("racecheck".into(), "shared race".into(), p.iter().map(|x| x.to_string()).collect());
+    let want: BTreeSet<Sig> =
+        [race(&["read@24", "write@23"]), race(&["read@26", "write@25"]), race(&["read@24", "write@25"])].into();
+    assert_eq!(warplight(&r), want, "{r:#?}");
+    for x in &r {
+        assert_eq!(x.sites[0].warp, x.sites[1].warp, "a race between lanes of one warp: {x}");
+        assert_eq!(x.sites[0].cta, x.sites[1].cta);
+    }
+}

@@ -108,6 +108,7 @@ fn writes(k: &Kind) -> Vec<RegId> {
         | Kind::Ret
         | Kind::Exit
         | Kind::Bar { .. }
+        | Kind::WarpSync { .. }
         | Kind::Membar
         | Kind::Nop
         | Kind::Trap => vec![],
