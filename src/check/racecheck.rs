@@ -151,9 +151,8 @@ impl Clocks {
         if y.warp as u32 == warp {
             // same warp, another lane: a barrier since orders them, and so does a warp
             // synchronisation of both lanes; one instruction does not race with itself
-            let synced = self.lanes[warp as usize]
-                .as_ref()
-                .is_some_and(|m| y.lane_clock <= m[lane as usize][y.lane as usize]);
+            let synced =
+                self.lanes[warp as usize].as_ref().is_some_and(|m| y.lane_clock <= m[lane as usize][y.lane as usize]);
             return y.clock == self.own(warp) && y.seq != seq && !synced;
         }
         y.clock > self.vc[warp as usize][y.warp as usize]
