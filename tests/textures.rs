@@ -226,8 +226,13 @@ fn indirect_calls_equal_the_h200() {
 
 #[test]
 fn txq_reports_the_dimensions() {
-    // The H200 returned 0 for every `txq` query through these texture objects
-    // (fixture case `txq`); warplight returns what the PTX ISA defines.
+    // tests/textures.cu's tex_query asks six queries in one kernel; the H200
+    // cannot load a kernel that asks channel_data_type, channel_order,
+    // normalized_coords, filter_mode, addr_mode_N or num_mipmap_levels of a
+    // texture object (cudaErrorSymbolNotFound, tests/fixtures/gpu_txq.txt), so
+    // the fixture's all-zero `txq` case is a buffer never written. warplight
+    // answers every query (width, height, depth as the H200 does; the others
+    // in its own numbering).
     let f = fixture();
     assert!(u32s(&case(&f, "txq")["results"]["f3d_linear_clamp"]).iter().all(|&v| v == 0));
     for d in BOTH {
@@ -237,6 +242,61 @@ fn txq_reports_the_dimensions() {
         let out = dev.alloc_zeroed::<u32>(6);
         run(&mut dev, d, "textures", "tex_query", 32, &[Arg::U64(t), Arg::Ptr(out)]);
         assert_eq!(dev.read::<u32>(out, 6), vec![3, 3, 2, TexelFormat::F32.code(), 1, 0], "{d:?}");
+    }
+}
+
+/// `txq.width/height/depth` on the six texture objects of
+/// tools/device/txq_probe.cu give what the H200 returned
+/// (tests/fixtures/gpu_txq.txt): a 1-D array's height is 1 and its depth 0,
+/// a 2-D array's depth 0, a linear resource's height and depth 0; and the
+/// other queries did not run there.
+#[test]
+fn txq_dimensions_equal_the_h200() {
+    const PTX: &str = ".version 7.8\n.target sm_90\n.address_size 64\n\
+        .visible .entry q(.param .u64 t, .param .u64 out) {\n.reg .b32 %r<4>;\n.reg .b64 %rd<3>;\n\
+        ld.param.u64 %rd1, [t];\nld.param.u64 %rd2, [out];\n\
+        txq.width.b32 %r1, [%rd1];\ntxq.height.b32 %r2, [%rd1];\ntxq.depth.b32 %r3, [%rd1];\n\
+        st.global.u32 [%rd2], %r1;\nst.global.u32 [%rd2+4], %r2;\nst.global.u32 [%rd2+8], %r3;\nret;\n}\n";
+    let text = std::fs::read_to_string("tests/fixtures/gpu_txq.txt").unwrap();
+    let rows: Vec<Vec<&str>> =
+        text.lines().filter(|l| !l.starts_with('#')).map(|l| l.split_whitespace().collect()).collect();
+    let gpu = |obj: &str, q: &str| rows.iter().find(|r| r[0] == obj && r[1] == q).map(|r| (r[2], r[3]));
+    use AddressMode::*;
+    use TexelFormat::*;
+    let objects: [(&str, TexelFormat, u32, [u32; 3], bool, AddressMode); 6] = [
+        ("f32_1d_w8_clamp_point", F32, 1, [8, 0, 0], false, Clamp),
+        ("f32x4_2d_5x3_clamp_linear", F32, 4, [5, 3, 0], false, Clamp),
+        ("f32_3d_3x3x2_border_linear_norm", F32, 1, [3, 3, 2], false, Border),
+        ("u8x4_2d_4x4_wrap_point_normread_norm", U8, 4, [4, 4, 0], false, Wrap),
+        ("s16x2_2d_7x2_mirror_point_norm", S16, 2, [7, 2, 0], false, Mirror),
+        ("f32_linear_16", F32, 1, [16, 0, 0], true, Clamp),
+    ];
+    for (name, format, channels, dims, linear, addr) in objects {
+        let mut dev = Device::new();
+        let data = dev.alloc_zeroed::<u8>(1024);
+        let t = dev.create_texture(TextureDesc {
+            data,
+            format,
+            channels,
+            dims,
+            row_pitch: 0,
+            linear,
+            addr: [addr; 3],
+            filter: FilterMode::Point,
+            read: ReadMode::ElementType,
+            normalized: false,
+        });
+        let m = dev.load_ptx(PTX, "txq.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(3);
+        dev.launch(&m, "q", LaunchConfig::linear(1, 1), &[Arg::U64(t), Arg::Ptr(out)]).unwrap();
+        let got = dev.read::<u32>(out, 3);
+        for (q, v) in ["width", "height", "depth"].into_iter().zip(got) {
+            assert_eq!(gpu(name, q), Some(("ok", v.to_string().as_str())), "{name} {q}");
+        }
+        // the rest failed to launch on the H200 (first object: the error ends the process)
+        for q in ["channel_data_type", "channel_order", "normalized_coords", "filter_mode", "num_mipmap_levels"] {
+            assert!(gpu(name, q).is_none_or(|(status, _)| status == "cudaErrorSymbolNotFound"), "{name} {q}");
+        }
     }
 }
 
