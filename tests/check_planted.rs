@@ -278,7 +278,7 @@ fn syncwarp_orders_the_lanes_of_a_warp() {
     let (r, synced) = run(&dir.join("planted_warp_race_synced.toml"), &args("all", &[], None), 2, "out");
     assert!(r.is_empty(), "across __syncwarp: {r:#?}");
     // out[64c + t] = s[t ^ 1] = v(t ^ 1) + (t ^ 1), v(u) = s[u ^ 1] = 3 (u ^ 1) + c
-    let want: Vec<i32> = (0..128).map(|i| (3 * (i % 64) + i / 64 + ((i % 64) ^ 1))).collect();
+    let want: Vec<i32> = (0..128).map(|i| 3 * (i % 64) + i / 64 + ((i % 64) ^ 1)).collect();
     assert_eq!(synced, want);
     // what the H200 computed (tests/fixtures/sanitizer/plain.txt)
     let plain = std::fs::read_to_string(dir.join("plain.txt")).unwrap();

@@ -263,7 +263,9 @@ fn txq_dimensions_equal_the_h200() {
     let gpu = |obj: &str, q: &str| rows.iter().find(|r| r[0] == obj && r[1] == q).map(|r| (r[2], r[3]));
     use AddressMode::*;
     use TexelFormat::*;
-    let objects: [(&str, TexelFormat, u32, [u32; 3], bool, AddressMode); 6] = [
+    // name, channel type and count, dimensions, linear resource, address mode
+    type Object<'a> = (&'a str, TexelFormat, u32, [u32; 3], bool, AddressMode);
+    let objects: [Object; 6] = [
         ("f32_1d_w8_clamp_point", F32, 1, [8, 0, 0], false, Clamp),
         ("f32x4_2d_5x3_clamp_linear", F32, 4, [5, 3, 0], false, Clamp),
         ("f32_3d_3x3x2_border_linear_norm", F32, 1, [3, 3, 2], false, Border),
