@@ -21,9 +21,13 @@
 //!
 //! Optional top-level limits hold for every launch: `max_instructions` (the
 //! watchdog, warp instructions per launch) and `max_call_depth` (nested
-//! device-function calls per warp); see `docs/limits.md`. `fmad = false` turns
+//! device-function calls per warp); see `docs/limits.md`.
+//! `[[texture]]` and `[[surface]]` tables describe texture and surface
+//! objects over buffers, passed to kernels by name ([`objects`]). `fmad = false` turns
 //! off ptxas's FMA contraction of unrounded `mul` + `add` pairs (on by default
 //! for the maxwell and hopper profiles; docs/semantics.md).
+
+pub mod objects;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -236,6 +240,8 @@ pub enum ArgSpec {
     Int(i64),
     /// A float scalar.
     Float(f64),
+    /// A texture or surface object's handle (`[[texture]]`, `[[surface]]`).
+    Object(String),
 }
 
 /// One launch.
@@ -266,6 +272,8 @@ pub struct Spec {
     pub buffers: Vec<BufferSpec>,
     /// `__constant__` variables of the module to fill before the launches (`[[constant]]`).
     pub constants: Vec<BufferSpec>,
+    /// Texture and surface objects over buffers (`[[texture]]`, `[[surface]]`).
+    pub objects: Vec<objects::ObjectSpec>,
     /// Launches in order.
     pub launches: Vec<LaunchSpec>,
     /// The watchdog: most warp instructions of one launch (`max_instructions`),
@@ -389,7 +397,7 @@ pub const MAX_PTX_BYTES: u64 = 256 << 20;
 pub const MAX_DYNAMIC_SHARED: u32 = 228 * 1024;
 
 /// The keys a spec knows: at the top, in `[[buffer]]` and in `[[launch]]` tables.
-const TOP_KEYS: [&str; 13] = [
+const TOP_KEYS: [&str; 15] = [
     "ptx",
     "device",
     "max_instructions",
@@ -397,6 +405,8 @@ const TOP_KEYS: [&str; 13] = [
     "fmad",
     "buffer",
     "constant",
+    "texture",
+    "surface",
     "launch",
     "kernel",
     "grid",
@@ -569,6 +579,7 @@ impl Spec {
         };
         let buffers = cx.buffers(&t, "buffer", dir)?;
         let constants = cx.buffers(&t, "constant", dir)?;
+        let objects = cx.objects(&t, &buffers)?;
         let launches = match t.get("launch") {
             Some(toml::Value::Array(a)) => a
                 .iter()
@@ -587,14 +598,20 @@ impl Spec {
         if launches.is_empty() {
             return cx.err("launch", "no launch: an empty list runs nothing; give at least one [[launch]] table");
         }
-        for (li, l) in launches.iter().enumerate() {
-            for (ai, a) in l.args.iter().enumerate() {
+        let mut launches = launches;
+        for (li, l) in launches.iter_mut().enumerate() {
+            for (ai, a) in l.args.iter_mut().enumerate() {
+                let key =
+                    if t.contains_key("launch") { format!("launch[{li}].args[{ai}]") } else { format!("args[{ai}]") };
+                if let ArgSpec::Buffer(n, off) = a
+                    && objects.iter().any(|o| &o.name == n)
+                {
+                    if *off != 0 {
+                        return cx.err(&key, format!("`{n}` is a texture or surface object: it takes no offset"));
+                    }
+                    *a = ArgSpec::Object(n.clone());
+                }
                 if let ArgSpec::Buffer(n, off) = a {
-                    let key = if t.contains_key("launch") {
-                        format!("launch[{li}].args[{ai}]")
-                    } else {
-                        format!("args[{ai}]")
-                    };
                     match buffers.iter().find(|b| &b.name == n) {
                         None => return cx.err(&key, format!("no buffer named `{n}`")),
                         Some(b) if *off > (b.len * b.ty.size()) as u64 => {
@@ -614,6 +631,7 @@ impl Spec {
             device,
             buffers,
             constants,
+            objects,
             launches,
             max_instructions,
             max_call_depth,
@@ -704,6 +722,8 @@ pub struct Prepared {
     pub module: Module,
     /// Buffer name → (device pointer, spec).
     pub buffers: BTreeMap<String, (DevicePtr, BufferSpec)>,
+    /// Texture and surface object name → handle.
+    pub objects: BTreeMap<String, u64>,
 }
 
 /// Loads the spec's PTX (a `.cu` is compiled with clang-16 first,
@@ -739,7 +759,15 @@ pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
         dev.write(p, &bytes)?;
         buffers.insert(b.name.clone(), (p, b.clone()));
     }
-    Ok(Prepared { module, buffers })
+    let mut objects = BTreeMap::new();
+    for o in &spec.objects {
+        let handle = match o.at(buffers[&o.buffer].0) {
+            crate::sim::texture::Object::Texture(t) => dev.create_texture(t),
+            crate::sim::texture::Object::Surface(s) => dev.create_surface(s),
+        };
+        objects.insert(o.name.clone(), handle);
+    }
+    Ok(Prepared { module, buffers, objects })
 }
 
 /// Host bytes the simulator holds for one resident CTA of `kernel` with
@@ -868,6 +896,15 @@ pub fn arguments(spec: &Spec, p: &Prepared, l: &LaunchSpec) -> Result<Vec<Arg>, 
                 (_, 1) => Arg::Bytes(vec![*x as u8]),
                 (t, s) => return Err(bad(format!("cannot pass an integer to `{}` (.{t}, {s} bytes)", prm.name))),
             },
+            ArgSpec::Object(n) => {
+                if prm.size != 8 {
+                    return Err(bad(format!(
+                        "object `{n}` passed to `{}`, a {}-byte .{} parameter (a handle is 8 bytes)",
+                        prm.name, prm.size, prm.ty
+                    )));
+                }
+                Arg::U64(p.objects[n])
+            }
             ArgSpec::Float(x) => match prm.ty {
                 Ty::F32 => Arg::F32(*x as f32),
                 Ty::F64 => Arg::F64(*x),

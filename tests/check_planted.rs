@@ -15,7 +15,7 @@ use warplight::launch_spec::{self, Spec};
 use warplight::model::Profile;
 use warplight::sim::Device;
 
-const PLANTED: [&str; 8] = [
+const PLANTED: [&str; 10] = [
     "planted_race_raw",
     "planted_race_waw",
     "planted_race_global",
@@ -24,6 +24,8 @@ const PLANTED: [&str; 8] = [
     "planted_oob",
     "planted_barrier_divergent",
     "planted_barrier_mismatch",
+    "planted_warp_race_synced",
+    "planted_warp_race_nosync",
 ];
 
 fn args(tools: &str, uninit: &[&str], seed: Option<u64>) -> CheckArgs {
@@ -148,7 +150,9 @@ fn planted_bugs_give_the_hazards_compute_sanitizer_reports() {
             "planted_uninit_shared" => assert_eq!(extra.len(), 1, "{k}: the uninitialised shared read: {extra:?}"),
             _ => assert!(extra.is_empty(), "{k}: {extra:?}"),
         }
-        assert!(!reports.is_empty(), "{k}: every planted kernel has a hazard");
+        // the one clean kernel: the lanes swap values across __syncwarp()
+        let clean = k == "planted_warp_race_synced";
+        assert_eq!(reports.is_empty(), clean, "{k}: every planted kernel but the synced swap has a hazard");
     }
 }
 
@@ -260,5 +264,44 @@ fn the_ray_tracing_kernel_reports_nothing() {
         let c = launch_checked(&mut dev, &module, v.kernel(), cfg, &bufs.launch_args(), &opts, None).unwrap();
         assert!(c.fault.is_none(), "{v:?}: {:?}", c.fault);
         assert!(c.reports.is_empty(), "{v:?}: {:#?}", c.reports);
+    }
+}
+
+/// `__syncwarp()` (`bar.warp.sync`) orders the lanes of a warp: lanes that
+/// swap values through shared memory across it do not race; the same kernel
+/// without it races between lanes of one warp (kernels/tests/planted_warp_race.cu;
+/// compute-sanitizer's racecheck reports the same three pairs on the H200 and
+/// nothing for the synced kernel: `planted_bugs_give_the_hazards_compute_sanitizer_reports`).
+#[test]
+fn syncwarp_orders_the_lanes_of_a_warp() {
+    let dir = Path::new("tests/fixtures/sanitizer");
+    let (r, synced) = run(&dir.join("planted_warp_race_synced.toml"), &args("all", &[], None), 2, "out");
+    assert!(r.is_empty(), "across __syncwarp: {r:#?}");
+    // out[64c + t] = s[t ^ 1] = v(t ^ 1) + (t ^ 1), v(u) = s[u ^ 1] = 3 (u ^ 1) + c
+    let want: Vec<i32> = (0..128).map(|i| 3 * (i % 64) + i / 64 + ((i % 64) ^ 1)).collect();
+    assert_eq!(synced, want);
+    // what the H200 computed (tests/fixtures/sanitizer/plain.txt)
+    let plain = std::fs::read_to_string(dir.join("plain.txt")).unwrap();
+    for k in ["planted_warp_race_synced", "planted_warp_race_nosync"] {
+        let section = plain.split(&format!("=== {k}\n")).nth(1).unwrap();
+        let gpu: Vec<i32> = section
+            .lines()
+            .next()
+            .unwrap()
+            .trim_start_matches("out:")
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(gpu, want, "{k} on the H200");
+    }
+    let (r, nosync) = run(&dir.join("planted_warp_race_nosync.toml"), &args("all", &[], None), 2, "out");
+    assert_eq!(nosync, want, "lockstep execution hides the race");
+    let race = |p: &[&str]| ("racecheck".into(), "shared race".into(), p.iter().map(|x| x.to_string()).collect());
+    let want: BTreeSet<Sig> =
+        [race(&["read@24", "write@23"]), race(&["read@26", "write@25"]), race(&["read@24", "write@25"])].into();
+    assert_eq!(warplight(&r), want, "{r:#?}");
+    for x in &r {
+        assert_eq!(x.sites[0].warp, x.sites[1].warp, "a race between lanes of one warp: {x}");
+        assert_eq!(x.sites[0].cta, x.sites[1].cta);
     }
 }

@@ -230,8 +230,13 @@ fn indirect_calls_equal_the_h200() {
 
 #[test]
 fn txq_reports_the_dimensions() {
-    // The H200 returned 0 for every `txq` query through these texture objects
-    // (fixture case `txq`); warplight returns what the PTX ISA defines.
+    // tests/textures.cu's tex_query asks six queries in one kernel; the H200
+    // cannot load a kernel that asks channel_data_type, channel_order,
+    // normalized_coords, filter_mode, addr_mode_N or num_mipmap_levels of a
+    // texture object (cudaErrorSymbolNotFound, tests/fixtures/gpu_txq.txt), so
+    // the fixture's all-zero `txq` case is a buffer never written. warplight
+    // answers every query (width, height, depth as the H200 does; the others
+    // in its own numbering).
     let f = fixture();
     assert!(u32s(&case(&f, "txq")["results"]["f3d_linear_clamp"]).iter().all(|&v| v == 0));
     for d in BOTH {
@@ -241,6 +246,63 @@ fn txq_reports_the_dimensions() {
         let out = dev.alloc_zeroed::<u32>(6);
         run(&mut dev, d, "textures", "tex_query", 32, &[Arg::U64(t), Arg::Ptr(out)]);
         assert_eq!(dev.read::<u32>(out, 6), vec![3, 3, 2, TexelFormat::F32.code(), 1, 0], "{d:?}");
+    }
+}
+
+/// `txq.width/height/depth` on the six texture objects of
+/// tools/device/txq_probe.cu give what the H200 returned
+/// (tests/fixtures/gpu_txq.txt): a 1-D array's height is 1 and its depth 0,
+/// a 2-D array's depth 0, a linear resource's height and depth 0; and the
+/// other queries did not run there.
+#[test]
+fn txq_dimensions_equal_the_h200() {
+    const PTX: &str = ".version 7.8\n.target sm_90\n.address_size 64\n\
+        .visible .entry q(.param .u64 t, .param .u64 out) {\n.reg .b32 %r<4>;\n.reg .b64 %rd<3>;\n\
+        ld.param.u64 %rd1, [t];\nld.param.u64 %rd2, [out];\n\
+        txq.width.b32 %r1, [%rd1];\ntxq.height.b32 %r2, [%rd1];\ntxq.depth.b32 %r3, [%rd1];\n\
+        st.global.u32 [%rd2], %r1;\nst.global.u32 [%rd2+4], %r2;\nst.global.u32 [%rd2+8], %r3;\nret;\n}\n";
+    let text = std::fs::read_to_string("tests/fixtures/gpu_txq.txt").unwrap();
+    let rows: Vec<Vec<&str>> =
+        text.lines().filter(|l| !l.starts_with('#')).map(|l| l.split_whitespace().collect()).collect();
+    let gpu = |obj: &str, q: &str| rows.iter().find(|r| r[0] == obj && r[1] == q).map(|r| (r[2], r[3]));
+    use AddressMode::*;
+    use TexelFormat::*;
+    // name, channel type and count, dimensions, linear resource, address mode
+    type Object<'a> = (&'a str, TexelFormat, u32, [u32; 3], bool, AddressMode);
+    let objects: [Object; 6] = [
+        ("f32_1d_w8_clamp_point", F32, 1, [8, 0, 0], false, Clamp),
+        ("f32x4_2d_5x3_clamp_linear", F32, 4, [5, 3, 0], false, Clamp),
+        ("f32_3d_3x3x2_border_linear_norm", F32, 1, [3, 3, 2], false, Border),
+        ("u8x4_2d_4x4_wrap_point_normread_norm", U8, 4, [4, 4, 0], false, Wrap),
+        ("s16x2_2d_7x2_mirror_point_norm", S16, 2, [7, 2, 0], false, Mirror),
+        ("f32_linear_16", F32, 1, [16, 0, 0], true, Clamp),
+    ];
+    for (name, format, channels, dims, linear, addr) in objects {
+        let mut dev = Device::new();
+        let data = dev.alloc_zeroed::<u8>(1024);
+        let t = dev.create_texture(TextureDesc {
+            data,
+            format,
+            channels,
+            dims,
+            row_pitch: 0,
+            linear,
+            addr: [addr; 3],
+            filter: FilterMode::Point,
+            read: ReadMode::ElementType,
+            normalized: false,
+        });
+        let m = dev.load_ptx(PTX, "txq.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(3);
+        dev.launch(&m, "q", LaunchConfig::linear(1, 1), &[Arg::U64(t), Arg::Ptr(out)]).unwrap();
+        let got = dev.read::<u32>(out, 3);
+        for (q, v) in ["width", "height", "depth"].into_iter().zip(got) {
+            assert_eq!(gpu(name, q), Some(("ok", v.to_string().as_str())), "{name} {q}");
+        }
+        // the rest failed to launch on the H200 (first object: the error ends the process)
+        for q in ["channel_data_type", "channel_order", "normalized_coords", "filter_mode", "num_mipmap_levels"] {
+            assert!(gpu(name, q).is_none_or(|(status, _)| status == "cudaErrorSymbolNotFound"), "{name} {q}");
+        }
     }
 }
 
@@ -261,11 +323,192 @@ fn texture_counters_equal_the_h200() {
         let out = dev.alloc_zeroed::<u32>(n);
         let module = load(&mut dev, "textures", d);
         let cfg = LaunchConfig::linear(m["grid"].as_u64().unwrap() as u32, m["block"].as_u64().unwrap() as u32);
+        let model = warplight::model::Model::new(warplight::model::Profile::Hopper, &module.prog);
         let s = dev
-            .launch(&module, "tex1d_f", cfg, &[Arg::U64(t), Arg::Ptr(x), Arg::Ptr(out), Arg::I32(n as i32)])
+            .launch_observed(
+                &module,
+                "tex1d_f",
+                cfg,
+                &[Arg::U64(t), Arg::Ptr(x), Arg::Ptr(out), Arg::I32(n as i32)],
+                Some(&model),
+            )
             .unwrap();
+        // the hopper profile lists them under the profiler's names too (`launch --all`, `--json`)
+        let named = model.finish().profiler_names(&s.totals);
         for name in ["smsp__inst_executed_op_texture.sum", "l1tex__t_requests_pipe_tex_mem_texture.sum"] {
             assert_eq!(s.totals.get(name), m["metrics"][name].as_u64(), "{name} ({d:?})");
+            assert_eq!(named.iter().find(|(n, _)| *n == name).map(|x| x.1), m["metrics"][name].as_u64(), "{name}");
+        }
+        for name in ["smsp__inst_executed_op_surface_ld.sum", "smsp__inst_executed_op_surface_st.sum"] {
+            assert_eq!(named.iter().find(|(n, _)| *n == name).map(|x| x.1), Some(0), "{name}");
         }
     }
+}
+
+/// A launch spec for a fixture case: the texels in a buffer of the format's
+/// width, the object a `[[texture]]` (or `[[surface]]`) table over it, the
+/// coordinates as buffers of their bits.
+fn case_spec(
+    d: Dialect,
+    c: &Value,
+    object: &str,
+    inputs: &[&str],
+    outputs: &[(&str, usize)],
+    scalars: &[i64],
+) -> String {
+    let o = &c[object];
+    let fmt = o["format"].as_str().unwrap();
+    let (buf_ty, fmt) = match fmt {
+        "f32" | "s32" => ("u32", fmt),
+        "f16" => ("u16", fmt),
+        "u8" => ("u8", fmt),
+        other => panic!("format {other}"),
+    };
+    let list = |v: &Value| u32s(v).iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", ");
+    let texels = list(&o["texels"]);
+    let n_texels = u32s(&o["texels"]).len();
+    let dims = u32s(&o["dims"]);
+    let n = c["x"].as_array().unwrap().len();
+    let mut s = format!(
+        "ptx = \"{}\"\nkernel = \"{}\"\ngrid = {}\nblock = 128\n",
+        common::path("textures", d),
+        c["kernel"].as_str().unwrap(),
+        n.div_ceil(128)
+    );
+    let mut args = vec!["\"obj\"".to_string()];
+    args.extend(inputs.iter().map(|k| format!("\"{k}\"")));
+    args.extend(outputs.iter().map(|(k, _)| format!("\"{k}\"")));
+    args.extend(scalars.iter().map(|x| x.to_string()));
+    s += &format!("args = [{}]\n", args.join(", "));
+    s += &format!("[[buffer]]\nname = \"texels\"\ntype = \"{buf_ty}\"\nlen = {n_texels}\ninit = [{texels}]\n");
+    for k in inputs {
+        s += &format!(
+            "[[buffer]]\nname = \"{k}\"\ntype = \"u32\"\nlen = {}\ninit = [{}]\n",
+            u32s(&c[*k]).len(),
+            list(&c[*k])
+        );
+    }
+    for (k, n) in outputs {
+        s += &format!("[[buffer]]\nname = \"{k}\"\ntype = \"u32\"\nlen = {n}\n");
+    }
+    s += &format!("[[{object}]]\nname = \"obj\"\nbuffer = \"texels\"\nformat = \"{fmt}\"\nwidth = {}\n", dims[0]);
+    for (key, v) in [("height", dims[1]), ("depth", dims[2])] {
+        if v != 0 {
+            s += &format!("{key} = {v}\n");
+        }
+    }
+    if object == "texture" {
+        s += &format!(
+            "channels = {}\naddress = \"{}\"\nfilter = \"{}\"\nread = \"{}\"\nnormalized_coords = {}\nlinear = {}\n",
+            o["channels"],
+            o["addr"].as_str().unwrap(),
+            o["filter"].as_str().unwrap(),
+            o["read"].as_str().unwrap(),
+            o["normalized"],
+            o["resource"] == "linear"
+        );
+    }
+    s
+}
+
+/// Runs a spec's text; returns its buffers' contents as u32 words.
+fn run_spec(text: &str, read: &[&str]) -> Vec<Vec<u32>> {
+    use warplight::launch_spec::{self, Spec};
+    let spec = Spec::parse(text, std::path::Path::new("spec.toml")).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    let mut dev = Device::new();
+    let p = launch_spec::prepare(&spec, &mut dev).unwrap();
+    launch_spec::run(&spec, &mut dev, &p, warplight::model::Profile::Hopper).unwrap_or_else(|e| panic!("{e}"));
+    read.iter()
+        .map(|k| {
+            let (ptr, b) = &p.buffers[*k];
+            let bytes: Vec<u8> = dev.read(*ptr, b.len * b.ty.size());
+            bytes.chunks(4).map(|w| u32::from_le_bytes(w.try_into().unwrap())).collect()
+        })
+        .collect()
+}
+
+/// Every texture case of the fixture through a launch spec (`[[texture]]`
+/// tables: format, channels, dimensions, address and filter modes, read
+/// mode, normalized coordinates, linear resources) gives the H200's results
+/// as the Rust API does.
+#[test]
+fn launch_specs_bind_textures_as_the_h200_ran_them() {
+    let f = fixture();
+    let mut ran = 0;
+    for d in BOTH {
+        for kernel in ["tex1d_f", "tex2d_f4", "tld4_f4", "tex2d_u4", "tex3d_f", "tex1dfetch_f"] {
+            for name in names(&f, kernel) {
+                let c = case(&f, &name);
+                let want = u32s(&c["out"]);
+                let n = c["x"].as_array().unwrap().len();
+                let inputs: Vec<&str> = ["x", "y", "z"].into_iter().filter(|k| c.get(*k).is_some()).collect();
+                let text = case_spec(d, c, "texture", &inputs, &[("out", want.len())], &[n as i64]);
+                let got = run_spec(&text, &["out"]).remove(0);
+                let linear = c["texture"]["filter"] == "linear" && kernel != "tld4_f4";
+                let (inexact, _) = compare(&name, d, &got, &want, linear, scale(&c["texture"]));
+                assert!(linear || inexact == 0, "{name}");
+                ran += 1;
+            }
+        }
+        // a surface: reads under .zero and .clamp
+        let c = case(&f, "surf_read");
+        let n = c["x"].as_array().unwrap().len();
+        let text = case_spec(d, c, "surface", &["x", "y"], &[("zero", n), ("clamp", n)], &[n as i64]);
+        let got = run_spec(&text, &["zero", "clamp"]);
+        assert_eq!(got[0], u32s(&c["zero"]), "surf_read .zero ({d:?})");
+        assert_eq!(got[1], u32s(&c["clamp"]), "surf_read .clamp ({d:?})");
+    }
+    assert_eq!(ran, 2 * 22);
+}
+
+/// The example spec (tests/fixtures/textures/lookup.toml) by hand: texels
+/// t[i] = i², linear filtering, clamped, at unnormalized coordinates
+/// (texel i's centre is i + 0.5), through `warplight launch`.
+#[test]
+fn the_texture_spec_example_filters_as_derived() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["launch", "tests/fixtures/textures/lookup.toml", "--print", "out", "--metrics", "ctas"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    // x = 0.5: t0; 1.0: (t0 + t1) / 2; 2.5: t2; 3.75: t3 + (t4 - t3) / 4; -3: clamped to t0; 9: clamped to t7
+    let words: Vec<&str> = text.split_whitespace().collect();
+    assert!(words.windows(7).any(|w| w == ["[0]", "0", "0.5", "4", "10.75", "0", "49"]), "{text}");
+}
+
+/// Spec errors name the table and key.
+#[test]
+fn texture_spec_errors_name_the_key() {
+    use warplight::launch_spec::Spec;
+    let base = "ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\nargs = [\"tex\"]\n\
+                [[buffer]]\nname = \"t\"\ntype = \"f32\"\nlen = 8\n[[texture]]\nname = \"tex\"\nbuffer = \"t\"\n";
+    let err =
+        |extra: &str| Spec::parse(&format!("{base}{extra}"), std::path::Path::new("s.toml")).unwrap_err().to_string();
+    assert!(Spec::parse(&format!("{base}format = \"f32\"\nwidth = 8\n"), std::path::Path::new("s.toml")).is_ok());
+    for (extra, want) in [
+        ("format = \"f64\"\nwidth = 8\n", "`texture[0].format`: expected one of u8"),
+        ("format = \"f32\"\nwidth = 9\n", "`texture[0].buffer`: `t` has 32 bytes; the object's texels span 36"),
+        (
+            "format = \"f32\"\nwidth = 2\nheight = 2\nrow_pitch = 4\n",
+            "`texture[0].row_pitch`: 4 bytes is less than a row",
+        ),
+        ("format = \"f32\"\nwidth = 8\naddress = \"wrap\"\n", "wrap and mirror need normalized_coords = true"),
+        ("format = \"f32\"\nwidth = 8\nread = \"normalized\"\n", "normalized reads are for 8- and 16-bit"),
+        ("format = \"f32\"\nwidth = 8\nchannels = 3\n", "`texture[0].channels`: expected 1, 2 or 4"),
+        (
+            "format = \"f32\"\nwidth = 8\nfliter = \"linear\"\n",
+            "`texture[0].fliter`: unknown key; did you mean `filter`?",
+        ),
+        ("format = \"f32\"\nwidth = 8\naddress = [\"clamp\", \"bounce\"]\n", "`texture[0].address`: expected clamp"),
+    ] {
+        let e = err(extra);
+        assert!(e.contains(want), "{extra}: {e}");
+    }
+    let e = Spec::parse(
+        &format!("{}format = \"f32\"\nwidth = 8\n", base.replace("[\"tex\"]", "[\"tex+4\"]")),
+        std::path::Path::new("s.toml"),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("`args[0]`: `tex` is a texture or surface object: it takes no offset"), "{e}");
 }

@@ -155,7 +155,14 @@ impl CtaCheck {
     #[allow(clippy::too_many_arguments)]
     fn byte_checks(&mut self, space: MemSpace, ev: &MemEvent, lane: u32, kind: racecheck::Kind, seq: u32) {
         let warp = ev.warp;
-        let x = Acc { warp: warp as u8, lane: lane as u8, clock: self.clocks.own(warp), seq, pc: (ev.func, ev.pc) };
+        let x = Acc {
+            warp: warp as u8,
+            lane: lane as u8,
+            clock: self.clocks.own(warp),
+            lane_clock: self.clocks.lane_clock(warp, lane),
+            seq,
+            pc: (ev.func, ev.pc),
+        };
         let base = ev.addrs[lane as usize];
         let race = self.tools.racecheck;
         let uninit_check = self.tools.initcheck && space == MemSpace::Shared && kind == racecheck::Kind::Read;
@@ -288,6 +295,12 @@ impl MemObserver for CtaCheck {
     fn barrier_arrive(&mut self, warp: u32, func: u32, pc: u32, _id: u32) {
         if self.tools.synccheck {
             self.arrivals.arrive(warp, (func, pc));
+        }
+    }
+
+    fn warp_sync(&mut self, warp: u32, lanes: u32) {
+        if self.tools.racecheck {
+            self.clocks.warp_sync(warp, lanes);
         }
     }
 

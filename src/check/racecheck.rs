@@ -4,10 +4,12 @@
 //! it released, so the verdict depends on which barriers separate the
 //! accesses and never on the order the scheduler happened to run them in
 //! (a race that lockstep scheduling hides is reported all the same). Threads
-//! of one warp are ordered by barriers only too (as on Volta and later GPUs,
-//! where a warp's threads need not run in lockstep), except that the lanes of
-//! one instruction do not race with each other. Between CTAs nothing orders
-//! plain accesses ([`CrossCta`]). Atomics never race.
+//! of one warp are ordered by barriers and by `bar.warp.sync` (`__syncwarp`)
+//! only, as on Volta and later GPUs, where a warp's threads need not run in
+//! lockstep: each lane carries a vector clock over its warp's lanes that a
+//! warp synchronisation merges among the lanes that passed it together. The
+//! lanes of one instruction do not race with each other. Between CTAs nothing
+//! orders plain accesses ([`CrossCta`]). Atomics never race.
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -23,6 +25,8 @@ pub struct Acc {
     pub lane: u8,
     /// The warp's own clock when it accessed.
     pub clock: u32,
+    /// The lane's own clock among its warp's lanes when it accessed ([`Clocks::lane_clock`]).
+    pub lane_clock: u32,
     /// The warp's memory-instruction count (same value: same instruction).
     pub seq: u32,
     /// The instruction.
@@ -33,7 +37,7 @@ impl Acc {
     /// Warp value of an empty slot.
     pub const NONE: u8 = u8::MAX;
     /// No access.
-    pub const EMPTY: Acc = Acc { warp: Acc::NONE, lane: 0, clock: 0, seq: 0, pc: (0, 0) };
+    pub const EMPTY: Acc = Acc { warp: Acc::NONE, lane: 0, clock: 0, lane_clock: 0, seq: 0, pc: (0, 0) };
 
     fn is_some(&self) -> bool {
         self.warp != Acc::NONE
@@ -64,10 +68,16 @@ impl Default for Cell {
     }
 }
 
-/// One vector clock per warp of a CTA (at most 32 warps).
+/// The vector clocks of one warp's lanes over its lanes (row: lane).
+type LaneClocks = [[u32; 32]; 32];
+
+/// One vector clock per warp of a CTA (at most 32 warps), and per lane of a
+/// warp one over the warp's lanes (made at the warp's first `bar.warp.sync`;
+/// until then every lane's own clock is 1 and it knows nothing of the others).
 #[derive(Debug, Clone)]
 pub struct Clocks {
     vc: Vec<[u32; 32]>,
+    lanes: Vec<Option<Box<LaneClocks>>>,
 }
 
 impl Clocks {
@@ -80,7 +90,35 @@ impl Clocks {
                 v
             })
             .collect();
-        Clocks { vc }
+        Clocks { vc, lanes: vec![None; warps] }
+    }
+
+    /// Lane `l` of warp `w`'s own clock among the warp's lanes.
+    pub fn lane_clock(&self, w: u32, l: u32) -> u32 {
+        self.lanes[w as usize].as_ref().map_or(1, |m| m[l as usize][l as usize])
+    }
+
+    /// Lanes `mask` of warp `w` passed a `bar.warp.sync` together: each learns
+    /// what the others did, then starts a new epoch of its own.
+    pub fn warp_sync(&mut self, w: u32, mask: u32) {
+        let m = self.lanes[w as usize].get_or_insert_with(|| {
+            let mut m = Box::new([[0u32; 32]; 32]);
+            for (l, row) in m.iter_mut().enumerate() {
+                row[l] = 1;
+            }
+            m
+        });
+        let mut merged = [0u32; 32];
+        let members = || (0..32usize).filter(|l| mask >> l & 1 != 0);
+        for l in members() {
+            for (x, y) in merged.iter_mut().zip(&m[l]) {
+                *x = (*x).max(*y);
+            }
+        }
+        for l in members() {
+            m[l] = merged;
+            m[l][l] += 1;
+        }
     }
 
     /// Warp `w`'s own clock.
@@ -111,8 +149,11 @@ impl Clocks {
             return false;
         }
         if y.warp as u32 == warp {
-            // same warp, another lane: a barrier since orders them; one instruction does not race with itself
-            return y.clock == self.own(warp) && y.seq != seq;
+            // same warp, another lane: a barrier since orders them, and so does a warp
+            // synchronisation of both lanes; one instruction does not race with itself
+            let synced =
+                self.lanes[warp as usize].as_ref().is_some_and(|m| y.lane_clock <= m[lane as usize][y.lane as usize]);
+            return y.clock == self.own(warp) && y.seq != seq && !synced;
         }
         y.clock > self.vc[warp as usize][y.warp as usize]
     }
@@ -274,7 +315,8 @@ mod tests {
     use super::*;
 
     fn acc(warp: u8, lane: u8, clocks: &Clocks, seq: u32) -> Acc {
-        Acc { warp, lane, clock: clocks.own(warp as u32), seq, pc: (0, seq) }
+        let lane_clock = clocks.lane_clock(warp as u32, lane as u32);
+        Acc { warp, lane, clock: clocks.own(warp as u32), lane_clock, seq, pc: (0, seq) }
     }
 
     #[test]
@@ -303,6 +345,44 @@ mod tests {
         let mut cell = Cell::default();
         access(&c, &mut cell, Kind::Write, acc(0, 0, &c, 1));
         assert_eq!(access(&c, &mut cell, Kind::Write, acc(0, 1, &c, 1)), [None, None]);
+    }
+
+    #[test]
+    fn a_warp_sync_orders_its_lanes_and_no_others() {
+        let mut c = Clocks::new(2);
+        let mut cell = Cell::default();
+        access(&c, &mut cell, Kind::Write, acc(0, 0, &c, 1));
+        // lanes 0 and 1 pass a __syncwarp(0b11) together: lane 1 reads lane 0's value
+        c.warp_sync(0, 0b11);
+        assert_eq!(access(&c, &mut cell, Kind::Read, acc(0, 1, &c, 2)), [None, None]);
+        // lane 2 was not in the mask: it races with lane 0's write ...
+        let mut other = Cell::default();
+        let mut c2 = Clocks::new(1);
+        access(&c2, &mut other, Kind::Write, acc(0, 0, &c2, 1));
+        c2.warp_sync(0, 0b11);
+        let h = access(&c2, &mut other, Kind::Read, acc(0, 2, &c2, 2));
+        assert_eq!(h[0].map(|x| x.0), Some(Hazard::ReadAfterWrite));
+        // ... and lane 0 writing again after the sync races with lane 1's read before the next one
+        let h = access(&c, &mut cell, Kind::Write, acc(0, 0, &c, 3));
+        assert_eq!(h[1].map(|x| x.0), Some(Hazard::WriteAfterRead));
+        // the sync orders lanes of its own warp only: warp 1 still races with warp 0
+        let h = access(&c, &mut cell, Kind::Read, acc(1, 1, &c, 1));
+        assert_eq!(h[0].map(|x| x.0), Some(Hazard::ReadAfterWrite));
+    }
+
+    #[test]
+    fn warp_syncs_order_transitively() {
+        let mut c = Clocks::new(1);
+        let mut cell = Cell::default();
+        access(&c, &mut cell, Kind::Write, acc(0, 0, &c, 1));
+        c.warp_sync(0, 0b011); // lanes 0, 1
+        c.warp_sync(0, 0b110); // lanes 1, 2: lane 2 now knows lane 0's past
+        assert_eq!(access(&c, &mut cell, Kind::Read, acc(0, 2, &c, 2)), [None, None]);
+        // a sync of lanes 1 and 2 alone orders nothing lane 0 did after the first one
+        access(&c, &mut cell, Kind::Write, acc(0, 0, &c, 3));
+        c.warp_sync(0, 0b110);
+        let h = access(&c, &mut cell, Kind::Read, acc(0, 2, &c, 4));
+        assert_eq!(h[0].map(|x| x.0), Some(Hazard::ReadAfterWrite));
     }
 
     #[test]

@@ -39,6 +39,10 @@ impl MemObserver for Both {
         self.first.barrier_release(id, warps);
         self.second.barrier_release(id, warps);
     }
+    fn warp_sync(&mut self, warp: u32, lanes: u32) {
+        self.first.warp_sync(warp, lanes);
+        self.second.warp_sync(warp, lanes);
+    }
 }
 
 impl ObserverFactory for Tee<'_> {

@@ -352,6 +352,7 @@ fn launch_header(i: usize, n: usize, l: &launch_spec::LaunchSpec) -> String {
             ArgSpec::Buffer(b, off) => format!("{b}+{off}"),
             ArgSpec::Int(v) => v.to_string(),
             ArgSpec::Float(v) => v.to_string(),
+            ArgSpec::Object(n) => n.clone(),
         })
         .collect();
     let threads: u64 = l.grid.iter().chain(&l.block).map(|&x| x as u64).product();

@@ -134,6 +134,7 @@ fn effect(k: &Kind) -> Effect {
         | Kind::Ret
         | Kind::Exit
         | Kind::Bar { .. }
+        | Kind::WarpSync { .. }
         | Kind::Membar => Effect::Boundary,
         _ => Effect::Unknown,
     }

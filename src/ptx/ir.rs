@@ -454,6 +454,11 @@ pub enum Kind {
     Exit,
     /// `bar.sync id[, count]` / `barrier.sync`.
     Bar { id: Src, count: Option<Src> },
+    /// `bar.warp.sync membermask`: the member lanes of the warp synchronise;
+    /// what they did before it happens before what they do after (PTX orders
+    /// their memory accesses). The emulator's lanes already run together, so
+    /// it only tells the race checker.
+    WarpSync { membermask: Src },
     /// `bar.red.op id[, count], a`: a barrier that also reduces predicate `a`
     /// over the CTA's arriving threads; `.popc` writes the count to `d`,
     /// `.and`/`.or` write predicate `p`.
@@ -507,7 +512,7 @@ impl Kind {
                 s(id);
                 count.iter().for_each(s)
             }
-            Kind::Vote { membermask, .. } => s(membermask),
+            Kind::Vote { membermask, .. } | Kind::WarpSync { membermask } => s(membermask),
             Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(s),
             Kind::Redux { a, membermask, .. } | Kind::Match { a, membermask, .. } => {
                 [a, membermask].into_iter().for_each(s)
@@ -607,6 +612,7 @@ impl Kind {
                 s(membermask, f);
                 x.iter_mut().for_each(|x| d(x, f))
             }
+            Kind::WarpSync { membermask } => s(membermask, f),
             Kind::Shfl { d: x, a, b, c, membermask, .. } => {
                 [a, b, c, membermask].into_iter().for_each(|y| s(y, f));
                 d(x, f)

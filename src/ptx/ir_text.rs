@@ -374,6 +374,7 @@ impl Names<'_> {
                 count.map(|c| format!(", {}", self.src(c))).unwrap_or_default(),
                 self.pred_src(*a)
             ),
+            Kind::WarpSync { membermask } => format!("warpsync mask {}", self.src(*membermask)),
             Kind::Membar => "membar".into(),
             Kind::Nop => "nop".into(),
             Kind::Trap => "trap".into(),

@@ -107,6 +107,7 @@ fn writes(k: &Kind) -> Vec<RegId> {
         | Kind::Ret
         | Kind::Exit
         | Kind::Bar { .. }
+        | Kind::WarpSync { .. }
         | Kind::Membar
         | Kind::Nop
         | Kind::Trap => vec![],

@@ -65,6 +65,10 @@ pub trait MemObserver: Send {
     /// Barrier `id` completed and released `warps` (ascending): what they
     /// did before it happens before what they do after. Default: nothing.
     fn barrier_release(&mut self, _id: u32, _warps: &[usize]) {}
+    /// Lanes `lanes` of warp `warp` executed one `bar.warp.sync` together:
+    /// what each did before it happens before what the others do after.
+    /// Default: nothing.
+    fn warp_sync(&mut self, _warp: u32, _lanes: u32) {}
 }
 
 /// Makes one observer per CTA and collects them when the CTA retires.

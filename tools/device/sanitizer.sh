@@ -12,8 +12,9 @@ set -uo pipefail
 export PATH=/usr/local/cuda/bin:$PATH
 OUT=${OUT:-/tmp/sanitizer_out}
 mkdir -p "$OUT"
-KERNELS="planted_race_raw planted_race_waw planted_race_global planted_uninit_global planted_uninit_shared
-  planted_oob planted_barrier_divergent planted_barrier_mismatch"
+# KERNELS (environment): run only these
+KERNELS=${KERNELS:-"planted_race_raw planted_race_waw planted_race_global planted_uninit_global planted_uninit_shared
+  planted_oob planted_barrier_divergent planted_barrier_mismatch planted_warp_race_synced planted_warp_race_nosync"}
 {
   date -u
   nvidia-smi --query-gpu=name,driver_version,compute_cap --format=csv

@@ -14,6 +14,7 @@
 #include "../../kernels/tests/planted_oob.cu"
 #include "../../kernels/tests/planted_barrier_divergent.cu"
 #include "../../kernels/tests/planted_barrier_mismatch.cu"
+#include "../../kernels/tests/planted_warp_race.cu"
 
 static int *device_ints(size_t n, const std::vector<int> *init) {
   int *p = nullptr;
@@ -81,6 +82,14 @@ int main(int argc, char **argv) {
     two_barriers<<<1, 64>>>(out);
     cudaDeviceSynchronize();
     print_ints("out", out, 64);
+  } else if (!strcmp(k, "planted_warp_race_synced") || !strcmp(k, "planted_warp_race_nosync")) {
+    int *out = device_ints(128, &zeros);
+    if (!strcmp(k, "planted_warp_race_synced"))
+      warp_swap_synced<<<2, 64>>>(out);
+    else
+      warp_swap_nosync<<<2, 64>>>(out);
+    cudaDeviceSynchronize();
+    print_ints("out", out, 128);
   } else {
     fprintf(stderr, "unknown kernel %s\n", k);
     return 2;

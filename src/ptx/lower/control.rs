@@ -24,7 +24,7 @@ impl FnLower<'_> {
             Ret => Kind::Ret,
             Exit => Kind::Exit,
             Trap => Kind::Trap,
-            Bar | Barrier if m.has("warp") => Kind::Nop, // bar.warp.sync: the warp executes in lockstep here
+            Bar | Barrier if m.has("warp") => Kind::WarpSync { membermask: self.src(&ops[0], Ty::U32, pos)? },
             Bar | Barrier if m.has("red") => {
                 let op = if m.has("popc") {
                     BarRedOp::Popc

@@ -258,7 +258,11 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             }
         }
         Call | Ret => only(d, &["uni"], i)?,
-        Bar | Barrier if m.has("warp") => {} // bar.warp.sync
+        Bar | Barrier if m.has("warp") => {
+            // bar.warp.sync membermask
+            only(d, &["warp", "sync"], i)?;
+            operands(i, 1)?;
+        }
         Bar | Barrier if m.has("red") => {
             only(d, &["red", "popc", "and", "or", "aligned", "sync"], i)?;
             let t = one_type(d, i)?;

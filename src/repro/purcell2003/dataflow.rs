@@ -99,6 +99,7 @@ fn writes(k: &Kind) -> Vec<Var> {
         | Kind::Ret
         | Kind::Exit
         | Kind::Bar { .. }
+        | Kind::WarpSync { .. }
         | Kind::Membar
         | Kind::Nop
         | Kind::Trap => vec![],

@@ -86,6 +86,19 @@ pub(super) fn member_mask(ctx: &Ctx, w: &Warp, cta: &CtaMut, mask: Src, exec: u3
     Ok(())
 }
 
+/// `bar.warp.sync`: the lanes run together already; an observer (the race
+/// checker) learns which of the member lanes passed it together. Lanes of the
+/// mask that are not executing it (divergent code) are not waited for.
+pub(super) fn warp_sync(ctx: &Ctx, w: &Warp, cta: &mut CtaMut, mask: Src, exec: u32) {
+    if cta.observer.is_none() {
+        return;
+    }
+    let m = read(ctx, w, cta, mask)[exec.trailing_zeros() as usize] as u32;
+    if let Some(obs) = cta.observer.as_deref_mut() {
+        obs.warp_sync(w.id, exec & m);
+    }
+}
+
 /// `membar`/`fence`: waits for this CTA's outstanding global atomics.
 pub(super) fn membar(w: &mut Warp, cta: &mut CtaMut) -> Effect {
     if !cta.pending.is_empty() {

@@ -528,6 +528,7 @@ fn exec_ir(
         Kind::Sust { geom, ty, vals, handle, coords, clamp } => {
             texture::sust(ctx, w, cta, *geom, *ty, vals, *handle, coords, *clamp, exec)?
         }
+        Kind::WarpSync { membermask } => control::warp_sync(ctx, w, cta, *membermask, exec),
         Kind::Membar => return Ok(control::membar(w, cta)),
         Kind::Nop => {}
         Kind::Trap => return Err(fault(FaultKind::Trap, lane_of_mask(exec))),

@@ -121,9 +121,12 @@ pub(super) fn txq(
     for l in lanes(exec) {
         let t = tex_of(ctx, h[l], l)?;
         out[l] = match query {
+            // as the H200 answers (tests/fixtures/gpu_txq.txt): a CUDA array's height is
+            // at least 1, its depth 0 unless 3-D; a linear resource has neither
             TxqQuery::Width => t.dims[0].max(1),
+            TxqQuery::Height if t.linear => 0,
             TxqQuery::Height => t.dims[1].max(1),
-            TxqQuery::Depth => t.dims[2].max(1),
+            TxqQuery::Depth => t.dims[2],
             TxqQuery::ChannelDataType => t.format.code(),
             TxqQuery::ChannelOrder => t.channels,
             TxqQuery::NormalizedCoords => t.normalized as u32,
