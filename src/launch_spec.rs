@@ -761,10 +761,16 @@ pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
     }
     let mut objects = BTreeMap::new();
     for o in &spec.objects {
-        let handle = match o.at(buffers[&o.buffer].0) {
-            crate::sim::texture::Object::Texture(t) => dev.create_texture(t),
-            crate::sim::texture::Object::Surface(s) => dev.create_surface(s),
+        let (handle, table) = match o.at(buffers[&o.buffer].0) {
+            crate::sim::texture::Object::Texture(t) => (dev.create_texture(t), "texture"),
+            crate::sim::texture::Object::Surface(s) => (dev.create_surface(s), "surface"),
         };
+        // the spec's checks come first; the device's own are the last word
+        let handle = handle.map_err(|e| SpecError::Key {
+            file: spec.file.display().to_string(),
+            key: format!("{table} `{}`", o.name),
+            msg: e.to_string(),
+        })?;
         objects.insert(o.name.clone(), handle);
     }
     Ok(Prepared { module, buffers, objects })

@@ -291,7 +291,8 @@ fn txq_dimensions_equal_the_h200() {
             filter: FilterMode::Point,
             read: ReadMode::ElementType,
             normalized: false,
-        });
+        })
+        .unwrap();
         let m = dev.load_ptx(PTX, "txq.ptx").unwrap();
         let out = dev.alloc_zeroed::<u32>(3);
         dev.launch(&m, "q", LaunchConfig::linear(1, 1), &[Arg::U64(t), Arg::Ptr(out)]).unwrap();
