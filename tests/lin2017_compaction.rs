@@ -35,7 +35,7 @@ fn flag_scan_scatter_is_a_stable_stream_compaction() {
             x ^= x << 13;
             x ^= x >> 17;
             x ^= x << 5;
-            let on = x % 3 == 0;
+            let on = x.is_multiple_of(3);
             for k in 0..STATE_FLOATS - 1 {
                 states[j * STATE_FLOATS + k] = (j * STATE_FLOATS + k) as f32;
             }

@@ -10,8 +10,8 @@ use warplight::host::scene::{Light, Material, MaterialKind, Scene, Triangle};
 use warplight::host::scene_file;
 use warplight::repro::purcell2003::image;
 use warplight::repro::purcell2003::native;
-use warplight::repro::purcell2003::photons::{self, Geometry};
 use warplight::repro::purcell2003::passes::Passes;
+use warplight::repro::purcell2003::photons::{self, Geometry};
 use warplight::repro::purcell2003::scenes::FIXTURES;
 
 fn bits(v: &[[f32; 4]]) -> Vec<u32> {
@@ -28,8 +28,8 @@ fn emulated_and_native_images_of_the_three_scenes_are_bit_for_bit_alike() {
         assert_eq!(bits(&q.query), bits(&r.queries.query), "{}: query points", f.scene);
         assert_eq!(bits(&q.normal), bits(&r.queries.normal), "{}: normals", f.scene);
         assert_eq!(bits(&direct), bits(&r.direct), "{}: shadow rays", f.scene);
-        for m in 0..2 {
-            assert_eq!(states[m], r.states[m], "{}: map {m}'s final states", f.scene);
+        for (m, (n, e)) in states.iter().zip(&r.states).enumerate() {
+            assert_eq!(n, e, "{}: map {m}'s final states", f.scene);
         }
         let (e, n) = (image::images(&r), image::native_images(&scene, &r));
         for m in 0..2 {
@@ -54,7 +54,13 @@ fn floor_and_blocker(albedo: f32, intensity: f32) -> Scene {
     let mut tris =
         quad(Vec3::new(-s, 0.0, -s), Vec3::new(-s, 0.0, s), Vec3::new(s, 0.0, s), Vec3::new(s, 0.0, -s), 0).to_vec();
     let (a, b) = (0.4, 0.6);
-    tris.extend(quad(Vec3::new(a, 0.5, -0.1), Vec3::new(a, 0.5, 0.1), Vec3::new(b, 0.5, 0.1), Vec3::new(b, 0.5, -0.1), 0));
+    tris.extend(quad(
+        Vec3::new(a, 0.5, -0.1),
+        Vec3::new(a, 0.5, 0.1),
+        Vec3::new(b, 0.5, 0.1),
+        Vec3::new(b, 0.5, -0.1),
+        0,
+    ));
     let m = Material { name: "floor".into(), kind: MaterialKind::Diffuse, color: [albedo; 3], emission: [0.0; 3] };
     let mut sc = Scene::assemble("floor", std::path::Path::new("floor"), tris, vec![m]);
     sc.lights.push(Light::Point { position: [0.0, 1.0, 0.0], intensity: [intensity; 3] });
@@ -98,4 +104,48 @@ fn shadow_rays_give_the_point_lights_direct_light_and_its_shadow() {
     assert!((got[3][0] - want(pts[3])).abs() < 1e-5 * want(pts[3]));
     // the native mirror gives the same bits
     assert_eq!(bits(&native::shadow_rays(&geo, &q, 1, 5)), bits(&got));
+}
+
+/// Saturation against convergence (004:L182): with the display clamped at 1,
+/// bright pixels show their final colour passes before their search ends,
+/// and the displayed image is final before every pixel has finished.
+#[test]
+fn saturated_pixels_show_their_final_colour_before_they_finish() {
+    let f = FIXTURES[0];
+    let scene = scene_file::load(&scene_file::resolve(f.scene)).unwrap();
+    let r = image::render_with(&scene, &f.reduced(100), 24, true).unwrap();
+    let iters = r.params.iters as i32;
+    for m in 0..2 {
+        let frames = &r.progress[m];
+        assert_eq!(frames.len(), r.finished_after[m].len(), "one running image per pass");
+        let last = frames.last().unwrap();
+        let shown: Vec<Vec<u8>> = frames.iter().map(|f| f.to_srgb8(0.0)).collect();
+        let fin = &shown[shown.len() - 1];
+        let (mut early, mut saturated) = (0, 0);
+        let mut visual = 0;
+        for (i, px) in last.pixels.iter().enumerate() {
+            // the pass from which the displayed colour stays final
+            let v = (0..shown.len()).rev().take_while(|&p| shown[p][3 * i..3 * i + 3] == fin[3 * i..3 * i + 3]).last();
+            let v = v.map_or(shown.len(), |p| p + 1);
+            visual = visual.max(v);
+            let done = (r.states[m][i].used + iters - 1) / iters;
+            if px.iter().any(|&c| c >= 1.0) && done > 1 {
+                saturated += 1;
+                if (v as i32) < done {
+                    early += 1;
+                }
+            }
+        }
+        eprintln!(
+            "map {m}: {early} of {saturated} saturated pixels final early; display final after pass {visual} of {}",
+            frames.len()
+        );
+        assert!(saturated > 0, "map {m}: bright pixels saturate");
+        assert!(early > 0, "map {m}: saturated pixels show their final colour before they finish");
+        assert!(visual <= frames.len());
+        let c = image::convergence(frames, &r.finished_after[m]);
+        assert_eq!(c.last().unwrap().rel_rmse, 0.0);
+        assert_eq!(c.last().unwrap().displayed_off, 0.0);
+        assert!(c.iter().all(|p| (0.0..=1.0).contains(&p.displayed_off)));
+    }
 }

@@ -5,7 +5,8 @@
 //!   of `purcell:1` (a, b, c) and `purcell:2` gives the verdict
 //!   `docs/results/purcell-baseline-reduced.json` records, cell for cell (a
 //!   verdict that moves either way fails until the baseline is re-recorded:
-//!   `WARPLIGHT_RECORD_BASELINE=1 cargo test --release --test purcell2003_tables`);
+//!   `WARPLIGHT_RECORD_BASELINE=1 cargo test --release --test purcell2003_tables`;
+//!   `WARPLIGHT_PURCELL_RESULTS=FILE` also writes the run's raw results);
 //! - the quick protocol's committed raw results
 //!   (`docs/results/purcell-quick.json`), rendered by `warplight tables
 //!   purcell:1 purcell:2 --from`, keep every cell that
@@ -22,7 +23,7 @@ use warplight::repro::registry::{Workspace, resolve};
 use warplight::repro::results::{Results, SceneInfo};
 use warplight::repro::table::Table;
 
-/// Photons (stored, pilot) and photons sought divided by this.
+/// Photons (stored, pilot) and photons sought divided by this (docs/fixtures.md).
 const DIV: u32 = 100;
 /// Image width of the reduced run.
 const SIDE: u32 = 16;
@@ -77,6 +78,10 @@ fn reduced_run_verdicts_are_the_baselines() {
     let scenes: Vec<String> = r.scenes.iter().map(|s| s.name.clone()).collect();
     let now = Baseline::record(&r.protocol.describe(), &scenes, &tables);
     let file = root().join(REDUCED);
+    // the raw results, for `warplight tables purcell:1 purcell:2 --from FILE`
+    if let Some(out) = std::env::var_os("WARPLIGHT_PURCELL_RESULTS") {
+        std::fs::write(out, serde_json::to_string_pretty(&r).unwrap()).unwrap();
+    }
     if std::env::var_os("WARPLIGHT_RECORD_BASELINE").is_some() {
         std::fs::write(&file, serde_json::to_string_pretty(&now).unwrap() + "\n").unwrap();
         eprintln!("recorded {}", file.display());

@@ -365,3 +365,26 @@ fn textured_scenes_match_the_native_caster() {
     assert_eq!(warplight::host::scene::Texture::index(w, h, 1.25, 1.999), (w / 4) as usize);
     assert_eq!(warplight::host::scene::Texture::index(w, h, -0.001, 0.999), (w - 1) as usize);
 }
+
+#[test]
+fn scene_info_lists_sibeniks_textures_and_reflection_weights() {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["scene", "info", "sibenik"])
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{out}{}", String::from_utf8_lossy(&o.stderr));
+    let line = |name: &str| {
+        out.lines().find(|l| l.split_whitespace().next() == Some(name)).unwrap_or_else(|| panic!("{name}: {out}"))
+    };
+    // the MTL's illum-4 glass reflects with its Ks; the marble floor with the scene file's weight, textured
+    assert!(line("staklo").ends_with("1687 triangles  reflect [0.784, 0.784, 0.784]"), "{out}");
+    assert!(
+        line("pod").ends_with("251 triangles  texture textures/mramor6x6.png  reflect [0.25, 0.25, 0.25]"),
+        "{out}"
+    );
+    assert!(!line("pod_tepih").contains("reflect") && !line("pod_tepih").contains("texture"), "{out}");
+    assert!(out.contains("materials  16 (8 textured, 6 reflecting"), "{out}");
+    assert!(out.contains("textures   3 (2.6 MB of 32-bit texels)"), "{out}");
+    assert!(line("textures/KAMEN-stup.png").contains("512 x 256 "), "{out}");
+}

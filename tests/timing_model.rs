@@ -255,6 +255,16 @@ fn results_without_the_timing_counters_give_no_frame_rates() {
     assert!(fab_timing::fps(&r, fab::TRAVERSAL, "scene6", "stack").is_nan());
 }
 
+#[test]
+fn frame_rate_tables_run_with_the_texture_cache_model() {
+    // the model charges texture misses more latency: a run of 4.1 or 4.6
+    // alone without the cache model would count no misses and predict too fast
+    for t in ["fabianowski:4.1", "fabianowski:4.6", "fabianowski:4.10"] {
+        let e = registry::resolve(&[t.to_string()]).unwrap()[0];
+        assert_eq!(registry::lowest_fidelity(&e), warplight::sim::Fidelity::Caches, "{t}");
+    }
+}
+
 /// Runs the chapter-4 kernels at `TIMING_RES` (128) over `TIMING_FRAMES` (3)
 /// frames of `TIMING_SCENES` (scene6,sponza,sibenik,conference) and writes the
 /// timing counters as a results file to `TIMING_OUT`, for
@@ -348,4 +358,99 @@ fn measure_chapter_4_frames() {
     r.normalise();
     std::fs::write(&out, serde_json::to_string_pretty(&r).unwrap()).unwrap();
     eprintln!("wrote {out}");
+}
+
+/// Where a chapter-4 kernel's waits and instructions come from: renders frame
+/// 0 of `TIMING_SCENES`' first scene with `TIMING_VARIANT` (stack) at each of
+/// `TIMING_RES` (a list, 48), prints the counters per pixel, the model's
+/// prediction at 512 x 512, the seconds the emulator took, and at the last
+/// resolution the busiest wait points (CUDA line, PTX line, opcode) and the
+/// warp instructions per opcode. A diagnostic for `docs/timing-model.md`'s
+/// analysis of the absolute frame rates.
+#[test]
+#[ignore = "diagnostic: prints where a kernel's waits come from"]
+fn where_the_waits_come_from() {
+    use warplight::host::kdtree::Heuristic;
+    use warplight::host::rt_kernels::{self, Variant};
+    use warplight::host::scene_file;
+    use warplight::model::Profile;
+    use warplight::sim::Device;
+    use warplight::timing::waits::{WaitSite, wait_sites};
+    let env = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
+    let name = env("TIMING_SCENES", "sibenik");
+    let name = name.split(',').next().unwrap();
+    let vname = env("TIMING_VARIANT", "stack");
+    let v = Variant::ALL.iter().chain(Variant::CACHES.iter()).find(|v| v.name() == vname).copied().unwrap();
+    let scene = scene_file::load(&scene_file::resolve(name)).unwrap();
+    let resolutions: Vec<u32> = env("TIMING_RES", "48").split(',').map(|r| r.parse().unwrap()).collect();
+    let last = *resolutions.last().unwrap();
+    for res in resolutions {
+        let mut ws = warplight::repro::registry::Workspace::new(&scene, 0..1, res);
+        ws.build(Heuristic::Siroh);
+        let cam = fab::flight::camera(&scene, 0, res);
+        let mut dev = Device::with_config(rt_kernels::sim_config(&cam));
+        let module = rt_kernels::load(&mut dev).unwrap();
+        let start = std::time::Instant::now();
+        let k = rt_kernels::render(
+            &mut dev,
+            &module,
+            &scene,
+            ws.tree(Heuristic::Siroh),
+            &cam,
+            scene.flight.light_offset(0),
+            v,
+            Profile::Gt200,
+        )
+        .unwrap();
+        let secs = start.elapsed().as_secs_f64();
+        let prog = &module.prog;
+        let c = fab_timing::counts_of(prog, &k.launch, &k.memory);
+        let px = (res * res) as f64;
+        let at512 = c.scaled(512.0 * 512.0 / px);
+        let p = predict(&GTX_280, &Launch { counts: at512, shape: THESIS_LAUNCH }).unwrap();
+        eprintln!(
+            "{name} {vname} {res}x{res} in {secs:.1} s: per pixel {:.1} warp instructions, {:.2} texture waits, {:.2} global waits, {:.1} texel fetches, {:.2} texture misses, {:.0} DRAM bytes; at 512x512 {:.1} fps ({:?}, issue {:.0} %)",
+            c.warp_instructions / px,
+            c.texture_waits / px,
+            c.global_waits / px,
+            c.texel_fetches / px,
+            c.texture_misses / px,
+            c.dram_bytes / px,
+            p.fps(),
+            p.bound,
+            p.issue_utilisation * 100.0
+        );
+        if res != last {
+            continue;
+        }
+        let mut sites = wait_sites(prog, &k.launch.profile);
+        let n = |s: &WaitSite| s.waits.global + s.waits.texture + s.waits.shared;
+        sites.sort_by_key(|s| std::cmp::Reverse(n(s)));
+        let total: u64 = sites.iter().map(n).sum();
+        eprintln!("{total} waits at {} points", sites.len());
+        for s in sites.iter().take(30) {
+            let info = &prog.functions[s.function].info[s.pc];
+            eprintln!(
+                "{:>9} {:5.1}%  {:?}  cu {:?}  ptx {}  {}",
+                n(s),
+                n(s) as f64 / total as f64 * 100.0,
+                s.waits,
+                info.src.map(|l| l.line),
+                info.ptx_line,
+                info.opcode
+            );
+        }
+        let mut ops: BTreeMap<String, u64> = BTreeMap::new();
+        for (f, counts) in prog.functions.iter().zip(&k.launch.profile.per_fn) {
+            for (info, c) in f.info.iter().zip(counts) {
+                *ops.entry(info.opcode.clone()).or_default() += c.warp;
+            }
+        }
+        let mut ops: Vec<_> = ops.into_iter().filter(|(_, c)| *c > 0).collect();
+        ops.sort_by_key(|(_, c)| std::cmp::Reverse(*c));
+        let all: u64 = ops.iter().map(|(_, c)| c).sum();
+        for (o, c) in ops {
+            eprintln!("{c:>10} {:5.2}%  {o}", c as f64 / all as f64 * 100.0);
+        }
+    }
 }

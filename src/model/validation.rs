@@ -108,7 +108,7 @@ pub enum ValidationError {
     },
     /// The PTX does not load (the message names the file and line).
     #[error(transparent)]
-    Ptx(SimError),
+    Ptx(Box<SimError>),
     /// A launch of the fixture failed on the emulator.
     #[error("{}: launch {launch} (`{kernel}`): {source}", fixture.display())]
     Launch {
@@ -119,7 +119,7 @@ pub enum ValidationError {
         /// Its kernel.
         kernel: String,
         /// Why (names the PTX file where it is about the PTX).
-        source: SimError,
+        source: Box<SimError>,
     },
 }
 
@@ -141,7 +141,7 @@ pub fn compare(fixture: &Path, ptx: &Path) -> Result<Vec<Row>, ValidationError> 
         let (a, b) = (l["a"].as_i64().unwrap_or(0), l["b"].as_i64().unwrap_or(0));
         let (grid, block) = (l["grid"].as_u64().unwrap_or(64) as u32, l["block"].as_u64().unwrap_or(256) as u32);
         let mut dev = Device::new();
-        let m = dev.load_ptx(&src, &ptx.display().to_string()).map_err(ValidationError::Ptx)?;
+        let m = dev.load_ptx(&src, &ptx.display().to_string()).map_err(|e| ValidationError::Ptx(Box::new(e)))?;
         let n = 1usize << 20;
         let out = dev.alloc_zeroed::<f32>(n);
         let inb = dev.alloc_zeroed::<f32>(n);
@@ -152,7 +152,7 @@ pub fn compare(fixture: &Path, ptx: &Path) -> Result<Vec<Row>, ValidationError> 
                 fixture: fixture.to_path_buf(),
                 launch: id,
                 kernel: kernel.clone(),
-                source,
+                source: Box::new(source),
             },
         )?;
         let stats = model.finish();

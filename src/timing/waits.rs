@@ -86,17 +86,44 @@ fn wait_points(f: &Function) -> Vec<Option<Space>> {
 /// The waits of a launch: each wait point's warp executions.
 pub fn waits(prog: &Program, profile: &InstProfile) -> Waits {
     let mut w = Waits::default();
-    for (f, counts) in prog.functions.iter().zip(&profile.per_fn) {
-        for (point, c) in wait_points(f).iter().zip(counts) {
+    for site in wait_sites(prog, profile) {
+        w.global += site.waits.global;
+        w.texture += site.waits.texture;
+        w.shared += site.waits.shared;
+    }
+    w
+}
+
+/// One instruction where warps wait on loads, and how often they did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WaitSite {
+    /// Index into [`Program::functions`].
+    pub function: usize,
+    /// The instruction's index in its function.
+    pub pc: usize,
+    /// Its warp executions, under the slowest space waited on.
+    pub waits: Waits,
+}
+
+/// The wait points of `prog` that `profile` executed, in program order
+/// (what [`waits`] sums; for finding where a kernel's waits come from).
+pub fn wait_sites(prog: &Program, profile: &InstProfile) -> Vec<WaitSite> {
+    let mut out = Vec::new();
+    for (fi, (f, counts)) in prog.functions.iter().zip(&profile.per_fn).enumerate() {
+        for (pc, (point, c)) in wait_points(f).iter().zip(counts).enumerate() {
+            let mut w = Waits::default();
             match point {
-                Some(Space::Global) => w.global += c.warp,
-                Some(Space::Texture) => w.texture += c.warp,
-                Some(Space::Shared) => w.shared += c.warp,
-                None => {}
+                Some(Space::Global) => w.global = c.warp,
+                Some(Space::Texture) => w.texture = c.warp,
+                Some(Space::Shared) => w.shared = c.warp,
+                None => continue,
+            }
+            if c.warp > 0 {
+                out.push(WaitSite { function: fi, pc, waits: w });
             }
         }
     }
-    w
+    out
 }
 
 #[cfg(test)]

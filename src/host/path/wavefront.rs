@@ -73,7 +73,7 @@ pub struct Level {
     pub active: u64,
     /// Warps that issued the `live` line (warps with at least one active path).
     pub busy_warps: u64,
-    /// Warps launched for the level.
+    /// Warps holding the level's threads (those of a CTA beyond `n` return at once).
     pub warps: u64,
     /// Warp instructions of the level's `path_level` launch.
     pub warp_instructions: u64,
@@ -198,7 +198,7 @@ pub fn level(
         threads: n as u64,
         active: get(|c| c.pred_on),
         busy_warps: get(|c| c.warp),
-        warps: st.totals.warps,
+        warps: (n as u64).div_ceil(WARP),
         warp_instructions: st.totals.warp_instructions,
         thread_instructions: st.totals.thread_instructions,
         compact_warp_instructions: 0,

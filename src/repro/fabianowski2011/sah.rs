@@ -149,13 +149,12 @@ impl Builder<'_> {
         let p_p = self.prob(&bounds);
         let split = if n > self.p.leaf_size && depth < self.p.max_depth { self.best_split(&lists) } else { None };
         let traverse = if self.p.pairs { 2.0 } else { 1.0 } * self.p.c_t * p_p;
-        let Some((cost, axis, k)) = split.filter(|&(c, _, _)| traverse + c <= p_p * n as f64 * self.p.c_i) else {
+        let Some((_, axis, k)) = split.filter(|&(c, _, _)| traverse + c <= p_p * n as f64 * self.p.c_i) else {
             let first = self.order.len() as u32;
             self.order.extend_from_slice(lists[0]);
             self.nodes[at].kind = PmKind::Leaf { first, count: n as u32 };
             return;
         };
-        let _ = cost;
         for (i, &prim) in lists[axis].iter().enumerate() {
             self.side[prim as usize] = i < k;
         }

@@ -110,10 +110,7 @@ pub fn plan(f: &Function, cap: u32, counts: Option<&[InstCounts]>) -> SpillPlan 
     let demand = press.iter().copied().max().unwrap_or(0);
     let mut spilled = Vec::new();
     let mut is_spilled = vec![false; n];
-    loop {
-        let Some((worst, &p)) = press.iter().enumerate().max_by_key(|&(i, p)| (*p, std::cmp::Reverse(i))) else {
-            break;
-        };
+    while let Some((worst, p)) = press.iter().copied().enumerate().max_by_key(|&(i, p)| (p, std::cmp::Reverse(i))) {
         if p <= cap {
             break;
         }

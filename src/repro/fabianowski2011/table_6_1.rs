@@ -297,7 +297,7 @@ fn columns() -> Vec<Column> {
     c
 }
 
-fn part(e: &Entry, r: &Results, b: Builder, heading: &str, published: &Published, address: &str) -> Table {
+fn part(r: &Results, b: Builder, heading: &str, published: &Published, address: &str) -> Table {
     let scenes = super::scenes_of(r, PM_BUILDERS);
     let mut ours = Vec::new();
     let mut per_threshold = Vec::new();
@@ -330,15 +330,13 @@ fn part(e: &Entry, r: &Results, b: Builder, heading: &str, published: &Published
     }
     t.notes.push(super::run_note(r, &scenes, &format!("{} photon maps per threshold, native walks", b.name())));
     t.notes.push(format!("n_T/n_I per query point by threshold: {}.", per_threshold.join("; ")));
-    let _ = e;
     t
 }
 
 /// Table 6.1 (a) and (b).
 pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     let h = e.heading();
-    let mut a =
-        part(e, r, Builder::Vvh, &format!("{h}\n\n(a) VVH construction"), &THESIS_A, &format!("{}a", e.address()));
+    let mut a = part(r, Builder::Vvh, &format!("{h}\n\n(a) VVH construction"), &THESIS_A, &format!("{}a", e.address()));
     a.notes.push(vvh::HOW.into());
     a.notes.push(
         "Rows reconciled as in the extract (§3.9): the conversion lost the Ring row (VVH FPS with n_auto 9.40 by Table \
@@ -346,6 +344,6 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
          missing. The 2^18 and 2^19 scenarios are not run."
             .into(),
     );
-    let b = part(e, r, Builder::Lbvh, "(b) LBVH construction", &THESIS_B, &format!("{}b", e.address()));
+    let b = part(r, Builder::Lbvh, "(b) LBVH construction", &THESIS_B, &format!("{}b", e.address()));
     vec![a, b]
 }

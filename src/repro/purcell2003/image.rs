@@ -210,7 +210,10 @@ pub fn convergence_chart(scene: &str, r: &Rendered) -> crate::chart::Scatter {
     for (m, name) in ["bitonic", "stencil"].iter().enumerate() {
         let c = convergence(&r.progress[m], &r.finished_after[m]);
         let pts = |f: &dyn Fn(&PassError) -> f64| c.iter().map(|p| (p.pass as f64, f(p))).collect::<Vec<_>>();
-        series.push(crate::chart::Series { name: format!("{name}: pixels not finished"), points: pts(&|p| 1.0 - p.finished) });
+        series.push(crate::chart::Series {
+            name: format!("{name}: pixels not finished"),
+            points: pts(&|p| 1.0 - p.finished),
+        });
         series.push(crate::chart::Series {
             name: format!("{name}: displayed colour not final"),
             points: pts(&|p| p.displayed_off),
@@ -271,7 +274,10 @@ pub fn run_cli(
         );
     }
     if let Some(x) = alike {
-        println!("native per-pixel passes: {}", if x { "bit for bit the emulated images" } else { "DIFFER from the emulated images" });
+        println!(
+            "native per-pixel passes: {}",
+            if x { "bit for bit the emulated images" } else { "DIFFER from the emulated images" }
+        );
     }
     if let Some(j) = &a.json {
         let chart = convergence_chart(&scene.name, &r);

@@ -355,8 +355,8 @@ fn consider(p: &Params, st: &mut State, d: f32, w: [f32; 4], scale: f32) {
         return;
     }
     st.n += 1;
-    for c in 0..3 {
-        st.sum[c] += w[c] * scale;
+    for (s, w) in st.sum.iter_mut().zip(w) {
+        *s += w * scale;
     }
 }
 
@@ -366,12 +366,7 @@ fn consider(p: &Params, st: &mut State, d: f32, w: [f32; 4], scale: f32) {
 pub fn estimate(grid: &Grid, map: &MapData, q: &QueryPoints, p: &Params) -> Vec<State> {
     let size = grid.size();
     let inv = grid.inv();
-    let g = G {
-        lo: grid.lo.to_array(),
-        inv: inv.to_array(),
-        size: size.to_array(),
-        dims: grid.dims.map(|d| d as i32),
-    };
+    let g = G { lo: grid.lo.to_array(), inv: inv.to_array(), size: size.to_array(), dims: grid.dims.map(|d| d as i32) };
     q.query
         .iter()
         .zip(&q.normal)

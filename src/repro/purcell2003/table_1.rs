@@ -72,9 +72,10 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
                 holds: re > rest,
             });
             // the same at the paper's image size: the per-pixel phases scaled by the pixel ratio
-            let paper = FIXTURES.iter().find(|f| f.scene == *s).map_or(f64::NAN, |f| {
-                f.paper_resolution[0] as f64 * f.paper_resolution[1] as f64
-            });
+            let paper = FIXTURES
+                .iter()
+                .find(|f| f.scene == *s)
+                .map_or(f64::NAN, |f| f.paper_resolution[0] as f64 * f.paper_resolution[1] as f64);
             let scale = paper / get(r, s, m, "pixels");
             if scale.is_finite() && scale != 1.0 {
                 let (tp, bm, tr) = (inst(s, m, "trace_photons"), inst(s, m, "build_map"), inst(s, m, "trace_rays"));

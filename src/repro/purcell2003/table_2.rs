@@ -126,7 +126,8 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
 
 /// [`measure`] with the settings `f`.
 pub fn measure_with(ws: &mut Workspace, f: &Fixture, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
-    let Prepared { mut passes, fixture, photons, queries, grid, .. } = pipeline::prepare_with(ws.scene, f, ws.resolution)?;
+    let Prepared { mut passes, fixture, photons, queries, grid, .. } =
+        pipeline::prepare_with(ws.scene, f, ws.resolution)?;
     let p = &mut passes;
     let mut out = Vec::new();
     // map A: cell keys, then the sort and the search measured on their own
