@@ -280,19 +280,20 @@ fn txq_dimensions_equal_the_h200() {
     for (name, format, channels, dims, linear, addr) in objects {
         let mut dev = Device::new();
         let data = dev.alloc_zeroed::<u8>(1024);
-        let t = dev.create_texture(TextureDesc {
-            data,
-            format,
-            channels,
-            dims,
-            row_pitch: 0,
-            linear,
-            addr: [addr; 3],
-            filter: FilterMode::Point,
-            read: ReadMode::ElementType,
-            normalized: false,
-        })
-        .unwrap();
+        let t = dev
+            .create_texture(TextureDesc {
+                data,
+                format,
+                channels,
+                dims,
+                row_pitch: 0,
+                linear,
+                addr: [addr; 3],
+                filter: FilterMode::Point,
+                read: ReadMode::ElementType,
+                normalized: false,
+            })
+            .unwrap();
         let m = dev.load_ptx(PTX, "txq.ptx").unwrap();
         let out = dev.alloc_zeroed::<u32>(3);
         dev.launch(&m, "q", LaunchConfig::linear(1, 1), &[Arg::U64(t), Arg::Ptr(out)]).unwrap();
