@@ -318,8 +318,14 @@ pub fn measure_caches(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<
 pub fn materials_note(r: &Results, group: &str, scenes: &[String], variant: &str) -> String {
     let mut with = Vec::new();
     let mut without = Vec::new();
+    let mut uncounted = Vec::new();
     for s in scenes {
         let Some(t) = Totals::from_results(r, group, s, variant) else { continue };
+        // a file written before the ray kinds and texel fetches were counted says nothing about materials
+        if COUNTERS[REQUIRED..].iter().any(|c| r.sum(group, s, variant, c).is_none()) {
+            uncounted.push(s.as_str());
+            continue;
+        }
         let px = r.scene(s).map_or(0, |i| i.frames.iter().map(|f| f.len() as u64).sum::<u64>())
             * u64::from(r.protocol.resolution).pow(2);
         if t.reflection_rays == 0 && t.texel_fetches == 0 {
@@ -353,6 +359,54 @@ pub fn materials_note(r: &Results, group: &str, scenes: &[String], variant: &str
             }
         ));
     }
+    if !uncounted.is_empty() {
+        if !with.is_empty() || !without.is_empty() {
+            note.push_str(". ");
+        }
+        note.push_str(&format!(
+            "Reflection rays and texel fetches not counted in this result file for {} (written before they were counted)",
+            uncounted.join(", ")
+        ));
+    }
     note.push('.');
     note
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::repro::protocol::Protocol;
+    use crate::repro::results::SceneInfo;
+
+    /// Results of one frame of `scene` whose counters are `counters` (all 1).
+    fn results(scene: &str, counters: &[&str]) -> Results {
+        let mut r = Results::new("abc", Protocol::quick(), vec![], vec!["g".into()]);
+        r.scenes.push(SceneInfo {
+            name: scene.into(),
+            triangles: 1,
+            thesis_triangles: None,
+            flight_frames: 1,
+            frames: vec![crate::repro::protocol::FrameRange::first(1)],
+        });
+        r.samples.push(Sample {
+            group: "g".into(),
+            scene: scene.into(),
+            frame: Some(0),
+            variant: "v".into(),
+            counters: counters.iter().map(|c| (c.to_string(), 1.0)).collect(),
+        });
+        r
+    }
+
+    #[test]
+    fn a_file_without_the_ray_kinds_says_so_instead_of_no_materials() {
+        let old = results("sponza", &COUNTERS[..REQUIRED]);
+        let note = materials_note(&old, "g", &["sponza".into()], "v");
+        assert!(note.contains("not counted in this result file for sponza"), "{note}");
+        assert!(!note.contains("No specular materials"), "{note}");
+        let new = results("sponza", &COUNTERS);
+        let note = materials_note(&new, "g", &["sponza".into()], "v");
+        assert!(note.contains("sponza 100.0 % reflection rays"), "{note}");
+        assert!(!note.contains("not counted"), "{note}");
+    }
 }

@@ -176,9 +176,10 @@ fn shapes(scene: &Scene) -> &'static [Shape] {
     if scene.name == "ring" { &[Shape::Uniform, Shape::Epanechnikov] } else { &[Shape::Uniform] }
 }
 
-/// Measurement group [`PM_LAYOUTS`]: per frame and variant, the queries, the
-/// walk's counts, the traffic and the warp instructions of the gather kernel.
-pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+/// The scene's VKDE photon maps as Table 5.1's parameters make them (uniform
+/// kernels, built on the SIROH tree, which is built first) and their n_auto:
+/// the photon maps that Tables 6.1-6.4 organise in BVHs.
+pub(super) fn vkde_maps(ws: &mut Workspace) -> Result<(photon_image::PhotonMaps, u32), MeasureError> {
     let (photons, spread) = parameters(&ws.scene.name)
         .ok_or_else(|| format!("{}: not a scene of Table 5.1 (its parameters are per scene)", ws.scene.name))?;
     let o = Options {
@@ -190,10 +191,17 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
         emulated: false,
     };
     ws.build(Heuristic::Siroh);
+    let maps = photon_image::photon_maps(ws.scene, ws.tree(Heuristic::Siroh), &o, None)?;
+    let n_auto = lbvh::n_auto(&maps.constructed.kernels, ws.scene);
+    Ok((maps, n_auto))
+}
+
+/// Measurement group [`PM_LAYOUTS`]: per frame and variant, the queries, the
+/// walk's counts, the traffic and the warp instructions of the gather kernel.
+pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    let (maps, n_auto) = vkde_maps(ws)?;
     let tree = ws.tree(Heuristic::Siroh);
-    let maps = photon_image::photon_maps(ws.scene, tree, &o, None)?;
     let kernels = &maps.constructed.kernels;
-    let n_auto = lbvh::n_auto(kernels, ws.scene);
     let pm = lbvh::build(kernels, n_auto).tree();
     let stats = pm.stats();
     let layouts = Layouts::new(&pm, kernels);

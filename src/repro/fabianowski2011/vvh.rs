@@ -11,11 +11,11 @@
 //! 64 (L2619, L2625), built serially on the host as the thesis does.
 
 use super::lbvh;
-use super::photon_image::{self, Estimator, Options};
+use super::photon_image;
 use super::pm_layout::{self, Layout, Layouts, PmTree};
 use super::sah;
-use super::table_5_1::parameters;
-use super::vkde::{self, Kernel, Shape};
+use super::table_6_4::vkde_maps;
+use super::vkde::{Kernel, Shape};
 use crate::host::kdtree::Heuristic;
 use crate::host::raycast::Caster;
 use crate::repro::registry::{MeasureError, Tick, Workspace};
@@ -73,21 +73,9 @@ pub fn build(builder: Builder, kernels: &[Kernel], threshold: u32) -> PmTree {
 
 /// Measurement group [`PM_BUILDERS`].
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
-    let (photons, spread) = parameters(&ws.scene.name)
-        .ok_or_else(|| format!("{}: not a scene of Table 5.1 (its parameters are per scene)", ws.scene.name))?;
-    let o = Options {
-        photons,
-        spread,
-        h_max: vkde::H_MAX,
-        estimator: Estimator::Vkde,
-        shape: Shape::Uniform,
-        emulated: false,
-    };
-    ws.build(Heuristic::Siroh);
+    let (maps, n_auto) = vkde_maps(ws)?;
     let tree = ws.tree(Heuristic::Siroh);
-    let maps = photon_image::photon_maps(ws.scene, tree, &o, None)?;
     let kernels = &maps.constructed.kernels;
-    let n_auto = lbvh::n_auto(kernels, ws.scene);
     let mut maps_built = Vec::new();
     for b in Builder::ALL {
         for t in std::iter::once(None).chain(THRESHOLDS.map(Some)) {
