@@ -83,6 +83,7 @@ fn emulated_traversals_equal_native_bit_for_bit_and_count_for_count() {
                 Traversal::ShortStack => assert!(k.pushes > 0 && k.ascents == 0, "{k:?}"),
                 Traversal::Restart => assert!(k.pushes == 0 && k.pops == 0 && k.ascents == 0, "{k:?}"),
                 Traversal::Backtrack => assert!(k.pushes == 0 && k.ascents > 0, "{k:?}"),
+                Traversal::FullStack => unreachable!("not a row of Fig. 3"),
             }
         }
     }
@@ -112,4 +113,55 @@ fn stackless_traversals_visit_the_same_leaves_and_every_traversal_finds_the_same
         }
         assert_eq!(runs[0].1.counts.rays, restart.rays, "{c:?}: the same rays traced");
     }
+}
+
+/// One frame of `p` on the emulator with the Maxwell memory model watching:
+/// the accumulation buffer, the tagged counts and the local-memory bytes
+/// (stored, loaded).
+fn emulate_local(ps: &PathScene, cam: &Camera, p: FrameParams) -> (Vec<f32>, Counts, (u64, u64)) {
+    use warplight::model::{Model, Profile};
+    use warplight::sim::{Arg, LaunchConfig};
+    let mut cfg = kernel::sim_config(&p);
+    cfg.fidelity = Fidelity::Instructions;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev).expect("load PTX");
+    let bufs = kernel::upload_scene(&mut dev, ps, cam, &p).expect("upload");
+    let n = p.paths() * 3;
+    let accum = dev.alloc_zeroed::<f32>(n);
+    let last = dev.alloc_zeroed::<f32>(n);
+    let args: Vec<Arg> = bufs.scene_args().into_iter().chain([accum, last]).map(Arg::Ptr).collect();
+    let model = Model::new(Profile::Maxwell, &module.prog);
+    let ctas = p.paths().div_ceil(kernel::THREADS as usize) as u32;
+    let st = dev
+        .launch_observed(&module, kernel::KERNEL, LaunchConfig::linear(ctas, kernel::THREADS), &args, Some(&model))
+        .expect("launch");
+    let c = Counts::from_tags(&counts::tagged(&module.prog, &st.profile, &counts::tags()));
+    let m = model.finish().counters;
+    (dev.read::<f32>(accum, n), c, (m.local_st.bytes, m.local_ld.bytes))
+}
+
+#[test]
+fn the_short_stacks_entries_move_8_bytes_and_the_standard_stacks_12() {
+    // 003:L175: a standard entry {node, tnear, tfar} is 12 bytes; Santos et
+    // al. derive tnear on a pop, so an entry is {node, tfar}, 8 bytes. Both
+    // stacks trace the same paths; kd-restart (no stack) moves only the rest
+    // of the kernel's local bytes (the arguments it passes through local
+    // memory), so the stacks' bytes are exact differences.
+    let s = scene("cornell-lambert");
+    let cam = Camera { resolution: [8, 6], ..s.camera };
+    let ps = layout(&s, Construction::Sah);
+    let (base_img, _, base) = emulate_local(&ps, &cam, params(8, 6, Traversal::Restart));
+    let (short_img, short, short_bytes) = emulate_local(&ps, &cam, params(8, 6, Traversal::ShortStack));
+    let (full_img, full, full_bytes) = emulate_local(&ps, &cam, params(8, 6, Traversal::FullStack));
+    assert!(short.pushes > 0 && short.pops > 0);
+    assert_eq!(full, short, "the same walk");
+    let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    assert!(same(&short_img, &full_img) && same(&short_img, &base_img), "the same image");
+    assert_eq!(short_bytes, (base.0 + 8 * short.pushes, base.1 + 8 * short.pops), "8-byte entries");
+    assert_eq!(full_bytes, (base.0 + 12 * full.pushes, base.1 + 12 * full.pops), "12-byte entries");
+    // natively too: the same image and walk
+    let native = render_native(&ps, &cam, params(8, 6, Traversal::FullStack), 1, false, |_| {});
+    assert!(same(&native.accum, &full_img));
+    assert_eq!(native.counts, full);
+    assert_eq!(Traversal::parse("stack12"), Some(Traversal::FullStack));
 }

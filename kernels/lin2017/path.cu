@@ -12,7 +12,8 @@
 // triangle offset) walked with the 8-byte short stack of Santos et al.
 // (§3.4: entries {node, tfar}; tnear is the previous tfar on a pop) and the
 // branch-reduced step of Fig. 15 (003:L479-492, 24-bit mask, errata 3;
-// non-strict comparisons, see trace()).
+// non-strict comparisons, see trace_stack()); or, for the comparison of
+// 003:L175, the standard stack whose 12-byte entries also hold tnear.
 // Triangles: the affine test of §6.4 (three float4 rows of the inverse of
 // [A-C, B-C, N] with the translation in w; N = (A-C) x (B-C), errata 4).
 //
@@ -51,6 +52,7 @@
 #define TRAVERSAL_SHORT_STACK 0
 #define TRAVERSAL_RESTART 1
 #define TRAVERSAL_BACKTRACK 2
+#define TRAVERSAL_FULL_STACK 3   // the standard 12-byte entries {node, tnear, tfar}
 #define LEAF_AXIS 3u
 #define STACK_ENTRIES 32
 // random dimensions: 2 for the camera ray, then 8 per bounce
@@ -222,24 +224,24 @@ static __device__ int trace_stackless(const Scene &s, bool backtrack, V3 o, V3 d
   return found;
 }
 
-// The nearest hit in [t_min, t_max] (with `any`, the first found); -1 for none.
-static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out) {
+// A short-stack entry (Santos et al., 003:L175): the node and its tfar, 8
+// bytes; tnear is the previous tfar on a pop. The standard entry (WIDE)
+// also stores tnear: 12 bytes.
+template <bool WIDE> struct Entry { unsigned node; float tfar; };
+template <> struct Entry<true> { unsigned node; float tfar, tnear; };
+static __device__ __forceinline__ void put_tnear(Entry<false> &, float) {}
+static __device__ __forceinline__ void put_tnear(Entry<true> &e, float t) { e.tnear = t; }
+static __device__ __forceinline__ float get_tnear(const Entry<false> &, float prev_tfar) { return prev_tfar; }
+static __device__ __forceinline__ float get_tnear(const Entry<true> &e, float) { return e.tnear; }
+
+// The stack traversal of [tnear, tfar] with WIDE's entries.
+template <bool WIDE>
+static __device__ __forceinline__ int trace_stack(const Scene &s, V3 o, V3 d, V3 inv, float t_min, float t_max,
+                                                  float tnear, float tfar, bool any, float *t_out) {
   const Params *p = s.p;
-  float inv_x = 1.0f / d.x;                          // @count rays rcp.rn.f32
-  V3 inv = v3(inv_x, 1.0f / d.y, 1.0f / d.z);
-  // clip to the scene box
-  float t0x = (p->lo[0] - o.x) * inv.x, t1x = (p->hi[0] - o.x) * inv.x;
-  float t0y = (p->lo[1] - o.y) * inv.y, t1y = (p->hi[1] - o.y) * inv.y;
-  float t0z = (p->lo[2] - o.z) * inv.z, t1z = (p->hi[2] - o.z) * inv.z;
-  float tn = fmaxf(fmaxf(fminf(t0x, t1x), fminf(t0y, t1y)), fminf(t0z, t1z));
-  float tf = fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z));
-  float tnear = fmaxf(t_min, tn), tfar = fminf(t_max, tf);
-  if (!(tnear <= tfar)) return -1;
-  if (p->traversal != TRAVERSAL_SHORT_STACK)
-    return trace_stackless(s, p->traversal == TRAVERSAL_BACKTRACK, o, d, inv, t_min, t_max, tnear, tfar, any, t_out);
   float t_hit = t_max;
   int found = -1;
-  struct Entry { unsigned node; float tfar; } stack[STACK_ENTRIES];   // 8-byte entries (Santos et al.)
+  Entry<WIDE> stack[STACK_ENTRIES];
   int size = 0;
   unsigned idx = 0;
   for (;;) {
@@ -263,6 +265,7 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
       if (f < 0 && tsplit <= tfar) {
         stack[size].node = second;                    // @count push st.local.u32
         stack[size].tfar = tfar;
+        put_tnear(stack[size], tsplit);
         size++;
         tfar = tsplit;
       }
@@ -284,12 +287,32 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
     }
     if (size == 0) break;
     size--;
-    tnear = tfar;
     idx = stack[size].node;                            // @count pop ld.local.u32
+    tnear = get_tnear(stack[size], tfar);
     tfar = stack[size].tfar;
   }
   *t_out = t_hit;
   return found;
+}
+
+// The nearest hit in [t_min, t_max] (with `any`, the first found); -1 for none.
+static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max, bool any, float *t_out) {
+  const Params *p = s.p;
+  float inv_x = 1.0f / d.x;                          // @count rays rcp.rn.f32
+  V3 inv = v3(inv_x, 1.0f / d.y, 1.0f / d.z);
+  // clip to the scene box
+  float t0x = (p->lo[0] - o.x) * inv.x, t1x = (p->hi[0] - o.x) * inv.x;
+  float t0y = (p->lo[1] - o.y) * inv.y, t1y = (p->hi[1] - o.y) * inv.y;
+  float t0z = (p->lo[2] - o.z) * inv.z, t1z = (p->hi[2] - o.z) * inv.z;
+  float tn = fmaxf(fmaxf(fminf(t0x, t1x), fminf(t0y, t1y)), fminf(t0z, t1z));
+  float tf = fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z));
+  float tnear = fmaxf(t_min, tn), tfar = fminf(t_max, tf);
+  if (!(tnear <= tfar)) return -1;
+  if (p->traversal == TRAVERSAL_SHORT_STACK)
+    return trace_stack<false>(s, o, d, inv, t_min, t_max, tnear, tfar, any, t_out);
+  if (p->traversal == TRAVERSAL_FULL_STACK)
+    return trace_stack<true>(s, o, d, inv, t_min, t_max, tnear, tfar, any, t_out);
+  return trace_stackless(s, p->traversal == TRAVERSAL_BACKTRACK, o, d, inv, t_min, t_max, tnear, tfar, any, t_out);
 }
 
 // A heuristic's weight of a strategy with pdf a against one with pdf b.

@@ -75,7 +75,7 @@ pub struct RenderArgs {
     /// Path tracer: seed of the random numbers.
     #[arg(long, default_value_t = 0)]
     pub seed: u32,
-    /// Path tracer: the kd-tree traversal, stack (the 8-byte short stack), restart or backtrack.
+    /// Path tracer: the kd-tree traversal, stack (the 8-byte short stack), stack12 (12-byte entries), restart or backtrack.
     #[arg(long, default_value = "stack")]
     pub traversal: String,
     /// Photon map (thesis 000 ch. 5): vkde, vkde-epanechnikov, knn (Table 5.1's k) or knn:K.
@@ -378,7 +378,7 @@ fn run_path(
         format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic) or mis-power", a.integrator)
     })?;
     let traversal = Traversal::parse(&a.traversal)
-        .ok_or_else(|| format!("unknown traversal `{}`; expected stack, restart or backtrack", a.traversal))?;
+        .ok_or_else(|| format!("unknown traversal `{}`; expected stack, stack12, restart or backtrack", a.traversal))?;
     let frames = crate::repro::lin2017::render::frames_for(a.spp)?;
     let emulated = match a.variant.as_str() {
         "native" => None,

@@ -9,6 +9,7 @@
 //! per-block Welch t-test under Holm's correction.
 
 pub mod build;
+pub mod bvh;
 pub mod counts;
 pub mod kernel;
 pub mod layout;
@@ -77,6 +78,10 @@ pub enum Traversal {
     /// kd-backtrack (Foley and Sugerman 2005): no stack, a leaf without a hit
     /// climbs the parent links to the first node whose box reaches past its exit.
     Backtrack,
+    /// The standard stack whose entries also hold tnear ({node, tnear, tfar},
+    /// 12 bytes), against which 003:L175 counts the short stack's 8 bytes.
+    /// Not a row of Fig. 3.
+    FullStack,
 }
 
 impl Traversal {
@@ -89,6 +94,7 @@ impl Traversal {
             Traversal::ShortStack => 0,
             Traversal::Restart => 1,
             Traversal::Backtrack => 2,
+            Traversal::FullStack => 3,
         }
     }
 
@@ -98,6 +104,7 @@ impl Traversal {
             Traversal::ShortStack => "short-stack",
             Traversal::Restart => "restart",
             Traversal::Backtrack => "backtrack",
+            Traversal::FullStack => "full-stack",
         }
     }
 
@@ -107,13 +114,15 @@ impl Traversal {
             Traversal::ShortStack => "8-byte stack",
             Traversal::Restart => "Kd-restart",
             Traversal::Backtrack => "Kd-backtrack",
+            Traversal::FullStack => "12-byte stack",
         }
     }
 
-    /// Parses a command-line name (`stack` is the short stack).
+    /// Parses a command-line name (`stack` is the short stack, `stack12` the full one).
     pub fn parse(s: &str) -> Option<Traversal> {
         match s {
             "stack" => Some(Traversal::ShortStack),
+            "stack12" | "full-stack" => Some(Traversal::FullStack),
             _ => Traversal::ALL.into_iter().find(|t| t.name() == s),
         }
     }

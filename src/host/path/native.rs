@@ -215,13 +215,16 @@ impl Tracer<'_> {
         if !(tnear <= tfar) {
             return None;
         }
-        if self.params.traversal != Traversal::ShortStack {
+        if matches!(self.params.traversal, Traversal::Restart | Traversal::Backtrack) {
             let backtrack = self.params.traversal == Traversal::Backtrack;
             return self.trace_stackless(backtrack, o, d, inv, t_min, t_max, tnear, tfar, any, c);
         }
         let t_hit = t_max;
         let mut found: Option<u32> = None;
-        let mut stack = [(0u32, 0.0f32); STACK_ENTRIES];
+        // entries {node, tfar} (8 bytes; tnear is the previous tfar on a pop)
+        // or, with the full stack, {node, tfar, tnear} (12 bytes)
+        let wide = self.params.traversal == Traversal::FullStack;
+        let mut stack = [(0u32, 0.0f32, 0.0f32); STACK_ENTRIES];
         let mut size = 0usize;
         let mut idx = 0u32;
         let mut hi;
@@ -239,7 +242,7 @@ impl Tracer<'_> {
                 idx = (first & f as u32).wrapping_add(second & !(f as u32));
                 if f < 0 && tsplit <= tfar {
                     c.pushes += 1;
-                    stack[size] = (second, tfar);
+                    stack[size] = (second, tfar, tsplit);
                     size += 1;
                     tfar = tsplit;
                 }
@@ -267,8 +270,9 @@ impl Tracer<'_> {
             }
             c.pops += 1;
             size -= 1;
-            tnear = tfar;
-            (idx, tfar) = stack[size];
+            let (node, entry_tfar, entry_tnear) = stack[size];
+            tnear = if wide { entry_tnear } else { tfar };
+            (idx, tfar) = (node, entry_tfar);
         }
         found.map(|t| (t, hi))
     }

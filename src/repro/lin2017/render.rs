@@ -61,7 +61,7 @@ pub fn render(
     // they need thesis 003's SAH tree, which keeps a triangle lying in a split
     // plane on both sides (docs/reproduction-lin2017.md, Fig. 3)
     let tree = match params.traversal {
-        Traversal::ShortStack => build(&tris, BuildParams::thesis(Heuristic::Sah)),
+        Traversal::ShortStack | Traversal::FullStack => build(&tris, BuildParams::thesis(Heuristic::Sah)),
         _ => path_build::build(&tris, &path_build::Params::fig3(Construction::Sah, tris.len())),
     };
     let ps = PathScene::new(scene, &tree)?;
