@@ -207,17 +207,17 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float t_max
           node = far;
         } else {
           if (SC == 1) {                              // Alg. 4.3
-            if (head_node > 0) {
-              stack[size].node = head_node;           // @count push st.local.u32
+            if (head_node > 0) {                      // @count regpush setp.eq.s32
+              stack[size].node = head_node;           // @count spill st.local.u32
               stack[size].tb = head_tb;
               size++;
               TALLY(st.local_stack++);
-              TALLY(st.pushes++);
-            }
+            }                                         // the old head spilled: a local access, not a push
+            TALLY(st.pushes++);                       // every push goes to the register head
             head_node = far;
             head_tb = tb;
-          } else if (SC == 2 && far < NC2_NODES) {    // Alg. 4.5 lines 1-6
-            if (top1 < (1u << 24)) top1 = (top1 << 8) | far;
+          } else if (SC == 2 && far < NC2_NODES) {    TALLY(st.pushes++);  // Alg. 4.5 lines 1-6: a register push
+            if (top1 < (1u << 24)) top1 = (top1 << 8) | far;  // @count regpush setp.gt.u32
             else top2 = (top2 << 8) | far;
           } else {                                    // push the far child and the end of its interval
             stack[size].node = far;                   // @count push st.local.u32

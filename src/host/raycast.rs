@@ -61,7 +61,10 @@ pub struct TraceStats {
     pub plane_tests: u64,
     /// Barycentric computations (Alg. 3.3 lines 7–8).
     pub barycentric_tests: u64,
-    /// Stack pushes.
+    /// Stack pushes: every entry pushed, whether it went to the local-memory
+    /// stack or (kernels with stack caches I and II) into registers. Stack
+    /// cache I moving its old head to local memory is a local access
+    /// (`local_stack_accesses`), not a push.
     pub pushes: u64,
     /// Inner-node fetches through the texture path (kernels; node-cache hits excluded).
     pub tex_node_fetches: u64,

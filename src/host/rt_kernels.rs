@@ -6,8 +6,10 @@
 //! The work is counted by the emulator, not the kernel: the plain build
 //! ([`Build::Plain`], what the tables run) has no tallies, and [`line_counts`]
 //! reads rays (shadow and reflection rays among them), inner-node steps, leaf
-//! visits, plane and barycentric tests, local-memory stack pushes and pops and
-//! texture-map texel fetches off the per-instruction counters of the source
+//! visits, plane and barycentric tests, stack pushes (every push, as the
+//! native caster counts them: to local memory or into stack caches I and
+//! II's registers), local-memory stack accesses and texture-map texel
+//! fetches off the per-instruction counters of the source
 //! lines tagged `@count` in `raytrace.cu`; a node-cache observer
 //! ([`NodeCacheFetches`]) tells inner nodes from leaves among the shared-memory
 //! node fetches, so that the texture fetches of inner nodes follow. The
@@ -591,8 +593,10 @@ pub fn render_build(
             trace.leaves = get("leaves");
             trace.plane_tests = get("planes");
             trace.barycentric_tests = get("barys");
-            trace.local_stack_accesses = get("push") + get("pop");
-            trace.pushes = get("push");
+            // `push`: a new entry to local memory; `spill`: stack cache I moving its
+            // old head there; `regpush`: a new entry to registers (stack caches I, II)
+            trace.local_stack_accesses = get("push") + get("spill") + get("pop");
+            trace.pushes = get("push") + get("regpush");
             trace.shadow = get("shadow");
             trace.reflection = get("reflection");
             trace.texel_fetches = get("texels");

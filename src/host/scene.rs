@@ -191,8 +191,29 @@ impl Scene {
 
     /// Builds a scene from parts, dropping zero-area triangles.
     pub fn assemble(name: &str, source: &Path, tris: Vec<Triangle>, materials: Vec<Material>) -> Scene {
+        Scene::assemble_with_uvs(name, source, tris, Vec::new(), materials)
+    }
+
+    /// [`Scene::assemble`] with the texture coordinates of each triangle's
+    /// vertices (`uvs`: none, or one entry per triangle of `tris`): a dropped
+    /// zero-area triangle drops its coordinates with it, so that
+    /// [`Scene::uv`] stays indexed like [`Scene::triangles`].
+    pub fn assemble_with_uvs(
+        name: &str,
+        source: &Path,
+        tris: Vec<Triangle>,
+        uvs: Vec<[[f32; 2]; 3]>,
+        materials: Vec<Material>,
+    ) -> Scene {
         let n = tris.len();
-        let triangles: Vec<Triangle> = tris.into_iter().filter(|t| t.double_area() > 0.0).collect();
+        let mut triangles = Vec::with_capacity(n);
+        let mut kept_uvs = Vec::with_capacity(uvs.len());
+        for (i, t) in tris.into_iter().enumerate() {
+            if t.double_area() > 0.0 {
+                triangles.push(t);
+                kept_uvs.extend(uvs.get(i).copied());
+            }
+        }
         let dropped = n - triangles.len();
         Scene {
             name: name.to_string(),
@@ -207,7 +228,7 @@ impl Scene {
             variant: String::new(),
             textures: Vec::new(),
             surfaces: Vec::new(),
-            uvs: Vec::new(),
+            uvs: kept_uvs,
         }
     }
 
@@ -246,5 +267,29 @@ impl Scene {
         let tv = w * uv[0][1] + u * uv[1][1] + v * uv[2][1];
         let s = tex.sample(tu, tv);
         [col[0] * s[0], col[1] * s[1], col[2] * s[2]]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A zero-area triangle between two textured ones takes its texture
+    /// coordinates with it: the kept triangles keep their own.
+    #[test]
+    fn a_dropped_triangle_drops_its_texture_coordinates() {
+        let tri = |x: f32| Triangle { v: [Vec3::ZERO, Vec3::new(x, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)], material: 0 };
+        let uv = |k: f32| [[k, 0.0], [k, 1.0], [k, 2.0]];
+        let s = Scene::assemble_with_uvs(
+            "t",
+            Path::new("t"),
+            vec![tri(1.0), tri(0.0), tri(2.0)],
+            vec![uv(0.0), uv(1.0), uv(2.0)],
+            Vec::new(),
+        );
+        assert_eq!((s.triangles.len(), s.dropped_degenerate), (2, 1));
+        assert_eq!((s.uv(0), s.uv(1)), (uv(0.0), uv(2.0)));
+        let plain = Scene::assemble("t", Path::new("t"), vec![tri(1.0), tri(0.0)], Vec::new());
+        assert!(plain.uvs.is_empty() && plain.triangles.len() == 1);
     }
 }

@@ -227,12 +227,6 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     };
     let tris: Vec<Triangle> =
         tris.into_iter().map(|tr| Triangle { v: tr.v.map(|p| p * scale + translate), material: tr.material }).collect();
-    // texture coordinates of the triangles `assemble` keeps (it drops those of zero area)
-    let uvs: Vec<[[f32; 2]; 3]> = if extra.uvs.is_empty() {
-        Vec::new()
-    } else {
-        tris.iter().zip(&extra.uvs).filter(|(tr, _)| tr.double_area() > 0.0).map(|(_, uv)| *uv).collect()
-    };
     for (i, r) in cx.tables(&t, "reflect")?.into_iter().enumerate() {
         let p = format!("reflect[{i}].");
         let Some(name) = r.get("material").and_then(|v| v.as_str()) else {
@@ -250,10 +244,9 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         }
         extra.surface(m as usize).reflect = w;
     }
-    let mut scene = Scene::assemble(&name, path, tris, materials);
+    let mut scene = Scene::assemble_with_uvs(&name, path, tris, std::mem::take(&mut extra.uvs), materials);
     scene.textures = extra.textures;
     scene.surfaces = extra.surfaces;
-    scene.uvs = uvs;
     scene.variant = t.get("variant").and_then(|v| v.as_str()).unwrap_or("").to_string();
     if let Some(th) = cx.table(&t, "thesis")? {
         let triangles = match th.get("triangles").and_then(|v| v.as_integer()) {
