@@ -50,10 +50,17 @@ fn load(k: &Kind) -> Option<(Vec<RegId>, Space)> {
 }
 
 /// Per instruction of `f`: the space of the wait it causes, if any.
+///
+/// Only the targets of branches start a new straight-line run: a label no
+/// branch names (clang's `$L__tmp` line-table labels, one between most
+/// inlined statements) joins nothing, and the loads before it are still
+/// pending after it.
 fn wait_points(f: &Function) -> Vec<Option<Space>> {
     let mut targets = vec![false; f.insts.len()];
-    for (_, t) in &f.labels {
-        if let Some(x) = targets.get_mut(*t as usize) {
+    for inst in &f.insts {
+        if let Kind::Bra { target, .. } = inst.kind
+            && let Some(x) = targets.get_mut(target as usize)
+        {
             *x = true;
         }
     }
