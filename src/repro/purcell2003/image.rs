@@ -43,6 +43,10 @@ pub struct Rendered {
     pub progress: [Vec<FrameBuffer>; 2],
     /// Share of the pixels finished after every pass, on map A and map B.
     pub finished_after: [Vec<f64>; 2],
+    /// Thread instructions of building map A and map B (the emulator's counts).
+    pub build_instructions: [u64; 2],
+    /// Thread instructions of the estimate on map A and map B up to each pass.
+    pub estimate_instructions: [Vec<u64>; 2],
 }
 
 fn read4(p: &super::passes::Passes, ptr: crate::sim::DevicePtr, n: usize) -> Vec<[f32; 4]> {
@@ -72,6 +76,7 @@ pub fn render_with(scene: &Scene, f: &Fixture, width: u32, progressive: bool) ->
     let mut finished_after: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
     let share = |st: &[State]| st.iter().filter(|s| s.done).count() as f64 / st.len().max(1) as f64;
     let a = bitonic::build(p, grid, &photons)?;
+    let build_a = p.take_phase(bitonic::BUILD_MAP).thread_instructions;
     let ea = knn::estimate_with(p, &Map::Bitonic(&a, &photons), &queries, &params, MAX_PASSES, &mut |_, st| {
         finished_after[0].push(share(st));
         if progressive {
@@ -86,6 +91,7 @@ pub fn render_with(scene: &Scene, f: &Fixture, width: u32, progressive: bool) ->
         dir: read4(p, photons.dir, slots),
     };
     let b = stencil::build(p, grid, &photons, fixture.slots)?;
+    let build_b = p.take_phase(bitonic::BUILD_MAP).thread_instructions;
     let eb = knn::estimate_with(p, &Map::Stencil(&b), &queries, &params, MAX_PASSES, &mut |_, st| {
         finished_after[1].push(share(st));
         if progressive {
@@ -113,6 +119,8 @@ pub fn render_with(scene: &Scene, f: &Fixture, width: u32, progressive: bool) ->
         grid,
         progress,
         finished_after,
+        build_instructions: [build_a, build_b],
+        estimate_instructions: [ea.instructions_after, eb.instructions_after],
     })
 }
 
@@ -235,19 +243,21 @@ pub fn convergence_chart(scene: &str, r: &Rendered) -> crate::chart::Scatter {
 /// maps, `-o out.png` writing `out-bitonic.png` and `out-stencil.png`;
 /// `--variant native` recomputes the per-pixel passes natively (and says
 /// whether they equal the emulated ones bit for bit); `--json FILE` writes
-/// the progressive display's convergence chart (`warplight chart scatter`).
+/// the progressive display's convergence chart (`warplight chart scatter`);
+/// `--variant error` writes the error charts instead ([`run_error_charts`]).
 pub fn run_cli(
     a: &crate::cli::render::RenderArgs,
     scene: &Scene,
     cam: &Camera,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let f = pipeline::fixture_of(scene).map_err(|e| e.to_string())?;
+    let width = cam.resolution[0];
     let native = match a.variant.as_str() {
         "native" => true,
         "emulated" => false,
-        v => return Err(format!("--method purcell --variant {v}: expected native or emulated").into()),
+        "error" => return run_error_charts(a, scene, &f, width),
+        v => return Err(format!("--method purcell --variant {v}: expected native, emulated or error").into()),
     };
-    let width = cam.resolution[0];
     let t = std::time::Instant::now();
     let r = render_with(scene, &f, width, a.json.is_some()).map_err(|e| e.to_string())?;
     let mut out = images(&r);
@@ -285,5 +295,39 @@ pub fn run_cli(
         println!("convergence chart data: {}", j.display());
     }
     println!("{:.1} s", t.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// Photon counts of the error chart, as multiples of the stated count.
+pub const ERROR_FACTORS: [f64; 4] = [0.125, 0.25, 0.5, 1.0];
+/// The error charts' reference, as a multiple of the stated count.
+pub const ERROR_REFERENCE: f64 = 4.0;
+
+/// `warplight render --method purcell --variant error -o out.svg`: the error
+/// of both maps against a reference with [`ERROR_REFERENCE`] times the stated
+/// photons, at [`ERROR_FACTORS`] times them (`out-photons.svg`) and pass by
+/// pass at the stated count (`out-time.svg`), each chart's data beside it as
+/// JSON ([`super::error`]).
+pub fn run_error_charts(
+    a: &crate::cli::render::RenderArgs,
+    scene: &Scene,
+    f: &Fixture,
+    width: u32,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let t = std::time::Instant::now();
+    let c = super::error::charts(scene, f, width, &ERROR_FACTORS, ERROR_REFERENCE, &mut |x| {
+        eprintln!("{}: {x} x the stated photons ({:.0} s)", scene.name, t.elapsed().as_secs_f64());
+    })
+    .map_err(|e| e.to_string())?;
+    let stem = a.output.with_extension("");
+    for (name, chart) in [("photons", c.photons), ("time", c.time)] {
+        let json = std::path::PathBuf::from(format!("{}-{name}.json", stem.display()));
+        crate::cli::write_atomically(&json, serde_json::to_string_pretty(&chart)?.as_bytes())?;
+        let svg = std::path::PathBuf::from(format!("{}-{name}.svg", stem.display()));
+        let chart = crate::chart::Chart::Scatter(chart);
+        crate::cli::write_atomically(&svg, chart.svg(chart.default_size())?.as_bytes())?;
+        println!("{}: {} and {}", chart.title(), svg.display(), json.display());
+    }
+    println!("reference: {} photons stored; {:.1} s", c.reference_stored, t.elapsed().as_secs_f64());
     Ok(())
 }

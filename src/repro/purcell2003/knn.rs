@@ -115,6 +115,9 @@ pub struct Estimate {
     pub lane_iterations: u64,
     /// Whether every pixel finished within the pass limit.
     pub finished: bool,
+    /// Thread instructions of the estimate's launches up to and including
+    /// each pass (the emulator's counts): the progressive display's time axis.
+    pub instructions_after: Vec<u64>,
 }
 
 /// Lane-iterations of one launch of the estimate: every iteration makes three
@@ -263,16 +266,19 @@ pub fn run_passes<E: From<SimError>>(
 ) -> Result<Estimate, E> {
     let mut n = 0;
     let mut lanes = 0;
+    let mut instructions_after = Vec::new();
     let mut st = read(passes);
     while n < max_passes && st.iter().any(|s| !s.done) {
         let s = launch(passes)?;
         lanes += lane_iterations(passes.module(Kernels::Knn), &s);
+        let before = instructions_after.last().copied().unwrap_or(0);
+        instructions_after.push(before + s.totals.thread_instructions);
         n += 1;
         st = read(passes);
         after_pass(n, &st);
     }
     let finished = st.iter().all(|s| s.done);
-    Ok(Estimate { states: st, passes: n, lane_iterations: lanes, finished })
+    Ok(Estimate { states: st, passes: n, lane_iterations: lanes, finished, instructions_after })
 }
 
 /// Radiance towards the eye at each pixel: albedo / π · Σ power / (π r²),

@@ -9,11 +9,13 @@
 //! - [`knn_2003`]: the same estimate with 2-D float addressing and packed state;
 //! - [`native`]: the per-pixel passes in Rust, bit for bit as the kernels;
 //! - [`image`]: Fig. 7's images (direct light + either map's estimate), emulated and native;
+//! - [`error`]: image error against a converged reference, over photons and over counted time;
 //! - [`dataflow`]: Table 2's instruction classes (TEX, Addr, Pack) read off the PTX;
 //! - [`pipeline`], [`table_1`], [`table_2`]: the measurement groups and tables.
 
 pub mod bitonic;
 pub mod dataflow;
+pub mod error;
 pub mod grid;
 pub mod image;
 pub mod knn;

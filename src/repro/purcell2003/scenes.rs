@@ -34,14 +34,23 @@ pub struct Fixture {
 
 impl Fixture {
     /// The fixture with `div` times fewer photons (stored, pilot) and photons
-    /// sought (at least 4), for runs of seconds (the tests' subset); the
-    /// other settings as they are.
+    /// sought (at least 4), and `div` times fewer grid cells, so that a cell
+    /// holds as many photons on average as at the stated settings (each axis
+    /// of more than one cell divided by `div`^(1/d), d such axes: 250 × 1 ×
+    /// 250 becomes 25 × 1 × 25 and 25 × 25 × 50 becomes 5 × 5 × 11 for
+    /// `div` = 100); the radius holding k photons stays about the same, and a
+    /// search explores about as many photons per cell as at full scale
+    /// instead of `div` times more empty cells. For runs of seconds (the
+    /// tests' subset); the other settings as they are.
     pub fn reduced(&self, div: u32) -> Fixture {
         let d = div.max(1);
+        let axes = self.grid.iter().filter(|&&n| n > 1).count().max(1) as i32;
+        let per_axis = (d as f64).powf(1.0 / axes as f64);
         Fixture {
             stated_photons: (self.stated_photons / d).max(1),
             pilot: (self.pilot / d as usize).max(1),
             k: (self.k / d).max(4),
+            grid: self.grid.map(|n| if n > 1 { ((n as f64 / per_axis).round() as u32).max(1) } else { n }),
             ..*self
         }
     }
