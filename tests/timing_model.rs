@@ -10,6 +10,8 @@ use warplight::repro::fabianowski2011::{self as fab, timing as fab_timing};
 use warplight::repro::protocol::{FrameRange, Protocol};
 use warplight::repro::registry;
 use warplight::repro::results::{Results, Sample, SceneInfo};
+use warplight::sim::{Arg, Device, LaunchConfig};
+use warplight::timing::waits::Waits;
 use warplight::timing::{Bound, GTX_280, KernelCounts, Launch, LaunchShape, TimingError, predict};
 
 /// The thesis' launch: 30 persistent CTAs of 256 threads, 54 registers (seed 000 L1896, L2140).
@@ -276,7 +278,6 @@ fn measure_chapter_4_frames() {
     use warplight::host::rt_kernels::{self, Variant};
     use warplight::host::scene_file;
     use warplight::model::Profile;
-    use warplight::sim::Device;
     let env = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
     let res: u32 = env("TIMING_RES", "128").parse().unwrap();
     let frames: u32 = env("TIMING_FRAMES", "3").parse().unwrap();
@@ -374,7 +375,6 @@ fn where_the_waits_come_from() {
     use warplight::host::rt_kernels::{self, Variant};
     use warplight::host::scene_file;
     use warplight::model::Profile;
-    use warplight::sim::Device;
     use warplight::timing::waits::{WaitSite, wait_sites};
     let env = |k: &str, d: &str| std::env::var(k).unwrap_or_else(|_| d.to_string());
     let name = env("TIMING_SCENES", "sibenik");
@@ -453,4 +453,46 @@ fn where_the_waits_come_from() {
             eprintln!("{c:>10} {:5.2}%  {o}", c as f64 / all as f64 * 100.0);
         }
     }
+}
+
+/// A label that no branch names (clang's line-table labels) between two
+/// loads leaves both pending: one wait at their use. A branch target
+/// between them ends the run: a wait there and one at the use.
+#[test]
+fn only_branch_targets_end_a_run_of_loads() {
+    let ptx = |label: &str, branch: &str| {
+        format!(
+            r#"
+.version 7.0
+.target sm_50
+.address_size 64
+.visible .entry k(.param .u64 p)
+{{
+.reg .pred %p<2>;
+.reg .b32 %r<8>;
+.reg .b64 %rd<4>;
+ld.param.u64 %rd1, [p];
+mov.u32 %r7, 0;
+setp.eq.s32 %p1, %r7, 1;
+{branch}
+ld.global.nc.u32 %r1, [%rd1];
+{label}:
+ld.global.nc.u32 %r2, [%rd1+4];
+add.s32 %r3, %r1, %r2;
+st.global.u32 [%rd1+8], %r3;
+ret;
+}}
+"#
+        )
+    };
+    let run = |src: String| {
+        let mut dev = Device::new();
+        let m = dev.load_ptx(&src, "labels.ptx").unwrap();
+        let a = dev.alloc_zeroed::<u32>(4);
+        let stats = dev.launch(&m, "k", LaunchConfig::linear(1, 32), &[Arg::Ptr(a)]).unwrap();
+        warplight::timing::waits::waits(&m.prog, &stats.profile)
+    };
+    assert_eq!(run(ptx("$L__tmp1", "")), Waits { global: 0, texture: 1, shared: 0 });
+    // `%p1` is false: the branch falls through to the first load
+    assert_eq!(run(ptx("$L__BB0_1", "@%p1 bra $L__BB0_1;")), Waits { global: 0, texture: 2, shared: 0 });
 }
