@@ -49,3 +49,40 @@ fn estimator_names() {
     assert_eq!(photon_image::render_parameters("sponza"), (262144, 40.0));
     assert_eq!(photon_image::render_parameters("cornell-box"), (131072, 10.0));
 }
+
+/// `render --method photon-map` runs the emulated kernels on the device it
+/// is given: a device whose CTAs are too small for the kernels' launch fails.
+#[test]
+fn the_emulated_render_runs_on_the_device_given() {
+    let scene = scene_file::load(Path::new("scenes/cornell-box.toml")).unwrap();
+    let mut cam = scene.camera;
+    cam.resolution = [4, 4];
+    let o = Options {
+        photons: 64,
+        spread: 4.0,
+        h_max: vkde::H_MAX,
+        estimator: Estimator::Vkde,
+        shape: Shape::Uniform,
+        emulated: true,
+    };
+    let small = warplight::sim::SimConfig { max_threads_per_cta: 32, ..Default::default() };
+    let dev = warplight::sim::Device::with_config(small);
+    assert!(photon_image::render_scene(&scene, &cam, &o, Vec3::ZERO, Some(dev)).is_err());
+    let (image, r) =
+        photon_image::render_scene(&scene, &cam, &o, Vec3::ZERO, Some(warplight::sim::Device::new())).unwrap();
+    assert!(r.launch.is_some() && image.pixels.len() == 16);
+}
+
+/// The photon-map branch checks the host memory it needs against the budget before any work.
+#[test]
+fn the_photon_map_render_checks_its_memory_first() {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight"))
+        .args(["render", "--scene", "cornell-box", "--method", "photon-map", "--resolution", "64x64", "-o"])
+        .arg(std::env::temp_dir().join("warplight-photon-budget.png"))
+        .env("WARPLIGHT_MEMORY_BUDGET", "64K")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("photon-mapped render of 64 x 64 pixels"), "{err}");
+}

@@ -29,7 +29,8 @@ fn list_shows_every_thesis_and_the_status_of_chapter_4() {
         ("fabianowski:4.2", "partly"),
         ("fabianowski:4.5", "reproduced"),
         ("fabianowski:4.10", "modelled"),
-        ("fabianowski:6.6", "missing"),
+        ("fabianowski:6.6", "modelled"),
+        ("fabianowski:7.3", "missing"),
         ("purcell:1", "partly"),
         ("lin:1", "missing"),
     ] {

@@ -121,3 +121,48 @@ fn the_emulated_traversals_equal_the_native_ones_and_the_byte_model_holds_on_the
         assert!(walk.pushes > 0 && walk.pops > 0);
     }
 }
+
+/// Table 6.5 (a)'s baseline: closest-hit rays stack t_a with the pair (8
+/// bytes) and skip entries beyond the hit, shadow rays stack the pair (4
+/// bytes); the emulated kernel equals the native traversal, finds the
+/// brute-force hits, and its local bytes are 4 per push or pop plus 4 per
+/// t_a word, the t_a words being the closest-hit rays' pushes and pops.
+#[test]
+fn part_a_baseline_stacks_t_a_for_primary_rays_only_and_its_bytes_follow() {
+    use scene_bvh::Traversal;
+    let s = scene("cornell-box");
+    let b = SceneBvh::build(&s);
+    let tris: Vec<[Vec3; 3]> = s.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+    let mut cam: Camera = s.camera;
+    cam.resolution = [16, 16];
+    let fr = scene_bvh::primary_shadow_rays(&Caster::new(&s, &tree), &cam);
+    // one primary ray a pixel, at most one shadow ray (one point light), no reflection rays
+    assert_eq!(fr.stats.primary, 256);
+    assert_eq!(fr.stats.reflection, 0);
+    assert!(fr.stats.shadow > 0 && fr.stats.shadow <= 256);
+    assert_eq!(fr.rays.len() as u64, fr.stats.primary + fr.stats.shadow);
+    let mut dev = Device::new();
+    let module = scene_bvh::load(&mut dev).unwrap();
+    let t = scene_bvh::trace_kernel_with(&mut dev, &module, &b, Traversal::CompleteTa, &fr.rays).unwrap();
+    let (mut walk, mut ta) = (warplight::repro::fabianowski2011::pm_layout::Walk::default(), 0u64);
+    for (r, h) in fr.rays.iter().zip(&t.hits) {
+        let (n, w) = scene_bvh::trace_with(&b, Traversal::CompleteTa, r);
+        assert!(n.same(h), "{r:?}");
+        let want = brute(&b, r);
+        if r.any {
+            assert_eq!(h.tri != u32::MAX, want.is_some(), "{r:?}");
+        } else {
+            assert_eq!(want.map(|w| w.0), (h.tri != u32::MAX).then_some(h.t), "{r:?}");
+            ta += w.pushes + w.pops;
+        }
+        walk.add(&w);
+    }
+    assert_eq!(t.walk, walk);
+    assert!(ta > 0 && t.ta_words == ta, "t_a words {} vs closest-hit pushes + pops {ta}", t.ta_words);
+    assert_eq!(t.traffic.nodes, 28 * walk.nodes);
+    assert_eq!(t.traffic.stack, 4 * (walk.pushes + walk.pops) + 4 * ta);
+    // the t_a check skips entries: never more nodes than (b)'s baseline on the same rays
+    let b_walk = scene_bvh::trace_all(&b, Layout::Complete, &fr.rays).1;
+    assert!(walk.nodes <= b_walk.nodes && walk.pops <= b_walk.pops, "{walk:?} vs {b_walk:?}");
+}

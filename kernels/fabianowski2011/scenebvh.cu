@@ -19,6 +19,12 @@
 // t_hit]; the stack holds the pair alone (4 bytes, Table 6.5 (b): "only node
 // pairs are pushed onto the stack for it", no t_a > t_max check).
 //
+// trace_complete_ta (B of Table 6.5 (a), the older code base's baseline): as
+// trace_complete, but a closest-hit ray pushes the far pair with its entry
+// distance t_a (8 bytes) and skips a popped entry when t_a > t_max; a shadow
+// ray pushes the pair alone (4 bytes), as in (a)'s "8 B (node + t_a) for
+// primary rays, 4 B for shadow rays".
+//
 // trace_compact (C): 32-byte pairs m[3] M[3] w0 w1 as the photon map's
 // (src/repro/fabianowski2011/pm_layout.rs: bits 0-27 the child, bit 28 leaf,
 // bits 29-31 the masks l (w0) and L (w1), x highest); Algorithm 6.1 verbatim,
@@ -251,6 +257,72 @@ extern "C" __global__ void trace_compact(const TraceParams *p, const float *pair
           pair = e;
           ta = ea;
           tb = eb;
+          found = true;
+          break;
+        }
+        if (!found) break;
+      }
+    }
+    store(out + i * HIT, best);
+  }
+}
+
+extern "C" __global__ void trace_complete_ta(const TraceParams *p, const float *pairs, const float *tris,
+                                             const float *rays, float *out) {
+  for (unsigned i = WL_TID; i < (unsigned)p->count; i += blockDim.x * gridDim.x) {
+    Ray r = load_ray(rays + i * RAY);
+    Best best = {rays[i * RAY + 7], 0.0f, 0.0f, NONE};
+    float ta = r.tmin, tb = best.t;
+    if (slab(p->lo[0], p->lo[1], p->lo[2], p->hi[0], p->hi[1], p->hi[2], r, ta, tb)) {
+      unsigned stack[STACK];
+      float stack_a[STACK];
+      int size = 0;
+      unsigned pair = 0;
+      for (;;) {
+        const float *pr = pairs + 14 * pair;
+        float b0 = LDG(pr);            // @count pairs ld.global.nc.f32
+        float b1 = LDG(pr + 1), b2 = LDG(pr + 2), b3 = LDG(pr + 3), b4 = LDG(pr + 4), b5 = LDG(pr + 5);
+        float c0 = LDG(pr + 6), c1 = LDG(pr + 7), c2 = LDG(pr + 8), c3 = LDG(pr + 9), c4 = LDG(pr + 10), c5 = LDG(pr + 11);
+        unsigned wl = __float_as_uint(LDG(pr + 12)), wr = __float_as_uint(LDG(pr + 13));
+        asm volatile("" ::"f"(b0), "f"(b1), "f"(b2), "f"(b3), "f"(b4), "f"(b5), "r"(wl), "r"(wr));
+        asm volatile("" ::"f"(c0), "f"(c1), "f"(c2), "f"(c3), "f"(c4), "f"(c5));
+        float tal = r.tmin, tbl = best.t, tar = r.tmin, tbr = best.t;
+        bool hl = slab(b0, b1, b2, b3, b4, b5, r, tal, tbl);
+        bool hr = slab(c0, c1, c2, c3, c4, c5, r, tar, tbr);
+        bool done = false;
+        if (hl && (wl & LEAF_BIT)) done = leaf(tris, wl & ~LEAF_BIT, r, best);
+        if (!done && hr && (wr & LEAF_BIT)) done = leaf(tris, wr & ~LEAF_BIT, r, best);
+        if (done) break;
+        bool il = hl && !(wl & LEAF_BIT), ir = hr && !(wr & LEAF_BIT);
+        unsigned next = NONE;
+        if (il && ir) {
+          bool left_first = tal <= tar;
+          unsigned far = left_first ? wr : wl;
+          float far_a = left_first ? tar : tal;
+          stack[size] = far;           // @count push st.local.u32
+          if (!r.any) {
+            stack_a[size] = far_a;     // @count push_ta st.local.f32
+          }
+          size++;
+          next = left_first ? wl : wr;
+        } else if (il) {
+          next = wl;
+        } else if (ir) {
+          next = wr;
+        }
+        if (next != NONE) {
+          pair = next;
+          continue;
+        }
+        bool found = false;
+        while (size > 0) {
+          size--;
+          unsigned e = stack[size];    // @count pop ld.local.u32
+          if (!r.any) {
+            float ea = stack_a[size];  // @count pop_ta ld.local.f32
+            if (ea > best.t) continue;
+          }
+          pair = e;
           found = true;
           break;
         }

@@ -419,7 +419,7 @@ fn run_photon_map(
     scene: &crate::host::scene::Scene,
     cam: &crate::host::camera::Camera,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    use crate::repro::fabianowski2011::photon_image::{Options, add, parse_estimator, render_parameters};
+    use crate::repro::fabianowski2011::photon_image::{Options, parse_estimator, render_parameters};
     use crate::repro::fabianowski2011::{knn, photon_image, vkde};
     let (estimator, shape) = parse_estimator(&a.estimator, &scene.name).ok_or_else(|| {
         format!(
@@ -435,16 +435,20 @@ fn run_photon_map(
     };
     let (photons, spread) = render_parameters(&scene.name);
     let o = Options { photons, spread, h_max: vkde::H_MAX, estimator, shape, emulated };
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = crate::host::kdtree::build(
-        &tris,
-        crate::host::kdtree::BuildParams::thesis(crate::host::kdtree::Heuristic::Siroh),
-    );
+    let [width, height] = cam.resolution;
+    crate::limits::check_memory(
+        || format!("a photon-mapped render of {width} x {height} pixels with {photons} photons"),
+        photon_image::host_bytes(photons, width as u64 * height as u64, emulated),
+    )?;
+    // the emulated kernels run on the command's profile, FMA contraction and fidelity
+    let profile = Profile::parse(&a.device).ok_or_else(|| format!("unknown device `{}`", a.device))?;
+    let dev = emulated.then(|| {
+        let mut config = crate::sim::SimConfig { fidelity: a.fidelity, ..Default::default() };
+        profile.configure(&mut config, a.fmad);
+        Device::with_config(config)
+    });
     let t = std::time::Instant::now();
-    let r = photon_image::render(scene, &tree, cam, &o)?;
-    let caster = Caster::new(scene, &tree);
-    let (direct, _) = crate::host::raycast::render(&caster, cam, glam::Vec3::ZERO);
-    let image = add(&direct, &r.indirect);
+    let (image, r) = photon_image::render_scene(scene, cam, &o, scene.flight.light_offset(a.frame), dev)?;
     let out = &a.output;
     write_image(&image, out, a.exposure)?;
     let c = &r.maps.constructed;

@@ -258,6 +258,19 @@ pub fn build_kernel(
     kernels: &[Kernel],
     n_auto: u32,
 ) -> Result<(Lbvh, Vec<LaunchStats>), PhotonError> {
+    build_kernel_observed(dev, module, kernels, n_auto, None)
+}
+
+/// As [`build_kernel`], every launch observed by `model` when given (its
+/// counters the sum over the launches).
+pub fn build_kernel_observed(
+    dev: &mut Device,
+    module: &Module,
+    kernels: &[Kernel],
+    n_auto: u32,
+    model: Option<&crate::model::Model>,
+) -> Result<(Lbvh, Vec<LaunchStats>), PhotonError> {
+    let observer = model.map(|m| m as &dyn crate::sim::ObserverFactory);
     let n = kernels.len();
     if n > (LEAF_REF - 1) as usize {
         return Err(PhotonError::TooMany(n));
@@ -275,7 +288,7 @@ pub fn build_kernel(
     let cb = up(dev, &to_bytes(&centres), "centres")?;
     let codes_out = dev.alloc_zeroed::<u32>(n);
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(codes_out)];
-    launches.push(dev.launch(module, CODES, LaunchConfig::linear(ctas(n), THREADS), &args)?);
+    launches.push(dev.launch_observed(module, CODES, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
     let codes = dev.read::<u32>(codes_out, n);
     let (order, codes, boxes) = sorted(&codes, kernels);
     let cb = up(dev, &to_bytes(&codes), "codes")?;
@@ -284,10 +297,10 @@ pub fn build_kernel(
     let bx = dev.alloc_zeroed::<f32>(6 * n);
     let pp = up(dev, &params(n, n_auto, 0, 0), "params")?;
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(bb), Arg::Ptr(size), Arg::Ptr(bx)];
-    launches.push(dev.launch(module, RUNS, LaunchConfig::linear(ctas(n), THREADS), &args)?);
+    launches.push(dev.launch_observed(module, RUNS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
     let lv = dev.alloc_zeroed::<u32>(n);
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(lv)];
-    launches.push(dev.launch(module, LEVELS, LaunchConfig::linear(ctas(n), THREADS), &args)?);
+    launches.push(dev.launch_observed(module, LEVELS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
     let lv = dev.read::<u32>(lv, n - 1);
     // the merge points sorted by level, ascending positions within a level
     let mut by_level = vec![Vec::new(); CODE_BITS as usize];
@@ -304,7 +317,13 @@ pub fn build_kernel(
         let pp = up(dev, &params(n, n_auto, points.len(), first), "params")?;
         let pb = up(dev, &to_bytes(points), "points")?;
         let args = [Arg::Ptr(pp), Arg::Ptr(pb), Arg::Ptr(size), Arg::Ptr(bx), Arg::Ptr(node_of), Arg::Ptr(nodes)];
-        launches.push(dev.launch(module, MERGE, LaunchConfig::linear(ctas(points.len()), THREADS), &args)?);
+        launches.push(dev.launch_observed(
+            module,
+            MERGE,
+            LaunchConfig::linear(ctas(points.len()), THREADS),
+            &args,
+            observer,
+        )?);
         first += points.len() as u32;
     }
     let raw = dev.read::<u32>(nodes, NODE_WORDS * total);

@@ -204,15 +204,76 @@ pub struct Rendered {
     pub launch: Option<LaunchStats>,
 }
 
-/// Renders the indirect light of `scene` seen by `cam` with options `o`.
+/// Renders the indirect light of `scene` seen by `cam` with options `o`
+/// (an emulated run on a device of the default configuration).
 pub fn render(scene: &Scene, tree: &KdTree, cam: &Camera, o: &Options) -> Result<Rendered, PhotonImageError> {
-    let mut dev = o.emulated.then(Device::new);
+    render_on(scene, tree, cam, o, o.emulated.then(Device::new))
+}
+
+/// As [`render`], the kernels on `dev` when given (its profile, FMA
+/// contraction and fidelity are the caller's), else natively; `o.emulated`
+/// is not read.
+pub fn render_on(
+    scene: &Scene,
+    tree: &KdTree,
+    cam: &Camera,
+    o: &Options,
+    mut dev: Option<Device>,
+) -> Result<Rendered, PhotonImageError> {
     let maps = photon_maps(scene, tree, o, dev.as_mut())?;
     let caster = Caster::new(scene, tree);
     let q = queries(&caster, cam);
     let (est, launch) = estimates(&maps, &q, o, dev.as_mut())?;
     let contributions = est.iter().map(|e| e.contributions as u64).sum();
     Ok(Rendered { indirect: image(cam, &est), maps, queries: q.iter().flatten().count(), contributions, launch })
+}
+
+/// The image `render --method photon-map` writes: the SIROH kd-tree over
+/// `scene`, the native ray caster's direct light from the light moved by
+/// `light_offset` plus the photon-mapped indirect light of photons emitted
+/// from there, the kernels on `dev` when given.
+pub fn render_scene(
+    scene: &Scene,
+    cam: &Camera,
+    o: &Options,
+    light_offset: glam::Vec3,
+    dev: Option<Device>,
+) -> Result<(FrameBuffer, Rendered), PhotonImageError> {
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = crate::host::kdtree::build(
+        &tris,
+        crate::host::kdtree::BuildParams::thesis(crate::host::kdtree::Heuristic::Siroh),
+    );
+    let moved;
+    let lit = if light_offset == glam::Vec3::ZERO {
+        scene
+    } else {
+        let mut m = scene.clone();
+        for l in &mut m.lights {
+            if let crate::host::scene::Light::Point { position, .. } = l {
+                *position = (glam::Vec3::from(*position) + light_offset).to_array();
+            }
+        }
+        moved = m;
+        &moved
+    };
+    let r = render_on(lit, &tree, cam, o, dev)?;
+    let caster = Caster::new(scene, &tree);
+    let (direct, _) = crate::host::raycast::render(&caster, cam, light_offset);
+    Ok((add(&direct, &r.indirect), r))
+}
+
+/// Host bytes a photon-mapped render of `photons` photons and `pixels` pixels
+/// holds at its peak, an upper bound: per photon its two stored interactions
+/// and their kernels (twice over when emulated: the device's buffers and
+/// their copies), the BVH and kd-tree over them (a node and an index a
+/// kernel), and per pixel a query point, an estimate and the frame buffers.
+pub fn host_bytes(photons: usize, pixels: u64, emulated: bool) -> u64 {
+    use std::mem::size_of;
+    let per_interaction = size_of::<Option<Photon>>() + size_of::<vkde::Kernel>() + 2 * 32 + 2 * 4;
+    let per_photon = (2 * per_interaction) as u64 * if emulated { 2 } else { 1 };
+    let per_pixel = (size_of::<Option<Query>>() + size_of::<Estimate>() + 3 * 12) as u64;
+    (photons as u64).saturating_mul(per_photon).saturating_add(pixels.saturating_mul(per_pixel))
 }
 
 /// `a` + `b`, pixel by pixel (direct light plus the indirect estimate).

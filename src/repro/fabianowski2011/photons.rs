@@ -234,6 +234,11 @@ pub struct Emission {
 }
 
 impl Emission {
+    /// The same emission from the light moved by `offset` (a flight's animated light).
+    pub fn moved(&self, offset: [f32; 3]) -> Emission {
+        Emission { position: std::array::from_fn(|c| self.position[c] + offset[c]), ..*self }
+    }
+
     /// Emission of `n` photons from `scene`'s first point light.
     pub fn of(scene: &Scene, n: usize) -> Result<Emission, PhotonError> {
         if n > i32::MAX as usize {
@@ -349,6 +354,18 @@ pub fn trace_kernel(
     tree: &KdTree,
     e: &Emission,
 ) -> Result<KernelPhotons, PhotonError> {
+    trace_kernel_observed(dev, module, scene, tree, e, None)
+}
+
+/// As [`trace_kernel`], the launch observed by `model` when given (a memory model for the timing model).
+pub fn trace_kernel_observed(
+    dev: &mut Device,
+    module: &Module,
+    scene: &Scene,
+    tree: &KdTree,
+    e: &Emission,
+    model: Option<&crate::model::Model>,
+) -> Result<KernelPhotons, PhotonError> {
     let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let lay = layout(tree, &tris, 0);
     let eps = tree.bounds.size().length().max(1e-3) * EPS_REL;
@@ -381,7 +398,8 @@ pub fn trace_kernel(
     let out = dev.alloc_zeroed::<f32>(2 * SLOT * e.n.max(1));
     let ctas = (e.n.div_ceil(THREADS as usize) as u32).clamp(1, MAX_CTAS);
     let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, out].into_iter().map(Arg::Ptr).collect();
-    let launch = dev.launch(module, KERNEL, LaunchConfig::linear(ctas, THREADS), &args)?;
+    let observer = model.map(|m| m as &dyn crate::sim::ObserverFactory);
+    let launch = dev.launch_observed(module, KERNEL, LaunchConfig::linear(ctas, THREADS), &args, observer)?;
     let raw = dev.read::<f32>(out, 2 * SLOT * e.n);
     let photons = raw.chunks_exact(2 * SLOT).map(|p| [slot(&p[..SLOT]), slot(&p[SLOT..])]).collect();
     Ok(KernelPhotons { photons, launch })

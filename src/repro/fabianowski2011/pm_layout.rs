@@ -36,7 +36,7 @@ use std::collections::BTreeMap;
 
 use super::photons::PhotonError;
 use super::vkde::{Kernel, Query, Shape, d2};
-use crate::host::rt_kernels::count_tags;
+use crate::host::rt_kernels::{count_tags, tagged_counts, upload};
 use crate::model::{Model, Profile};
 use crate::ptx::ir::Program;
 use crate::sim::device::to_bytes;
@@ -61,8 +61,10 @@ pub const REF_LEAF: u32 = 0x1000_0000;
 pub const STACK: usize = 64;
 /// Floats of a kernel record: z, M, m', Φ', n, end flag.
 pub const KERNEL_FLOATS: usize = 16;
-const THREADS: u32 = 256;
-const MAX_CTAS: u32 = 30;
+/// Threads per CTA of the traversal launches (the gathers and the scene BVH's rays).
+pub(super) const THREADS: u32 = 256;
+/// The most CTAs of a traversal launch.
+pub(super) const MAX_CTAS: u32 = 30;
 
 /// What a node of a photon-map tree is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -296,7 +298,8 @@ impl Walk {
         self.pushes + self.pops
     }
 
-    fn add(&mut self, o: &Walk) {
+    /// Adds `o`'s counts.
+    pub fn add(&mut self, o: &Walk) {
         self.nodes += o.nodes;
         self.pushes += o.pushes;
         self.pops += o.pops;
@@ -445,28 +448,55 @@ pub struct Gathered {
     pub walk: Walk,
     /// Summed over the queries.
     pub traffic: Traffic,
+    /// Everything the memory model counted.
+    pub memory: crate::model::ModelStats,
     /// The launch.
     pub launch: LaunchStats,
 }
 
 /// Per tag name, the lanes that executed the tagged instruction on a tagged line of `pmgather.cu`.
 pub fn line_counts(prog: &Program, stats: &LaunchStats) -> BTreeMap<String, u64> {
-    let tags = count_tags(SOURCE);
-    let mut out: BTreeMap<String, u64> = tags.iter().map(|t| (t.name.clone(), 0)).collect();
-    let Some(file) = prog.files.iter().position(|f| f.ends_with(SOURCE_FILE)) else { return out };
-    for (fi, counts) in stats.profile.per_fn.iter().enumerate() {
-        for (pc, c) in counts.iter().enumerate() {
-            let info = &prog.functions[fi].info[pc];
-            let Some(src) = info.src else { continue };
-            if src.file as usize != file || c.pred_on == 0 {
-                continue;
-            }
-            for t in tags.iter().filter(|t| t.line == src.line && t.opcode == info.opcode) {
-                *out.entry(t.name.clone()).or_default() += c.pred_on;
-            }
-        }
+    tagged_counts(prog, &stats.profile, SOURCE_FILE, &count_tags(SOURCE), |c| c.pred_on)
+}
+
+/// One traversal launch on the emulator, observed by the gt200 memory model.
+#[derive(Debug, Clone)]
+pub(super) struct TraversalRun {
+    /// The output buffer: four floats an item.
+    pub out: Vec<f32>,
+    /// Node (read-only path) and stack (local) bytes by the memory model.
+    pub traffic: Traffic,
+    /// Everything the memory model counted.
+    pub memory: crate::model::ModelStats,
+    /// The launch.
+    pub launch: LaunchStats,
+}
+
+/// Uploads `buffers` (named for errors), launches `entry` of `module` over
+/// `n` items (at most [`MAX_CTAS`] CTAs of [`THREADS`], the buffers then an
+/// output of four floats an item as its arguments) under the gt200 memory
+/// model, and reads back the output and the read-only and local traffic:
+/// the launch the gather and scene-BVH kernels share.
+pub(super) fn run_traversal(
+    dev: &mut Device,
+    module: &Module,
+    entry: &str,
+    buffers: &[(&[u8], &str)],
+    n: usize,
+) -> Result<TraversalRun, SimError> {
+    let mut args = Vec::with_capacity(buffers.len() + 1);
+    for (bytes, name) in buffers {
+        args.push(Arg::Ptr(upload(dev, bytes, name)?));
     }
-    out
+    let out = dev.alloc_zeroed::<f32>(4 * n.max(1));
+    args.push(Arg::Ptr(out));
+    let model = Model::new(Profile::Gt200, &module.prog);
+    let ctas = (n.div_ceil(THREADS as usize) as u32).clamp(1, MAX_CTAS);
+    let launch = dev.launch_observed(module, entry, LaunchConfig::linear(ctas, THREADS), &args, Some(&model))?;
+    let memory = model.finish();
+    let m = &memory.counters;
+    let traffic = Traffic { nodes: m.texture.bytes, stack: m.local_ld.bytes + m.local_st.bytes };
+    Ok(TraversalRun { out: dev.read::<f32>(out, 4 * n), traffic, memory, launch })
 }
 
 /// Loads the gather kernels' PTX on `dev`.
@@ -492,22 +522,18 @@ pub fn gather_kernel(
     let mut params = to_bytes(&[root[0], root[1]].concat());
     params.extend(to_bytes(&[n as i32, shape.code()]));
     let q: Vec<f32> = queries.iter().flat_map(|q| Query::floats(q.as_ref())).collect();
-    let up = crate::host::rt_kernels::upload;
-    let pp = up(dev, &params, "params")?;
     let (entry, nodes) = match layout {
         Layout::Complete => (COMPLETE, &l.complete),
         Layout::Compact => (COMPACT, &l.compact),
     };
-    let nb = up(dev, &to_bytes(&nodes.concat()), "nodes")?;
-    let kb = up(dev, &to_bytes(&l.kernel_floats()), "kernels")?;
-    let qb = up(dev, &to_bytes(&q), "queries")?;
-    let out = dev.alloc_zeroed::<f32>(4 * n.max(1));
-    let args: Vec<Arg> = [pp, nb, kb, qb, out].into_iter().map(Arg::Ptr).collect();
-    let model = Model::new(Profile::Gt200, &module.prog);
-    let ctas = (n.div_ceil(THREADS as usize) as u32).clamp(1, MAX_CTAS);
-    let launch = dev.launch_observed(module, entry, LaunchConfig::linear(ctas, THREADS), &args, Some(&model))?;
-    let raw = dev.read::<f32>(out, 4 * n);
-    let c = line_counts(&module.prog, &launch);
+    let buffers = [
+        (&params[..], "params"),
+        (&to_bytes(&nodes.concat())[..], "nodes"),
+        (&to_bytes(&l.kernel_floats())[..], "kernels"),
+        (&to_bytes(&q)[..], "queries"),
+    ];
+    let run = run_traversal(dev, module, entry, &buffers, n)?;
+    let c = line_counts(&module.prog, &run.launch);
     let get = |k: &str| c.get(k).copied().unwrap_or(0);
     let walk = Walk {
         nodes: get("nodes") + 2 * get("pairs"),
@@ -515,9 +541,8 @@ pub fn gather_kernel(
         pops: get("pop"),
         retrieved: get("retrieved"),
     };
-    let m = model.finish().counters;
-    let traffic = Traffic { nodes: m.texture.bytes, stack: m.local_ld.bytes + m.local_st.bytes };
-    Ok(Gathered { radiance: raw.chunks_exact(4).map(|r| [r[0], r[1], r[2]]).collect(), walk, traffic, launch })
+    let radiance = run.out.chunks_exact(4).map(|r| [r[0], r[1], r[2]]).collect();
+    Ok(Gathered { radiance, walk, traffic: run.traffic, memory: run.memory, launch: run.launch })
 }
 
 /// The native gathers at `queries` (radiance per query, the walks summed).
@@ -532,4 +557,34 @@ pub fn gather_all(l: &Layouts, layout: Layout, queries: &[Option<Query>], shape:
         total.add(w);
     }
     (each.into_iter().map(|(r, _)| r).collect(), total)
+}
+
+/// `c` relative to `b` in percent.
+pub(super) fn change(c: f64, b: f64) -> f64 {
+    (c / b - 1.0) * 100.0
+}
+
+/// The six columns Tables 6.4 and 6.5 share after their counts: Bytes B,
+/// Bytes C, Instr. B, Instr. C, FPS B and FPS C, with `digits` decimals for
+/// the three absolute ones. Instr. B is shown, not compared: the thesis
+/// counts `instr_whole`, ours the traversal kernel alone (`instr_ours`), so
+/// only the relative Instr. C is the same quantity; the FPS are not
+/// reproducible (`fps_why`).
+pub(super) fn layout_columns(
+    digits: [usize; 3],
+    instr_whole: &str,
+    instr_ours: &str,
+    fps_why: &str,
+) -> Vec<crate::repro::table::Column> {
+    use crate::repro::compare::Tolerance;
+    use crate::repro::table::{Column, Unit};
+    let instr_why = format!("the thesis counts {instr_whole}, ours {instr_ours}: not the same quantity");
+    vec![
+        Column::measured("Bytes B", Unit::Number(digits[0]), Tolerance::COUNT),
+        Column::measured("Bytes C", Unit::Change, Tolerance::RATIO),
+        Column::measured("Instr. B", Unit::Number(digits[1]), Tolerance::COUNT).uncompared(&instr_why),
+        Column::measured("Instr. C", Unit::Change, Tolerance::RATIO),
+        Column::not_reproducible("FPS B", Unit::Number(digits[2]), fps_why),
+        Column::not_reproducible("FPS C", Unit::Change, fps_why),
+    ]
 }

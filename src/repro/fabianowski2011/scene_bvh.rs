@@ -33,12 +33,11 @@ use super::sah::{self, Bounds};
 use crate::host::camera::{Camera, Ray};
 use crate::host::kdtree::layout::wald;
 use crate::host::raycast::{Caster, Hit, TraceStats};
-use crate::host::rt_kernels::{count_tags, tagged_counts, upload};
+use crate::host::rt_kernels::{count_tags, tagged_counts};
 use crate::host::scene::{Light, MaterialKind, Scene};
-use crate::model::{Model, Profile};
 use crate::ptx::ir::Program;
 use crate::sim::device::to_bytes;
-use crate::sim::{Arg, Device, LaunchConfig, LaunchStats, Module, SimError};
+use crate::sim::{Device, LaunchStats, Module, SimError};
 
 /// The kernels' PTX (clang-16), compiled in.
 pub const PTX: &str = include_str!("../../../kernels/fabianowski2011/scenebvh.ptx");
@@ -49,6 +48,8 @@ const SOURCE_FILE: &str = "kernels/fabianowski2011/scenebvh.cu";
 pub const COMPLETE: &str = "trace_complete";
 /// Entry: the compact layout with Algorithm 6.1.
 pub const COMPACT: &str = "trace_compact";
+/// Entry: the complete layout with t_a stacked for closest-hit rays (Table 6.5 (a)'s baseline).
+pub const COMPLETE_TA: &str = "trace_complete_ta";
 /// The leaf bit of a complete pair's reference word.
 pub const LEAF_BIT: u32 = 0x8000_0000;
 /// Words of a complete pair (56 bytes).
@@ -59,12 +60,51 @@ pub const TRI_WORDS: usize = 12;
 pub const RAY_FLOATS: usize = 12;
 /// Entries of the kernels' traversal stacks.
 pub const STACK: usize = 64;
-const THREADS: u32 = 256;
-const MAX_CTAS: u32 = 30;
 const NONE: u32 = u32::MAX;
 
 /// Which layout a traversal reads.
 pub use pm_layout::Layout;
+
+/// The traversals of Table 6.5: part (b)'s two and part (a)'s older baseline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Traversal {
+    /// B of (b): [AL09]'s complete pairs, the pair alone on the stack (4 bytes).
+    Complete,
+    /// B of (a): the complete pairs; a closest-hit ray stacks the pair with its
+    /// entry distance t_a (8 bytes) and skips a popped entry when t_a > t_max,
+    /// a shadow ray the pair alone (4 bytes).
+    CompleteTa,
+    /// C of both: the compact pairs with Algorithm 6.1, pair and [t_a, t_b] stacked (12 bytes).
+    Compact,
+}
+
+impl From<Layout> for Traversal {
+    fn from(l: Layout) -> Traversal {
+        match l {
+            Layout::Complete => Traversal::Complete,
+            Layout::Compact => Traversal::Compact,
+        }
+    }
+}
+
+impl Traversal {
+    /// The kernel's entry in `scenebvh.cu`.
+    pub fn entry(self) -> &'static str {
+        match self {
+            Traversal::Complete => COMPLETE,
+            Traversal::CompleteTa => COMPLETE_TA,
+            Traversal::Compact => COMPACT,
+        }
+    }
+
+    /// The layout it reads.
+    pub fn layout(self) -> Layout {
+        match self {
+            Traversal::Complete | Traversal::CompleteTa => Layout::Complete,
+            Traversal::Compact => Layout::Compact,
+        }
+    }
+}
 
 /// The scene BVH in both layouts.
 #[derive(Debug, Clone, Default)]
@@ -258,6 +298,34 @@ fn shadow_rays(caster: &Caster, ray: &Ray, h: &Hit, out: &mut Vec<TraceRay>, st:
     }
 }
 
+/// Table 6.5 (a)'s rays of `cam` (L2829: "one primary ray and, if a surface
+/// is hit, one shadow ray per pixel"): each primary ray and, where it hits a
+/// diffuse surface facing the light, the shadow ray toward the hit, as the
+/// caster shades it.
+pub fn primary_shadow_rays(caster: &Caster, cam: &Camera) -> FrameRays {
+    let [w, h] = cam.resolution;
+    let mut out = FrameRays::default();
+    let st = &mut out.stats;
+    let eps = caster.eps();
+    for y in 0..h {
+        for x in 0..w {
+            let ray = cam.ray(x, y);
+            st.primary += 1;
+            out.rays.push(TraceRay {
+                origin: ray.origin.to_array(),
+                dir: ray.dir.to_array(),
+                t_min: eps,
+                t_max: f32::INFINITY,
+                any: false,
+            });
+            if let Some(hit) = caster.intersect(&ray, eps, f32::INFINITY, false, st) {
+                shadow_rays(caster, &ray, &hit, &mut out.rays, st);
+            }
+        }
+    }
+    out
+}
+
 /// Up to four rays per pixel of `cam` (§A.1, L2845 "primary, reflection and
 /// shadow rays"): the primary ray, a mirror reflection ray where the surface
 /// seen reflects, and a shadow ray from the light toward each diffuse hit;
@@ -382,6 +450,11 @@ fn slab(lo: [f32; 3], hi: [f32; 3], r: &R, ta: &mut f32, tb: &mut f32) -> bool {
 /// step): the result and what it did (nodes: node accesses, two a pair;
 /// retrieved: triangles tested).
 pub fn trace(b: &SceneBvh, layout: Layout, ray: &TraceRay) -> (Best, Walk) {
+    trace_with(b, layout.into(), ray)
+}
+
+/// The native traversal of `ray` by `traversal` (the kernel's step for step).
+pub fn trace_with(b: &SceneBvh, traversal: Traversal, ray: &TraceRay) -> (Best, Walk) {
     let r =
         R { o: ray.origin, d: ray.dir, inv: std::array::from_fn(|c| 1.0 / ray.dir[c]), tmin: ray.t_min, any: ray.any };
     let mut best = Best { t: ray.t_max, u: 0.0, v: 0.0, tri: NONE };
@@ -390,15 +463,18 @@ pub fn trace(b: &SceneBvh, layout: Layout, ray: &TraceRay) -> (Best, Walk) {
     if b.complete.is_empty() || !slab(b.root[0], b.root[1], &r, &mut ta, &mut tb) {
         return (best, walk);
     }
-    match layout {
-        Layout::Complete => complete(b, &r, &mut best, &mut walk),
-        Layout::Compact => compact(b, &r, ta, tb, &mut best, &mut walk),
+    match traversal {
+        Traversal::Complete => complete(b, &r, false, &mut best, &mut walk),
+        Traversal::CompleteTa => complete(b, &r, !r.any, &mut best, &mut walk),
+        Traversal::Compact => compact(b, &r, ta, tb, &mut best, &mut walk),
     }
     (best, walk)
 }
 
-fn complete(b: &SceneBvh, r: &R, best: &mut Best, walk: &mut Walk) {
-    let mut stack = Vec::new();
+/// B's traversal; with `check` the stack holds each pair's entry distance
+/// t_a and a popped entry beyond the hit is skipped.
+fn complete(b: &SceneBvh, r: &R, check: bool, best: &mut Best, walk: &mut Walk) {
+    let mut stack: Vec<(u32, f32)> = Vec::new();
     let mut pair = 0u32;
     loop {
         let p = &b.complete[pair as usize];
@@ -425,7 +501,7 @@ fn complete(b: &SceneBvh, r: &R, best: &mut Best, walk: &mut Walk) {
         let (il, ir) = (hl && wl & LEAF_BIT == 0, hr && wr & LEAF_BIT == 0);
         let next = if il && ir {
             let left_first = tal <= tar;
-            stack.push(if left_first { wr } else { wl });
+            stack.push(if left_first { (wr, tar) } else { (wl, tal) });
             walk.pushes += 1;
             Some(if left_first { wl } else { wr })
         } else if il {
@@ -439,9 +515,15 @@ fn complete(b: &SceneBvh, r: &R, best: &mut Best, walk: &mut Walk) {
             pair = n;
             continue;
         }
-        let Some(n) = stack.pop() else { return };
-        walk.pops += 1;
-        pair = n;
+        loop {
+            let Some((n, a)) = stack.pop() else { return };
+            walk.pops += 1;
+            if check && a > best.t {
+                continue;
+            }
+            pair = n;
+            break;
+        }
     }
 }
 
@@ -522,6 +604,9 @@ pub struct Traced {
     pub walk: Walk,
     /// Node (read-only path) and stack (local) bytes by the memory model.
     pub traffic: Traffic,
+    /// Entry distances t_a written and read on the stack (part (a)'s baseline
+    /// alone: its closest-hit rays' pushes and pops), read off the `@count` lines.
+    pub ta_words: u64,
     /// The launch.
     pub launch: LaunchStats,
 }
@@ -555,6 +640,17 @@ pub fn trace_kernel(
     layout: Layout,
     rays: &[TraceRay],
 ) -> Result<Traced, TraceError> {
+    trace_kernel_with(dev, module, b, layout.into(), rays)
+}
+
+/// Traces `rays` by `traversal` on the emulator.
+pub fn trace_kernel_with(
+    dev: &mut Device,
+    module: &Module,
+    b: &SceneBvh,
+    traversal: Traversal,
+    rays: &[TraceRay],
+) -> Result<Traced, TraceError> {
     let n = rays.len();
     if n > i32::MAX as usize {
         return Err(TraceError::TooMany(n));
@@ -563,28 +659,25 @@ pub fn trace_kernel(
     let root = if b.complete.is_empty() { [[f32::INFINITY; 3], [f32::NEG_INFINITY; 3]] } else { b.root };
     let mut params = to_bytes(&[root[0], root[1]].concat());
     params.extend(to_bytes(&[n as i32]));
-    let pp = upload(dev, &params, "params")?;
-    let (entry, nodes) = match layout {
-        Layout::Complete => (COMPLETE, b.complete.concat()),
-        Layout::Compact => (COMPACT, b.compact.concat()),
+    let entry = traversal.entry();
+    let nodes = match traversal.layout() {
+        Layout::Complete => b.complete.concat(),
+        Layout::Compact => b.compact.concat(),
     };
-    let nb = upload(dev, &to_bytes(&nodes), "pairs")?;
-    let tb = upload(dev, &to_bytes(&b.tris.concat()), "triangles")?;
     let r: Vec<f32> = rays.iter().flat_map(|r| r.floats()).collect();
-    let rb = upload(dev, &to_bytes(&r), "rays")?;
-    let out = dev.alloc_zeroed::<f32>(4 * n.max(1));
-    let args: Vec<Arg> = [pp, nb, tb, rb, out].into_iter().map(Arg::Ptr).collect();
-    let model = Model::new(Profile::Gt200, &module.prog);
-    let ctas = (n.div_ceil(THREADS as usize) as u32).clamp(1, MAX_CTAS);
-    let launch = dev.launch_observed(module, entry, LaunchConfig::linear(ctas, THREADS), &args, Some(&model))?;
-    let raw = dev.read::<f32>(out, 4 * n);
-    let c = line_counts(&module.prog, &launch);
+    let buffers = [
+        (&params[..], "params"),
+        (&to_bytes(&nodes)[..], "pairs"),
+        (&to_bytes(&b.tris.concat())[..], "triangles"),
+        (&to_bytes(&r)[..], "rays"),
+    ];
+    let run = pm_layout::run_traversal(dev, module, entry, &buffers, n)?;
+    let c = line_counts(&module.prog, &run.launch);
     let get = |k: &str| c.get(k).copied().unwrap_or(0);
     let walk = Walk { nodes: 2 * get("pairs"), pushes: get("push"), pops: get("pop"), retrieved: get("tested") };
-    let m = model.finish().counters;
-    let traffic = Traffic { nodes: m.texture.bytes, stack: m.local_ld.bytes + m.local_st.bytes };
-    let hits = raw.chunks_exact(4).map(|h| Best { t: h[0], u: h[1], v: h[2], tri: h[3].to_bits() }).collect();
-    Ok(Traced { hits, walk, traffic, launch })
+    let hits = run.out.chunks_exact(4).map(|h| Best { t: h[0], u: h[1], v: h[2], tri: h[3].to_bits() }).collect();
+    let ta_words = get("push_ta") + get("pop_ta");
+    Ok(Traced { hits, walk, traffic: run.traffic, ta_words, launch: run.launch })
 }
 
 /// The native traversals of `rays` (results per ray, the walks summed).

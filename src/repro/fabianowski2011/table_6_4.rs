@@ -18,7 +18,7 @@
 
 use super::lbvh;
 use super::photon_image::{self, Estimator, Options};
-use super::pm_layout::{self, Layout, Layouts};
+use super::pm_layout::{self, Layout, Layouts, change};
 use super::scenes_of;
 use super::table_5_1::parameters;
 use super::vkde::{self, Shape};
@@ -271,28 +271,22 @@ fn per_query(r: &Results, scene: &str, v: &str, per_node: f64) -> Option<PerQuer
     })
 }
 
-fn change(c: f64, b: f64) -> f64 {
-    (c / b - 1.0) * 100.0
-}
-
 /// The table.
 pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     let scenes = scenes_of(r, PM_LAYOUTS);
     let fps_why = "the thesis' frame rates are of its whole rendering kernel (ray tracing and density estimation, \
                    code base I) on a GTX 280; only the gather is emulated here and no timing model is applied to it";
-    let columns = vec![
+    let mut columns = vec![
         Column::measured("n_T", Unit::Number(1), Tolerance::COUNT),
         Column::measured("Stack B", Unit::Number(1), Tolerance::COUNT),
         Column::measured("Stack C", Unit::Change, Tolerance::RATIO),
-        Column::measured("Bytes B", Unit::Number(0), Tolerance::COUNT),
-        Column::measured("Bytes C", Unit::Change, Tolerance::RATIO),
-        Column::measured("Instr. B", Unit::Number(0), Tolerance::COUNT).uncompared(
-            "the thesis counts its whole rendering kernel, ours the gather kernel alone: not the same quantity",
-        ),
-        Column::measured("Instr. C", Unit::Change, Tolerance::RATIO),
-        Column::not_reproducible("FPS B", Unit::Number(2), fps_why),
-        Column::not_reproducible("FPS C", Unit::Change, fps_why),
     ];
+    columns.extend(pm_layout::layout_columns(
+        [0, 0, 2],
+        "its whole rendering kernel",
+        "the gather kernel alone",
+        fps_why,
+    ));
     let mut ours = Vec::new();
     let mut exact = Vec::new();
     let mut stack_b = Vec::new();

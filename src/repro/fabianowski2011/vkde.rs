@@ -534,6 +534,17 @@ pub fn construct_kernel(
     photons: &[[Option<Photon>; 2]],
     s: &Settings,
 ) -> Result<(Vec<Construction>, LaunchStats), PhotonError> {
+    construct_kernel_observed(dev, module, photons, s, None)
+}
+
+/// As [`construct_kernel`], the launch observed by `model` when given.
+pub fn construct_kernel_observed(
+    dev: &mut Device,
+    module: &Module,
+    photons: &[[Option<Photon>; 2]],
+    s: &Settings,
+    model: Option<&crate::model::Model>,
+) -> Result<(Vec<Construction>, LaunchStats), PhotonError> {
     let slots = slot_floats(photons);
     let n = slots.len() / SLOT;
     if n > i32::MAX as usize {
@@ -546,7 +557,8 @@ pub fn construct_kernel(
     let inp = up(dev, &to_bytes(&slots), "slots")?;
     let out = dev.alloc_zeroed::<f32>(RECORD * n.max(1));
     let args: Vec<Arg> = [pp, inp, out].into_iter().map(Arg::Ptr).collect();
-    let launch = dev.launch(module, CONSTRUCT, LaunchConfig::linear(ctas(n), THREADS), &args)?;
+    let observer = model.map(|m| m as &dyn crate::sim::ObserverFactory);
+    let launch = dev.launch_observed(module, CONSTRUCT, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?;
     let raw = dev.read::<f32>(out, RECORD * n);
     Ok((raw.chunks_exact(RECORD).map(record).collect(), launch))
 }
