@@ -47,13 +47,15 @@ fn the_plan_charges_each_emulated_run_its_measured_cost() {
 
 /// Below the thesis' size the per-side rate overestimates: a run's measured
 /// cost (about 0.5 s + 6.2e-5 s per pixel: 1.1 s at 96 x 96, 2.8 s at
-/// 192 x 192) stays under the plan's charge, so `--plan` is an upper bound
-/// for the quick protocol and exact at 512 x 512.
+/// 192 x 192) stays under the plan's charge (by more than half there), so
+/// `--plan` is an upper bound for the quick protocol and exact at 512 x 512.
 #[test]
 fn smaller_images_are_overestimated_not_under() {
     for (side, measured) in [(96.0, 1.1), (192.0, 2.8), (512.0, MEASURED_RUN_AT_512)] {
         let charged = side * EMULATED;
         assert!(charged >= measured * 0.99, "{side}: {charged} s charged against {measured} s measured");
+        if side < 512.0 {
+            assert!(charged > 2.0 * measured, "{side}: charged more than twice its cost");
+        }
     }
-    assert!(96.0 * EMULATED > 2.0 * 1.1, "the quick protocol is charged more than twice its cost");
 }
