@@ -50,6 +50,31 @@ fn estimator_names() {
     assert_eq!(photon_image::render_parameters("cornell-box"), (131072, 10.0));
 }
 
+/// The committed first frames of `render --method photon-map` (96 x 96,
+/// native, Table 5.1's photons and s): two small scenes re-rendered match
+/// within one 8-bit step a channel.
+#[test]
+fn photon_map_first_frames_match_their_references() {
+    use warplight::host::image::FrameBuffer;
+    for name in ["scene6", "ring"] {
+        let scene = scene_file::load(Path::new(&format!("scenes/{name}.toml"))).unwrap();
+        let mut cam = scene.flight.camera(&scene.camera, 0);
+        cam.resolution = [96, 96];
+        for est in ["vkde", "knn"] {
+            let (estimator, shape) = parse_estimator(est, name).unwrap();
+            let (photons, spread) = photon_image::render_parameters(name);
+            let o = Options { photons, spread, h_max: vkde::H_MAX, estimator, shape, emulated: false };
+            let (image, _) = photon_image::render_scene(&scene, &cam, &o, Vec3::ZERO, None).unwrap();
+            let got = image.to_srgb8(0.0);
+            let path = format!("reference_images/fabianowski-{name}-{est}.png");
+            let want = FrameBuffer::read_png(Path::new(&path)).unwrap().to_srgb8(0.0);
+            assert_eq!(got.len(), want.len(), "{path}");
+            let worst = got.iter().zip(&want).map(|(a, b)| (*a as i32 - *b as i32).abs()).max().unwrap();
+            assert!(worst <= 1, "{path}: a channel differs by {worst} steps");
+        }
+    }
+}
+
 /// `render --method photon-map` runs the emulated kernels on the device it
 /// is given: a device whose CTAs are too small for the kernels' launch fails.
 #[test]
