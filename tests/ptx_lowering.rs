@@ -199,6 +199,15 @@ fn validation_names_what_is_wrong() {
         ("tanh.f32 %f1, %f1;", "invalid: `tanh.f32`: tanh is .approx on .f32 and halves"),
         ("tex.2d.v4.f32.f32 {%f1, %f1, %f1, %f1}, [%rd1, {%f1}];", "takes 2 coordinate(s), found 1"),
         ("sust.p.2d.b32.trap [%rd1, {%r1, %r2}], {%r3};", "`sust.p.2d.b32.trap (modifier .p)`"),
+        ("sured.p.add.1d.u32.trap [%rd1, {%r1}], %r3;", "`sured.p.add.1d.u32.trap (modifier .p)`"),
+        ("sured.b.xor.1d.b32.trap [%rd1, {%r1}], %r3;", "`sured.b.xor.1d.b32.trap (modifier .xor)`"),
+        ("sured.b.add.1d.b32.trap [%rd1, {%r1}], %r3;", "invalid: `sured.b.add.1d.b32.trap`: .add .min .max take"),
+        ("sured.b.add.1d.u32.trap [%rd1, {%r1}], {%r3, %r3};", "takes an address and one value"),
+        (
+            "set.lt.f32.f16x2 %r1, %r2, %r3;",
+            "invalid: `set.lt.f32.f16x2`: packed halves compare into .f16x2, .u32 or .s32",
+        ),
+        ("set.lt.f16x2.bf16x2 %r1, %r2, %r3;", "packed halves compare into .bf16x2, .u32 or .s32"),
     ];
     for (inst, expected) in cases {
         let src = format!(
@@ -208,5 +217,48 @@ fn validation_names_what_is_wrong() {
         );
         let e = ptx::load(&src, "v.ptx").map(|_| ()).unwrap_err().to_string();
         assert!(e.starts_with("v.ptx:11:1: ") && e.contains(expected), "{inst}: {e}");
+    }
+}
+
+/// What each instruction form writes, hand-derived from PTX: the data
+/// registers ([`warplight::ptx::ir::Kind::writes`], from the one register visitor) and
+/// the predicates ([`warplight::ptx::ir::Kind::pred_writes`]).
+#[test]
+fn writes_of_every_form_with_a_destination() {
+    let cases: &[(&str, &[&str], &[&str])] = &[
+        ("mov.u32 %r1, %r2;", &["%r1"], &[]),
+        ("mov.b64 %rd1, {%r1, %r2};", &["%rd1"], &[]),
+        ("mov.b64 {%r1, %r2}, %rd1;", &["%r1", "%r2"], &[]),
+        ("add.cc.u32 %r3, %r1, %r2;", &["%r3", "%cc (carry)"], &[]),
+        ("addc.u32 %r3, %r1, %r2;", &["%r3"], &[]),
+        ("setp.lt.s32 %p1|%p2, %r1, %r2;", &[], &["%p1", "%p2"]),
+        ("and.pred %p1, %p2, %p3;", &[], &["%p1"]),
+        ("set.lt.u32.f16x2 %r1, %r2, %r3;", &["%r1"], &[]),
+        ("ld.global.v2.u32 {%r1, %r2}, [%rd1];", &["%r1", "%r2"], &[]),
+        ("st.global.u32 [%rd1], %r1;", &[], &[]),
+        ("atom.global.add.u32 %r1, [%rd1], 1;", &["%r1"], &[]),
+        ("red.global.add.u32 [%rd1], 1;", &[], &[]),
+        ("vote.sync.ballot.b32 %r1, %p1, -1;", &["%r1"], &[]),
+        ("vote.sync.any.pred %p1, %p2, -1;", &[], &["%p1"]),
+        ("shfl.sync.down.b32 %r1|%p1, %r2, 1, 31, -1;", &["%r1"], &["%p1"]),
+        ("match.all.sync.b32 %r1|%p1, %r2, -1;", &["%r1"], &["%p1"]),
+        ("redux.sync.add.u32 %r1, %r2, -1;", &["%r1"], &[]),
+        ("bar.red.popc.u32 %r1, 0, %p1;", &["%r1"], &[]),
+        ("sured.b.add.1d.u32.trap [%rd1, {%r1}], %r2;", &[], &[]),
+        ("bar.warp.sync -1;", &[], &[]),
+    ];
+    for (inst, want, want_p) in cases {
+        let src = format!(
+            ".version 7.8\n.target sm_90\n.address_size 64\n.visible .entry k()\n{{\n\
+             .reg .pred %p<4>;\n.reg .b32 %r<4>;\n.reg .b64 %rd<2>;\n{inst}\nret;\n}}\n"
+        );
+        let prog = ptx::load(&src, "w.ptx").unwrap_or_else(|e| panic!("{inst}: {e}"));
+        let f = &prog.functions[0];
+        let k = &f.insts[0].kind;
+        let name = |r: &warplight::ptx::ir::RegId| f.reg_names[*r as usize].clone();
+        let got: Vec<String> = k.writes().iter().map(name).collect();
+        assert_eq!(got, *want, "{inst}");
+        let got_p: Vec<&str> = k.pred_writes().iter().map(|p| f.pred_names[*p as usize].as_str()).collect();
+        assert_eq!(got_p, *want_p, "{inst}");
     }
 }

@@ -335,3 +335,118 @@ fn bit_counts_of_64_bit_values() {
     );
     assert_eq!(out, [5, 0, 63, 0, 0, 0x8000_0000]);
 }
+
+/// Function pointers to an unusable function and to one naming shared
+/// memory: `via_pointer` reaches `bad_fn` only through a register, `via_table`
+/// through a table in global memory; `no_pointer` calls nothing indirectly.
+const INDIRECT: &str = "
+.version 7.8
+.target sm_90
+.address_size 64
+.shared .align 4 .b8 big[4096];
+.func (.param .b32 r) bad_fn(.param .b32 a)
+{
+	.reg .b32 %r<3>;
+	ld.param.b32 %r1, [a];
+	sad.u32 %r2, %r1, %r1, %r1;
+	st.param.b32 [r], %r2;
+	ret;
+}
+.func (.param .b32 r) shared_fn(.param .b32 a)
+{
+	.reg .b32 %r<3>;
+	ld.param.b32 %r1, [a];
+	st.shared.u32 [big], %r1;
+	st.param.b32 [r], %r1;
+	ret;
+}
+.global .align 8 .u64 table[1] = {shared_fn};
+.visible .entry via_pointer(.param .u64 out)
+{
+	.reg .b32 %r<3>;
+	.reg .b64 %rd<3>;
+	mov.u64 %rd1, bad_fn;
+	{
+		.param .b32 a;
+		st.param.b32 [a], 1;
+		.param .b32 r;
+		proto: .callprototype (.param .b32 _) _ (.param .b32 _);
+		call (r), %rd1, (a), proto;
+		ld.param.b32 %r2, [r];
+	}
+	ret;
+}
+.visible .entry via_table(.param .u64 out)
+{
+	.reg .b32 %r<3>;
+	.reg .b64 %rd<3>;
+	ld.global.u64 %rd1, [table];
+	{
+		.param .b32 a;
+		st.param.b32 [a], 1;
+		.param .b32 r;
+		proto2: .callprototype (.param .b32 _) _ (.param .b32 _);
+		call (r), %rd1, (a), proto2;
+		ld.param.b32 %r2, [r];
+	}
+	ret;
+}
+.visible .entry no_pointer(.param .u64 out)
+{
+	ret;
+}
+";
+
+/// An unusable function reached only through a function pointer makes every
+/// kernel making an indirect call unusable (which function a register holds
+/// is known at run time only), and a function reached that way counts for
+/// the kernel's shared memory: conservative, never silently wrong.
+#[test]
+fn indirect_calls_reach_every_function_whose_address_is_taken() {
+    let mut dev = Device::new();
+    let m = dev.load_ptx(INDIRECT, "ind.ptx").unwrap_or_else(|e| panic!("{e}"));
+    let k = |n: &str| m.prog.kernel(n).unwrap();
+    let mut taken: Vec<&str> =
+        m.prog.address_taken().iter().map(|&f| m.prog.functions[f as usize].name.as_str()).collect();
+    taken.sort();
+    assert_eq!(taken, ["bad_fn", "shared_fn"]);
+    let e = m.prog.kernel_error(k("via_pointer")).expect("via_pointer reaches bad_fn").to_string();
+    assert!(e.starts_with("ind.ptx:10:2: unsupported instruction `sad.u32`"), "{e}");
+    // via_table may hold any taken function too
+    assert!(m.prog.kernel_error(k("via_table")).is_some());
+    assert!(m.prog.kernel_error(k("no_pointer")).is_none());
+    assert_eq!(m.prog.kernel_shared_size(k("no_pointer")), 0);
+    // without the unusable function: via_table runs, and its shared memory is shared_fn's
+    let fine = INDIRECT.replace("sad.u32 %r2, %r1, %r1, %r1;", "add.u32 %r2, %r1, %r1;");
+    let m = dev.load_ptx(&fine, "fine.ptx").unwrap();
+    let kt = m.prog.kernel("via_table").unwrap();
+    assert!(m.prog.kernel_error(kt).is_none());
+    assert_eq!(m.prog.kernel_shared_size(kt), 4096);
+    assert_eq!(m.prog.kernel_shared_size(m.prog.kernel("no_pointer").unwrap()), 0);
+    let out = dev.alloc_zeroed::<u32>(1);
+    dev.launch(&m, "via_table", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap();
+}
+
+/// A direct call passing an argument or taking a return value of another
+/// size than the function declares is refused at load, naming file and line.
+#[test]
+fn direct_calls_with_mismatched_sizes_are_errors() {
+    let src = |arg: &str, ret: &str| {
+        format!(
+            ".version 7.8\n.target sm_90\n.address_size 64\n\
+             .func (.param .b32 r) f(.param .b64 a)\n{{\n\t.reg .b64 %rd<2>;\n\tld.param.b64 %rd1, [a];\n\
+             \tst.param.b32 [r], 1;\n\tret;\n}}\n\
+             .visible .entry k()\n{{\n\t.reg .b32 %r<2>;\n\t{{\n\t\t.param {arg} a;\n\t\tst.param.b32 [a], 1;\n\
+             \t\t.param {ret} r;\n\t\tcall.uni (r), f, (a);\n\t\tld.param.b32 %r1, [r];\n\t}}\n\tret;\n}}\n"
+        )
+    };
+    warplight::ptx::load(&src(".b64", ".b32"), "call.ptx").unwrap_or_else(|e| panic!("{e}"));
+    let e = warplight::ptx::load(&src(".b32", ".b32"), "call.ptx").unwrap_err().to_string();
+    assert!(
+        e.starts_with("call.ptx:18:3: invalid")
+            && e.contains("argument 1 of the call of `f` has 4 byte(s); the function's has 8"),
+        "{e}"
+    );
+    let e = warplight::ptx::load(&src(".b64", ".b64"), "call.ptx").unwrap_err().to_string();
+    assert!(e.contains("call.ptx:18:3") && e.contains("return value 1 of the call of `f` has 8 byte(s)"), "{e}");
+}

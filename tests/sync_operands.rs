@@ -201,3 +201,135 @@ fn a_local_frame_over_the_device_limit_is_a_typed_error_through_the_api() {
     let m = dev.load_ptx(&src, "local.ptx").unwrap();
     dev.launch(&m, "k", LaunchConfig::linear(2, 32), &[]).unwrap();
 }
+
+/// `bar.warp.sync` with the mask in `mask` for lanes below 16 and `hi` for
+/// the others (`__syncwarp(m)`), then a store of the lane id.
+const WARP_SYNC: &str = "
+.visible .entry warp_sync(.param .u64 out, .param .u32 lo, .param .u32 hi)
+{
+.reg .pred %p<2>;
+.reg .b32 %r<6>;
+.reg .b64 %rd<4>;
+ld.param.u64 %rd1, [out];
+ld.param.u32 %r3, [lo];
+ld.param.u32 %r4, [hi];
+mov.u32 %r1, %tid.x;
+setp.lt.u32 %p1, %r1, 16;
+selp.b32 %r5, %r3, %r4, %p1;
+bar.warp.sync %r5;
+mul.wide.u32 %rd2, %r1, 4;
+add.s64 %rd3, %rd1, %rd2;
+st.global.u32 [%rd3], %r1;
+ret;
+}
+";
+
+fn warp_sync(lo: u32, hi: u32, checked: bool) -> (Result<LaunchStats, SimError>, Vec<warplight::check::Report>) {
+    let mut dev = device();
+    let m = dev.load_ptx(&format!("{HEAD}{WARP_SYNC}"), "ws.ptx").unwrap();
+    let out = dev.alloc_zeroed::<u32>(32);
+    let args = [Arg::Ptr(out), Arg::U32(lo), Arg::U32(hi)];
+    let cfg = LaunchConfig::linear(1, 32);
+    if !checked {
+        return (dev.launch(&m, "warp_sync", cfg, &args), Vec::new());
+    }
+    let opts = warplight::check::CheckOptions {
+        tools: warplight::check::Tools::ALL,
+        uninit: Vec::new(),
+        elem_sizes: Vec::new(),
+    };
+    let c = warplight::check::launch_checked(&mut dev, &m, "warp_sync", cfg, &args, &opts, None).unwrap();
+    (c.stats.ok_or_else(|| SimError::Fault(c.fault.unwrap())), c.reports)
+}
+
+#[test]
+fn a_warp_sync_mask_leaving_out_an_executing_lane_is_a_fault_and_a_synccheck_finding() {
+    // lanes 16-31 name only lanes 0-15
+    let (r, _) = warp_sync(0xFFFF, 0xFFFF, false);
+    let f = fault_of(r);
+    assert!(matches!(f.kind, FaultKind::MemberMask { mask: 0xFFFF, active: u32::MAX, .. }), "{f}");
+    assert_eq!((f.lane, f.ptx_line), (Some(16), 16), "{f}");
+    assert!(f.to_string().contains("ws.ptx:16"), "{f}");
+    // `warplight check`: synccheck's invalid member mask, at the line, naming the lane
+    let (_, reports) = warp_sync(0xFFFF, 0xFFFF, true);
+    assert_eq!(reports.len(), 1, "{reports:?}");
+    let rep = &reports[0];
+    assert_eq!(rep.hazard, warplight::check::Hazard::InvalidMemberMask);
+    assert_eq!(rep.hazard.tool(), "synccheck");
+    assert_eq!(rep.sites[0].ptx_line, 16);
+    assert!(rep.note.contains("of lane 16") && rep.note.contains("leaves out lane 16"), "{}", rep.note);
+    // each half naming itself (two groups), or the whole warp: no fault, no finding
+    warp_sync(0xFFFF, 0xFFFF_0000, false).0.unwrap();
+    warp_sync(u32::MAX, u32::MAX, false).0.unwrap();
+    let (r, reports) = warp_sync(0xFFFF, 0xFFFF_0000, true);
+    r.unwrap();
+    assert!(reports.is_empty(), "{reports:?}");
+    // a mask naming more lanes than execute it is waited for on the GPU, not an error
+    warp_sync(0x0001_FFFF, 0xFFFF_0000, false).0.unwrap();
+}
+
+/// `redux.sync.add.u32` and `match.any.sync.b32` with lanes below `split`
+/// naming `lo` and the others `hi`; each lane writes both results.
+const GROUPS: &str = "
+.visible .entry groups(.param .u64 out, .param .u32 split, .param .u32 lo, .param .u32 hi)
+{
+.reg .pred %p<2>;
+.reg .b32 %r<12>;
+.reg .b64 %rd<4>;
+ld.param.u64 %rd1, [out];
+ld.param.u32 %r2, [split];
+ld.param.u32 %r3, [lo];
+ld.param.u32 %r4, [hi];
+mov.u32 %r1, %tid.x;
+setp.lt.u32 %p1, %r1, %r2;
+selp.b32 %r5, %r3, %r4, %p1;
+mul.lo.u32 %r6, %r1, %r1;
+redux.sync.add.u32 %r7, %r6, %r5;
+and.b32 %r8, %r1, 3;
+match.any.sync.b32 %r9, %r8, %r5;
+mul.wide.u32 %rd2, %r1, 8;
+add.s64 %rd3, %rd1, %rd2;
+st.global.v2.u32 [%rd3], {%r7, %r9};
+ret;
+}
+";
+
+fn groups(split: u32, lo: u32, hi: u32) -> Result<Vec<u32>, SimError> {
+    let mut dev = device();
+    let m = dev.load_ptx(&format!("{HEAD}{GROUPS}"), "groups.ptx").unwrap();
+    let out = dev.alloc_zeroed::<u32>(64);
+    let args = [Arg::Ptr(out), Arg::U32(split), Arg::U32(lo), Arg::U32(hi)];
+    dev.launch(&m, "groups", LaunchConfig::linear(1, 32), &args)?;
+    Ok(dev.read::<u32>(out, 64))
+}
+
+/// The Rust model: each lane's redux and match over the lanes of its mask.
+fn groups_model(split: u32, lo: u32, hi: u32) -> Vec<u32> {
+    let mask = |l: u32| if l < split { lo } else { hi };
+    let mut out = Vec::new();
+    for l in 0..32u32 {
+        let m = mask(l);
+        let members = (0..32u32).filter(|k| m >> k & 1 != 0);
+        out.push(members.clone().map(|k| k * k).fold(0u32, u32::wrapping_add));
+        out.push(members.filter(|k| k & 3 == l & 3).fold(0u32, |s, k| s | 1 << k));
+    }
+    out
+}
+
+#[test]
+fn redux_and_match_compute_each_member_group() {
+    for (split, lo, hi) in [
+        (16, 0xFFFF, 0xFFFF_0000),
+        (8, 0xFF, 0xFFFF_FF00),
+        (0, 0, u32::MAX),
+        (32, u32::MAX, 0),
+        (31, !(1 << 31), 1 << 31),
+    ] {
+        assert_eq!(groups(split, lo, hi).unwrap(), groups_model(split, lo, hi), "split {split} {lo:#x} {hi:#x}");
+    }
+    // lanes 0-15 name the whole warp, lanes 16-31 only themselves: undefined, a fault naming lane 16
+    let e = groups(16, u32::MAX, 0xFFFF_0000).unwrap_err();
+    let SimError::Fault(f) = e else { panic!("{e:?}") };
+    assert!(matches!(f.kind, FaultKind::MemberMask { mask: 0xFFFF_0000, .. }), "{f}");
+    assert_eq!((f.lane, f.ptx_line), (Some(16), 18), "{f}");
+}

@@ -13,7 +13,7 @@ mod common;
 use common::{BOTH, Dialect, load};
 use serde_json::Value;
 use warplight::sim::texture::{AddressMode, FilterMode, ReadMode, SurfaceDesc, TexelFormat, TextureDesc};
-use warplight::sim::{Arg, Device, DevicePtr, LaunchConfig};
+use warplight::sim::{Arg, Device, DevicePtr, LaunchConfig, SimError};
 
 fn fixture() -> Value {
     serde_json::from_str(&std::fs::read_to_string("tests/fixtures/gpu_textures.json").unwrap()).unwrap()
@@ -513,4 +513,51 @@ fn texture_spec_errors_name_the_key() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("`args[0]`: `tex` is a texture or surface object: it takes no offset"), "{e}");
+}
+
+/// `sured.b` on a 2-D surface of 4 × 4 words: each of 64 threads applies
+/// its value at (tid % 4, tid / 4 % 4), so every element takes four
+/// lanes' values (two warps); compared with the operation in Rust.
+#[test]
+fn surface_reductions_combine_every_lane_in_place() {
+    let ptx = |op: &str, ty: &str| {
+        format!(
+            ".version 7.8\n.target sm_90\n.address_size 64\n\
+             .visible .entry k(.param .u64 h)\n{{\n.reg .b64 %rd<2>;\n.reg .b32 %r<8>;\n\
+             ld.param.u64 %rd1, [h];\nmov.u32 %r1, %tid.x;\nand.b32 %r2, %r1, 3;\nshl.b32 %r3, %r2, 2;\n\
+             shr.u32 %r4, %r1, 2;\nand.b32 %r5, %r4, 3;\nmul.lo.u32 %r6, %r1, 2654435761;\n\
+             sured.b.{op}.2d.{ty}.trap [%rd1, {{%r3, %r5}}], %r6;\nret;\n}}\n"
+        )
+    };
+    let init: Vec<u32> = (0..16u32).map(|i| i.wrapping_mul(0x9E37_79B9)).collect();
+    type Op = fn(u32, u32) -> u32;
+    let cases: [(&str, &str, Op); 5] = [
+        ("add", "u32", u32::wrapping_add),
+        ("min", "s32", |a, b| (a as i32).min(b as i32) as u32),
+        ("max", "u32", u32::max),
+        ("and", "b32", |a, b| a & b),
+        ("or", "b32", |a, b| a | b),
+    ];
+    for (op, ty, f) in cases {
+        let mut dev = Device::new();
+        let m = dev.load_ptx(&ptx(op, ty), "sured.ptx").unwrap();
+        let data = dev.alloc_from(&init);
+        let h = dev.create_surface(SurfaceDesc { data, elem_bytes: 4, dims: [4, 4, 0], row_pitch: 0 }).unwrap();
+        dev.launch(&m, "k", LaunchConfig::linear(1, 64), &[Arg::U64(h)]).unwrap();
+        let mut want = init.clone();
+        for t in 0..64u32 {
+            let e = (t / 4 % 4 * 4 + t % 4) as usize;
+            want[e] = f(want[e], t.wrapping_mul(2_654_435_761));
+        }
+        assert_eq!(dev.read::<u32>(data, 16), want, "sured.b.{op}.{ty}");
+    }
+    // out of range with .trap: a fault naming the lane
+    let src = ptx("add", "u32").replace("%r5}", "%r1}");
+    let mut dev = Device::new();
+    let m = dev.load_ptx(&src, "sured.ptx").unwrap();
+    let data = dev.alloc_from(&init);
+    let h = dev.create_surface(SurfaceDesc { data, elem_bytes: 4, dims: [4, 4, 0], row_pitch: 0 }).unwrap();
+    let r = dev.launch(&m, "k", LaunchConfig::linear(1, 64), &[Arg::U64(h)]);
+    let Err(SimError::Fault(f)) = r else { panic!("expected a fault, got {r:?}") };
+    assert_eq!(f.lane, Some(4), "{f}");
 }

@@ -3,7 +3,9 @@
 //! (`src/model/vectorize.rs`): hand-derived counts on small kernels, with the
 //! pass on (the default) and off.
 
+use warplight::model::uniform::{Uniformity, analyse};
 use warplight::model::{MemCounters, Model, Profile};
+use warplight::ptx::ir::{Function, PredId, PredSrc};
 use warplight::sim::{Arg, Device, LaunchConfig};
 
 fn counters(
@@ -139,6 +141,9 @@ const PROBE: &str = r#"
     // 7: an atomic whose result nobody reads is a reduction; one that is read is not
     atom.global.add.u32 %r10, [%rd1], 1;
     atom.global.add.u32 %r11, [%rd1+4], 1;
+    // 8: a `red` at a uniform address, and atomics at a lane's own word
+    red.global.add.u32 [%rd1+8], 1;
+    atom.global.add.u32 %r12, [%rd3], 1;
     st.global.u32 [%rd3+128], %r11;
     ret;
 }
@@ -155,15 +160,96 @@ fn repeated_loads_alignment_guards_and_reductions() {
     // lane, 1; f10, 4 bytes at 8 tid: lanes 2 words apart, 2-way, 2; the
     // 8-byte load at 8 tid + 256: 2 (two half-warps, no pairs)
     assert_eq!(on.shared_ld.wavefronts, 5 + 1 + 2 + 2);
-    assert_eq!((on.global_red.instructions, on.global_atom.instructions), (1, 1));
-    // the same-address atomics: 32 lanes on one word, 32 L1 sectors each
-    assert_eq!((on.global_red.sectors, on.global_atom.sectors), (32, 32));
+    assert_eq!((on.global_red.instructions, on.global_atom.instructions), (3, 1));
+    // the same-address atomics: their address is a kernel parameter, the same
+    // in every lane, so ptxas merges each into one lane's (1 L1 sector each);
+    // the lanes' own words (4 tid): 4 sectors
+    assert_eq!((on.global_red.sectors, on.global_atom.sectors), (1 + 1 + 4, 1));
     let off = counters(PROBE, "probe", cfg, &args, false, Profile::Hopper);
     assert_eq!(off.shared_ld.instructions, 10);
     // f1 f2 f3 f4 f5 f6: 1 each; f7 f8 f10 at 8 tid: 2 each; f9: 1
     assert_eq!(off.shared_ld.wavefronts, 6 + 3 * 2 + 1);
-    assert_eq!((off.global_red.instructions, off.global_atom.instructions), (0, 2));
+    assert_eq!((off.global_red.instructions, off.global_atom.instructions), (1, 3));
+    // as written: 32 lanes on one word, 32 L1 sectors each
+    assert_eq!((off.global_red.sectors, off.global_atom.sectors), (32, 32 + 32 + 4));
     // the GT200 profile never applies the pass
     let gt = counters(PROBE, "probe", cfg, &args, true, Profile::Gt200);
     assert_eq!(gt.shared_ld.instructions, 10);
+}
+
+// ---- which values ptxas can prove warp-uniform (src/model/uniform.rs)
+
+fn uniformity(ptx: &str) -> (Function, Uniformity) {
+    let mut dev = Device::new();
+    let m = dev.load_ptx(ptx, "u.ptx").unwrap();
+    let f = m.prog.functions[0].clone();
+    let u = analyse(&f);
+    (f, u)
+}
+
+fn reg(f: &Function, name: &str) -> usize {
+    f.reg_names.iter().position(|n| n == name).unwrap_or_else(|| panic!("no {name}"))
+}
+
+const UHEAD: &str = ".version 7.8\n.target sm_90\n.address_size 64\n";
+
+#[test]
+fn params_block_index_and_loads_are_uniform_thread_index_is_not() {
+    let ptx = format!(
+        "{UHEAD}.visible .entry k(.param .u64 p) {{\n.reg .b32 %r<6>;\n.reg .b64 %rd<6>;\n\
+         ld.param.u64 %rd1, [p];\ncvta.to.global.u64 %rd2, %rd1;\nmov.u32 %r1, %ctaid.x;\n\
+         mul.wide.u32 %rd3, %r1, 4;\nadd.s64 %rd4, %rd2, %rd3;\nld.global.u32 %r2, [%rd2];\n\
+         mov.u32 %r3, %tid.x;\nadd.s32 %r4, %r2, %r3;\natom.global.add.u32 %r5, [%rd4], 1;\nret;\n}}\n"
+    );
+    let (f, u) = uniformity(&ptx);
+    for r in ["%rd1", "%rd2", "%r1", "%rd3", "%rd4", "%r2"] {
+        assert!(u.regs[reg(&f, r)], "{r} uniform");
+    }
+    for r in ["%r3", "%r4", "%r5"] {
+        assert!(!u.regs[reg(&f, r)], "{r} varying");
+    }
+}
+
+#[test]
+fn divergent_branches_make_registers_defined_twice_varying() {
+    // %r1 is 1 or 2 depending on the lane's branch; %r2, defined once, stays uniform
+    let body = "mov.u32 %r3, %tid.x;\nsetp.lt.u32 %p1, %r3, 5;\nmov.u32 %r2, 7;\nmov.u32 %r1, 1;\n\
+                @%p1 bra L;\nmov.u32 %r1, 2;\nL:\nadd.u32 %r4, %r1, %r2;\nret;\n";
+    let ptx = format!("{UHEAD}.visible .entry k() {{\n.reg .pred %p<2>;\n.reg .b32 %r<5>;\n{body}}}\n");
+    let (f, u) = uniformity(&ptx);
+    assert!(!u.regs[reg(&f, "%r1")]);
+    assert!(u.regs[reg(&f, "%r2")]);
+    assert!(!u.regs[reg(&f, "%r4")]);
+    // the same with a uniform condition: both stay uniform
+    let ptx = ptx.replace("mov.u32 %r3, %tid.x;", "mov.u32 %r3, %ctaid.x;");
+    let (f, u) = uniformity(&ptx);
+    assert!(u.regs[reg(&f, "%r1")]);
+    assert!(u.regs[reg(&f, "%r4")]);
+}
+
+#[test]
+fn a_varying_guard_makes_the_result_varying() {
+    let body = "mov.u32 %r3, %laneid;\nsetp.lt.u32 %p1, %r3, 5;\nmov.u32 %r1, 1;\n@%p1 mov.u32 %r2, 2;\nret;\n";
+    let ptx = format!("{UHEAD}.visible .entry k() {{\n.reg .pred %p<2>;\n.reg .b32 %r<5>;\n{body}}}\n");
+    let (f, u) = uniformity(&ptx);
+    assert!(u.regs[reg(&f, "%r1")]);
+    assert!(!u.regs[reg(&f, "%r2")]);
+    let p1 = f.pred_names.iter().position(|n| n == "%p1").unwrap() as PredId;
+    assert!(!u.pred(PredSrc { reg: p1, neg: false }));
+}
+
+#[test]
+fn global_loads_under_divergent_control_flow_are_varying() {
+    // one load of a parameter's word; the branch on %r3 is divergent (%tid) or not (%ctaid)
+    let body = "ld.param.u64 %rd1, [p];\nld.global.u32 %r1, [%rd1];\nld.const.u32 %r2, [%rd1];\n\
+                mov.u32 %r3, %tid.x;\nsetp.lt.u32 %p1, %r3, 5;\n@%p1 bra L;\nL:\nret;\n";
+    let ptx = format!(
+        "{UHEAD}.visible .entry k(.param .u64 p) {{\n.reg .pred %p<2>;\n.reg .b32 %r<5>;\n.reg .b64 %rd<2>;\n{body}}}\n"
+    );
+    let (f, u) = uniformity(&ptx);
+    assert!(u.regs[reg(&f, "%rd1")]);
+    assert!(!u.regs[reg(&f, "%r1")], "a global load may run at different times for different lanes");
+    assert!(u.regs[reg(&f, "%r2")], "constant memory does not change");
+    let (f, u) = uniformity(&ptx.replace("%tid.x", "%ctaid.x"));
+    assert!(u.regs[reg(&f, "%r1")]);
 }

@@ -111,6 +111,11 @@ pub enum Hazard {
     MismatchedBarrier,
     /// Warps waiting at barriers that can never complete.
     BarrierDeadlock,
+    /// A warp-synchronous instruction (`bar.warp.sync`, `shfl.sync`,
+    /// `vote.sync`, `redux.sync`, `match.sync`) whose member mask leaves out
+    /// a lane executing it, names a live lane not executing it, or differs
+    /// between lanes it names: undefined in PTX.
+    InvalidMemberMask,
 }
 
 impl Hazard {
@@ -120,7 +125,10 @@ impl Hazard {
             Hazard::ReadAfterWrite | Hazard::WriteAfterRead | Hazard::WriteAfterWrite => "racecheck",
             Hazard::UninitializedRead => "initcheck",
             Hazard::OutOfBounds | Hazard::Misaligned => "memcheck",
-            Hazard::DivergentBarrier | Hazard::MismatchedBarrier | Hazard::BarrierDeadlock => "synccheck",
+            Hazard::DivergentBarrier
+            | Hazard::MismatchedBarrier
+            | Hazard::BarrierDeadlock
+            | Hazard::InvalidMemberMask => "synccheck",
         }
     }
 
@@ -136,6 +144,7 @@ impl Hazard {
             Hazard::DivergentBarrier => "divergent barrier",
             Hazard::MismatchedBarrier => "mismatched barriers",
             Hazard::BarrierDeadlock => "barrier deadlock",
+            Hazard::InvalidMemberMask => "invalid member mask",
         }
     }
 
@@ -148,6 +157,7 @@ impl Hazard {
             Hazard::UninitializedRead => ["read", ""],
             Hazard::OutOfBounds | Hazard::Misaligned => ["access", ""],
             Hazard::DivergentBarrier | Hazard::BarrierDeadlock | Hazard::MismatchedBarrier => ["barrier", "barrier"],
+            Hazard::InvalidMemberMask => ["warp-synchronous instruction", ""],
         }
     }
 }

@@ -5,9 +5,9 @@
 //! Measured on the H200 by the single-warp probes of
 //! `kernels/validation/suite.cu` (`l1tex__t_sectors_pipe_lsu_mem_global_op_{atom,red}.sum`):
 //! 32 lanes on consecutive words: 4 sectors; on one word: 32; lanes `l` and
-//! `l+16` on one word, 16 words: 4; words 8 apart: 32; 2 apart: 8. (ptxas
-//! also aggregates an atomic whose address it proves uniform into one lane's
-//! `RED`; warplight does not model that, see `docs/validation.md`.)
+//! `l+16` on one word, 16 words: 4; words 8 apart: 32; 2 apart: 8. (An
+//! atomic whose address ptxas proves warp-uniform is one lane's access,
+//! counted so by the ptxas plan: `vectorize.rs`, `uniform.rs`.)
 
 /// L1 sectors of a warp-level global atomic: lanes in `mask`, `bytes` each at `addr(lane)`.
 pub fn sectors(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64, scratch: &mut Vec<u64>) -> u64 {

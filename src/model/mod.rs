@@ -24,6 +24,7 @@ pub mod explain;
 pub mod occupancy;
 pub mod profile;
 pub mod sectors;
+pub mod uniform;
 pub mod validation;
 pub mod validation_suite;
 pub mod vectorize;
@@ -422,6 +423,24 @@ impl CtaModel {
                 return self.count_as_written(&red);
             }
             vectorize::Action::Red => {}
+            vectorize::Action::Uniform { red, full_warp_only }
+                if self.profile == Profile::Hopper
+                    && matches!(ev.op, MemOp::Atomic | MemOp::Reduction)
+                    && ev.mask != 0
+                    && (!full_warp_only || ev.mask == u32::MAX) =>
+            {
+                // one lane (the first active one) does it for the warp
+                let op = if red || ev.op == MemOp::Reduction { MemOp::Reduction } else { MemOp::Atomic };
+                let one = MemEvent { op, mask: 1 << ev.mask.trailing_zeros(), ..*ev };
+                return self.count_as_written(&one);
+            }
+            vectorize::Action::Uniform { red: true, .. }
+                if self.profile == Profile::Hopper && ev.op == MemOp::Atomic =>
+            {
+                let red = MemEvent { op: MemOp::Reduction, ..*ev };
+                return self.count_as_written(&red);
+            }
+            vectorize::Action::Uniform { .. } => {}
         }
         self.count_as_written(ev)
     }

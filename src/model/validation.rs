@@ -63,11 +63,6 @@ fn expectation(metric: &str, kernel: &str) -> Expect {
     {
         return Expect::TimingDependent;
     }
-    // ptxas proves atom_one's address uniform and makes one lane's RED of the
-    // warp's sum: 1 sector per warp, where warplight's lanes are 32 on one word
-    if kernel == "atom_one" && metric == "l1tex__t_sectors_pipe_lsu_mem_global_op_red.sum" {
-        return Expect::SideBySide;
-    }
     if kernel == "local_array" && metric.contains("local_op") {
         return Expect::SideBySide;
     }

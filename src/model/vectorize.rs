@@ -24,10 +24,20 @@
 //! - **Repeated loads.** A shared load of the same base register (same
 //!   definition), offset and width as an earlier load of the same run is
 //!   dropped (ptxas reuses the register): not counted.
-//! - **Reductions.** A global `atom` whose destination register no
+//! - **Reductions.** A `.global` `atom` whose destination register no
 //!   instruction of the function reads is executed as `RED` (add, min, max,
 //!   inc, dec, and, or, xor; not exch or cas) — counted as a reduction on the
-//!   hopper profile.
+//!   hopper profile. A generic `atom` stays `ATOM` (clang's generic
+//!   `atom.inc`: `ATOM.E.INC` on the H200).
+//! - **Warp-uniform atomics.** A global or generic 32-bit integer atomic
+//!   whose address is warp-uniform ([`super::uniform`]) is done once per warp
+//!   by one lane (`VOTEU.ANY`, then `POPC` or `REDUX` of the operands, then
+//!   one lane's `RED`/`ATOM`; the old value handed back by `SHFL`): `add`,
+//!   `min`, `max`, `and`, `or`, `xor` whose result is unused, in any lanes;
+//!   `add` whose result is used, in any lanes when its operand is uniform,
+//!   and only in a full warp when it varies. Not merged: floats, `inc`/`dec`,
+//!   `exch`, `cas`, `min`/`max`/logic whose result is used. Counted as one
+//!   lane's access on the hopper profile (1 L1 sector instead of 1 per lane).
 //!
 //! The rules were read off the SASS that ptxas 13.0 makes for sm_90 of the
 //! validation suite (`kernels/validation/suite.cu`, `docs/validation.md`):
@@ -60,6 +70,17 @@ pub enum Action {
     },
     /// A global atomic whose result is unused: a reduction.
     Red,
+    /// A global or generic atomic whose address ptxas proves warp-uniform
+    /// ([`super::uniform`]): one lane does it for the whole warp, with the
+    /// warp's combined operand — as a reduction when `red` — and, when
+    /// `full_warp_only`, only where all 32 lanes take part (otherwise each
+    /// lane does its own, as written).
+    Uniform {
+        /// Executed as `RED` (a `.global` atom whose result is unused).
+        red: bool,
+        /// Merged only when the whole warp is active.
+        full_warp_only: bool,
+    },
 }
 
 /// The pass's decisions: `actions[function][pc]`.
@@ -328,9 +349,28 @@ fn plan_function(f: &Function) -> Vec<Action> {
         if let Kind::Atom { space: MemSpace::Global | MemSpace::Generic, op, d, .. } = &inst.kind {
             let reducible = !matches!(op, AtomOp::Exch | AtomOp::Cas);
             let unused = d.is_none_or(|d| d.reg == Dst::SINK || !read.get(d.reg as usize).copied().unwrap_or(true));
-            if reducible && unused {
+            let global = matches!(inst.kind, Kind::Atom { space: MemSpace::Global, .. });
+            if reducible && unused && global {
                 actions[pc] = Action::Red;
             }
+        }
+    }
+    let uniform = super::uniform::analyse(f);
+    for (pc, inst) in f.insts.iter().enumerate() {
+        if let Kind::Atom { space: space @ (MemSpace::Global | MemSpace::Generic), op, ty, d, addr, b, .. } = &inst.kind
+        {
+            if !ty.is_int() || ty.bits() != 32 || !uniform.src(&addr.base) {
+                continue;
+            }
+            let unused = d.is_none_or(|d| d.reg == Dst::SINK || !read.get(d.reg as usize).copied().unwrap_or(true));
+            let red = unused && *space == MemSpace::Global;
+            actions[pc] = match (op, unused) {
+                (AtomOp::Add | AtomOp::Min | AtomOp::Max | AtomOp::And | AtomOp::Or | AtomOp::Xor, true) => {
+                    Action::Uniform { red, full_warp_only: false }
+                }
+                (AtomOp::Add, false) => Action::Uniform { red, full_warp_only: !uniform.src(b) },
+                _ => continue,
+            };
         }
     }
     let mut target = vec![false; f.insts.len() + 1];

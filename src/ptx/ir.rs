@@ -446,8 +446,10 @@ pub enum Kind {
     Txq { query: TxqQuery, d: Dst, handle: Src },
     /// `suld.b.geom[.vec].ty.clamp d, [handle, {coords}]` (x in bytes).
     Suld { geom: TexGeom, ty: Ty, ds: Vec<Dst>, handle: Src, coords: Vec<Src>, clamp: SurfClamp },
-    /// `sust.b.geom[.vec].ty.clamp [handle, {coords}], vals`.
-    Sust { geom: TexGeom, ty: Ty, vals: Vec<Src>, handle: Src, coords: Vec<Src>, clamp: SurfClamp },
+    /// `sust.b.geom[.vec].ty.clamp [handle, {coords}], vals`; with `red`,
+    /// `sured.b.op.geom.ty.clamp [handle, {coords}], val`: the operation on
+    /// the element in place (a global atomic without a result).
+    Sust { geom: TexGeom, ty: Ty, vals: Vec<Src>, handle: Src, coords: Vec<Src>, clamp: SurfClamp, red: Option<AtomOp> },
     /// `ret`
     Ret,
     /// `exit`
@@ -486,62 +488,73 @@ pub enum Kind {
 impl Kind {
     /// The data registers the instruction reads (its sources, address bases,
     /// member masks and carry flag), in operand order; predicates are not data.
+    /// Taken from [`Kind::visit_regs_mut`], the one list of every
+    /// instruction's register fields.
     pub fn reads(&self) -> Vec<RegId> {
-        let k = self;
         let mut v = Vec::new();
-        let mut s = |x: &Src| {
-            if let Src::Reg(r) = x {
+        self.clone().visit_regs_mut(&mut |r, read, _| {
+            if read {
                 v.push(*r)
             }
-        };
-        match k {
-            Kind::Mov { a, .. } | Kind::Unpack { a, .. } | Kind::Cvt { a, .. } | Kind::Cvta { a, .. } => s(a),
-            Kind::Pack { parts, .. } => parts.iter().for_each(s),
-            Kind::Arith { a, b, c, .. } => [a, b, c].into_iter().for_each(s),
-            Kind::Setp { a, b, .. } | Kind::Set { a, b, .. } | Kind::Selp { a, b, .. } => {
-                [a, b].into_iter().for_each(s)
+        });
+        v
+    }
+
+    /// The data registers the instruction writes (destinations, and the
+    /// condition code of a carry-out), in operand order; the `_` sink is not
+    /// one. Taken from [`Kind::visit_regs_mut`].
+    pub fn writes(&self) -> Vec<RegId> {
+        let mut v = Vec::new();
+        self.clone().visit_regs_mut(&mut |r, _, written| {
+            if written {
+                v.push(*r)
             }
-            Kind::Bfi { a, b, c, e, .. } => [a, b, c, e].into_iter().for_each(s),
-            Kind::Ld { addr, .. } => s(&addr.base),
-            Kind::St { vals, addr, .. } => {
-                vals.iter().for_each(&mut s);
-                s(&addr.base)
-            }
-            Kind::Atom { addr, b, c, .. } => [&addr.base, b, c].into_iter().for_each(s),
-            Kind::Bar { id, count } | Kind::BarRed { id, count, .. } => {
-                s(id);
-                count.iter().for_each(s)
-            }
-            Kind::Vote { membermask, .. } | Kind::WarpSync { membermask } => s(membermask),
-            Kind::Shfl { a, b, c, membermask, .. } => [a, b, c, membermask].into_iter().for_each(s),
-            Kind::Redux { a, membermask, .. } | Kind::Match { a, membermask, .. } => {
-                [a, membermask].into_iter().for_each(s)
-            }
-            Kind::Carry { a, b, c, cc, .. } => {
-                [a, b, c].into_iter().for_each(s);
-                v.push(*cc)
-            }
-            Kind::CallIndirect { target, .. } => s(target),
-            Kind::Tex { handle, coords, .. } | Kind::Suld { handle, coords, .. } => {
-                s(handle);
-                coords.iter().for_each(s)
-            }
-            Kind::Txq { handle, .. } => s(handle),
-            Kind::Sust { vals, handle, coords, .. } => {
-                s(handle);
-                coords.iter().for_each(&mut s);
-                vals.iter().for_each(s)
-            }
-            Kind::PredLogic { .. }
+        });
+        v
+    }
+
+    /// The predicate registers the instruction writes (`setp`'s `p` and `q`,
+    /// predicate logic, `vote`'s and `bar.red`'s predicate, `shfl`'s and
+    /// `match.all`'s `p`; not the constant predicates, which stand for an
+    /// absent one). Predicates are not data registers, so
+    /// [`Kind::visit_regs_mut`] does not visit them; this is their one list.
+    pub fn pred_writes(&self) -> Vec<PredId> {
+        let written: Vec<PredId> = match self {
+            Kind::Setp { p, q, .. } => std::iter::once(*p).chain(*q).collect(),
+            Kind::PredLogic { d, .. } => vec![*d],
+            Kind::Vote { p, .. } | Kind::BarRed { p, .. } => vec![*p],
+            Kind::Shfl { p, .. } | Kind::Match { p, .. } => p.iter().copied().collect(),
+            Kind::Mov { .. }
+            | Kind::Pack { .. }
+            | Kind::Unpack { .. }
+            | Kind::Arith { .. }
+            | Kind::Set { .. }
+            | Kind::Bfi { .. }
+            | Kind::Selp { .. }
+            | Kind::Cvt { .. }
+            | Kind::Cvta { .. }
+            | Kind::Ld { .. }
+            | Kind::St { .. }
+            | Kind::Atom { .. }
             | Kind::Bra { .. }
             | Kind::Call { .. }
+            | Kind::CallIndirect { .. }
+            | Kind::Tex { .. }
+            | Kind::Txq { .. }
+            | Kind::Suld { .. }
+            | Kind::Sust { .. }
             | Kind::Ret
             | Kind::Exit
+            | Kind::Bar { .. }
+            | Kind::WarpSync { .. }
+            | Kind::Redux { .. }
+            | Kind::Carry { .. }
             | Kind::Membar
             | Kind::Nop
-            | Kind::Trap => {}
-        }
-        v
+            | Kind::Trap => Vec::new(),
+        };
+        // the constants `false`/`true` stand for an absent predicate (a sink)
+        written.into_iter().filter(|&p| p != PRED_FALSE && p != PRED_TRUE).collect()
     }
 
     /// Calls `f(reg, read, written)` exactly once for every data-register
@@ -823,25 +836,84 @@ impl Program {
     /// CTA the whole module layout ([`Program::static_shared_size`]); this is the
     /// figure for occupancy.
     pub fn kernel_shared_size(&self, kernel: u32) -> u32 {
+        let taken = self.address_taken();
         let mut seen = vec![false; self.functions.len()];
         let mut todo = vec![kernel as usize];
         let mut offsets = std::collections::BTreeSet::new();
         while let Some(f) = todo.pop() {
-            if std::mem::replace(&mut seen[f], true) {
+            if f >= seen.len() || std::mem::replace(&mut seen[f], true) {
                 continue;
             }
             offsets.extend(self.functions[f].shared_refs.iter().copied());
-            for i in &self.functions[f].insts {
-                if let Kind::Call { func, .. } = i.kind {
-                    todo.push(func as usize);
-                }
-            }
+            todo.extend(self.callees(f as u32, &taken).into_iter().map(|c| c as usize));
         }
         let mut size = 0u32;
         for v in self.shared_vars.iter().filter(|v| v.size > 0 && offsets.contains(&v.offset)) {
             size = size.div_ceil(v.align) * v.align + v.size;
         }
         size
+    }
+
+    /// The functions whose address the module takes (`mov.u64 %rd, f;`, or a
+    /// function's name in a variable's initializer): those an indirect call
+    /// may reach. Found from the values themselves ([`func_at`]): every
+    /// immediate operand, and every 8 bytes of the module variables' and the
+    /// constant bank's initial values.
+    pub fn address_taken(&self) -> Vec<u32> {
+        let n = self.functions.len();
+        let mut taken = vec![false; n];
+        let mut see = |v: u64| {
+            if let Some(f) = func_at(v, n) {
+                taken[f as usize] = true;
+            }
+        };
+        for f in &self.functions {
+            for i in &f.insts {
+                let mut imm = |s: &Src| {
+                    if let Src::Imm(v) = s {
+                        see(*v)
+                    }
+                };
+                match &i.kind {
+                    Kind::Mov { a, .. } | Kind::Cvt { a, .. } | Kind::Cvta { a, .. } => imm(a),
+                    Kind::Selp { a, b, .. } => [a, b].into_iter().for_each(imm),
+                    Kind::Arith { a, b, c, .. } => [a, b, c].into_iter().for_each(imm),
+                    Kind::St { vals, .. } => vals.iter().for_each(imm),
+                    Kind::Pack { parts, .. } => parts.iter().for_each(imm),
+                    Kind::CallIndirect { target, .. } => imm(target),
+                    _ => {}
+                }
+            }
+        }
+        for bytes in self.globals.iter().map(|g| &g.init[..]).chain([&self.const_bank[..]]) {
+            for w in bytes.windows(8) {
+                see(u64::from_le_bytes(w.try_into().expect("8 bytes")));
+            }
+        }
+        (0..n as u32).filter(|&f| taken[f as usize]).collect()
+    }
+
+    /// The functions `f` may call: its direct calls' targets and, when it
+    /// makes an indirect call, every function in `address_taken`
+    /// ([`Program::address_taken`]) — which of them a register holds is
+    /// known only at run time, so each is assumed reachable.
+    pub fn callees(&self, f: u32, address_taken: &[u32]) -> Vec<u32> {
+        let Some(func) = self.functions.get(f as usize) else { return Vec::new() };
+        let mut out: Vec<u32> = Vec::new();
+        let mut indirect = false;
+        for i in &func.insts {
+            match i.kind {
+                Kind::Call { func, .. } => out.push(func),
+                Kind::CallIndirect { .. } => indirect = true,
+                _ => {}
+            }
+        }
+        if indirect {
+            out.extend_from_slice(address_taken);
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
     }
 
     /// Why kernel (or function) `k` cannot run, when it needs an instruction

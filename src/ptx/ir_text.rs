@@ -312,8 +312,9 @@ impl Names<'_> {
                 self.src(*handle),
                 self.srcs(coords)
             ),
-            Kind::Sust { geom, ty, vals, handle, coords, clamp } => format!(
-                "sust.{}.{ty}.{} [{}, {{{}}}] <- {{{}}}",
+            Kind::Sust { geom, ty, vals, handle, coords, clamp, red } => format!(
+                "{}.{}.{ty}.{} [{}, {{{}}}] <- {{{}}}",
+                red.map_or("sust".to_string(), |op| format!("sured.{}", lc(op))),
                 lc(geom),
                 lc(clamp),
                 self.src(*handle),

@@ -83,6 +83,7 @@ pub const KNOWN_OPCODES: &[&str] = &[
     "txq",
     "suld",
     "sust",
+    "sured",
     "tanh",
     "addc",
     "subc",

@@ -69,51 +69,6 @@ pub struct Fused {
     pub neg_c: bool,
 }
 
-/// The data registers an instruction writes.
-fn writes(k: &Kind) -> Vec<RegId> {
-    let d = |d: &Dst| d.reg;
-    match k {
-        Kind::Mov { d: x, .. }
-        | Kind::Pack { d: x, .. }
-        | Kind::Arith { d: x, .. }
-        | Kind::Set { d: x, .. }
-        | Kind::Bfi { d: x, .. }
-        | Kind::Selp { d: x, .. }
-        | Kind::Cvt { d: x, .. }
-        | Kind::Cvta { d: x, .. }
-        | Kind::Shfl { d: x, .. }
-        | Kind::Redux { d: x, .. }
-        | Kind::Match { d: x, .. } => vec![d(x)],
-        // the condition code only with `.cc` (`addc` without it reads it only)
-        Kind::Carry { d: x, cc, cout, .. } => {
-            if *cout {
-                vec![d(x), *cc]
-            } else {
-                vec![d(x)]
-            }
-        }
-        Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } | Kind::Tex { ds, .. } | Kind::Suld { ds, .. } => {
-            ds.iter().map(d).collect()
-        }
-        Kind::Txq { d: x, .. } => vec![d(x)],
-        Kind::Atom { d: x, .. } | Kind::Vote { d: x, .. } | Kind::BarRed { d: x, .. } => x.iter().map(d).collect(),
-        Kind::Setp { .. }
-        | Kind::PredLogic { .. }
-        | Kind::St { .. }
-        | Kind::Bra { .. }
-        | Kind::Call { .. }
-        | Kind::CallIndirect { .. }
-        | Kind::Sust { .. }
-        | Kind::Ret
-        | Kind::Exit
-        | Kind::Bar { .. }
-        | Kind::WarpSync { .. }
-        | Kind::Membar
-        | Kind::Nop
-        | Kind::Trap => vec![],
-    }
-}
-
 /// The predicate registers an instruction (guard included) reads and writes.
 fn preds(i: &Inst) -> (Vec<PredId>, Vec<PredId>) {
     let mut r: Vec<PredId> = i.guard.iter().map(|g| g.reg).collect();
@@ -154,7 +109,7 @@ struct Facts<'a> {
 impl<'a> Facts<'a> {
     fn new(f: &'a Function) -> Self {
         let reads: Vec<_> = f.insts.iter().map(|i| i.kind.reads()).collect();
-        let writes: Vec<_> = f.insts.iter().map(|i| writes(&i.kind)).collect();
+        let writes: Vec<_> = f.insts.iter().map(|i| i.kind.writes()).collect();
         let mut defs = HashMap::new();
         for w in writes.iter().flatten() {
             *defs.entry(*w).or_insert(0) += 1;
@@ -366,7 +321,7 @@ mod tests {
         let src = ".version 8.0\n.target sm_90\n.address_size 64\n.visible .entry k()\n{\n.reg .b32 %r<8>;\n\
                    add.cc.u32 %r1, %r2, %r3;\naddc.u32 %r4, %r2, %r3;\naddc.cc.u32 %r5, %r2, %r3;\nret;\n}\n";
         let prog = crate::ptx::load(src, "c.ptx").unwrap();
-        let w: Vec<usize> = prog.functions[0].insts[..3].iter().map(|i| writes(&i.kind).len()).collect();
+        let w: Vec<usize> = prog.functions[0].insts[..3].iter().map(|i| i.kind.writes().len()).collect();
         assert_eq!(w, [2, 1, 2], "add.cc, addc, addc.cc");
     }
 

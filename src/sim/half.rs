@@ -231,6 +231,53 @@ pub fn cvt(dty: Ty, sty: Ty, m: FloatMode, a: u64) -> Option<u64> {
     })
 }
 
+/// The value `set` writes for "true" into a destination of type `dty`: 1.0
+/// in a float type (`.f16`, `.bf16` and each half of `.f16x2`/`.bf16x2`
+/// included), all ones in an integer type (each 16-bit half of a packed
+/// comparison into `.u32`/`.s32`).
+pub fn set_true(dty: Ty, packed: bool) -> u64 {
+    let one: u64 = match dty {
+        Ty::F16 | Ty::F16x2 => 0x3C00,
+        Ty::BF16 | Ty::BF16x2 => 0x3F80,
+        Ty::F32 => 1.0f32.to_bits() as u64,
+        Ty::F64 => 1.0f64.to_bits(),
+        t if packed => t.mask() & 0xFFFF,
+        t => t.mask(),
+    };
+    if packed { one | one << 16 } else { one }
+}
+
+/// `set.cmp[.bool].dty.f16x2 d, a, b[, c]` (and `.bf16x2`) in one lane: each
+/// half of `d` is [`set_true`]'s half where that half of `a` compares true
+/// with the same half of `b` (combined with `c` when `comb` is given), else 0.
+pub fn set_x2(
+    cmp: crate::ptx::ir::Cmp,
+    dty: Ty,
+    sty: Ty,
+    ftz: bool,
+    a: u64,
+    b: u64,
+    comb: Option<(crate::ptx::ir::BoolOp, bool)>,
+) -> u64 {
+    let half = if sty == Ty::BF16x2 { Ty::BF16 } else { Ty::F16 };
+    let one = set_true(dty, true) & 0xFFFF;
+    let mut d = 0;
+    for k in [0, 16] {
+        let mut t = crate::sim::alu::compare(cmp, half, ftz, a >> k & 0xFFFF, b >> k & 0xFFFF);
+        if let Some((op, c)) = comb {
+            t = match op {
+                crate::ptx::ir::BoolOp::And => t & c,
+                crate::ptx::ir::BoolOp::Or => t | c,
+                crate::ptx::ir::BoolOp::Xor => t ^ c,
+            };
+        }
+        if t {
+            d |= one << k;
+        }
+    }
+    d
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,9 +2,10 @@
 // one of them, by name, with the buffers and launch shape that
 // tests/fixtures/sanitizer/planted_*.toml give warplight, and prints the
 // results. Built and run under compute-sanitizer by tools/device/sanitizer.sh.
-#include <cstdio>
 #include <cstring>
 #include <vector>
+
+#include "host_harness.h"
 
 #include "../../kernels/tests/planted_race_raw.cu"
 #include "../../kernels/tests/planted_race_waw.cu"
@@ -16,16 +17,27 @@
 #include "../../kernels/tests/planted_barrier_mismatch.cu"
 #include "../../kernels/tests/planted_warp_race.cu"
 
+// `n` ints on the device, copied from `init` (left unwritten without it).
 static int *device_ints(size_t n, const std::vector<int> *init) {
   int *p = nullptr;
-  cudaMalloc(&p, n * sizeof(int));
-  if (init) cudaMemcpy(p, init->data(), n * sizeof(int), cudaMemcpyHostToDevice);
+  CK(cudaMalloc(&p, n * sizeof(int)));
+  if (init) CK(cudaMemcpy(p, init->data(), n * sizeof(int), cudaMemcpyHostToDevice));
   return p;
 }
 
-static void print_ints(const char *name, const int *p, size_t n) {
+// Launches a planted kernel and waits for it: what it does wrong is
+// compute-sanitizer's to report (the status is printed at the end), so its
+// errors do not stop the harness. Then prints `n` ints of `out` as `name`
+// ("done" for none).
+template <class Launch> static void run(Launch launch, const char *name, const int *out, size_t n) {
+  launch();
+  cudaDeviceSynchronize();
+  if (!n) {
+    printf("done\n");
+    return;
+  }
   std::vector<int> h(n);
-  cudaMemcpy(h.data(), p, n * sizeof(int), cudaMemcpyDeviceToHost);
+  cudaMemcpy(h.data(), out, n * sizeof(int), cudaMemcpyDeviceToHost);
   printf("%s:", name);
   for (size_t i = 0; i < n; i++) printf(" %d", h[i]);
   printf("\n");
@@ -42,54 +54,36 @@ int main(int argc, char **argv) {
     std::vector<int> in(512);
     for (int i = 0; i < 512; i++) in[i] = i % 7;
     int *sums = device_ints(2, &zeros), *din = device_ints(512, &in);
-    block_sum_nosync<<<2, 256>>>(sums, din);
-    cudaDeviceSynchronize();
-    print_ints("sums", sums, 2);
+    run([&] { block_sum_nosync<<<2, 256>>>(sums, din); }, "sums", sums, 2);
   } else if (!strcmp(k, "planted_race_waw")) {
     int *out = device_ints(2, &zeros);
-    last_writer<<<2, 128>>>(out);
-    cudaDeviceSynchronize();
-    print_ints("out", out, 2);
+    run([&] { last_writer<<<2, 128>>>(out); }, "out", out, 2);
   } else if (!strcmp(k, "planted_race_global")) {
     int *out = device_ints(1, &zeros);
-    global_total<<<4, 32>>>(out);
-    cudaDeviceSynchronize();
-    print_ints("out", out, 1);
+    run([&] { global_total<<<4, 32>>>(out); }, "out", out, 1);
   } else if (!strcmp(k, "planted_uninit_global")) {
     int *out = device_ints(32, &zeros), *in = device_ints(32, nullptr);  // `in` never written
-    add_one<<<1, 32>>>(out, in);
-    cudaDeviceSynchronize();
-    printf("done\n");
+    run([&] { add_one<<<1, 32>>>(out, in); }, "", out, 0);
   } else if (!strcmp(k, "planted_uninit_shared")) {
     int *out = device_ints(64, &zeros);
-    mirror<<<1, 64>>>(out);
-    cudaDeviceSynchronize();
-    printf("done\n");
+    run([&] { mirror<<<1, 64>>>(out); }, "", out, 0);
   } else if (!strcmp(k, "planted_oob")) {
     std::vector<int> data(4096);
     for (int i = 0; i < 4096; i++) data[i] = i;
     int *out = device_ints(4096, &zeros), *d = device_ints(4096, &data);
-    shift_left<<<16, 256>>>(out, d);
-    cudaDeviceSynchronize();
-    print_ints("out[4094..]", out + 4094, 2);
+    run([&] { shift_left<<<16, 256>>>(out, d); }, "out[4094..]", out + 4094, 2);
   } else if (!strcmp(k, "planted_barrier_divergent")) {
     int *out = device_ints(32, &zeros);
-    half_barrier<<<1, 32>>>(out);
-    cudaDeviceSynchronize();
-    print_ints("out", out, 32);
+    run([&] { half_barrier<<<1, 32>>>(out); }, "out", out, 32);
   } else if (!strcmp(k, "planted_barrier_mismatch")) {
     int *out = device_ints(64, &zeros);
-    two_barriers<<<1, 64>>>(out);
-    cudaDeviceSynchronize();
-    print_ints("out", out, 64);
-  } else if (!strcmp(k, "planted_warp_race_synced") || !strcmp(k, "planted_warp_race_nosync")) {
+    run([&] { two_barriers<<<1, 64>>>(out); }, "out", out, 64);
+  } else if (!strcmp(k, "planted_warp_race_synced")) {
     int *out = device_ints(128, &zeros);
-    if (!strcmp(k, "planted_warp_race_synced"))
-      warp_swap_synced<<<2, 64>>>(out);
-    else
-      warp_swap_nosync<<<2, 64>>>(out);
-    cudaDeviceSynchronize();
-    print_ints("out", out, 128);
+    run([&] { warp_swap_synced<<<2, 64>>>(out); }, "out", out, 128);
+  } else if (!strcmp(k, "planted_warp_race_nosync")) {
+    int *out = device_ints(128, &zeros);
+    run([&] { warp_swap_nosync<<<2, 64>>>(out); }, "out", out, 128);
   } else {
     fprintf(stderr, "unknown kernel %s\n", k);
     return 2;

@@ -3,7 +3,8 @@
 kernels/validation/suite.cu, as the clang PTX (suite.ptx) and the nvcc PTX
 (suite.nvcc.ptx), each loaded through the driver's JIT (CuPy RawModule), and
 records the output buffers; Nsight Compute (tools/device/validation_run.sh)
-measures the same launches.
+measures the same launches. VALIDATION_SUITE=uniform_atomics does the same
+for kernels/validation/uniform_atomics.cu (ptxas's warp-uniform atomics).
 
   validation.py plan               the cases as JSON (buffers, inits, launches)
   validation.py run OUT            run them on the GPU; OUT/outputs.json, OUT/launches.txt
@@ -74,6 +75,8 @@ def I(v):
 
 
 def cases():
+    if SUITE == "uniform_atomics":
+        return uniform_atomics_cases()
     cs = []
     n = 16384
     cs.append({"name": "reduce_shfl", "buffers": [
@@ -143,11 +146,43 @@ def cases():
     return cs
 
 
-DIALECTS = [("clang", "kernels/validation/suite.ptx"), ("nvcc", "kernels/validation/suite.nvcc.ptx")]
+def uniform_atomics_cases():
+    """kernels/validation/uniform_atomics.cu: every kernel takes (c, in, out)."""
+    cs = []
+
+    def case(name, kernel, grid, block, init_in, n_out=256):
+        cs.append({"name": name, "buffers": [
+            {"name": "c", "n": 8, "init": {"kind": "zero"}, "output": True},
+            {"name": "in", "n": 512, "init": init_in},
+            {"name": "out", "n": n_out, "init": {"kind": "zero"}, "output": True}],
+            "launches": [L(kernel, [grid], [block], [B("c"), B("in"), B("out")])]})
+
+    h = {"kind": "hash", "seed": 11}
+    # result unused: 2 CTAs of 2 full warps; and 48 threads (a full and a half warp)
+    for k in ("ua_inc", "ua_add_val", "ua_min", "ua_max_u", "ua_or", "ua_xor", "ua_inc_wrap", "ua_block",
+              "ua_loop", "ua_loaded", "ua_cond", "ua_lane", "ua_warp"):
+        case(k, k, 2, 64, h)
+    case("ua_f32", "ua_f32", 2, 64, {"kind": "f32", "seed": 12})
+    for k in ("ua_inc", "ua_add_val", "ua_cond"):
+        case(k + "_48", k, 1, 48, h)
+    # result used, or the order of the lanes matters: one warp, and 24 lanes of one
+    for k in ("ua_exch", "ua_inc_ret", "ua_add_val_ret", "ua_min_ret", "ua_cond_ret"):
+        case(k, k, 1, 32, h)
+    for k in ("ua_inc_ret", "ua_add_val_ret"):
+        case(k + "_24", k, 1, 24, h)
+    # set on packed halves: 5 results for each pair of input words
+    for k in ("set_f16x2", "set_bf16x2"):
+        case(k, k, 1, 256, {"kind": "hash", "seed": 13}, n_out=1280)
+    return cs
+
+
+import os
+# The suite: `suite` (kernels/validation/suite.cu) or `uniform_atomics`.
+SUITE = os.environ.get("VALIDATION_SUITE", "suite")
+DIALECTS = [("clang", f"kernels/validation/{SUITE}.ptx"), ("nvcc", f"kernels/validation/{SUITE}.nvcc.ptx")]
 # The committed nvcc PTX says `.version 9.5` (nvcc 13.5); a CUDA 13.0 driver
 # accepts PTX up to 9.0, so the run script loads a copy whose only change is
 # that line (VALIDATION_NVCC_PTX names it).
-import os
 LOAD = {"clang": DIALECTS[0][1], "nvcc": os.environ.get("VALIDATION_NVCC_PTX", DIALECTS[1][1])}
 
 

@@ -8,7 +8,12 @@
 #   ncu.csv            every metric of every launch
 #   suite.{clang,nvcc}.sass   ptxas -arch=sm_90 of each PTX (what the JIT makes of it)
 # Then: python3 tools/device/validation.py fixture $OUT tests/fixtures/validation/h200.json
+# SUITE=uniform_atomics measures kernels/validation/uniform_atomics.cu instead
+# (fixture tests/fixtures/validation/h200_uniform_atomics.json, made with
+# VALIDATION_SUITE=uniform_atomics).
 set -uo pipefail
+SUITE=${SUITE:-suite}
+export VALIDATION_SUITE=$SUITE
 export PATH=/usr/local/cuda/bin:$PATH
 OUT=${OUT:-/tmp/validation}
 mkdir -p "$OUT"
@@ -20,10 +25,10 @@ mkdir -p "$OUT"
   python3 -c 'import cupy; print("cupy", cupy.__version__)'
 } > "$OUT/env.txt" 2>&1
 # nvcc 13.5's PTX (.version 9.5) for a CUDA 13.0 toolkit: only the version line changed
-sed 's/^\.version 9\.5$/.version 9.0/' kernels/validation/suite.nvcc.ptx > /tmp/suite.nvcc.ptx
-export VALIDATION_NVCC_PTX=/tmp/suite.nvcc.ptx
-for d in clang:kernels/validation/suite.ptx nvcc:/tmp/suite.nvcc.ptx; do
-  ptxas -arch=sm_90 -o "/tmp/suite_${d%%:*}.cubin" "${d#*:}" && cuobjdump -sass "/tmp/suite_${d%%:*}.cubin" > "$OUT/suite.${d%%:*}.sass"
+sed 's/^\.version 9\.5$/.version 9.0/' "kernels/validation/$SUITE.nvcc.ptx" > "/tmp/$SUITE.nvcc.ptx"
+export VALIDATION_NVCC_PTX=/tmp/$SUITE.nvcc.ptx
+for d in "clang:kernels/validation/$SUITE.ptx" "nvcc:/tmp/$SUITE.nvcc.ptx"; do
+  ptxas -arch=sm_90 -o "/tmp/${SUITE}_${d%%:*}.cubin" "${d#*:}" && cuobjdump -sass "/tmp/${SUITE}_${d%%:*}.cubin" > "$OUT/$SUITE.${d%%:*}.sass"
 done 2>> "$OUT/env.txt"
 want="smsp__inst_executed.sum smsp__thread_inst_executed.sum smsp__sass_branch_targets_threads_divergent.sum"
 for m in shared_ld shared_st shared_atom global_ld global_st global_atom global_red local_ld local_st; do
@@ -45,7 +50,7 @@ for m in $want; do
 done
 # an unexpected listing format: ask for all of them
 [ "$(echo "$metrics" | tr ',' '\n' | grep -c .)" -lt 12 ] && metrics=$(echo $want | tr ' ' ',')
-kernels=$(grep -o '^K [a-z0-9_]*' kernels/validation/suite.cu | cut -d' ' -f2 | paste -sd'|')
+kernels=$(grep -oE '^(K |SETX2\()[a-z0-9_]+' "kernels/validation/$SUITE.cu" | sed -E 's/^(K |SETX2\()//' | paste -sd'|')
 ncu --metrics "$metrics" --csv --print-units base -k "regex:^($kernels)\$" \
   python3 tools/device/validation.py run "$OUT" > "$OUT/ncu.csv" 2> "$OUT/ncu.err"
 echo "ncu rc=$?" >> "$OUT/env.txt"

@@ -28,6 +28,14 @@
     }                                                                                      \
   } while (0)
 
+// A kernel launch whose configuration is checked at once (cudaGetLastError);
+// what the kernel did is checked where its results are read (back()).
+#define LAUNCH(kernel, grid, block, ...)    \
+  do {                                     \
+    kernel<<<grid, block>>>(__VA_ARGS__);  \
+    CK(cudaGetLastError());                \
+  } while (0)
+
 static FILE *J;
 static bool first_case = true;
 
@@ -40,6 +48,15 @@ static void arr_u32(const char *name, const std::vector<unsigned> &v) {
   fprintf(J, "\"%s\":[", name);
   for (size_t i = 0; i < v.size(); i++) fprintf(J, "%s%u", i ? "," : "", v[i]);
   fprintf(J, "]");
+}
+// Named arrays of a case, comma-separated: "a":[...],"b":[...]
+static void arrays(std::initializer_list<std::pair<const char *, std::vector<unsigned>>> named) {
+  bool first = true;
+  for (auto &n : named) {
+    if (!first) fprintf(J, ",");
+    first = false;
+    arr_u32(n.first, n.second);
+  }
 }
 static std::vector<unsigned> fb(const std::vector<float> &v) {
   std::vector<unsigned> o;
@@ -142,14 +159,12 @@ static void case_1d(const char *name, Tex &t, const std::vector<float> &xs) {
   int n = xs.size();
   float *dx = dev(xs), *dout;
   CK(cudaMalloc(&dout, n * 4));
-  tex1d_f<<<grid(n), B>>>(t.obj, dx, dout, n);
+  LAUNCH(tex1d_f, grid(n), B, t.obj, dx, dout, n);
   auto out = back(dout, n);
   begin_case(name, "tex1d_f");
   tex_json(t);
   fprintf(J, ",");
-  arr_u32("x", fb(xs));
-  fprintf(J, ",");
-  arr_u32("out", fb(out));
+  arrays({{"x", fb(xs)}, {"out", fb(out)}});
   fprintf(J, "}");
 }
 
@@ -162,28 +177,24 @@ static void case_2d(const char *name, const char *kernel, Tex &t, const std::vec
   if (!strcmp(kernel, "tex2d_f4")) {
     float4 *o;
     CK(cudaMalloc(&o, n * 16));
-    tex2d_f4<<<grid(n), B>>>(t.obj, dx, dy, o, n);
+    LAUNCH(tex2d_f4, grid(n), B, t.obj, dx, dy, o, n);
     auto v = back((unsigned *)o, 4 * n);
     out = v;
   } else if (!strcmp(kernel, "tld4_f4")) {
     float4 *o;
     CK(cudaMalloc(&o, n * 64));
-    tld4_f4<<<grid(n), B>>>(t.obj, dx, dy, o, n);
+    LAUNCH(tld4_f4, grid(n), B, t.obj, dx, dy, o, n);
     out = back((unsigned *)o, 16 * n);
   } else {
     unsigned *o;
     CK(cudaMalloc(&o, n * 4));
-    tex2d_u4<<<grid(n), B>>>(t.obj, dx, dy, o, n);
+    LAUNCH(tex2d_u4, grid(n), B, t.obj, dx, dy, o, n);
     out = back(o, n);
   }
   begin_case(name, kernel);
   tex_json(t);
   fprintf(J, ",");
-  arr_u32("x", fb(xs));
-  fprintf(J, ",");
-  arr_u32("y", fb(ys));
-  fprintf(J, ",");
-  arr_u32("out", out);
+  arrays({{"x", fb(xs)}, {"y", fb(ys)}, {"out", out}});
   fprintf(J, "}");
 }
 
@@ -274,18 +285,12 @@ static void textures() {
     int n = xs.size();
     float *dx = dev(xs), *dy = dev(ys), *dz = dev(zs), *o;
     CK(cudaMalloc(&o, n * 4));
-    tex3d_f<<<grid(n), B>>>(t.obj, dx, dy, dz, o, n);
+    LAUNCH(tex3d_f, grid(n), B, t.obj, dx, dy, dz, o, n);
     auto out = back(o, n);
     begin_case("f3d_linear_clamp", "tex3d_f");
     tex_json(t);
     fprintf(J, ",");
-    arr_u32("x", fb(xs));
-    fprintf(J, ",");
-    arr_u32("y", fb(ys));
-    fprintf(J, ",");
-    arr_u32("z", fb(zs));
-    fprintf(J, ",");
-    arr_u32("out", fb(out));
+    arrays({{"x", fb(xs)}, {"y", fb(ys)}, {"z", fb(zs)}, {"out", fb(out)}});
     fprintf(J, "}");
     // txq of the 3-D, the 2-D float4 and the uchar4 textures
     int *q;
@@ -298,7 +303,7 @@ static void textures() {
     const char *names[] = {"f3d_linear_clamp", "f2d_linear_clamp", "u8_linear_border_normalized_norm"};
     cudaTextureObject_t objs[] = {t.obj, t2.obj, t8.obj};
     for (int k = 0; k < 3; k++) {
-      tex_query<<<1, 32>>>(objs[k], q);
+      LAUNCH(tex_query, 1, 32, objs[k], q);
       auto r = back((unsigned *)q, 6);
       fprintf(J, "%s\"%s\":", k ? "," : "", names[k]);
       fprintf(J, "[%u,%u,%u,%u,%u,%u]", r[0], r[1], r[2], r[3], r[4], r[5]);
@@ -319,15 +324,13 @@ static void textures() {
     int *di = dev(is);
     float *o;
     CK(cudaMalloc(&o, n * 4));
-    tex1dfetch_f<<<1, 32>>>(t.obj, di, o, n);
+    LAUNCH(tex1dfetch_f, 1, 32, t.obj, di, o, n);
     auto out = back(o, n);
     begin_case("linear_fetch", "tex1dfetch_f");
     tex_json(t);
     fprintf(J, ",");
     std::vector<unsigned> iu(is.begin(), is.end());
-    arr_u32("x", iu);
-    fprintf(J, ",");
-    arr_u32("out", fb(out));
+    arrays({{"x", iu}, {"out", fb(out)}});
     fprintf(J, "}");
   }
 }
@@ -362,20 +365,14 @@ static void surfaces() {
   int *z, *c;
   CK(cudaMalloc(&z, n * 4));
   CK(cudaMalloc(&c, n * 4));
-  surf_read<<<1, 64>>>(s, dx, dy, z, c, n);
+  LAUNCH(surf_read, 1, 64, s, dx, dy, z, c, n);
   auto oz = back((unsigned *)z, n), oc = back((unsigned *)c, n);
   std::vector<unsigned> iu(init.begin(), init.end()), xu(xs.begin(), xs.end()), yu(ys.begin(), ys.end());
   begin_case("surf_read", "surf_read");
   fprintf(J, "\"surface\":{\"format\":\"s32\",\"dims\":[%d,%d,0],", W, H);
   arr_u32("texels", iu);
   fprintf(J, "},");
-  arr_u32("x", xu);
-  fprintf(J, ",");
-  arr_u32("y", yu);
-  fprintf(J, ",");
-  arr_u32("zero", oz);
-  fprintf(J, ",");
-  arr_u32("clamp", oc);
+  arrays({{"x", xu}, {"y", yu}, {"zero", oz}, {"clamp", oc}});
   fprintf(J, "}");
   // writes: each lane writes 1000 + lane at its coordinates, in zero and clamp mode
   for (int clamp = 0; clamp < 2; clamp++) {
@@ -384,7 +381,7 @@ static void surfaces() {
     std::vector<int> v;
     for (int i = 0; i < n; i++) v.push_back(1000 + i);
     int *dv = dev(v);
-    surf_write<<<1, 64>>>(s2, dx, dy, dv, clamp, n);
+    LAUNCH(surf_write, 1, 64, s2, dx, dy, dv, clamp, n);
     CK(cudaDeviceSynchronize());
     std::vector<unsigned> after(W * H);
     CK(cudaMemcpy2DFromArray(after.data(), W * 4, a2, 0, 0, W * 4, H, cudaMemcpyDeviceToHost));
@@ -392,14 +389,8 @@ static void surfaces() {
     fprintf(J, "\"surface\":{\"format\":\"s32\",\"dims\":[%d,%d,0],", W, H);
     arr_u32("texels", iu);
     fprintf(J, "},\"clamp\":%d,", clamp);
-    arr_u32("x", xu);
-    fprintf(J, ",");
-    arr_u32("y", yu);
-    fprintf(J, ",");
     std::vector<unsigned> vu(v.begin(), v.end());
-    arr_u32("v", vu);
-    fprintf(J, ",");
-    arr_u32("after", after);
+    arrays({{"x", xu}, {"y", yu}, {"v", vu}, {"after", after}});
     fprintf(J, "}");
   }
 }
@@ -414,29 +405,32 @@ static void indirect() {
   }
   float *da = dev(a), *db = dev(b), *ds = dev(s), *o;
   CK(cudaMalloc(&o, n * 4));
-  call_table<<<2, 128>>>(da, db, o, n);
+  LAUNCH(call_table, 2, 128, da, db, o, n);
   auto t = back(o, n);
   begin_case("call_table", "call_table");
-  arr_u32("a", fb(a));
-  fprintf(J, ",");
-  arr_u32("b", fb(b));
-  fprintf(J, ",");
-  arr_u32("out", fb(t));
+  arrays({{"a", fb(a)}, {"b", fb(b)}, {"out", fb(t)}});
   fprintf(J, "}");
-  call_select<<<2, 128>>>(ds, o, n);
+  LAUNCH(call_select, 2, 128, ds, o, n);
   auto sel = back(o, n);
   begin_case("call_select", "call_select");
-  arr_u32("a", fb(s));
-  fprintf(J, ",");
-  arr_u32("out", fb(sel));
+  arrays({{"a", fb(s)}, {"out", fb(sel)}});
   fprintf(J, "}");
-  call_virtual<<<2, 128>>>(da, o, n);
+  LAUNCH(call_virtual, 2, 128, da, o, n);
   auto vir = back(o, n);
   begin_case("call_virtual", "call_virtual");
-  arr_u32("a", fb(a));
-  fprintf(J, ",");
-  arr_u32("out", fb(vir));
+  arrays({{"a", fb(a)}, {"out", fb(vir)}});
   fprintf(J, "}");
+}
+
+// Every input's result, little-endian, in DIR/half_NAME.bin.
+template <class T> static void write_bin(const char *dir, const char *name, const std::vector<T> &v) {
+  std::string p = std::string(dir) + "/half_" + name + ".bin";
+  FILE *f = fopen(p.c_str(), "wb");
+  if (!f || fwrite(v.data(), sizeof(T), v.size(), f) != v.size()) {
+    fprintf(stderr, "cannot write %s\n", p.c_str());
+    exit(1);
+  }
+  fclose(f);
 }
 
 static void halves(const char *dir) {
@@ -450,12 +444,8 @@ static void halves(const char *dir) {
     void (*k)(unsigned short *, int);
   } k16[] = {{"ex2_f16", ex2_f16}, {"tanh_f16", tanh_f16}, {"ex2_bf16", ex2_bf16}, {"tanh_bf16", tanh_bf16}};
   for (auto &k : k16) {
-    k.k<<<n / 256, 256>>>(o16, n);
-    auto v = back(o16, n);
-    std::string p = std::string(dir) + "/half_" + k.name + ".bin";
-    FILE *f = fopen(p.c_str(), "wb");
-    fwrite(v.data(), 2, n, f);
-    fclose(f);
+    LAUNCH(k.k, n / 256, 256, o16, n);
+    write_bin(dir, k.name, back(o16, n));
   }
   struct K32 {
     const char *name;
@@ -463,12 +453,8 @@ static void halves(const char *dir) {
   } k32[] = {{"ex2_f16x2", ex2_f16x2}, {"tanh_f16x2", tanh_f16x2}, {"ex2_bf16x2", ex2_bf16x2},
              {"tanh_bf16x2", tanh_bf16x2}};
   for (auto &k : k32) {
-    k.k<<<n / 256, 256>>>(o32, n);
-    auto v = back(o32, n);
-    std::string p = std::string(dir) + "/half_" + k.name + ".bin";
-    FILE *f = fopen(p.c_str(), "wb");
-    fwrite(v.data(), 4, n, f);
-    fclose(f);
+    LAUNCH(k.k, n / 256, 256, o32, n);
+    write_bin(dir, k.name, back(o32, n));
   }
   // setp on packed halves: every pair of 11 values in the low halves, the reverse in the high
   unsigned hv[] = {0x0000, 0x8000, 0x3c00, 0xbc00, 0x7c00, 0xfc00, 0x7e00, 0x7c01, 0x0001, 0x3c01, 0x4000};
@@ -483,16 +469,12 @@ static void halves(const char *dir) {
     unsigned *da = dev(as), *db = dev(bs), *o;
     CK(cudaMalloc(&o, 121 * 4));
     if (bf)
-      setp_bf16x2<<<1, 128>>>(da, db, o, 121);
+      LAUNCH(setp_bf16x2, 1, 128, da, db, o, 121);
     else
-      setp_f16x2<<<1, 128>>>(da, db, o, 121);
+      LAUNCH(setp_f16x2, 1, 128, da, db, o, 121);
     auto out = back(o, 121);
     begin_case(bf ? "setp_bf16x2" : "setp_f16x2", bf ? "setp_bf16x2" : "setp_f16x2");
-    arr_u32("a", as);
-    fprintf(J, ",");
-    arr_u32("b", bs);
-    fprintf(J, ",");
-    arr_u32("out", out);
+    arrays({{"a", as}, {"b", bs}, {"out", out}});
     fprintf(J, "}");
   }
 }

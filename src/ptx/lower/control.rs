@@ -113,15 +113,32 @@ impl FnLower<'_> {
                 _ => unsupported(pos, "call argument that is not a .param variable"),
             }
         };
-        let mut a = Vec::new();
-        for (o, p) in args.iter().zip(&callee.params) {
+        // each argument and return value as large as the callee's parameter:
+        // PTX passes `.param` variables whole, so a difference is an error,
+        // never a copy silently shortened
+        let sized = |what: &str, k: usize, o: &Operand, want: u32| -> LResult<(u32, u32)> {
             let (off, size) = param_var(o)?;
-            a.push((off, p.offset, size.min(p.size)));
+            if size != want {
+                return invalid(
+                    pos,
+                    format!(
+                        "{what} {} of the call of `{}` has {size} byte(s); the function's has {want}",
+                        k + 1,
+                        callee.name
+                    ),
+                );
+            }
+            Ok((off, size))
+        };
+        let mut a = Vec::new();
+        for (k, (o, p)) in args.iter().zip(&callee.params).enumerate() {
+            let (off, size) = sized("argument", k, o, p.size)?;
+            a.push((off, p.offset, size));
         }
         let mut r = Vec::new();
-        for (o, p) in rets.iter().zip(&callee.returns) {
-            let (off, size) = param_var(o)?;
-            r.push((p.offset, off, size.min(p.size)));
+        for (k, (o, p)) in rets.iter().zip(&callee.returns).enumerate() {
+            let (off, size) = sized("return value", k, o, p.size)?;
+            r.push((p.offset, off, size));
         }
         Ok(Kind::Call { func: fidx as u32, args: a, rets: r })
     }

@@ -66,18 +66,21 @@ enum Sym {
 }
 
 /// Marks every function that calls an unusable one (directly or through
-/// others) unusable, with the callee's error.
+/// others) unusable, with the callee's error. An indirect call may reach any
+/// function whose address the module takes ([`Program::callees`]), so a
+/// function making one inherits the error of any unusable such function:
+/// conservative, never a launch that runs into a `trap` unannounced.
 fn mark_callers_unusable(prog: &mut Program) {
+    let taken = prog.address_taken();
+    let callees: Vec<Vec<u32>> = (0..prog.functions.len() as u32).map(|f| prog.callees(f, &taken)).collect();
     loop {
         let mut changed = false;
-        for k in 0..prog.functions.len() {
+        for (k, calls) in callees.iter().enumerate() {
             if prog.functions[k].unsupported.is_some() {
                 continue;
             }
-            let inherited = prog.functions[k].insts.iter().find_map(|i| match i.kind {
-                Kind::Call { func, .. } => prog.functions[func as usize].unsupported.clone(),
-                _ => None,
-            });
+            let inherited =
+                calls.iter().find_map(|&c| prog.functions.get(c as usize).and_then(|f| f.unsupported.clone()));
             if inherited.is_some() {
                 prog.functions[k].unsupported = inherited;
                 changed = true;

@@ -87,6 +87,7 @@ pub enum Opcode {
     Txq,
     Suld,
     Sust,
+    Sured,
 }
 
 /// The instruction families, one file of the lowering each.
@@ -192,6 +193,7 @@ impl Opcode {
             "txq" => Txq,
             "suld" => Suld,
             "sust" => Sust,
+            "sured" => Sured,
             _ => return None,
         })
     }
@@ -208,7 +210,7 @@ impl Opcode {
             Bra | Call | Ret | Exit | Trap | Bar | Barrier | Membar | Fence | Prefetch | Prefetchu | Pmevent
             | Nanosleep | Brkpt | Nop => Family::Control,
             Vote | Activemask | Shfl | Redux | Match => Family::Warp,
-            Tex | Tld4 | Txq | Suld | Sust => Family::Texture,
+            Tex | Tld4 | Txq | Suld | Sust | Sured => Family::Texture,
             _ => Family::Arith,
         }
     }
@@ -217,7 +219,7 @@ impl Opcode {
     pub fn class(self) -> InstClass {
         use Opcode::*;
         match self {
-            Ld | St | Atom | Red | Tex | Tld4 | Txq | Suld | Sust => InstClass::Memory,
+            Ld | St | Atom | Red | Tex | Tld4 | Txq | Suld | Sust | Sured => InstClass::Memory,
             Bra | Call | Ret | Exit | Bar | Barrier | Membar | Fence | Trap => InstClass::Control,
             Vote | Shfl | Activemask | Redux | Match => InstClass::Warp,
             Sqrt | Rsqrt | Rcp | Sin | Cos | Ex2 | Lg2 | Tanh => InstClass::Sfu,

@@ -1,4 +1,4 @@
-//! Texture and surface objects: `tex`, `tld4`, `txq`, `suld.b`, `sust.b`
+//! Texture and surface objects: `tex`, `tld4`, `txq`, `suld.b`, `sust.b`, `sured.b`
 //! through a 64-bit object handle in a register (`cudaTextureObject_t`,
 //! `cudaSurfaceObject_t`), as nvcc and clang write them for `tex2D<T>(obj, x,
 //! y)`, `tex2Dgather`, `surf2Dread`/`surf2Dwrite`. Texture references
@@ -49,6 +49,27 @@ fn clamp_mode(d: &Decoded) -> SurfClamp {
         SurfClamp::Zero
     } else {
         SurfClamp::Trap
+    }
+}
+
+/// The operation of `sured.b.op` (`None` without exactly one).
+fn sured_op(d: &Decoded) -> Option<AtomOp> {
+    let ops: Vec<AtomOp> = d
+        .mods
+        .words
+        .iter()
+        .filter_map(|w| match w.as_str() {
+            "add" => Some(AtomOp::Add),
+            "min" => Some(AtomOp::Min),
+            "max" => Some(AtomOp::Max),
+            "and" => Some(AtomOp::And),
+            "or" => Some(AtomOp::Or),
+            _ => None,
+        })
+        .collect();
+    match ops.as_slice() {
+        [op] => Some(*op),
+        _ => None,
     }
 }
 
@@ -135,6 +156,33 @@ pub(super) fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             }
             tex_addr(&i.operands[1], g, d, i)?;
         }
+        Opcode::Sured => {
+            only(d, &["b", "add", "min", "max", "and", "or", "trap", "clamp", "zero"], i)?;
+            if !m.has("b") {
+                return unsupported(pos, format!("{} (formatted surface reduction)", d.full));
+            }
+            let Some(op) = sured_op(d) else {
+                return invalid(pos, format!("`{}` needs one of .add .min .max .and .or", d.full));
+            };
+            let t = match m.types.as_slice() {
+                [t] => *t,
+                _ => return invalid(pos, format!("`{}` needs one type", d.full)),
+            };
+            let ok = match op {
+                AtomOp::And | AtomOp::Or => matches!(t, Ty::B32 | Ty::B64),
+                _ => matches!(t, Ty::U32 | Ty::U64 | Ty::S32 | Ty::S64),
+            };
+            if !ok {
+                return invalid(
+                    pos,
+                    format!("`{}`: .add .min .max take .u32 .u64 .s32 .s64, .and .or .b32 .b64", d.full),
+                );
+            }
+            if i.operands.len() != 2 || matches!(i.operands[1], Operand::Vector(_)) {
+                return invalid(pos, format!("`{}` takes an address and one value", d.full));
+            }
+            tex_addr(&i.operands[0], g, d, i)?;
+        }
         Opcode::Suld | Opcode::Sust => {
             only(d, &["b", "v2", "v4", "trap", "clamp", "zero"], i)?;
             if !m.has("b") {
@@ -184,7 +232,8 @@ impl FnLower<'_> {
             return Ok(Kind::Txq { query: q, d: self.dst(&ops[0], pos)?, handle: self.handle(h, pos)? });
         }
         let g = geom(d).expect("validated");
-        let (addr, vals) = if d.op == Opcode::Sust { (&ops[0], &ops[1]) } else { (&ops[1], &ops[0]) };
+        let (addr, vals) =
+            if matches!(d.op, Opcode::Sust | Opcode::Sured) { (&ops[0], &ops[1]) } else { (&ops[1], &ops[0]) };
         let Operand::TexAddr(h, c) = addr else { unreachable!("validated") };
         let handle = self.handle(h, pos)?;
         match d.op {
@@ -205,7 +254,8 @@ impl FnLower<'_> {
                     Ok(Kind::Suld { geom: g, ty: t, ds, handle, coords, clamp })
                 } else {
                     let vs = vec_of(vals).iter().map(|o| self.src(o, t, pos)).collect::<LResult<Vec<_>>>()?;
-                    Ok(Kind::Sust { geom: g, ty: t, vals: vs, handle, coords, clamp })
+                    let red = if d.op == Opcode::Sured { sured_op(d) } else { None };
+                    Ok(Kind::Sust { geom: g, ty: t, vals: vs, handle, coords, clamp, red })
                 }
             }
         }

@@ -173,14 +173,21 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             }
             operands(i, if comb { 4 } else { 3 })?;
             let packed = m.types.iter().any(|t| matches!(t, Ty::F16x2 | Ty::BF16x2));
-            if packed && (d.op == Set || !matches!(i.operands[0], Operand::Pair(..))) {
-                // `set` on packed halves writes two halves; `setp` needs `p|q`
+            if packed && d.op == Setp && !matches!(i.operands[0], Operand::Pair(..)) {
+                // `setp` on packed halves writes two predicates: `p|q`
                 return unsupported(pos, format!("{} (packed halves)", d.full));
             }
             if d.op == Setp {
                 one_type(d, i)?;
             } else if m.types.len() != 2 {
                 return invalid(pos, "`set` needs a destination and a source type");
+            } else if packed {
+                // `set.dty.f16x2`: dty `.f16x2 .u32 .s32`; `set.dty.bf16x2`: `.bf16x2 .u32 .s32`
+                let (dty, sty) = (m.types[0], m.types[1]);
+                let ok = matches!(sty, Ty::F16x2 | Ty::BF16x2) && (dty == sty || matches!(dty, Ty::U32 | Ty::S32));
+                if !ok {
+                    return invalid(pos, format!("`{}`: packed halves compare into .{sty}, .u32 or .s32 only", d.full));
+                }
             }
         }
         Selp => {
@@ -335,7 +342,7 @@ pub fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             operands(i, if m.has("sync") { 5 } else { 4 })?;
         }
         Exit | Trap | Membar | Fence | Prefetch | Prefetchu | Pmevent | Nanosleep | Brkpt | Nop => {}
-        Tex | Tld4 | Txq | Suld | Sust => super::texture::validate(d, i)?,
+        Tex | Tld4 | Txq | Suld | Sust | Sured => super::texture::validate(d, i)?,
         // the arithmetic opcodes
         _ => {
             let t = one_type(d, i)?;

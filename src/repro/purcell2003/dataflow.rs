@@ -65,45 +65,9 @@ fn is_memory(space: MemSpace) -> bool {
     !matches!(space, MemSpace::KernelParam | MemSpace::FrameParam)
 }
 
-/// The values an instruction writes.
+/// The values an instruction writes ([`Kind::writes`], [`Kind::pred_writes`]).
 fn writes(k: &Kind) -> Vec<Var> {
-    let r = |d: &crate::ptx::ir::Dst| Var::R(d.reg);
-    match k {
-        Kind::Mov { d, .. }
-        | Kind::Pack { d, .. }
-        | Kind::Arith { d, .. }
-        | Kind::Set { d, .. }
-        | Kind::Bfi { d, .. }
-        | Kind::Selp { d, .. }
-        | Kind::Cvt { d, .. }
-        | Kind::Cvta { d, .. }
-        | Kind::Shfl { d, .. }
-        | Kind::Redux { d, .. } => vec![r(d)],
-        Kind::Match { d, p, .. } => std::iter::once(r(d)).chain(p.map(Var::P)).collect(),
-        Kind::Carry { d, cc, .. } => vec![r(d), Var::R(*cc)],
-        Kind::Unpack { ds, .. } | Kind::Ld { ds, .. } | Kind::Tex { ds, .. } | Kind::Suld { ds, .. } => {
-            ds.iter().map(r).collect()
-        }
-        Kind::Txq { d, .. } => vec![r(d)],
-        Kind::Atom { d, .. } => d.iter().map(r).collect(),
-        Kind::Vote { d, p, .. } | Kind::BarRed { d, p, .. } => {
-            d.iter().map(r).chain(std::iter::once(Var::P(*p))).collect()
-        }
-        Kind::Setp { p, q, .. } => std::iter::once(Var::P(*p)).chain(q.map(Var::P)).collect(),
-        Kind::PredLogic { d, .. } => vec![Var::P(*d)],
-        Kind::St { .. }
-        | Kind::Sust { .. }
-        | Kind::Bra { .. }
-        | Kind::Call { .. }
-        | Kind::CallIndirect { .. }
-        | Kind::Ret
-        | Kind::Exit
-        | Kind::Bar { .. }
-        | Kind::WarpSync { .. }
-        | Kind::Membar
-        | Kind::Nop
-        | Kind::Trap => vec![],
-    }
+    k.writes().into_iter().map(Var::R).chain(k.pred_writes().into_iter().map(Var::P)).collect()
 }
 
 /// The values an instruction reads, with how it uses each.

@@ -8,7 +8,7 @@ use crate::ptx::ir::{
     ArithOp, BoolOp, CarryOp, Dst, FloatMode, Kind, PredId, PredSrc, ReduxOp, RegId, ShflMode, Src, VoteMode,
 };
 use crate::ptx::types::Ty;
-use crate::sim::alu;
+use crate::sim::{alu, half};
 
 /// `mov`.
 pub(super) fn mov(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, d: Dst, a: Src, exec: u32) {
@@ -160,11 +160,14 @@ pub(super) fn set(ctx: &Ctx, w: &mut Warp, cta: &CtaMut, kind: &Kind, exec: u32)
     let (va, vb) = (read(ctx, w, cta, *a), read(ctx, w, cta, *b));
     let fr = w.frames.last_mut().expect("frame");
     let cv = comb.map(|(op, c)| (op, pred_bits(fr, c)));
-    let one = match dty {
-        Ty::F32 => 1.0f32.to_bits() as u64,
-        Ty::F64 => 1.0f64.to_bits(),
-        t => t.mask(),
-    };
+    let one = half::set_true(*dty, false);
+    if matches!(sty, Ty::F16x2 | Ty::BF16x2) {
+        let r: Lanes = std::array::from_fn(|l| {
+            let c = cv.map(|(op, c)| (op, c >> l & 1 != 0));
+            half::set_x2(*cmp, *dty, *sty, *ftz, va[l], vb[l], c)
+        });
+        return write(fr, *d, &r, exec);
+    }
     let r: Lanes = std::array::from_fn(|l| {
         let mut t = alu::compare(*cmp, *sty, *ftz, va[l], vb[l]);
         if let Some((op, c)) = cv {

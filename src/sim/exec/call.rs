@@ -107,6 +107,18 @@ pub(super) fn call_indirect(
             Some(first),
         ));
     }
+    // each argument as large as the parameter it fills (never a shortened copy)
+    if let Some((k, (&(_, size), p))) = args.iter().zip(&cf.params).enumerate().find(|(_, (a, p))| a.1 != p.size) {
+        return Err(fault(
+            FaultKind::Unsupported(format!(
+                "indirect call of `{}`: argument {} has {size} byte(s); the parameter has {}",
+                cf.name,
+                k + 1,
+                p.size
+            )),
+            Some(first),
+        ));
+    }
     // the return values as the call site declares them: the callee's, or a fault
     // (copying back fewer or truncated values would leave registers unset)
     if let Kind::CallIndirect { rets, .. } = &ctx.prog.functions[w.frame().func as usize].insts[pc as usize].kind
@@ -134,7 +146,7 @@ pub(super) fn call_indirect(
         w.stack.push(SimtEntry { pc: next, rpc: next, mask: group });
     }
     let triples: Vec<(u32, u32, u32)> =
-        args.iter().zip(&cf.params).map(|(&(off, size), p)| (off, p.offset, size.min(p.size))).collect();
+        args.iter().zip(&cf.params).map(|(&(off, size), p)| (off, p.offset, size)).collect();
     call(ctx, w, cta, pc, callee, &triples, group)
 }
 

@@ -86,17 +86,59 @@ pub(super) fn member_mask(ctx: &Ctx, w: &Warp, cta: &CtaMut, mask: Src, exec: u3
     Ok(())
 }
 
+/// The groups of lanes a `redux.sync`/`match.sync` computes over: the
+/// executing lanes split by the member mask each one holds (lanes 0–15 may
+/// name 0x0000ffff and lanes 16–31 0xffff0000: two reductions), lowest lane's
+/// group first. Every lane of a group must hold the same mask — a lane whose
+/// mask names an executing lane holding another mask is undefined in PTX
+/// and faults ([`FaultKind::MemberMask`], naming that lane). The forms
+/// without a mask compute over all executing lanes. [`member_mask`] has
+/// checked the masks against the executing lanes before.
+pub(super) fn member_groups(
+    ctx: &Ctx,
+    w: &Warp,
+    cta: &CtaMut,
+    mask: Src,
+    exec: u32,
+) -> Result<Vec<u32>, Box<ExecFault>> {
+    if mask == crate::ptx::lower::warp::NO_MEMBER_MASK || exec == 0 {
+        return Ok(vec![exec]);
+    }
+    let m = read(ctx, w, cta, mask);
+    let mut groups = Vec::new();
+    let mut rest = exec;
+    while rest != 0 {
+        let l = rest.trailing_zeros() as usize;
+        let ml = m[l] as u32;
+        let group = exec & ml;
+        if let Some(k) = (0..32).find(|&k| group >> k & 1 != 0 && m[k] as u32 != ml) {
+            return Err(fault(FaultKind::MemberMask { mask: m[k] as u32, active: exec, live: w.live }, Some(k)));
+        }
+        groups.push(group);
+        rest &= !group;
+    }
+    Ok(groups)
+}
+
 /// `bar.warp.sync`: the lanes run together already; an observer (the race
 /// checker) learns which of the member lanes passed it together. Lanes of the
-/// mask that are not executing it (divergent code) are not waited for.
-pub(super) fn warp_sync(ctx: &Ctx, w: &Warp, cta: &mut CtaMut, mask: Src, exec: u32) {
-    if cta.observer.is_none() {
-        return;
+/// mask that are not executing it (divergent code) are not waited for. An
+/// executing lane that its own mask leaves out is undefined in PTX: a
+/// [`FaultKind::MemberMask`] fault naming the lane (`warplight check`
+/// reports it as synccheck's invalid member mask, at the instruction's line).
+pub(super) fn warp_sync(ctx: &Ctx, w: &Warp, cta: &mut CtaMut, mask: Src, exec: u32) -> Result<(), Box<ExecFault>> {
+    if exec == 0 {
+        return Ok(());
     }
-    let m = read(ctx, w, cta, mask)[exec.trailing_zeros() as usize] as u32;
+    let m = read(ctx, w, cta, mask);
+    if let Some(l) = (0..32).find(|&l| exec >> l & 1 != 0 && (m[l] as u32) >> l & 1 == 0) {
+        return Err(fault(FaultKind::MemberMask { mask: m[l] as u32, active: exec, live: w.live }, Some(l)));
+    }
+    let m = m[exec.trailing_zeros() as usize] as u32;
     if let Some(obs) = cta.observer.as_deref_mut() {
         obs.warp_sync(w.id, exec & m);
     }
+    Ok(())
 }
 
 /// `membar`/`fence`: waits for this CTA's outstanding global atomics.

@@ -507,13 +507,15 @@ fn exec_ir(
         }
         Kind::Redux { op, ty, d, a, membermask } => {
             control::member_mask(ctx, w, cta, *membermask, exec)?;
-            let members = exec & read(ctx, w, cta, *membermask)[exec.trailing_zeros() as usize] as u32;
-            arith::redux(ctx, w, cta, *op, *ty, *d, *a, members)
+            for members in control::member_groups(ctx, w, cta, *membermask, exec)? {
+                arith::redux(ctx, w, cta, *op, *ty, *d, *a, members)
+            }
         }
         Kind::Match { all, ty, d, p, a, membermask } => {
             control::member_mask(ctx, w, cta, *membermask, exec)?;
-            let members = exec & read(ctx, w, cta, *membermask)[exec.trailing_zeros() as usize] as u32;
-            arith::match_sync(ctx, w, cta, *all, *ty, *d, *p, *a, members)
+            for members in control::member_groups(ctx, w, cta, *membermask, exec)? {
+                arith::match_sync(ctx, w, cta, *all, *ty, *d, *p, *a, members)
+            }
         }
         Kind::Carry { op, cin, cout, ty, d, a, b, c, cc } => {
             arith::carry(ctx, w, cta, (*op, *cin, *cout, *ty), *d, [*a, *b, *c], *cc, exec)
@@ -525,10 +527,10 @@ fn exec_ir(
         Kind::Suld { geom, ty, ds, handle, coords, clamp } => {
             texture::suld(ctx, w, cta, *geom, *ty, ds, *handle, coords, *clamp, exec)?
         }
-        Kind::Sust { geom, ty, vals, handle, coords, clamp } => {
-            texture::sust(ctx, w, cta, *geom, *ty, vals, *handle, coords, *clamp, exec)?
+        Kind::Sust { geom, ty, vals, handle, coords, clamp, red } => {
+            texture::sust(ctx, w, cta, (*geom, *ty, *red), vals, *handle, coords, *clamp, exec)?
         }
-        Kind::WarpSync { membermask } => control::warp_sync(ctx, w, cta, *membermask, exec),
+        Kind::WarpSync { membermask } => control::warp_sync(ctx, w, cta, *membermask, exec)?,
         Kind::Membar => return Ok(control::membar(w, cta)),
         Kind::Nop => {}
         Kind::Trap => return Err(fault(FaultKind::Trap, lane_of_mask(exec))),

@@ -1,5 +1,5 @@
 //! Texture and surface instructions (`tex`, `tld4`, `txq`, `suld.b`,
-//! `sust.b`): each lane's object handle names a texture or surface object of
+//! `sust.b`, `sured.b`): each lane's object handle names a texture or surface object of
 //! the device ([`crate::sim::texture`]); texels are read from and written to
 //! device memory.
 
@@ -211,14 +211,16 @@ pub(super) fn suld(
     Ok(())
 }
 
-/// `sust.b`.
+/// `sust.b`, and with `red` the reduction `sured.b`: every lane's element is
+/// checked now (out of range, outside every allocation: the lowest such lane
+/// faults) and the operation applied with the CTA's global atomics at the
+/// round's end, in lane order (`atomic::apply_pending`).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn sust(
     ctx: &Ctx,
     w: &mut Warp,
     cta: &mut CtaMut,
-    geom: TexGeom,
-    ty: Ty,
+    (geom, ty, red): (TexGeom, Ty, Option<AtomOp>),
     vals: &[Src],
     handle: Src,
     coords: &[Src],
@@ -242,6 +244,17 @@ pub(super) fn sust(
                 at.push((l, k, ak));
             }
         }
+    }
+    if let Some(op) = red {
+        if eb > 1 && at.iter().any(|&(_, _, a)| a % eb as u64 != 0) {
+            let &(l, _, a) = at.iter().find(|&&(_, _, a)| a % eb as u64 != 0).expect("found");
+            return Err(fault(FaultKind::Misaligned { space: MemSpace::Global, addr: a, size: eb }, Some(l)));
+        }
+        let lanes = at.iter().map(|&(l, k, a)| (l as u8, a, vs[k][l], 0)).collect::<Vec<_>>();
+        if !lanes.is_empty() {
+            cta.pending.push(super::atomic::PendingAtomic { warp: w.id, op, ty, d: None, lanes });
+        }
+        return Ok(());
     }
     // lanes storing to one element: the lowest lane's value stays (the H200's order)
     for &(l, k, ak) in at.iter().rev() {
