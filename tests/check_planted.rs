@@ -305,3 +305,133 @@ fn syncwarp_orders_the_lanes_of_a_warp() {
         assert_eq!(x.sites[0].cta, x.sites[1].cta);
     }
 }
+
+/// Reads by lanes that a partial `__syncwarp(mask)` does not order still
+/// race with a write after it, however many lanes read the same element
+/// (`v = s[0]` by the whole warp; lanes 16-31 pass `__syncwarp(0xFFFF0000)`;
+/// lane 31 writes `s[0]`: lanes 0-15's reads race with it).
+#[test]
+fn a_partial_syncwarp_leaves_the_other_lanes_reads_racing() {
+    let dir = std::env::temp_dir().join(format!("warplight-partial-syncwarp-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ptx = r#".version 7.8
+.target sm_90
+.address_size 64
+.visible .entry partial_sync(.param .u64 out)
+{
+    .reg .pred %p<3>;
+    .reg .b32 %r<3>;
+    .reg .b64 %rd<4>;
+    .shared .align 4 .b32 s[1];
+    mov.u32 %r1, %tid.x;
+    ld.shared.u32 %r2, [s];
+    setp.lt.u32 %p1, %r1, 16;
+    @%p1 bra DONE;
+    bar.warp.sync -65536;
+    setp.ne.u32 %p2, %r1, 31;
+    @%p2 bra DONE;
+    st.shared.u32 [s], 1;
+DONE:
+    ld.param.u64 %rd1, [out];
+    cvta.to.global.u64 %rd1, %rd1;
+    mul.wide.u32 %rd2, %r1, 4;
+    add.s64 %rd3, %rd1, %rd2;
+    st.global.u32 [%rd3], %r2;
+    ret;
+}
+"#;
+    std::fs::write(dir.join("partial_sync.ptx"), ptx).unwrap();
+    let spec = "ptx = \"partial_sync.ptx\"\nkernel = \"partial_sync\"\ngrid = 1\nblock = 32\nargs = [\"out\"]\n\
+                [[buffer]]\nname = \"out\"\ntype = \"i32\"\nlen = 32\n";
+    std::fs::write(dir.join("spec.toml"), spec).unwrap();
+    let (r, _) = run(&dir.join("spec.toml"), &args("racecheck", &[], None), 1, "out");
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(r.len(), 1, "{r:#?}");
+    assert_eq!(r[0].hazard, Hazard::WriteAfterRead, "{r:#?}");
+    assert_eq!((r[0].sites[0].lanes, r[0].sites[1].lanes), (1 << 31, 0xFFFF), "{r:#?}");
+}
+
+/// Writes `spec` and `ptx` to a fresh folder and runs the spec checked with
+/// `tools` (`uninit`: buffers tracked as uninitialised).
+fn run_files(tag: &str, spec: &str, ptx: &str, tools: &str, uninit: &[&str]) -> Vec<Report> {
+    let dir = std::env::temp_dir().join(format!("warplight-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("k.ptx"), ptx).unwrap();
+    std::fs::write(dir.join("spec.toml"), spec).unwrap();
+    let (r, _) = run(&dir.join("spec.toml"), &args(tools, uninit, None), 1, "out");
+    std::fs::remove_dir_all(&dir).ok();
+    r
+}
+
+/// Surface stores and loads (`sust`, `suld`) and texel fetches (`tex`) are
+/// global accesses to the checker: `sust` initialises what `ld.global` then
+/// reads, two CTAs storing one element race, and a texel fetch of a
+/// `--uninit` buffer nothing wrote is an uninitialised read.
+#[test]
+fn the_checker_sees_surface_and_texture_accesses() {
+    let ptx = r#".version 7.8
+.target sm_90
+.address_size 64
+.visible .entry store_then_load(.param .u64 img, .param .u64 pix, .param .u64 out)
+{
+    .reg .b32 %r<5>;
+    .reg .b64 %rd<8>;
+    ld.param.u64 %rd1, [img];
+    ld.param.u64 %rd2, [pix];
+    ld.param.u64 %rd3, [out];
+    cvta.to.global.u64 %rd2, %rd2;
+    cvta.to.global.u64 %rd3, %rd3;
+    mov.u32 %r1, %tid.x;
+    shl.b32 %r2, %r1, 2;
+    sust.b.1d.b32.trap [%rd1, {%r2}], {%r1};
+    bar.sync 0;
+    mul.wide.u32 %rd4, %r1, 4;
+    add.s64 %rd5, %rd2, %rd4;
+    ld.global.u32 %r3, [%rd5];
+    add.s64 %rd6, %rd3, %rd4;
+    st.global.u32 [%rd6], %r3;
+    ret;
+}
+.visible .entry store_one(.param .u64 img, .param .u64 pix, .param .u64 out)
+{
+    .reg .b32 %r<3>;
+    .reg .b64 %rd<2>;
+    ld.param.u64 %rd1, [img];
+    mov.u32 %r1, 0;
+    mov.u32 %r2, %ctaid.x;
+    sust.b.1d.b32.trap [%rd1, {%r1}], {%r2};
+    ret;
+}
+.visible .entry fetch(.param .u64 tex, .param .u64 pix, .param .u64 out)
+{
+    .reg .b32 %r<6>;
+    .reg .b64 %rd<5>;
+    ld.param.u64 %rd1, [tex];
+    ld.param.u64 %rd2, [out];
+    cvta.to.global.u64 %rd2, %rd2;
+    mov.u32 %r1, %tid.x;
+    tex.1d.v4.s32.s32 {%r2, %r3, %r4, %r5}, [%rd1, {%r1}];
+    mul.wide.u32 %rd3, %r1, 4;
+    add.s64 %rd4, %rd2, %rd3;
+    st.global.u32 [%rd4], %r2;
+    ret;
+}
+"#;
+    let spec = |kernel: &str, grid: u32, object: &str| {
+        format!(
+            "ptx = \"k.ptx\"\nkernel = \"{kernel}\"\ngrid = {grid}\nblock = 32\nargs = [\"img\", \"pix\", \"out\"]\n\
+             [[buffer]]\nname = \"pix\"\ntype = \"i32\"\nlen = 32\n\
+             [[buffer]]\nname = \"out\"\ntype = \"i32\"\nlen = 32\n\
+             [[{object}]]\nname = \"img\"\nbuffer = \"pix\"\nformat = \"s32\"\nwidth = 32\n"
+        )
+    };
+    // sust initialises: the loads after it read written bytes
+    let r = run_files("surface-init", &spec("store_then_load", 1, "surface"), ptx, "all", &["pix"]);
+    assert!(r.is_empty(), "{r:#?}");
+    // two CTAs store element 0 with nothing between them
+    let r = run_files("surface-race", &spec("store_one", 2, "surface"), ptx, "racecheck", &[]);
+    assert_eq!(r.iter().map(|x| x.hazard).collect::<Vec<_>>(), [Hazard::WriteAfterWrite], "{r:#?}");
+    // texels nothing wrote
+    let r = run_files("texture-uninit", &spec("fetch", 1, "texture"), ptx, "initcheck", &["pix"]);
+    assert_eq!(r.iter().map(|x| x.hazard).collect::<Vec<_>>(), [Hazard::UninitializedRead], "{r:#?}");
+}

@@ -515,3 +515,36 @@ fn validate_names_the_file_in_every_error() {
     assert!(ok, "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `step --device` and `trace --device` say that the profile sets the run's
+/// arithmetic (contraction, SFU), not only the memory views.
+#[test]
+fn step_and_trace_help_say_the_device_sets_the_arithmetic() {
+    for cmd in ["step", "trace"] {
+        let (ok, out, err) = warplight(&[cmd, "--help"]);
+        assert!(ok, "{cmd} --help: {err}");
+        let flat = out.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(flat.contains("FMA contraction and the SFU model"), "{cmd} --help: {out}");
+    }
+}
+
+/// `render` refuses options that do not apply to the method or variant
+/// asked for (they were accepted and ignored), before any work.
+#[test]
+fn render_refuses_options_that_do_not_apply() {
+    for (args, want) in [
+        (vec!["--traversal", "restart"], "--traversal applies to --method path only, not raycast"),
+        (vec!["--method", "purcell", "--spp", "8"], "--spp applies to --method path only, not purcell"),
+        (vec!["--method", "path", "--estimator", "knn"], "--estimator applies to --method photon-map only"),
+        (vec!["--method", "path", "--heuristic", "siroh"], "--heuristic applies to --method raycast only"),
+        (vec!["--method", "path", "--json", "x.json"], "--json applies to --method raycast and purcell"),
+        (vec!["--fmad", "false"], "--fmad applies to emulated kernels; --method raycast --variant native runs none"),
+        (vec!["--method", "path", "--device", "hopper"], "--device applies to emulated kernels"),
+        (vec!["--method", "path", "--fidelity", "functional"], "--fidelity applies to emulated kernels"),
+    ] {
+        let mut a = vec!["render", "--scene", "no-such-scene"];
+        a.extend(args);
+        let (ok, _, err) = warplight(&a);
+        assert!(!ok && err.contains(want), "{a:?}: {err}");
+    }
+}

@@ -484,3 +484,20 @@ fn a_function_address_in_a_zero_length_array_is_an_error_not_a_panic() {
     let ptx = module(".global .u64 t[0];\n.const .u32 c[0] = {};\n.visible .entry k()\n{\nret;\n}\n");
     warplight::ptx::load(&ptx, "empty.ptx").unwrap();
 }
+
+/// An unsized first dimension of a multi-dimensional array takes its size
+/// from the initializer, as a one-dimensional `t[]` does (the last row filled
+/// with zeros); it was refused as "more elements than the array".
+#[test]
+fn an_unsized_first_dimension_comes_from_the_initializer() {
+    let ptx = module(
+        ".global .u32 t[][2] = {1, 2, 3, 4, 5};\n.global .u16 u[][2][2] = {{{1, 2}, {3, 4}}};\n\
+         .visible .entry k()\n{\nret;\n}\n",
+    );
+    let p = warplight::ptx::load(&ptx, "unsized.ptx").unwrap();
+    let t = p.globals.iter().find(|g| g.name == "t").unwrap();
+    let words: Vec<u32> = t.init.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().unwrap())).collect();
+    assert_eq!((t.size, words), (24, vec![1, 2, 3, 4, 5, 0]));
+    let u = p.globals.iter().find(|g| g.name == "u").unwrap();
+    assert_eq!((u.size, &u.init[..]), (8, &[1u8, 0, 2, 0, 3, 0, 4, 0][..]));
+}

@@ -488,6 +488,9 @@ fn texture_spec_errors_name_the_key() {
     let err =
         |extra: &str| Spec::parse(&format!("{base}{extra}"), std::path::Path::new("s.toml")).unwrap_err().to_string();
     assert!(Spec::parse(&format!("{base}format = \"f32\"\nwidth = 8\n"), std::path::Path::new("s.toml")).is_ok());
+    // linear filtering of 8-bit texels read normalized (as floats) is fine
+    let u8_normalized = "format = \"u8\"\nwidth = 8\nfilter = \"linear\"\nread = \"normalized\"\n";
+    assert!(Spec::parse(&format!("{base}{u8_normalized}"), std::path::Path::new("s.toml")).is_ok());
     for (extra, want) in [
         ("format = \"f64\"\nwidth = 8\n", "`texture[0].format`: expected one of u8"),
         ("format = \"f32\"\nwidth = 9\n", "`texture[0].buffer`: `t` has 32 bytes; the object's texels span 36"),
@@ -498,6 +501,19 @@ fn texture_spec_errors_name_the_key() {
         ("format = \"f32\"\nwidth = 8\naddress = \"wrap\"\n", "wrap and mirror need normalized_coords = true"),
         ("format = \"f32\"\nwidth = 8\nread = \"normalized\"\n", "normalized reads are for 8- and 16-bit"),
         ("format = \"f32\"\nwidth = 8\nchannels = 3\n", "`texture[0].channels`: expected 1, 2 or 4"),
+        // CUDA rejects linear filtering of texels that do not read as floats
+        (
+            "format = \"s8\"\nwidth = 8\nfilter = \"linear\"\n",
+            "`texture[0].filter`: linear filtering needs float texels",
+        ),
+        (
+            "format = \"u32\"\nwidth = 8\nfilter = \"linear\"\n",
+            "`texture[0].filter`: linear filtering needs float texels",
+        ),
+        (
+            "format = \"f32\"\nchannels = 4\nwidth = 4294967295\nheight = 4294967295\ndepth = 2\n",
+            "`texture[0].buffer`: the object's texels span more than 2^64 bytes (4294967295 × 4294967295 × 2 texels",
+        ),
         (
             "format = \"f32\"\nwidth = 8\nfliter = \"linear\"\n",
             "`texture[0].fliter`: unknown key; did you mean `filter`?",

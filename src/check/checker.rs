@@ -157,7 +157,7 @@ impl CtaCheck {
         let warp = ev.warp;
         let x = Acc {
             warp: warp as u8,
-            lane: lane as u8,
+            lanes: 1 << lane,
             clock: self.clocks.own(warp),
             lane_clock: self.clocks.lane_clock(warp, lane),
             seq,
@@ -198,7 +198,7 @@ impl CtaCheck {
                     continue;
                 }
                 let key = Key { hazard: h, space: sk, at: x.pc, with: Some(y.pc) };
-                let other = Some((self.cta, y.warp as u32, 1u32 << y.lane));
+                let other = Some((self.cta, y.warp as u32, y.lanes));
                 self.found.add(key, self.cta, warp, lane, other, addr, ev.elem_bytes);
             }
         }
@@ -296,6 +296,11 @@ impl MemObserver for CtaCheck {
         if self.tools.synccheck {
             self.arrivals.arrive(warp, (func, pc));
         }
+    }
+
+    fn texture_access(&mut self, ev: &MemEvent) {
+        // texels and surface elements are global memory: races and initialisation as for ld/st
+        self.access(ev);
     }
 
     fn warp_sync(&mut self, warp: u32, lanes: u32) {

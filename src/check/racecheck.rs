@@ -16,16 +16,18 @@ use std::collections::{BTreeMap, HashMap};
 use super::Hazard;
 use super::findings::{Findings, Key, Pc, SpaceKey};
 
-/// One access as the shadow memory remembers it.
+/// One instruction's access by one or more lanes of a warp, as the shadow
+/// memory remembers it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Acc {
     /// Warp ([`Acc::NONE`]: no access).
     pub warp: u8,
-    /// Lane.
-    pub lane: u8,
+    /// The lanes that accessed (bit per lane; a write: one lane).
+    pub lanes: u32,
     /// The warp's own clock when it accessed.
     pub clock: u32,
-    /// The lane's own clock among its warp's lanes when it accessed ([`Clocks::lane_clock`]).
+    /// The largest of the lanes' own clocks among their warp's lanes when
+    /// they accessed ([`Clocks::lane_clock`]).
     pub lane_clock: u32,
     /// The warp's memory-instruction count (same value: same instruction).
     pub seq: u32,
@@ -37,34 +39,66 @@ impl Acc {
     /// Warp value of an empty slot.
     pub const NONE: u8 = u8::MAX;
     /// No access.
-    pub const EMPTY: Acc = Acc { warp: Acc::NONE, lane: 0, clock: 0, lane_clock: 0, seq: 0, pc: (0, 0) };
+    pub const EMPTY: Acc = Acc { warp: Acc::NONE, lanes: 0, clock: 0, lane_clock: 0, seq: 0, pc: (0, 0) };
 
     fn is_some(&self) -> bool {
         self.warp != Acc::NONE
     }
+}
 
-    fn same_thread(&self, o: &Acc) -> bool {
-        self.warp == o.warp && self.lane == o.lane
+/// Reads that no longer fit in a byte's two read slots, merged into one
+/// summary that over-approximates them: the warps and lanes that read, and the
+/// largest warp and lane clocks among the reads. A later access races with the
+/// summary when it might race with one of them, so nothing is missed; the
+/// price is a possible report where lanes' own clocks differed (partial
+/// `__syncwarp` masks) or warps' clocks differed (barriers of some warps only).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Lost {
+    /// Warps that read (bit per warp; 0: nothing lost).
+    pub warps: u32,
+    /// Lanes that read, over all those warps.
+    pub lanes: u32,
+    /// The largest warp clock of the reads.
+    pub clock: u32,
+    /// The largest lane clock of the reads.
+    pub lane_clock: u32,
+    /// The first read merged in, named as the other party of a report.
+    pub first: Acc,
+}
+
+impl Lost {
+    /// Nothing lost.
+    pub const NONE: Lost = Lost { warps: 0, lanes: 0, clock: 0, lane_clock: 0, first: Acc::EMPTY };
+
+    fn add(&mut self, r: &Acc) {
+        if self.warps == 0 {
+            self.first = *r;
+        }
+        self.warps |= 1 << r.warp;
+        self.lanes |= r.lanes;
+        self.clock = self.clock.max(r.clock);
+        self.lane_clock = self.lane_clock.max(r.lane_clock);
     }
 }
 
-/// The shadow of one byte: its last write, its last two reads by different
-/// threads since then, and whether anything wrote it (initcheck).
+/// The shadow of one byte: its last write, the reads since then that are not
+/// ordered before a later read (two, each one instruction's lanes, and the
+/// rest merged into [`Lost`]), and whether anything wrote it (initcheck).
 #[derive(Debug, Clone, Copy)]
 pub struct Cell {
     /// Last write.
     pub write: Acc,
-    /// Last read.
-    pub read: Acc,
-    /// Last read by another thread than `read`'s.
-    pub read2: Acc,
+    /// Reads since the last write, oldest first.
+    pub reads: [Acc; 2],
+    /// Older reads since the last write that may still race.
+    pub lost: Lost,
     /// Written at least once.
     pub init: bool,
 }
 
 impl Default for Cell {
     fn default() -> Self {
-        Cell { write: Acc::EMPTY, read: Acc::EMPTY, read2: Acc::EMPTY, init: false }
+        Cell { write: Acc::EMPTY, reads: [Acc::EMPTY; 2], lost: Lost::NONE, init: false }
     }
 }
 
@@ -142,20 +176,48 @@ impl Clocks {
         }
     }
 
-    /// Whether the earlier access `y` and the current access by (`warp`,
-    /// `lane`) in memory instruction `seq` may happen in either order.
-    pub fn concurrent(&self, y: &Acc, warp: u32, lane: u32, seq: u32) -> bool {
-        if !y.is_some() || (y.warp as u32 == warp && y.lane as u32 == lane) {
-            return false;
+    /// Of `lanes` of warp `warp`, which read or wrote at a lane clock of
+    /// `lane_clock` (or less) that lane `lane` has not learnt of through a
+    /// warp synchronisation (bit per lane; `lane` itself excluded).
+    fn unsynced(&self, warp: u32, lane: u32, lanes: u32, lane_clock: u32) -> u32 {
+        let lanes = lanes & !(1 << lane);
+        match &self.lanes[warp as usize] {
+            None => lanes,
+            Some(m) => {
+                (0..32).filter(|l| lanes >> l & 1 != 0 && lane_clock > m[lane as usize][*l]).fold(0, |a, l| a | 1 << l)
+            }
+        }
+    }
+
+    /// The lanes of the earlier access `y` that may happen in either order
+    /// with the current access by (`warp`, `lane`) in memory instruction
+    /// `seq` (bit per lane; 0: `y` happens before it, or is the same thread or
+    /// instruction).
+    pub fn concurrent(&self, y: &Acc, warp: u32, lane: u32, seq: u32) -> u32 {
+        if !y.is_some() {
+            return 0;
         }
         if y.warp as u32 == warp {
             // same warp, another lane: a barrier since orders them, and so does a warp
             // synchronisation of both lanes; one instruction does not race with itself
-            let synced =
-                self.lanes[warp as usize].as_ref().is_some_and(|m| y.lane_clock <= m[lane as usize][y.lane as usize]);
-            return y.clock == self.own(warp) && y.seq != seq && !synced;
+            if y.clock != self.own(warp) || y.seq == seq {
+                return 0;
+            }
+            return self.unsynced(warp, lane, y.lanes, y.lane_clock);
         }
-        y.clock > self.vc[warp as usize][y.warp as usize]
+        if y.clock > self.vc[warp as usize][y.warp as usize] { y.lanes } else { 0 }
+    }
+
+    /// Whether one of the reads merged into `lost` may happen in either order
+    /// with the current access by (`warp`, `lane`) (over-approximated).
+    pub fn lost_concurrent(&self, lost: &Lost, warp: u32, lane: u32) -> bool {
+        let others = lost.warps & !(1 << warp);
+        let other_warp =
+            (0..self.vc.len() as u32).any(|u| others >> u & 1 != 0 && lost.clock > self.vc[warp as usize][u as usize]);
+        let own_warp = lost.warps >> warp & 1 != 0
+            && lost.clock >= self.own(warp)
+            && self.unsynced(warp, lane, lost.lanes, lost.lane_clock) != 0;
+        other_warp || own_warp
     }
 }
 
@@ -170,37 +232,70 @@ pub enum Kind {
     Atomic,
 }
 
+/// Records the read `x` (one lane) among a byte's reads: the same
+/// instruction's other lanes take it in, reads ordered before it are
+/// forgotten (whatever races with them races with `x` or was reported), and
+/// the oldest read is merged into [`Lost`] when both slots hold reads that
+/// may still race.
+fn add_read(clocks: &Clocks, cell: &mut Cell, x: Acc) {
+    let (warp, lane) = (x.warp as u32, x.lanes.trailing_zeros());
+    if let Some(g) = cell.reads.iter_mut().find(|g| g.is_some() && g.warp == x.warp && g.seq == x.seq) {
+        g.lanes |= x.lanes;
+        g.lane_clock = g.lane_clock.max(x.lane_clock);
+        return;
+    }
+    for g in &mut cell.reads {
+        if clocks.concurrent(g, warp, lane, x.seq) == 0 {
+            *g = Acc::EMPTY;
+        }
+    }
+    if cell.lost.warps != 0 && !clocks.lost_concurrent(&cell.lost, warp, lane) {
+        cell.lost = Lost::NONE;
+    }
+    match cell.reads {
+        [a, b] if !a.is_some() && !b.is_some() => cell.reads = [x, Acc::EMPTY],
+        [a, b] if !b.is_some() => cell.reads = [a, x],
+        [a, b] if !a.is_some() => cell.reads = [b, x],
+        [a, b] => {
+            cell.lost.add(&a);
+            cell.reads = [b, x];
+        }
+    }
+}
+
 /// Checks one lane's access to one byte against the byte's shadow and
-/// updates it. Returns the hazards found (with the other party).
+/// updates it. `x.lanes` holds that one lane. Returns the hazards found, each
+/// with the other party (its lanes: those that may race).
 pub fn access(clocks: &Clocks, cell: &mut Cell, kind: Kind, x: Acc) -> [Option<(Hazard, Acc)>; 2] {
-    let (warp, lane, seq) = (x.warp as u32, x.lane as u32, x.seq);
+    let (warp, lane, seq) = (x.warp as u32, x.lanes.trailing_zeros(), x.seq);
     let mut out = [None, None];
+    let racing = |y: &Acc| {
+        let lanes = clocks.concurrent(y, warp, lane, seq);
+        (lanes != 0).then_some(Acc { lanes, ..*y })
+    };
     match kind {
         Kind::Atomic => {
             cell.init = true;
         }
         Kind::Write => {
-            if clocks.concurrent(&cell.write, warp, lane, seq) {
-                out[0] = Some((Hazard::WriteAfterWrite, cell.write));
+            if let Some(y) = racing(&cell.write) {
+                out[0] = Some((Hazard::WriteAfterWrite, y));
             }
-            for r in [cell.read, cell.read2] {
-                if out[1].is_none() && clocks.concurrent(&r, warp, lane, seq) {
-                    out[1] = Some((Hazard::WriteAfterRead, r));
-                }
+            let lost =
+                (cell.lost.warps != 0 && clocks.lost_concurrent(&cell.lost, warp, lane)).then_some(cell.lost.first);
+            if let Some(y) = cell.reads.iter().find_map(racing).or(lost) {
+                out[1] = Some((Hazard::WriteAfterRead, y));
             }
             cell.write = x;
-            cell.read = Acc::EMPTY;
-            cell.read2 = Acc::EMPTY;
+            cell.reads = [Acc::EMPTY; 2];
+            cell.lost = Lost::NONE;
             cell.init = true;
         }
         Kind::Read => {
-            if clocks.concurrent(&cell.write, warp, lane, seq) {
-                out[0] = Some((Hazard::ReadAfterWrite, cell.write));
+            if let Some(y) = racing(&cell.write) {
+                out[0] = Some((Hazard::ReadAfterWrite, y));
             }
-            if cell.read.is_some() && !cell.read.same_thread(&x) {
-                cell.read2 = cell.read;
-            }
-            cell.read = x;
+            add_read(clocks, cell, x);
         }
     }
     out
@@ -316,7 +411,71 @@ mod tests {
 
     fn acc(warp: u8, lane: u8, clocks: &Clocks, seq: u32) -> Acc {
         let lane_clock = clocks.lane_clock(warp as u32, lane as u32);
-        Acc { warp, lane, clock: clocks.own(warp as u32), lane_clock, seq, pc: (0, seq) }
+        Acc { warp, lanes: 1 << lane, clock: clocks.own(warp as u32), lane_clock, seq, pc: (0, seq) }
+    }
+
+    /// The hazard and the other party's warp and lanes.
+    fn war(h: [Option<(Hazard, Acc)>; 2]) -> Option<(u8, u32)> {
+        h[1].filter(|x| x.0 == Hazard::WriteAfterRead).map(|x| (x.1.warp, x.1.lanes))
+    }
+
+    #[test]
+    fn a_partial_warp_sync_orders_only_its_lanes_reads_before_a_write() {
+        // v = s[0] by all 32 lanes; lanes 16-31 pass __syncwarp(0xFFFF0000); lane 31 writes:
+        // lanes 0-15's reads race with the write (the two reads kept last, lanes 30 and 31,
+        // are ordered before it)
+        let mut c = Clocks::new(1);
+        let mut cell = Cell::default();
+        for lane in 0..32 {
+            assert_eq!(access(&c, &mut cell, Kind::Read, acc(0, lane, &c, 1)), [None, None]);
+        }
+        c.warp_sync(0, 0xFFFF_0000);
+        let h = access(&c, &mut cell, Kind::Write, acc(0, 31, &c, 2));
+        assert_eq!(war(h), Some((0, 0xFFFF)));
+        // with the whole warp synchronised, nothing races
+        let mut c = Clocks::new(1);
+        let mut cell = Cell::default();
+        for lane in 0..32 {
+            access(&c, &mut cell, Kind::Read, acc(0, lane, &c, 1));
+        }
+        c.warp_sync(0, u32::MAX);
+        assert_eq!(access(&c, &mut cell, Kind::Write, acc(0, 31, &c, 2)), [None, None]);
+    }
+
+    #[test]
+    fn a_read_pushed_out_of_the_slots_still_races() {
+        // warps 0, 1, 2 read one after another (unordered): warp 0's read no longer has a slot;
+        // a barrier of warps 1-3 orders warps 1 and 2's reads before warp 3's write, not warp 0's
+        let mut c = Clocks::new(4);
+        let mut cell = Cell::default();
+        for w in 0..3 {
+            access(&c, &mut cell, Kind::Read, acc(w, 5, &c, 1));
+        }
+        c.barrier(&[1, 2, 3]);
+        let h = access(&c, &mut cell, Kind::Write, acc(3, 0, &c, 1));
+        assert_eq!(war(h), Some((0, 1 << 5)));
+        // after a barrier of every warp, the same write races with nothing
+        let mut c = Clocks::new(4);
+        let mut cell = Cell::default();
+        for w in 0..3 {
+            access(&c, &mut cell, Kind::Read, acc(w, 5, &c, 1));
+        }
+        c.barrier(&[0, 1, 2, 3]);
+        assert_eq!(access(&c, &mut cell, Kind::Write, acc(3, 0, &c, 1)), [None, None]);
+    }
+
+    #[test]
+    fn reads_ordered_before_a_later_read_are_forgotten() {
+        // lane 1 reads, then lanes 1 and 2 synchronise and lane 2 reads: lane 1's read is
+        // ordered before lane 2's and leaves the slots; lane 3's read fills the other
+        let mut c = Clocks::new(1);
+        let mut cell = Cell::default();
+        access(&c, &mut cell, Kind::Read, acc(0, 1, &c, 1));
+        c.warp_sync(0, 0b110);
+        access(&c, &mut cell, Kind::Read, acc(0, 2, &c, 2));
+        access(&c, &mut cell, Kind::Read, acc(0, 3, &c, 3));
+        assert_eq!(cell.reads.map(|r| r.lanes), [1 << 2, 1 << 3]);
+        assert_eq!(cell.lost, Lost::NONE);
     }
 
     #[test]

@@ -43,6 +43,10 @@ impl MemObserver for Both {
         self.first.warp_sync(warp, lanes);
         self.second.warp_sync(warp, lanes);
     }
+    fn texture_access(&mut self, ev: &MemEvent) {
+        self.first.texture_access(ev);
+        self.second.texture_access(ev);
+    }
 }
 
 impl ObserverFactory for Tee<'_> {

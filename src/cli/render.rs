@@ -34,7 +34,8 @@ pub struct RenderArgs {
     /// node-cache-1, stack-cache-1, node-cache-1+stack-cache-1, node-cache-2+stack-cache-2.
     #[arg(long, default_value = "native")]
     pub variant: String,
-    /// Device profile of the emulated kernels' memory counters: gt200, maxwell, hopper.
+    /// Device profile of the emulated kernels (every method's): their memory
+    /// counters and arithmetic (FMA contraction, SFU model): gt200, maxwell, hopper.
     #[arg(long, default_value = "gt200")]
     pub device: String,
     /// ptxas's FMA contraction in the emulated kernels: --fmad=false rounds every
@@ -189,11 +190,49 @@ fn encode(fb: &crate::host::image::FrameBuffer, exr: bool, exposure: f32) -> Res
     Ok(bytes.into_inner())
 }
 
+/// An error naming the first option given a value other than its default
+/// for a method or variant it does not apply to (rather than ignoring it).
+fn check_applicable(a: &RenderArgs) -> Result<(), String> {
+    let m = a.method.as_str();
+    let path_only = [
+        ("--integrator", a.integrator != "nee"),
+        ("--spp", a.spp != 16),
+        ("--bounces", a.bounces != crate::host::path::DEFAULT_MAX_BOUNCES),
+        ("--seed", a.seed != 0),
+        ("--traversal", a.traversal != "stack"),
+    ];
+    if let Some((o, _)) = path_only.iter().find(|x| m != "path" && x.1) {
+        return Err(format!("{o} applies to --method path only, not {m}"));
+    }
+    if m != "photon-map" && a.estimator != "vkde" {
+        return Err(format!("--estimator applies to --method photon-map only, not {m}"));
+    }
+    if m != "raycast" && a.heuristic != "sah" {
+        return Err(format!("--heuristic applies to --method raycast only ({m} builds its own tree)"));
+    }
+    if m == "path" && a.json.is_some() {
+        return Err("--json applies to --method raycast and purcell (the path tracer writes no counters)".into());
+    }
+    // natively, raycast and path run no kernel (purcell's native variant still emulates the map passes)
+    if matches!(m, "raycast" | "path") && a.variant == "native" {
+        let emulated_only = [
+            ("--device", a.device != "gt200"),
+            ("--fmad", a.fmad.is_some()),
+            ("--fidelity", a.fidelity != crate::sim::Fidelity::Caches),
+        ];
+        if let Some((o, _)) = emulated_only.iter().find(|x| x.1) {
+            return Err(format!("{o} applies to emulated kernels; --method {m} --variant native runs none"));
+        }
+    }
+    Ok(())
+}
+
 /// Renders one frame.
 fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if !matches!(a.method.as_str(), "raycast" | "path" | "photon-map" | "purcell") {
         return Err(format!("unknown method `{}`; expected raycast, path, photon-map or purcell", a.method).into());
     }
+    check_applicable(&a)?;
     let kernel_variant = match a.variant.as_str() {
         _ if a.method == "path" || a.method == "photon-map" || a.method == "purcell" => None,
         "native" => None,
@@ -239,13 +278,13 @@ fn run_frame(a: RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     }
     let [width, height] = cam.resolution;
     if a.method == "path" {
-        return run_path(&a, &scene, &cam);
+        return run_path(&a, &scene, &cam, profile);
     }
     if a.method == "photon-map" {
         return run_photon_map(&a, &scene, &cam);
     }
     if a.method == "purcell" {
-        return crate::repro::purcell2003::image::run_cli(&a, &scene, &cam);
+        return crate::repro::purcell2003::image::run_cli(&a, &scene, &cam, profile);
     }
     crate::limits::check_memory(
         || format!("a render of {width} x {height} pixels"),
@@ -372,6 +411,7 @@ fn run_path(
     a: &RenderArgs,
     scene: &crate::host::scene::Scene,
     camera: &crate::host::camera::Camera,
+    profile: Profile,
 ) -> Result<(), Box<dyn std::error::Error>> {
     use crate::host::path::{FrameParams, Integrator, Traversal};
     let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
@@ -380,9 +420,14 @@ fn run_path(
     let traversal = Traversal::parse(&a.traversal)
         .ok_or_else(|| format!("unknown traversal `{}`; expected stack, stack12, restart or backtrack", a.traversal))?;
     let frames = crate::repro::lin2017::render::frames_for(a.spp)?;
-    let emulated = match a.variant.as_str() {
+    // the emulated kernel runs on the command's profile, FMA contraction and fidelity
+    let set = |c: &mut crate::sim::SimConfig| {
+        c.fidelity = a.fidelity;
+        profile.configure(c, a.fmad);
+    };
+    let emulated: Option<&dyn Fn(&mut crate::sim::SimConfig)> = match a.variant.as_str() {
         "native" => None,
-        "emulated" => Some(a.fidelity),
+        "emulated" => Some(&set),
         v => return Err(format!("--method path --variant {v}: expected native or emulated").into()),
     };
     let [width, height] = camera.resolution;

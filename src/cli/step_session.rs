@@ -20,8 +20,11 @@ pub struct SessionArgs {
     /// (default: the spec's `max_instructions`, else 2^32). See docs/limits.md.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub max_instructions: Option<u64>,
-    /// Device profile for the memory views' transactions, sectors and banks:
-    /// gt200, maxwell or hopper (default: the spec's `device`, else hopper).
+    /// Device profile: gt200, maxwell or hopper (default: the spec's `device`,
+    /// else hopper). It sets the memory views' transactions, sectors and banks,
+    /// and the arithmetic of the stepped launch and of the `--check` run before
+    /// it: FMA contraction and the SFU model, so register values can differ
+    /// between profiles.
     #[arg(long)]
     pub device: Option<String>,
     /// Checking (`--check`, `--uninit`; the reports come first, on stderr) and

@@ -192,18 +192,18 @@ impl Ctx<'_> {
     fn fits(&self, lay: &Layout, b: &BufferSpec, key: &str) -> Result<(), SpecError> {
         let texel = lay.format.bytes() as u64 * lay.channels as u64;
         let [w, h, d] = lay.dims.map(|x| x.max(1) as u64);
-        let pitch = if lay.row_pitch == 0 { w * texel } else { lay.row_pitch };
+        let shape = format!("{w} × {h} × {d} texels of {texel} bytes");
         // the last row needs only its texels, not the whole pitch
-        let need = (pitch * h * d).saturating_sub(pitch) + w * texel;
-        let have = (b.len * b.ty.size()) as u64;
+        let need = w.checked_mul(texel).and_then(|row| {
+            let pitch = if lay.row_pitch == 0 { row } else { lay.row_pitch };
+            pitch.checked_mul(h * d - 1)?.checked_add(row)
+        });
+        let Some(need) = need else {
+            return self.err(key, format!("the object's texels span more than 2^64 bytes ({shape})"));
+        };
+        let have = (b.len as u64).saturating_mul(b.ty.size() as u64);
         if have < need {
-            return self.err(
-                key,
-                format!(
-                    "`{}` has {have} bytes; the object's texels span {need} ({w} × {h} × {d} texels of {texel} bytes)",
-                    b.name
-                ),
-            );
+            return self.err(key, format!("`{}` has {have} bytes; the object's texels span {need} ({shape})", b.name));
         }
         Ok(())
     }
@@ -260,9 +260,15 @@ impl Ctx<'_> {
                 "wrap and mirror need normalized_coords = true (CUDA supports them with normalized coordinates only)",
             );
         }
-        let small_int = matches!(lay.format, TexelFormat::U8 | TexelFormat::S8 | TexelFormat::U16 | TexelFormat::S16);
-        if read == ReadMode::NormalizedFloat && !small_int {
+        if read == ReadMode::NormalizedFloat && !lay.format.is_small_int() {
             return self.err(&k("read"), "normalized reads are for 8- and 16-bit integer formats");
+        }
+        if filter == FilterMode::Linear && !lay.format.is_float() && read != ReadMode::NormalizedFloat {
+            return self.err(
+                &k("filter"),
+                "linear filtering needs float texels: an f16 or f32 format, or read = \"normalized\" \
+                 (CUDA rejects linear filtering of a non-float texture)",
+            );
         }
         if linear && lay.dims[1] != 0 {
             return self.err(&k("linear"), "a linear-memory texture is 1-D (no height)");

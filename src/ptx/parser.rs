@@ -388,8 +388,13 @@ impl<'a> Parser<'a> {
         if self.eat_punct('=') {
             let mut vals = Vec::new();
             self.initializer(&mut vals, &mut init_syms)?;
-            if dims.len() == 1 && dims[0].is_none() {
-                dims[0] = Some(vals.len() as u64 / vector.unwrap_or(1) as u64);
+            // `t[] = {..}`, `t[][2] = {..}`: the first dimension from the initializer's
+            // elements over the other dimensions' (the last row filled with zeros)
+            if dims.first() == Some(&None) && dims[1..].iter().all(Option::is_some) {
+                let inner: u64 = dims[1..].iter().flatten().product();
+                if inner > 0 {
+                    dims[0] = Some((vals.len() as u64 / vector.unwrap_or(1) as u64).div_ceil(inner));
+                }
             }
             init = Some(vals);
         }

@@ -69,6 +69,13 @@ pub trait MemObserver: Send {
     /// what each did before it happens before what the others do after.
     /// Default: nothing.
     fn warp_sync(&mut self, _warp: u32, _lanes: u32) {}
+    /// One warp-level access to global memory through the texture path: the
+    /// texels a `tex` or `tld4` read ([`MemOp::Load`]; one event per texel of
+    /// a lane's footprint and texel size) or the elements a `suld`
+    /// ([`MemOp::Load`]) or `sust` ([`MemOp::Store`]) accessed. The memory
+    /// model counts this path apart (texture counters), so only checkers look
+    /// at it. Default: nothing.
+    fn texture_access(&mut self, _ev: &MemEvent) {}
 }
 
 /// Makes one observer per CTA and collects them when the CTA retires.

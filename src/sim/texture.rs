@@ -35,6 +35,16 @@ impl TexelFormat {
         }
     }
 
+    /// A floating-point format (f16, f32).
+    pub fn is_float(self) -> bool {
+        matches!(self, TexelFormat::F16 | TexelFormat::F32)
+    }
+
+    /// An 8- or 16-bit integer format (the ones a normalized read converts).
+    pub fn is_small_int(self) -> bool {
+        matches!(self, TexelFormat::U8 | TexelFormat::S8 | TexelFormat::U16 | TexelFormat::S16)
+    }
+
     /// The `txq.channel_data_type` value (CUDA's `cudaChannelFormatKind`-like
     /// code the PTX ISA leaves to the driver; warplight's numbering).
     pub fn code(self) -> u32 {
@@ -312,17 +322,39 @@ fn span(elem: u64, dims: [u32; 3], row_pitch: u64) -> Result<u64, String> {
 
 impl TextureDesc {
     /// Checks the descriptor as `cudaCreateTextureObject` would: 1, 2 or 4
-    /// channels, and the texels (`dims`, `row_pitch`) within one allocation
-    /// from `data` (`fits(addr, bytes)`). The error says what is wrong.
+    /// channels; normalized reads of 8- and 16-bit integer formats only
+    /// (`cudaErrorInvalidNormSetting`); linear filtering of floats only, that
+    /// is a float format or a normalized read (`cudaErrorInvalidFilterSetting`);
+    /// and the texels (`dims`, `row_pitch`) within one allocation from `data`
+    /// (`fits(addr, bytes)`). The error says what is wrong.
     pub fn validate(&self, fits: impl Fn(u64, u64) -> bool) -> Result<(), String> {
         if ![1, 2, 4].contains(&self.channels) {
             return Err(format!("{} channels (1, 2 or 4)", self.channels));
+        }
+        if let Some(e) = self.read_error() {
+            return Err(e.into());
         }
         let bytes = span(self.format.bytes() as u64 * self.channels as u64, self.dims, self.row_pitch)?;
         if !fits(self.data.0, bytes) {
             return Err(format!("its {bytes} bytes from {:#x} are not within one allocation", self.data.0));
         }
         Ok(())
+    }
+
+    /// What CUDA rejects in the read mode and filter of this format: a
+    /// normalized read of anything but an 8- or 16-bit integer format, or
+    /// linear filtering of texels that do not read as floats. `None`: fine.
+    pub fn read_error(&self) -> Option<&'static str> {
+        if self.read == ReadMode::NormalizedFloat && !self.format.is_small_int() {
+            return Some("normalized reads are for 8- and 16-bit integer formats");
+        }
+        if self.filter == FilterMode::Linear && !self.format.is_float() && self.read != ReadMode::NormalizedFloat {
+            return Some(
+                "linear filtering needs float texels: an f16 or f32 format, or read = normalized \
+                 (CUDA: a non-float texture accessed with linear filtering)",
+            );
+        }
+        None
     }
 }
 
@@ -367,6 +399,36 @@ mod tests {
         assert_eq!(surface_addr(&s, [9, 1, 0], 2, 4, true), Some(0x1004));
         let z = SurfaceDesc { elem_bytes: 0, ..s };
         assert_eq!(surface_addr(&z, [0, 0, 0], 2, 4, true), None);
+    }
+
+    #[test]
+    fn linear_filtering_and_normalized_reads_need_the_formats_cuda_accepts() {
+        let t = |format, filter, read| TextureDesc {
+            data: DevicePtr(0x1000),
+            format,
+            channels: 1,
+            dims: [4, 0, 0],
+            row_pitch: 0,
+            linear: false,
+            addr: [AddressMode::Clamp; 3],
+            filter,
+            read,
+            normalized: false,
+        };
+        let ok = |t: TextureDesc| t.validate(|_, _| true);
+        use {FilterMode::*, ReadMode::*, TexelFormat::*};
+        assert!(ok(t(F32, Linear, ElementType)).is_ok());
+        assert!(ok(t(F16, Linear, ElementType)).is_ok());
+        assert!(ok(t(U8, Linear, NormalizedFloat)).is_ok());
+        assert!(ok(t(S8, Point, ElementType)).is_ok());
+        for f in [U8, S8, U16, S16, U32, S32] {
+            let e = ok(t(f, Linear, ElementType)).unwrap_err();
+            assert!(e.contains("linear filtering needs float texels"), "{f:?}: {e}");
+        }
+        for f in [U32, S32, F16, F32] {
+            let e = ok(t(f, Point, NormalizedFloat)).unwrap_err();
+            assert!(e.contains("normalized reads"), "{f:?}: {e}");
+        }
     }
 
     #[test]

@@ -48,13 +48,15 @@ fn bar(frames: u32, what: &str) -> Option<indicatif::ProgressBar> {
     })
 }
 
-/// Renders `scene` with the path tracer: `emulated` on the emulator at `fidelity`.
+/// Renders `scene` with the path tracer: natively, or with `emulated` on
+/// the emulator, `emulated` setting the kernel's settings (fidelity, the
+/// device's arithmetic: [`crate::model::Profile::configure`]).
 pub fn render(
     scene: &crate::host::scene::Scene,
     camera: &Camera,
     params: FrameParams,
     frames: u32,
-    emulated: Option<crate::sim::Fidelity>,
+    emulated: Option<&dyn Fn(&mut crate::sim::SimConfig)>,
 ) -> Result<PathRender, Box<dyn std::error::Error>> {
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     // the stackless traversals cannot return to a split plane they crossed:
@@ -81,9 +83,9 @@ pub fn render(
     let t0 = Instant::now();
     let (image, instructions) = match emulated {
         None => (render_native(&ps, camera, params, frames, false, tick).image(), None),
-        Some(fidelity) => {
+        Some(set) => {
             let mut cfg = kernel::sim_config(&params);
-            cfg.fidelity = fidelity;
+            set(&mut cfg);
             let mut dev = Device::with_config(cfg);
             let module = kernel::load(&mut dev)?;
             let k = kernel::render(&mut dev, &module, &ps, camera, params, frames, false, tick)?;

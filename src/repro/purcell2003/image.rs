@@ -60,7 +60,20 @@ pub fn render(scene: &Scene, f: &Fixture, width: u32) -> Result<Rendered, Measur
 
 /// [`render`], keeping the running image after every pass when `progressive`.
 pub fn render_with(scene: &Scene, f: &Fixture, width: u32, progressive: bool) -> Result<Rendered, MeasureError> {
-    let Prepared { mut passes, fixture, photons, queries, grid, direct } = pipeline::prepare_with(scene, f, width)?;
+    render_configured(scene, f, width, progressive, &|_| {})
+}
+
+/// [`render_with`] on a device whose settings `set` adjusts
+/// ([`super::passes::Passes::configured`]).
+pub fn render_configured(
+    scene: &Scene,
+    f: &Fixture,
+    width: u32,
+    progressive: bool,
+    set: &dyn Fn(&mut crate::sim::SimConfig),
+) -> Result<Rendered, MeasureError> {
+    let Prepared { mut passes, fixture, photons, queries, grid, direct } =
+        pipeline::prepare_configured(scene, f, width, set)?;
     let p = &mut passes;
     let params = pipeline::params(&fixture);
     let npix = (queries.width * queries.height) as usize;
@@ -249,6 +262,7 @@ pub fn run_cli(
     a: &crate::cli::render::RenderArgs,
     scene: &Scene,
     cam: &Camera,
+    profile: crate::model::Profile,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let f = pipeline::fixture_of(scene).map_err(|e| e.to_string())?;
     let width = cam.resolution[0];
@@ -259,7 +273,12 @@ pub fn run_cli(
         v => return Err(format!("--method purcell --variant {v}: expected native, emulated or error").into()),
     };
     let t = std::time::Instant::now();
-    let r = render_with(scene, &f, width, a.json.is_some()).map_err(|e| e.to_string())?;
+    // the emulated kernels run on the command's profile, FMA contraction and fidelity
+    let set = |c: &mut crate::sim::SimConfig| {
+        c.fidelity = a.fidelity;
+        profile.configure(c, a.fmad);
+    };
+    let r = render_configured(scene, &f, width, a.json.is_some(), &set).map_err(|e| e.to_string())?;
     let mut out = images(&r);
     let mut alike = None;
     if native {

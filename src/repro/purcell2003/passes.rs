@@ -137,10 +137,17 @@ impl Passes {
     /// Loads the kernels on a fresh device with the default settings and a
     /// watchdog of `max_warp_instructions` per launch (`None`: the default).
     pub fn new(max_warp_instructions: Option<u64>) -> Result<Passes, SimError> {
+        Passes::configured(max_warp_instructions, &|_| {})
+    }
+
+    /// [`Passes::new`] with `set` adjusting the settings (fidelity, the
+    /// device's arithmetic: [`crate::model::Profile::configure`]).
+    pub fn configured(max_warp_instructions: Option<u64>, set: &dyn Fn(&mut SimConfig)) -> Result<Passes, SimError> {
         let mut c = SimConfig::default();
         if let Some(m) = max_warp_instructions {
             c.schedule.max_warp_instructions = m;
         }
+        set(&mut c);
         let mut dev = Device::with_config(c);
         let photons = dev.load_ptx(PHOTONS_PTX, "kernels/purcell2003/photons.ptx")?;
         let grid = dev.load_ptx(GRID_PTX, "kernels/purcell2003/grid.ptx")?;

@@ -69,9 +69,20 @@ pub fn prepare(scene: &Scene, width: u32) -> Result<Prepared, MeasureError> {
 /// that land straight from the light are not stored, the shadow rays
 /// (`f.shadow_samples` per pixel) giving direct light.
 pub fn prepare_with(scene: &Scene, f: &Fixture, width: u32) -> Result<Prepared, MeasureError> {
+    prepare_configured(scene, f, width, &|_| {})
+}
+
+/// [`prepare_with`] on a device whose settings `set` adjusts
+/// ([`Passes::configured`]).
+pub fn prepare_configured(
+    scene: &Scene,
+    f: &Fixture,
+    width: u32,
+    set: &dyn Fn(&mut crate::sim::SimConfig),
+) -> Result<Prepared, MeasureError> {
     let f = *f;
     let geo = Geometry::of(scene);
-    let mut passes = Passes::new(Some(WATCHDOG))?;
+    let mut passes = Passes::configured(Some(WATCHDOG), set)?;
     // calibration: a pilot run's share of stored photons sets the emitted count
     let pilot = photons::trace(&mut passes, &geo, f.pilot, f.bounces, PILOT_SEED, false)?;
     let pilot_stored = pilot.count_stored(&passes);

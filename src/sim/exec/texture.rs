@@ -3,12 +3,13 @@
 //! the device ([`crate::sim::texture`]); texels are read from and written to
 //! device memory.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 use super::{CtaMut, Ctx, ExecFault, Lanes, fault, read, write};
 use crate::ptx::ir::*;
 use crate::ptx::types::Ty;
 use crate::sim::fault::FaultKind;
+use crate::sim::observer::{MemEvent, MemOp};
 use crate::sim::texture::{self, Object, SurfaceDesc, TextureDesc};
 use crate::sim::warp::Warp;
 
@@ -52,6 +53,50 @@ fn lanes(exec: u32) -> impl Iterator<Item = usize> {
     (0..32).filter(move |l| exec >> l & 1 != 0)
 }
 
+/// One lane's texture-path accesses of one instruction: (address, bytes,
+/// bytes per element), in order.
+type Footprint = Vec<(u64, u32, u32)>;
+
+/// Hands one instruction's texture-path accesses (`per_lane[l]`: lane `l`'s)
+/// to the CTA's observer: the k-th access of every lane in one event per
+/// access size ([`crate::sim::observer::MemObserver::texture_access`]).
+fn observe(cta: &mut CtaMut, w: &Warp, op: MemOp, per_lane: &[Footprint]) {
+    let cta_linear = cta.cta_linear;
+    let Some(obs) = cta.observer.as_deref_mut() else { return };
+    // `exec` moved the running path past this instruction before running it
+    let func = w.frame().func;
+    let pc = w.stack.top().map_or(0, |t| t.pc.wrapping_sub(1));
+    let rounds = per_lane.iter().map(Vec::len).max().unwrap_or(0);
+    for k in 0..rounds {
+        let mut left = (0..per_lane.len()).filter(|&l| per_lane[l].len() > k).fold(0u32, |m, l| m | 1 << l);
+        while left != 0 {
+            let (_, bytes, elem) = per_lane[left.trailing_zeros() as usize][k];
+            let (mut addrs, mut mask) = ([0u64; 32], 0u32);
+            for l in lanes(left) {
+                let (a, b, e) = per_lane[l][k];
+                if (b, e) == (bytes, elem) {
+                    addrs[l] = a;
+                    mask |= 1 << l;
+                }
+            }
+            left &= !mask;
+            obs.texture_access(&MemEvent {
+                func,
+                pc,
+                op,
+                space: MemSpace::Global,
+                nc: op == MemOp::Load,
+                bytes,
+                elem_bytes: elem,
+                mask,
+                addrs: &addrs,
+                cta: cta_linear,
+                warp: w.id,
+            });
+        }
+    }
+}
+
 /// `tex` / `tld4`.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn tex(
@@ -71,7 +116,15 @@ pub(super) fn tex(
     let h = read(ctx, w, cta, handle);
     let cs: Vec<Lanes> = coords.iter().map(|c| read(ctx, w, cta, *c)).collect();
     let miss = Cell::new(None);
-    let rd = |a: u64, n: u32| load(ctx, a, n, &miss);
+    // the texels each lane read, for the observer
+    let watch = cta.observer.is_some();
+    let (texels, mut per_lane) = (RefCell::new(Vec::new()), vec![Footprint::new(); 32]);
+    let rd = |a: u64, n: u32| {
+        if watch {
+            texels.borrow_mut().push((a, n, n));
+        }
+        load(ctx, a, n, &miss)
+    };
     let mut out = [[0u64; 32]; 4];
     for l in lanes(exec) {
         let t = tex_of(ctx, h[l], l)?;
@@ -97,7 +150,9 @@ pub(super) fn tex(
         for c in 0..4 {
             out[c][l] = v[c] as u64;
         }
+        per_lane[l] = texels.take();
     }
+    observe(cta, w, MemOp::Load, &per_lane);
     let f = w.frames.last_mut().expect("frame");
     for (d, v) in ds.iter().zip(&out) {
         write(f, *d, v, exec);
@@ -194,6 +249,7 @@ pub(super) fn suld(
     let cs: Vec<Lanes> = coords.iter().map(|c| read(ctx, w, cta, *c)).collect();
     let eb = ty.bytes();
     let mut out = vec![[0u64; 32]; ds.len()];
+    let mut per_lane = vec![Footprint::new(); 32];
     for l in lanes(exec) {
         let s = surf_of(ctx, h[l], l)?;
         if let Some(a) = surf_addr(s, &cs, geom, eb * ds.len() as u32, clamp, l)? {
@@ -202,8 +258,10 @@ pub(super) fn suld(
                 let (al, off) = ctx.mem.find(at, eb as u64).ok_or_else(|| out_of_bounds(at, eb, l))?;
                 o[l] = al.load(off, eb);
             }
+            per_lane[l].push((a, eb * ds.len() as u32, eb));
         }
     }
+    observe(cta, w, MemOp::Load, &per_lane);
     let f = w.frames.last_mut().expect("frame");
     for (d, v) in ds.iter().zip(&out) {
         write(f, *d, v, exec);
@@ -235,6 +293,7 @@ pub(super) fn sust(
     // every lane's elements first, in lane order: outside every allocation
     // the lowest such lane faults, before anything is stored
     let mut at = Vec::new();
+    let mut per_lane = vec![Footprint::new(); 32];
     for l in lanes(exec) {
         let s = surf_of(ctx, h[l], l)?;
         if let Some(a) = surf_addr(s, &cs, geom, eb * vals.len() as u32, clamp, l)? {
@@ -243,6 +302,7 @@ pub(super) fn sust(
                 ctx.mem.find(ak, eb as u64).ok_or_else(|| out_of_bounds(ak, eb, l))?;
                 at.push((l, k, ak));
             }
+            per_lane[l].push((a, eb * vals.len() as u32, eb));
         }
     }
     if let Some(op) = red {
@@ -250,12 +310,14 @@ pub(super) fn sust(
             let &(l, _, a) = at.iter().find(|&&(_, _, a)| a % eb as u64 != 0).expect("found");
             return Err(fault(FaultKind::Misaligned { space: MemSpace::Global, addr: a, size: eb }, Some(l)));
         }
+        observe(cta, w, MemOp::Reduction, &per_lane);
         let lanes = at.iter().map(|&(l, k, a)| (l as u8, a, vs[k][l], 0)).collect::<Vec<_>>();
         if !lanes.is_empty() {
             cta.pending.push(super::atomic::PendingAtomic { warp: w.id, op, ty, d: None, lanes });
         }
         return Ok(());
     }
+    observe(cta, w, MemOp::Store, &per_lane);
     // lanes storing to one element: the lowest lane's value stays (the H200's order)
     for &(l, k, ak) in at.iter().rev() {
         if let Some((al, off)) = ctx.mem.find(ak, eb as u64) {
@@ -318,5 +380,41 @@ mod tests {
             assert_eq!(f.kind, FaultKind::OutOfBounds { space: MemSpace::Global, addr, size: 4 }, "{kernel}");
             assert_eq!(f.lane, Some(0), "{kernel}");
         }
+    }
+
+    /// Lane 0 stores 7 to element (0, 0) of its surface, lane 1 to its own.
+    const STORE2: &str = ".version 7.8\n.target sm_90\n.address_size 64\n\
+        .visible .entry store2(.param .u64 h0, .param .u64 h1)\n{\n.reg .pred %p<2>;\n.reg .b64 %rd<4>;\n\
+        .reg .b32 %r<4>;\nld.param.u64 %rd1, [h0];\nld.param.u64 %rd2, [h1];\nmov.u32 %r1, %tid.x;\n\
+        setp.eq.u32 %p1, %r1, 0;\nselp.b64 %rd3, %rd1, %rd2, %p1;\nmov.b32 %r2, 0;\nmov.b32 %r3, 7;\n\
+        sust.b.2d.b32.trap [%rd3, {%r2, %r2}], {%r3};\nret;\n}\n";
+
+    /// A `sust` whose lane 1 stores outside every allocation faults on lane 1
+    /// and stores nothing, not even lane 0's element, which is in range.
+    #[test]
+    fn a_surface_store_faulting_in_a_later_lane_stores_nothing() {
+        let mut dev = Device::new();
+        let m = dev.load_ptx(STORE2, "store2.ptx").unwrap();
+        let data = dev.alloc_from(&[0x11u32; 4]);
+        let nowhere = 0xdead_0000_0000u64;
+        assert!(dev.memory().find(nowhere, 64).is_none());
+        let surf = |dev: &mut Device, data| {
+            dev.create_object_unchecked(Object::Surface(SurfaceDesc {
+                data,
+                elem_bytes: 4,
+                dims: [2, 2, 0],
+                row_pitch: 0,
+            }))
+        };
+        let (good, bad) = (surf(&mut dev, data), surf(&mut dev, DevicePtr(nowhere)));
+        let r = dev.launch(&m, "store2", LaunchConfig::linear(1, 2), &[Arg::U64(good), Arg::U64(bad)]);
+        let Err(SimError::Fault(f)) = r else { panic!("expected a fault, got {r:?}") };
+        assert_eq!(f.kind, FaultKind::OutOfBounds { space: MemSpace::Global, addr: nowhere, size: 4 });
+        assert_eq!(f.lane, Some(1));
+        assert_eq!(dev.read::<u32>(data, 4), [0x11; 4], "lane 0's element was stored");
+        // both lanes in range: both store
+        let r = dev.launch(&m, "store2", LaunchConfig::linear(1, 2), &[Arg::U64(good), Arg::U64(good)]);
+        r.unwrap();
+        assert_eq!(dev.read::<u32>(data, 4), [7, 0x11, 0x11, 0x11]);
     }
 }
