@@ -344,10 +344,17 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
     c.thread_instructions_pred_on += exec.count_ones() as u64;
     c.by_class.add(op.class);
     if ctx.per_inst {
-        let ic = &mut cta.profile.per_fn[func as usize][pc as usize];
-        ic.warp += 1;
-        ic.thread += mask.count_ones() as u64;
-        ic.pred_on += exec.count_ones() as u64;
+        // per counting block: warp and thread counts once per block entry,
+        // `pred_on` where a guard makes it differ (`InstProfile::expand_blocks`)
+        let counts = &mut cta.profile.per_fn[func as usize];
+        if op.leader {
+            let ic = &mut counts[pc as usize];
+            ic.warp += 1;
+            ic.thread += mask.count_ones() as u64;
+        }
+        if op.guarded() {
+            counts[pc as usize].pred_on += exec.count_ones() as u64;
+        }
     }
 
     match op.exec {
