@@ -161,6 +161,13 @@ impl InstCounts {
 }
 
 /// Per-instruction counts of every function of a program.
+///
+/// While a CTA runs, the executor counts per *counting block*
+/// ([`counting_leaders`](super::decode::counting_leaders)): one add of the
+/// warp and thread counts at the block's first instruction per entry, and
+/// `pred_on` only for guarded instructions. [`InstProfile::expand_blocks`]
+/// turns that into per-instruction counts (a CTA's profile is expanded when
+/// it retires, before it is merged into the launch's).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct InstProfile {
     /// `per_fn[f][pc]`.
@@ -171,6 +178,28 @@ impl InstProfile {
     /// An all-zero profile shaped like `prog`.
     pub fn new(prog: &Program) -> Self {
         InstProfile { per_fn: prog.functions.iter().map(|f| vec![InstCounts::default(); f.insts.len()]).collect() }
+    }
+
+    /// Turns counts kept per counting block (at each block's first
+    /// instruction; `pred_on` only at guarded instructions) into counts per
+    /// instruction: every instruction of a block was issued as often, with
+    /// as many lanes, as its first, and an unguarded instruction's `pred_on`
+    /// is its thread count. Non-first instructions' warp and thread counts
+    /// are assigned, not added, so expanding twice changes nothing.
+    pub fn expand_blocks(&mut self, code: &super::decode::Code) {
+        for (counts, f) in self.per_fn.iter_mut().zip(&code.funcs) {
+            let (mut warp, mut thread) = (0, 0);
+            for (c, op) in counts.iter_mut().zip(&f.ops) {
+                if op.leader {
+                    (warp, thread) = (c.warp, c.thread);
+                } else {
+                    (c.warp, c.thread) = (warp, thread);
+                }
+                if !op.guarded() {
+                    c.pred_on = c.thread;
+                }
+            }
+        }
     }
 
     /// Adds `o` into `self`.

@@ -359,6 +359,36 @@ impl Cta {
         Ok(n)
     }
 
+    /// The per-instruction counts of what this CTA has issued so far. While
+    /// it runs, warp and thread counts are kept per counting block, added
+    /// when a warp enters the block ([`InstProfile::expand_blocks`]); a warp
+    /// stopped inside a block has not issued the block's rest yet, which is
+    /// taken off here, so the counts are exact at any point between
+    /// instructions.
+    pub fn issued_profile(&self, ctx: &Ctx) -> InstProfile {
+        let mut p = self.profile.clone();
+        if !ctx.per_inst {
+            return p;
+        }
+        p.expand_blocks(ctx.code);
+        for w in self.warps.iter().filter(|w| w.state != WarpState::Done) {
+            let (Some(top), Some(fr)) = (w.stack.top(), w.frames.last()) else { continue };
+            let (ops, counts) = (&ctx.code.funcs[fr.func as usize].ops, &mut p.per_fn[fr.func as usize]);
+            let lanes = top.mask.count_ones() as u64;
+            let mut pc = top.pc as usize;
+            while pc < ops.len() && !ops[pc].leader {
+                let c = &mut counts[pc];
+                c.warp = c.warp.saturating_sub(1);
+                c.thread = c.thread.saturating_sub(lanes);
+                if !ops[pc].guarded() {
+                    c.pred_on = c.thread;
+                }
+                pc += 1;
+            }
+        }
+        p
+    }
+
     /// Applies this CTA's pending global atomics and wakes their warps.
     pub fn commit_atomics(&mut self, ctx: &Ctx) {
         exec::apply_pending(ctx, &mut self.warps, &mut self.pending);

@@ -191,6 +191,50 @@ pub struct Op {
     pub guard: PredSrc,
     /// Its class, for the class counters.
     pub class: InstClass,
+    /// First instruction of a counting block ([`counting_leaders`]): the
+    /// executor adds the block's warp and thread counts here, once per entry.
+    pub leader: bool,
+}
+
+impl Op {
+    /// True when the instruction has a guard other than the always-true
+    /// predicate (its `pred_on` count differs from its thread count).
+    #[inline(always)]
+    pub fn guarded(&self) -> bool {
+        self.guard.reg != PRED_TRUE || self.guard.neg
+    }
+}
+
+/// The instructions that start a *counting block*: a run of instructions
+/// that a warp, once it issued the first, issues in order with the same
+/// active lanes. They are the CFG's leaders (the first instruction, branch
+/// targets, the instruction after a branch, `ret`, `exit` or `trap`; every
+/// reconvergence point is a branch target's or a fall-through's block), and
+/// also the instruction after a `call`, where a callee's `exit` may have
+/// removed lanes. Nothing else changes a running path's lanes: divergence
+/// and reconvergence happen at branches and at block starts.
+pub fn counting_leaders(insts: &[Inst]) -> Vec<bool> {
+    let n = insts.len();
+    let mut leader = vec![false; n + 1];
+    if n > 0 {
+        leader[0] = true;
+    }
+    for (pc, i) in insts.iter().enumerate() {
+        match &i.kind {
+            Kind::Bra { target, .. } => {
+                if let Some(l) = leader.get_mut(*target as usize) {
+                    *l = true;
+                }
+                leader[pc + 1] = true;
+            }
+            Kind::Ret | Kind::Exit | Kind::Trap | Kind::Call { .. } | Kind::CallIndirect { .. } => {
+                leader[pc + 1] = true
+            }
+            _ => {}
+        }
+    }
+    leader.truncate(n);
+    leader
 }
 
 /// A function's decoded instructions, parallel to its IR instructions.
@@ -309,11 +353,13 @@ impl Code {
                     rename(&mut fz.c);
                 }
                 let mut consts = Consts::default();
+                let leaders = counting_leaders(&insts);
                 let ops = insts
                     .iter()
                     .zip(&f.info)
+                    .zip(&leaders)
                     .enumerate()
-                    .map(|(k, (i, info))| {
+                    .map(|(k, ((i, info), &leader))| {
                         let fz = fused.get(&(k as u32));
                         let exec = compact_form(i, fz, opts.sfu, &mut consts).unwrap_or(if fz.is_some() {
                             Exec::Fused
@@ -321,7 +367,7 @@ impl Code {
                             Exec::Ir
                         });
                         let guard = i.guard.unwrap_or(PredSrc { reg: PRED_TRUE, neg: false });
-                        Op { exec, guard, class: info.class }
+                        Op { exec, guard, class: info.class, leader }
                     })
                     .collect();
                 let consts = consts.rows;
@@ -787,6 +833,33 @@ mod tests {
         // one row per distinct immediate
         let (_, code) = decode_body("mov.u32 %r1, 5;\nadd.s32 %r2, %r1, 5;\nadd.s32 %r3, %r2, 6;\nret;");
         assert_eq!(code.funcs[0].consts.len(), 2);
+    }
+
+    /// Counting blocks start at the first instruction, at branch targets and
+    /// after branches, `exit`, `ret` and `call`; nowhere else.
+    #[test]
+    fn counting_blocks_start_where_a_paths_lanes_may_change() {
+        let src = ".version 7.8\n.target sm_90\n.address_size 64\n\
+            .func f()\n{\nret;\n}\n\
+            .entry k(.param .u64 out)\n{\n.reg .pred %p<3>;\n.reg .b32 %r<8>;\n\
+            mov.u32 %r1, %tid.x;\n\
+            setp.lt.u32 %p1, %r1, 5;\n\
+            @%p1 bra SKIP;\n\
+            add.s32 %r2, %r1, 1;\n\
+            call f;\n\
+            add.s32 %r2, %r2, 1;\n\
+            @%p1 exit;\n\
+            add.s32 %r2, %r2, 1;\n\
+            SKIP:\n\
+            add.s32 %r3, %r1, 2;\n\
+            ret;\n}\n";
+        let p = crate::ptx::load(src, "t.ptx").unwrap();
+        let code = Code::decode(&p, FloatOptions::default());
+        let k = p.functions.iter().position(|f| f.name == "k").unwrap();
+        let leaders: Vec<bool> = code.funcs[k].ops.iter().map(|o| o.leader).collect();
+        //           mov   setp   bra    add   call   add   exit   add   SKIP: add  ret
+        assert_eq!(leaders, [true, false, false, true, false, true, false, true, true, false]);
+        assert!(code.funcs[k].ops[2].guarded() && !code.funcs[k].ops[3].guarded());
     }
 
     /// A `mul` feeding an `add` (contraction on) executes as one fma lane

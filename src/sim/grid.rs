@@ -131,6 +131,9 @@ impl<'a> GridRun<'a> {
 
     fn retire(&mut self, mut c: Cta) {
         self.totals.merge(&c.counters);
+        if self.ctx.per_inst {
+            c.profile.expand_blocks(self.ctx.code);
+        }
         self.profile.merge(&c.profile);
         if let (Some(f), Some(o)) = (self.ctx.observers, c.observer.take()) {
             f.retire(o);
@@ -231,7 +234,7 @@ impl<'a> GridRun<'a> {
         let mut lines: BTreeMap<u32, (u64, u32, (usize, usize))> = BTreeMap::new();
         let mut total = 0u64;
         for c in &self.resident {
-            for (f, counts) in c.profile.per_fn.iter().enumerate() {
+            for (f, counts) in c.issued_profile(&self.ctx).per_fn.iter().enumerate() {
                 for (pc, n) in counts.iter().enumerate() {
                     if n.warp == 0 {
                         continue;

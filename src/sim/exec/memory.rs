@@ -373,7 +373,7 @@ pub(super) fn load(
         four = [[0u64; 32]; 4];
         &mut four[..ds.len()]
     };
-    load_into(ctx, w, cta, (func, pc), space, ty, &addrs, nc, exec, vals)?;
+    transfer(ctx, w, cta, (func, pc), space, ty, &addrs, false, nc, exec, vals)?;
     let fr = w.frames.last_mut().expect("frame");
     for (v, d) in vals.iter().zip(ds) {
         write(fr, *d, v, exec);
@@ -381,10 +381,12 @@ pub(super) fn load(
     Ok(())
 }
 
-/// Loads `vals.len()` elements of `ty` per active lane at `addrs` into
-/// `vals`, counts the instruction and tells the observer.
+/// Loads (`store` false: into `vals`) or stores (`store` true: from `vals`)
+/// `vals.len()` elements of `ty` per active lane at `addrs`, counts the
+/// instruction under the space its first lane resolved to and tells the
+/// observer (`nc`: a non-coherent load; stores pass false).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn load_into(
+pub(super) fn transfer(
     ctx: &Ctx,
     w: &mut Warp,
     cta: &mut CtaMut,
@@ -392,16 +394,19 @@ pub(super) fn load_into(
     space: MemSpace,
     ty: Ty,
     addrs: &Lanes,
+    store: bool,
     nc: bool,
     exec: u32,
     vals: &mut [Lanes],
 ) -> Result<(), Box<ExecFault>> {
     let mut touched = Touched::new();
-    let first = vector_access(ctx, w, cta.shared, space, ty, addrs, exec, vals, false, &mut touched)?;
+    let first = vector_access(ctx, w, cta.shared, space, ty, addrs, exec, vals, store, &mut touched)?;
+    let (counts, op) =
+        if store { (&mut cta.counters.stores, MemOp::Store) } else { (&mut cta.counters.loads, MemOp::Load) };
     if let Some(r) = first {
-        count_space(&mut cta.counters.loads, r);
+        count_space(counts, r);
     }
-    emit(cta, w, func, pc, MemOp::Load, nc, ty.bytes(), vals.len() as u32, &touched);
+    emit(cta, w, func, pc, op, nc, ty.bytes(), vals.len() as u32, &touched);
     Ok(())
 }
 
@@ -423,30 +428,7 @@ pub(super) fn store(
     for (k, v) in srcs.iter().enumerate() {
         vs[k] = read(ctx, w, cta, *v);
     }
-    store_from(ctx, w, cta, (func, pc), space, ty, &addrs, exec, &mut vs[..srcs.len()])
-}
-
-/// Stores `vals.len()` elements of `ty` per active lane at `addrs`, counts
-/// the instruction and tells the observer.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn store_from(
-    ctx: &Ctx,
-    w: &mut Warp,
-    cta: &mut CtaMut,
-    (func, pc): (u32, u32),
-    space: MemSpace,
-    ty: Ty,
-    addrs: &Lanes,
-    exec: u32,
-    vals: &mut [Lanes],
-) -> Result<(), Box<ExecFault>> {
-    let mut touched = Touched::new();
-    let first = vector_access(ctx, w, cta.shared, space, ty, addrs, exec, vals, true, &mut touched)?;
-    if let Some(r) = first {
-        count_space(&mut cta.counters.stores, r);
-    }
-    emit(cta, w, func, pc, MemOp::Store, false, ty.bytes(), vals.len() as u32, &touched);
-    Ok(())
+    transfer(ctx, w, cta, (func, pc), space, ty, &addrs, true, false, exec, &mut vs[..srcs.len()])
 }
 
 /// `cvta`: between a space's own addresses and generic ones.

@@ -344,10 +344,17 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
     c.thread_instructions_pred_on += exec.count_ones() as u64;
     c.by_class.add(op.class);
     if ctx.per_inst {
-        let ic = &mut cta.profile.per_fn[func as usize][pc as usize];
-        ic.warp += 1;
-        ic.thread += mask.count_ones() as u64;
-        ic.pred_on += exec.count_ones() as u64;
+        // per counting block: warp and thread counts once per block entry,
+        // `pred_on` where a guard makes it differ (`InstProfile::expand_blocks`)
+        let counts = &mut cta.profile.per_fn[func as usize];
+        if op.leader {
+            let ic = &mut counts[pc as usize];
+            ic.warp += 1;
+            ic.thread += mask.count_ones() as u64;
+        }
+        if op.guarded() {
+            counts[pc as usize].pred_on += exec.count_ones() as u64;
+        }
     }
 
     match op.exec {
@@ -406,7 +413,7 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
                 four = [[0u64; 32]; 4];
                 &mut four[..n as usize]
             };
-            memory::load_into(ctx, w, cta, (func, pc), space, ty, &addrs, nc, exec, vals)?;
+            memory::transfer(ctx, w, cta, (func, pc), space, ty, &addrs, false, nc, exec, vals)?;
             let fr = w.frames.last_mut().expect("frame");
             for (v, &slot) in vals.iter().zip(&ds) {
                 put(&mut fr.regs, Dest { slot, bits }, v, exec);
@@ -419,7 +426,7 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             for (v, &o) in vs.iter_mut().zip(&vals[..n as usize]) {
                 *v = *opnd(&fr.regs, consts, o);
             }
-            memory::store_from(ctx, w, cta, (func, pc), space, ty, &addrs, exec, &mut vs[..n as usize])?;
+            memory::transfer(ctx, w, cta, (func, pc), space, ty, &addrs, true, false, exec, &mut vs[..n as usize])?;
         }
         Exec::Bra { .. } | Exec::Ir => unreachable!("handled above"),
     }
