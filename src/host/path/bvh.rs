@@ -146,8 +146,10 @@ impl Box3 {
         }
     }
     fn union(mut self, o: &Box3) -> Box3 {
-        self.grow(o.lo);
-        self.grow(o.hi);
+        for k in 0..3 {
+            self.lo[k] = self.lo[k].min(o.lo[k]);
+            self.hi[k] = self.hi[k].max(o.hi[k]);
+        }
         self
     }
     fn area(&self) -> f64 {
