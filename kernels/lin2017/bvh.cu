@@ -165,7 +165,7 @@ extern "C" __global__ void bvh_refit(const BvhParams *params, float4 *nodes, con
     if (idx == 0) break;
     __threadfence();
     unsigned p = parents[idx];
-    if (atomicAdd(&arrivals[p], 1u) == 0u) break;        // @count arrivals atom.add.u32
+    if (atomicAdd(&arrivals[p], 1u) == 0u) break;   // the kernel's only atomic
     // the second arrival: both children's boxes are final; their union,
     // left then right whichever arrived second
     unsigned l = 8 * (p + 1), r = 8 * (__float_as_uint(vn[8 * p + 3]) & 0x3fffffffu);

@@ -146,8 +146,10 @@ impl Box3 {
         }
     }
     fn union(mut self, o: &Box3) -> Box3 {
-        self.grow(o.lo);
-        self.grow(o.hi);
+        for k in 0..3 {
+            self.lo[k] = self.lo[k].min(o.lo[k]);
+            self.hi[k] = self.hi[k].max(o.hi[k]);
+        }
         self
     }
     fn area(&self) -> f64 {
@@ -543,7 +545,7 @@ pub struct Traced {
 pub struct Refitted {
     /// The nodes as the kernel left them.
     pub nodes: Vec<[u32; 8]>,
-    /// Atomic arrivals (lanes that executed the tagged `atom.add`).
+    /// Atomic arrivals (the launch's atomic lane operations: the kernel's only atomic).
     pub arrivals: u64,
     /// The launch (its counters hold the atomic lane operations).
     pub launch: LaunchStats,
@@ -647,6 +649,7 @@ pub fn refit_kernel(dev: &mut Device, module: &Module, bvh: &Bvh, offsets: &[[f3
     let launch = dev.launch(module, REFIT, LaunchConfig::linear(ctas, THREADS), &args)?;
     let words = dev.read::<u32>(nb, 8 * bvh.nodes.len());
     let nodes = words.chunks_exact(8).map(|c| c.try_into().expect("8 words")).collect();
-    let c = line_counts(&module.prog, &launch);
-    Ok(Refitted { nodes, arrivals: c.get("arrivals").copied().unwrap_or(0), launch })
+    // the kernel's only atomic is the arrival (its instruction is the prelude's
+    // inlined atomicAdd, so no line of bvh.cu carries it)
+    Ok(Refitted { nodes, arrivals: launch.totals.atomic_lane_ops, launch })
 }

@@ -88,10 +88,10 @@ pub fn charts(
             photon_series[m].push((n, rel_rmse(img, &want)));
         }
         if timed {
-            for m in 0..2 {
+            for (m, series) in time_series.iter_mut().enumerate() {
                 let build = r.build_instructions[m] as f64;
                 for (frame, &inst) in r.progress[m].iter().zip(&r.estimate_instructions[m]) {
-                    time_series[m].push((build + inst as f64, rel_rmse(frame, &want)));
+                    series.push((build + inst as f64, rel_rmse(frame, &want)));
                 }
             }
         }
