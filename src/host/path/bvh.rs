@@ -140,9 +140,9 @@ struct Box3 {
 impl Box3 {
     const EMPTY: Box3 = Box3 { lo: [f64::INFINITY; 3], hi: [f64::NEG_INFINITY; 3] };
     fn grow(&mut self, p: [f64; 3]) {
-        for k in 0..3 {
-            self.lo[k] = self.lo[k].min(p[k]);
-            self.hi[k] = self.hi[k].max(p[k]);
+        for (k, v) in p.into_iter().enumerate() {
+            self.lo[k] = self.lo[k].min(v);
+            self.hi[k] = self.hi[k].max(v);
         }
     }
     fn union(mut self, o: &Box3) -> Box3 {
