@@ -64,7 +64,7 @@ fn rays(s: &Scene, side: u32) -> Vec<BvhRay> {
             let cx = ((x as f32 + 0.5) / side as f32 * 2.0 - 1.0) * th;
             let cy = (1.0 - (y as f32 + 0.5) / side as f32 * 2.0) * th;
             let d = (f + r * cx + up * cy).normalize();
-            out.push(BvhRay { origin: cam.position.into(), dir: d.into(), t_min: 1e-4, t_max: f32::INFINITY });
+            out.push(BvhRay { origin: cam.position, dir: d.into(), t_min: 1e-4, t_max: f32::INFINITY });
         }
     }
     for i in 0..side * side {
