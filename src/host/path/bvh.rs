@@ -140,15 +140,17 @@ struct Box3 {
 impl Box3 {
     const EMPTY: Box3 = Box3 { lo: [f64::INFINITY; 3], hi: [f64::NEG_INFINITY; 3] };
     fn grow(&mut self, p: [f64; 3]) {
-        for (k, v) in p.into_iter().enumerate() {
-            self.lo[k] = self.lo[k].min(v);
-            self.hi[k] = self.hi[k].max(v);
+        for ((l, h), v) in self.lo.iter_mut().zip(self.hi.iter_mut()).zip(p) {
+            *l = l.min(v);
+            *h = h.max(v);
         }
     }
     fn union(mut self, o: &Box3) -> Box3 {
-        for k in 0..3 {
-            self.lo[k] = self.lo[k].min(o.lo[k]);
-            self.hi[k] = self.hi[k].max(o.hi[k]);
+        for (l, v) in self.lo.iter_mut().zip(o.lo) {
+            *l = l.min(v);
+        }
+        for (h, v) in self.hi.iter_mut().zip(o.hi) {
+            *h = h.max(v);
         }
         self
     }
