@@ -166,6 +166,11 @@ pub struct Scene {
     pub surfaces: Vec<Surface>,
     /// Per triangle, the texture coordinates of its three vertices (empty: none).
     pub uvs: Vec<[[f32; 2]; 3]>,
+    /// Per material, the Beckmann roughness α of a mirror or glass (a scene
+    /// file's `roughness`; a material past the end, or 0, is smooth). Thesis
+    /// 003's path tracer makes a rough mirror a Cook-Torrance conductor and a
+    /// rough glass a Walter dielectric; the other renderers treat them as smooth.
+    pub roughness: Vec<f32>,
 }
 
 impl Scene {
@@ -229,7 +234,13 @@ impl Scene {
             textures: Vec::new(),
             surfaces: Vec::new(),
             uvs: kept_uvs,
+            roughness: Vec::new(),
         }
+    }
+
+    /// Material `m`'s Beckmann roughness α (0: smooth).
+    pub fn roughness(&self, m: u32) -> f32 {
+        self.roughness.get(m as usize).copied().unwrap_or(0.0)
     }
 
     /// Material `m`'s texture and specular part.

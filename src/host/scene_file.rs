@@ -141,7 +141,8 @@ impl Cx<'_> {
     }
 }
 
-fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<Material, SceneError> {
+/// A material and its Beckmann roughness (`roughness`, mirrors and glass only; 0 is smooth).
+fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32), SceneError> {
     let p = format!("material[{i}].");
     let name = match t.get("name").and_then(|v| v.as_str()) {
         Some(n) => n.to_string(),
@@ -154,12 +155,20 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<Material, SceneError> 
         "emitter" => MaterialKind::Emitter,
         other => return cx.err(&format!("{p}kind"), format!("`{other}`; expected diffuse, mirror, glass or emitter")),
     };
-    Ok(Material {
+    let roughness = cx.float(t, "roughness", &p, 0.0)?;
+    if t.contains_key("roughness") && !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) {
+        return cx.err(&format!("{p}roughness"), "only a mirror or glass has a roughness");
+    }
+    if !(0.0..=1.0).contains(&roughness) {
+        return cx.err(&format!("{p}roughness"), "expected a Beckmann alpha between 0 and 1");
+    }
+    let m = Material {
         name,
         kind,
         color: cx.vec3(t, "color", &p, Some([0.8; 3]))?,
         emission: cx.vec3(t, "emission", &p, Some([0.0; 3]))?,
-    })
+    };
+    Ok((m, roughness))
 }
 
 /// Loads a scene description.
@@ -184,8 +193,11 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         .map(String::from)
         .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     let mut materials: Vec<Material> = Vec::new();
+    let mut roughness: Vec<f32> = Vec::new();
     for (i, m) in cx.tables(&t, "material")?.into_iter().enumerate() {
-        materials.push(material(&cx, m, i)?);
+        let (m, r) = material(&cx, m, i)?;
+        materials.push(m);
+        roughness.push(r);
     }
     let by_name = |ms: &[Material], n: &str| ms.iter().position(|m| m.name == n).map(|i| i as u32);
     let scale = cx.float(&t, "scale", "", 1.0)?;
@@ -247,6 +259,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let mut scene = Scene::assemble_with_uvs(&name, path, tris, std::mem::take(&mut extra.uvs), materials);
     scene.textures = extra.textures;
     scene.surfaces = extra.surfaces;
+    scene.roughness = roughness;
     scene.variant = t.get("variant").and_then(|v| v.as_str()).unwrap_or("").to_string();
     if let Some(th) = cx.table(&t, "thesis")? {
         let triangles = match th.get("triangles").and_then(|v| v.as_integer()) {
