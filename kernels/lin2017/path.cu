@@ -17,14 +17,20 @@
 // Triangles: the affine test of §6.4 (three float4 rows of the inverse of
 // [A-C, B-C, N] with the translation in w; N = (A-C) x (B-C), errata 4).
 //
-// Shading (§4.4-4.5): Lambertian diffuse with cosine sampling, perfect
-// mirror, and a glass whose Fresnel switch (Schlick, (1 - c)^5 by repeated
-// multiplication) picks reflection or refraction; emitters are one-sided
-// (front = the winding's normal) and black. Integrators: pt (BSDF sampling
-// only), nee (a light sample and shadow ray at diffuse hits, emission after
-// a diffuse bounce not counted, 003:L249), mis (both, balance or power
-// heuristic, §4.6). Russian roulette on the per-bounce mask (003:L267-271):
-// continue with q = max RGB of the bounce's f cos / p, then divide by q.
+// Shading (§4.4-4.5, §5.1): Lambertian diffuse with cosine sampling, perfect
+// mirror, a glass whose Fresnel switch (Schlick, (1 - c)^5 by repeated
+// multiplication) picks reflection or refraction, a rough mirror
+// (Cook-Torrance: Beckmann D, Walter et al.'s approximation of Smith's G,
+// Schlick's F with R0 the colour; microfacet normals sampled from D cos) and
+// rough glass (Walter et al. 2007: the same D and G, Schlick's F as the
+// switch between the reflected and the refracted microfacet direction);
+// emitters are one-sided (front = the winding's normal) and black.
+// Integrators: pt (BSDF sampling only), nee (a light sample and shadow ray at
+// diffuse and rough-mirror hits, emission after such a bounce not counted,
+// 003:L249), mis (both, balance or power heuristic, §4.6). Rough glass is
+// sampled only (emission after it counts in full). Russian roulette on the
+// per-bounce mask (003:L267-271): continue with q = max RGB of the bounce's
+// f cos / p, then divide by q.
 //
 // Random numbers are counter based: dimension d of path i in frame f is a
 // hash of (i, f, seed, d), so the native path tracer (src/host/path/) draws
@@ -44,6 +50,9 @@
 #define KIND_MIRROR 1
 #define KIND_GLASS 2
 #define KIND_EMITTER 3
+#define KIND_CONDUCTOR 4     // rough mirror: Cook-Torrance, Beckmann
+#define KIND_ROUGH_GLASS 5   // rough glass: Walter et al. 2007, Beckmann
+#define PI_F 3.14159265358979324f
 #if defined(__NVCC__)
 #define FLOORF floorf
 #else
@@ -87,7 +96,7 @@ struct Scene {
   const unsigned *refs;    // the concatenated leaf triangle lists
   const float4 *tris;      // 3 float4 per triangle: the affine rows (§6.4)
   const float4 *tri_data;  // per triangle: unit geometric normal, material index (int bits)
-  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior]
+  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior], [alpha 0 0 0]
   const float4 *lights;    // per emitting triangle: [v0, cdf], [e1, triangle (int bits)], [e2, 0]
   const float4 *boxes;     // per node (kd-backtrack): [box lo, parent (int bits)], [box hi, 0]
 };
@@ -127,6 +136,62 @@ static __device__ __forceinline__ void azimuth(float y, float *c, float *s) {
   else if (q == 1) { *c = -sr; *s = cr; }
   else if (q == 2) { *c = -cr; *s = -sr; }
   else { *c = sr; *s = -cr; }
+}
+
+// ln x for a normal positive x: x = 2^e m with m in [sqrt(1/2), sqrt(2)),
+// ln m = 2 atanh(s), s = (m - 1) / (m + 1), |s| < 0.172, by its series to
+// s^11 (no lg2 instruction; the native mirror computes the same operations).
+static __device__ __forceinline__ float ln(float x) {
+  int bits = __float_as_int(x);
+  int e = ((bits >> 23) & 255) - 127;
+  float m = __int_as_float((bits & 0x7fffff) | 0x3f800000);
+  if (m > 1.41421356237309505f) {   // sqrt 2
+    m = m * 0.5f;
+    e = e + 1;
+  }
+  float sv = (m - 1.0f) / (m + 1.0f);
+  float s2 = sv * sv;
+  float poly = 1.0f + s2 * (1.0f / 3.0f + s2 * (0.2f + s2 * (1.0f / 7.0f + s2 * (1.0f / 9.0f + s2 * (1.0f / 11.0f)))));
+  return (float)e * 0.693147180559945309f + 2.0f * sv * poly;
+}
+
+// e^x for x <= 0 (0 below -87): x = n ln 2 + r (Cody-Waite, two parts of
+// ln 2), |r| <= ln 2 / 2, e^r by its Taylor series to r^7 (no ex2 instruction).
+static __device__ __forceinline__ float exp_neg(float x) {
+  if (x < -87.0f) return 0.0f;
+  float n = FLOORF(x * 1.44269504088896341f + 0.5f);
+  float r = x - n * 0.693145751953125f - n * 1.42860682030941723e-6f;
+  float poly = 1.0f + r * (1.0f + r * 0.5f * (1.0f + r / 3.0f * (1.0f + r * 0.25f * (1.0f + r * 0.2f * (1.0f + r / 6.0f * (1.0f + r / 7.0f))))));
+  return poly * __int_as_float(((int)n + 127) << 23);
+}
+
+// Beckmann's distribution (§5.1, 003:L344) of a microfacet normal whose cosine
+// with the macro normal is cm, for a2 = alpha^2: e^(-tan^2 / a2) / (pi a2 cos^4).
+static __device__ __forceinline__ float beckmann(float a2, float cm) {
+  if (!(cm > 0.0f)) return 0.0f;
+  float c2 = cm * cm;
+  float tan2 = (1.0f - c2) / c2;
+  return exp_neg(-tan2 / a2) / (PI_F * a2 * (c2 * c2));
+}
+
+// Smith's masking of direction v (cosine cv with the macro normal, cvm with the
+// microfacet normal) by Walter et al. 2007's rational approximation for
+// Beckmann ("a numerical approximation to Smith shadowing function", 003:L357);
+// 0 when v sees the microfacet's back.
+static __device__ __forceinline__ float smith_g1(float alpha, float cv, float cvm) {
+  if (!(cvm * cv > 0.0f)) return 0.0f;
+  float acv = fabsf(cv);
+  float a = acv / (alpha * sqrtf(fmaxf(1.0f - acv * acv, 0.0f)));
+  if (a >= 1.6f) return 1.0f;
+  return (3.535f * a + 2.181f * (a * a)) / (1.0f + 2.276f * a + 2.577f * (a * a));
+}
+
+// Schlick's Fresnel term with reflectance r0 at normal incidence, c the cosine
+// (§4.5, 003:L255-259; (1 - c)^5 by repeated multiplication).
+static __device__ __forceinline__ float schlick(float r0, float c) {
+  float x = 1.0f - c;
+  float x2 = x * x;
+  return r0 + (1.0f - r0) * (x2 * x2 * x);
 }
 
 // smallpt's tent warp of a uniform y in [0, 1) to [-1, 1).
@@ -379,12 +444,12 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
   if (tri < 0) return false;
   float4 td = s.tri_data[tri];
   V3 n = v3(td.x, td.y, td.z);
-  float4 m0 = s.mats[2 * __float_as_int(td.w)];
+  float4 m0 = s.mats[3 * __float_as_int(td.w)];
   int kind = __float_as_int(m0.w);
   float cos_d = dot3(d, n);
   if (kind == KIND_EMITTER) {
     if (cos_d < 0.0f) {   // the front face emits
-      float4 m1 = s.mats[2 * __float_as_int(td.w) + 1];
+      float4 m1 = s.mats[3 * __float_as_int(td.w) + 1];
       float w = 1.0f;
       if (!P.count_emission) {
         if (integrator == INTEGRATOR_NEE) {
@@ -401,8 +466,10 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
   V3 hitp = add3(o, scale3(d, t));
   V3 ns = cos_d < 0.0f ? n : v3(-n.x, -n.y, -n.z);   // faces the ray
   V3 color = v3(m0.x, m0.y, m0.z);
+  float cos_o = -dot3(d, ns);   // the viewer's side, > 0
   unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
-  if (kind == KIND_DIFFUSE && integrator != INTEGRATOR_PT && bounce < p->max_bounces) {
+  bool sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
+  if (sampled_light && integrator != INTEGRATOR_PT && bounce < p->max_bounces) {
     // next event estimation: a light triangle by area, a point on it uniformly
     float yl = rng(key, dim);
     int l = 0;
@@ -421,19 +488,34 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
     float cos_s = dot3(ns, wl);
     float cos_l = -dot3(v3(ld.x, ld.y, ld.z), wl);
     if (cos_s > 0.0f && cos_l > 0.0f) {
+      // the BSDF times the cosine, as a colour fc times a scalar fs, and its sampling pdf
+      V3 fc = color;
+      float fs = cos_s * INV_PI, bsdf_pdf = cos_s * INV_PI;
+      if (kind == KIND_CONDUCTOR) {
+        float alpha = s.mats[3 * __float_as_int(td.w) + 2].x;
+        float a2 = alpha * alpha;
+        V3 h = normalize3(sub3(wl, d));
+        float ch = dot3(h, ns), coh = -dot3(d, h);
+        float dm = beckmann(a2, ch);
+        float g = smith_g1(alpha, cos_o, coh) * smith_g1(alpha, cos_s, dot3(wl, h));
+        fc = v3(schlick(color.x, coh), schlick(color.y, coh), schlick(color.z, coh));
+        fs = dm * g / (4.0f * cos_o);
+        bsdf_pdf = dm * ch / (4.0f * coh);
+      }
       float ts;
-      if (trace(s, hitp, wl, p->eps, dist - p->eps, true, &ts) < 0) {
-        float4 le = s.mats[2 * __float_as_int(ld.w) + 1];
+      if (fs > 0.0f && trace(s, hitp, wl, p->eps, dist - p->eps, true, &ts) < 0) {
+        float4 le = s.mats[3 * __float_as_int(ld.w) + 1];
         float light_pdf = dist2 / (cos_l * p->light_area);
         float w = 1.0f;
-        if (integrator != INTEGRATOR_NEE) w = mis_weight(integrator, light_pdf, cos_s * INV_PI);
-        float g = cos_s * INV_PI / light_pdf * w;
-        P.L = add3(P.L, scale3(mul3(mul3(P.beta, color), v3(le.x, le.y, le.z)), g));
+        if (integrator != INTEGRATOR_NEE) w = mis_weight(integrator, light_pdf, bsdf_pdf);
+        float g = fs / light_pdf * w;
+        P.L = add3(P.L, scale3(mul3(mul3(P.beta, fc), v3(le.x, le.y, le.z)), g));
       }
     }
   }
   if (bounce == p->max_bounces) return false;
-  // the next direction
+  // the next direction, and the bounce's mask f cos / p
+  V3 wgt = color;
   if (kind == KIND_DIFFUSE) {
     float y1 = rng(key, dim + 3);
     float r = sqrtf(y1), c, sn;
@@ -444,12 +526,58 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
     d = add3(add3(scale3(b1, r * c), scale3(b2, r * sn)), scale3(ns, lz));
     P.bsdf_pdf = lz * INV_PI;
     P.count_emission = false;
+  } else if (kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS) {
+    // a microfacet normal from Beckmann's D cos: tan^2 = -a2 ln(1 - y), uniform azimuth (§5.1)
+    float alpha = s.mats[3 * __float_as_int(td.w) + 2].x;
+    float a2 = alpha * alpha;
+    float tan2 = a2 * -ln(1.0f - rng(key, dim + 3));
+    float cm = 1.0f / sqrtf(1.0f + tan2);
+    float sm = sqrtf(tan2) * cm;
+    float c, sn;
+    azimuth(rng(key, dim + 4), &c, &sn);
+    V3 b1, b2;
+    basis(ns, &b1, &b2);
+    V3 mh = add3(add3(scale3(b1, sm * c), scale3(b2, sm * sn)), scale3(ns, cm));
+    float co = -dot3(d, mh);
+    if (!(co > 0.0f)) return false;
+    V3 next = add3(d, scale3(mh, 2.0f * co));   // reflected about the microfacet
+    float scale = 1.0f;
+    bool refracted = false;
+    if (kind == KIND_CONDUCTOR) {
+      wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
+      P.bsdf_pdf = beckmann(a2, cm) * cm / (4.0f * co);
+      P.count_emission = false;
+    } else {
+      // the Fresnel switch on the microfacet (Walter et al. 2007): reflect with
+      // probability F, else refract through it; radiance scales by eta^2
+      float ior = s.mats[3 * __float_as_int(td.w) + 1].w;
+      bool into = cos_d < 0.0f;
+      float eta = into ? 1.0f / ior : ior;
+      float k = 1.0f - eta * eta * (1.0f - co * co);
+      if (k > 0.0f) {   // else total internal reflection
+        float cos_t = sqrtf(k);
+        float r0 = (1.0f - ior) / (1.0f + ior);
+        float fr = schlick(r0 * r0, into ? co : cos_t);
+        if (!(rng(key, dim + 6) < fr)) {
+          next = add3(scale3(d, eta), scale3(mh, eta * co - cos_t));
+          scale = eta * eta;
+          refracted = true;
+        }
+      }
+      P.count_emission = true;
+    }
+    float ci = dot3(next, ns);
+    if (refracted ? !(ci < 0.0f) : !(ci > 0.0f)) return false;   // on the wrong side
+    float g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, dot3(next, mh));
+    float f = g * co / (cos_o * cm) * scale;
+    wgt = scale3(wgt, f);
+    d = next;
   } else {
     float cos_i = -dot3(d, ns);   // > 0: ns faces the ray
     V3 next = add3(d, scale3(ns, 2.0f * cos_i));
     if (kind == KIND_GLASS) {
       // the Fresnel switch (Schlick): reflect with probability R, else refract
-      float ior = s.mats[2 * __float_as_int(td.w) + 1].w;
+      float ior = s.mats[3 * __float_as_int(td.w) + 1].w;
       bool into = cos_d < 0.0f;
       float eta = into ? 1.0f / ior : ior;
       float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
@@ -467,13 +595,13 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
     d = next;
     P.count_emission = true;
   }
-  // Russian roulette on the bounce's mask f cos / p = color
-  float q = fmaxf(fmaxf(color.x, color.y), color.z);
+  // Russian roulette on the bounce's mask f cos / p
+  float q = fmaxf(fmaxf(wgt.x, wgt.y), wgt.z);
   if (q < 1.0f) {
     if (!(rng(key, dim + 5) < q)) return false;
-    P.beta = v3(P.beta.x * (color.x / q), P.beta.y * (color.y / q), P.beta.z * (color.z / q));
+    P.beta = v3(P.beta.x * (wgt.x / q), P.beta.y * (wgt.y / q), P.beta.z * (wgt.z / q));
   } else {
-    P.beta = mul3(P.beta, color);
+    P.beta = mul3(P.beta, wgt);
   }
   P.o = hitp;
   P.d = d;

@@ -9,6 +9,21 @@ sides; Mitsuba's `diffuse` on the front only), emitters one-sided (the
 winding's normal, as warplight) with a black BSDF, the pinhole camera with
 the same vertical field of view, and the longest path (max_depth = bounces + 1).
 
+Mirrors: a smooth mirror (warplight: the colour times the mirror direction)
+is Mitsuba's `conductor` with `material = "none"` (Fresnel 1) and
+`specular_reflectance` the colour. A rough mirror (`roughness` = Beckmann
+alpha; warplight: Cook-Torrance with Beckmann's D, Walter et al.'s
+approximation of Smith's G, Schlick's F with R0 the colour) is
+`roughconductor` with `distribution = "beckmann"`, the same `alpha`,
+`material = "none"` and `specular_reflectance` the colour: Mitsuba's
+Beckmann D and its G1 (the same rational approximation) are the same
+functions; its F is the colour at every angle, Schlick's only when R0 = 1,
+so a rough mirror whose colour is not white is refused (not comparable).
+Both are made two-sided (warplight's mirrors reflect on both sides).
+Mitsuba samples visible normals, warplight D cos: the same BSDF, other
+pdfs, equal in expectation. Glass (warplight: Schlick's Fresnel; Mitsuba's
+dielectrics: the exact Fresnel equations) is refused: not comparable.
+
 The pixel filter: warplight jitters a tent-distributed sample (radius one
 subpixel) in each of the 2 x 2 subpixels of a pixel (smallpt's filter).
 Mitsuba renders the same at twice the resolution with a tent filter of
@@ -24,6 +39,9 @@ Usage (the committed fixtures were made by):
   python3 tools/mitsuba/reference.py scenes/cornell-lambert.toml \
       --size 32 --batches 16 --spp 1024 --bounces 16 \
       --out tests/fixtures/mitsuba/cornell-lambert-32
+  python3 tools/mitsuba/reference.py scenes/cornell-rough.toml \
+      --size 32 --batches 16 --spp 512 --bounces 16 \
+      --out tests/fixtures/mitsuba/cornell-rough-32
 writes OUT.exr (mean), OUT-var.exr (variance of the mean) and OUT.json.
 """
 
@@ -90,12 +108,14 @@ def load_scene(toml_path):
     mtl = parse_mtl(mtllib) if mtllib else {}
     own = {m["name"]: m for m in sc.get("material", [])}
     over = {o["group"]: o["material"] for o in sc.get("override", [])}
-    shapes = {}   # material name -> (kind, colour, emission, triangles)
+    shapes = {}   # material name -> (kind, colour, emission, triangles, roughness)
     for g, m, tris in groups:
         name = over.get(g) or (over.get(m) if m else None) or m or "default"
+        rough = 0.0
         if name in own:
             d = own[name]
-            kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.75] * 3), d.get("emission", [0.0] * 3)
+            kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.8] * 3), d.get("emission", [0.0] * 3)
+            rough = float(d.get("roughness", 0.0))
         else:
             d = mtl.get(name, {})
             kd, ks, ke = d.get("Kd", [0.75] * 3), d.get("Ks", [0.0] * 3), d.get("Ke", [0.0] * 3)
@@ -105,11 +125,13 @@ def load_scene(toml_path):
                 kind, color, em = "mirror", ks, ke
             else:
                 kind, color, em = "diffuse", kd, ke
-        if kind not in ("diffuse", "emitter"):
-            sys.exit(f"{toml_path}: material {name} is {kind}; this tool exports Lambertian scenes only")
+        if kind not in ("diffuse", "emitter", "mirror"):
+            sys.exit(f"{toml_path}: material {name} is {kind}: its Fresnel term (Schlick's) is not Mitsuba's; not exported")
+        if kind == "mirror" and rough > 0 and any(c != 1.0 for c in color):
+            sys.exit(f"{toml_path}: rough mirror {name} has colour {color}: Schlick's F equals Mitsuba's only for R0 = 1")
         # zero-area triangles are dropped, as warplight's loader does
         keep = [t for t in tris if np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0]))) > 0]
-        shapes.setdefault(name, (kind, color, em, []))[3].extend(keep)
+        shapes.setdefault(name, (kind, color, em, [], rough))[3].extend(keep)
     return sc, shapes
 
 
@@ -152,7 +174,7 @@ def main():
         },
     }
     triangles, light_area = 0, 0.0
-    for k, (name, (kind, color, em, tris)) in enumerate(sorted(shapes.items())):
+    for k, (name, (kind, color, em, tris, rough)) in enumerate(sorted(shapes.items())):
         if not tris:
             continue
         f = os.path.join(tmp, f"{k}.obj")
@@ -169,6 +191,26 @@ def main():
             shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": em}}
             for t in tris:
                 light_area += 0.5 * np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0])))
+        elif kind == "mirror" and rough > 0:
+            shape["bsdf"] = {
+                "type": "twosided",
+                "bsdf": {
+                    "type": "roughconductor",
+                    "distribution": "beckmann",
+                    "alpha": rough,
+                    "material": "none",
+                    "specular_reflectance": {"type": "rgb", "value": color},
+                },
+            }
+        elif kind == "mirror":
+            shape["bsdf"] = {
+                "type": "twosided",
+                "bsdf": {
+                    "type": "conductor",
+                    "material": "none",
+                    "specular_reflectance": {"type": "rgb", "value": color},
+                },
+            }
         else:
             shape["bsdf"] = {
                 "type": "twosided",

@@ -38,13 +38,31 @@ pub enum LayoutError {
     NoLight(String),
 }
 
-/// Material kinds as the kernel numbers them.
-pub fn kind_code(k: MaterialKind) -> u32 {
+/// The kernel's material kind: Lambertian diffuse.
+pub const KIND_DIFFUSE: u32 = 0;
+/// A perfect (smooth) mirror.
+pub const KIND_MIRROR: u32 = 1;
+/// Smooth glass (Schlick's Fresnel switch between reflection and refraction).
+pub const KIND_GLASS: u32 = 2;
+/// An emitter.
+pub const KIND_EMITTER: u32 = 3;
+/// A rough mirror: Cook-Torrance with Beckmann's D, the Smith G of Walter
+/// et al.'s approximation, Schlick's F with R0 the colour (§5.1, §4.5).
+pub const KIND_CONDUCTOR: u32 = 4;
+/// Rough glass: Walter et al. 2007's microfacet refraction, Beckmann's D,
+/// Schlick's F as the Fresnel switch (§5.1, 003:L357).
+pub const KIND_ROUGH_GLASS: u32 = 5;
+
+/// Material kinds as the kernel numbers them; a mirror or glass with a
+/// positive Beckmann `roughness` is rough.
+pub fn kind_code(k: MaterialKind, roughness: f32) -> u32 {
     match k {
-        MaterialKind::Diffuse => 0,
-        MaterialKind::Mirror => 1,
-        MaterialKind::Glass { .. } => 2,
-        MaterialKind::Emitter => 3,
+        MaterialKind::Diffuse => KIND_DIFFUSE,
+        MaterialKind::Mirror if roughness > 0.0 => KIND_CONDUCTOR,
+        MaterialKind::Mirror => KIND_MIRROR,
+        MaterialKind::Glass { .. } if roughness > 0.0 => KIND_ROUGH_GLASS,
+        MaterialKind::Glass { .. } => KIND_GLASS,
+        MaterialKind::Emitter => KIND_EMITTER,
     }
 }
 
@@ -63,8 +81,9 @@ pub struct PathScene {
     pub tris: Vec<[f32; 12]>,
     /// Per triangle: unit geometric normal, material index (u32 bits).
     pub tri_data: Vec<[f32; 4]>,
-    /// Per material: colour, kind (u32 bits); emission, index of refraction.
-    pub mats: Vec<[f32; 8]>,
+    /// Per material: colour, kind (u32 bits); emission, index of refraction;
+    /// Beckmann α (0 for smooth kinds), 0, 0, 0.
+    pub mats: Vec<[f32; 12]>,
     /// Per emitting triangle: v0, cumulative area fraction; e1, triangle (u32 bits); e2, 0.
     pub lights: Vec<[f32; 12]>,
     /// Total emitting area.
@@ -148,11 +167,15 @@ impl PathScene {
         let mats = scene
             .materials
             .iter()
-            .map(|m| {
+            .enumerate()
+            .map(|(i, m)| {
                 let ior = if let MaterialKind::Glass { ior } = m.kind { ior } else { 1.0 };
                 let [r, g, b] = m.color;
                 let [er, eg, eb] = m.emission;
-                [r, g, b, f32::from_bits(kind_code(m.kind)), er, eg, eb, ior]
+                let alpha = scene.roughness(i as u32);
+                let kind = kind_code(m.kind, alpha);
+                let alpha = if matches!(kind, KIND_CONDUCTOR | KIND_ROUGH_GLASS) { alpha } else { 0.0 };
+                [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, 0.0, 0.0, 0.0]
             })
             .collect();
         let emitting: Vec<(usize, f64)> = scene

@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use super::counts::Counts;
-use super::layout::{LEAF_AXIS, PathScene};
+use super::layout::{KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, LEAF_AXIS, PathScene};
 use super::rng::{azimuth, path_key, rng, tent};
 use super::{FrameParams, Integrator, Traversal};
 
@@ -19,9 +19,6 @@ pub const DIMS_CAMERA: u32 = 2;
 /// Random dimensions per bounce.
 pub const DIMS_PER_BOUNCE: u32 = 8;
 const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
-const KIND_DIFFUSE: u32 = 0;
-const KIND_GLASS: u32 = 2;
-const KIND_EMITTER: u32 = 3;
 /// Stack entries of the traversal (the builder's depth limit).
 pub const STACK_ENTRIES: usize = 32;
 
@@ -334,8 +331,10 @@ impl Tracer<'_> {
             let hitp = o.add(d.scale(t));
             let ns = if cos_d < 0.0 { n } else { v3(-n.x, -n.y, -n.z) };
             let color = xyz(mat, 0);
+            let cos_o = -d.dot(ns);
             let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
-            if kind == KIND_DIFFUSE && integrator != Integrator::Pt && bounce < p.max_bounces {
+            let sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
+            if sampled_light && integrator != Integrator::Pt && bounce < p.max_bounces {
                 let yl = rng(key, dim);
                 let mut li = 0usize;
                 while li + 1 < s.lights.len() && !(yl < s.lights[li][3]) {
@@ -353,20 +352,37 @@ impl Tracer<'_> {
                 let ld = s.tri_data[lg[7].to_bits() as usize];
                 let cos_s = ns.dot(wl);
                 let cos_l = -v3(ld[0], ld[1], ld[2]).dot(wl);
-                if cos_s > 0.0 && cos_l > 0.0 && self.trace(hitp, wl, cam.eps, dist - cam.eps, true, counts).is_none() {
-                    let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
-                    let light_pdf = dist2 / (cos_l * s.light_area);
-                    let mut wgt = 1.0;
-                    if integrator != Integrator::Nee {
-                        wgt = self.mis_weight(light_pdf, cos_s * INV_PI);
+                if cos_s > 0.0 && cos_l > 0.0 {
+                    // the BSDF times the cosine, as a colour fc times a scalar fs, and its sampling pdf
+                    let (mut fc, mut fs, mut bsdf_pdf_l) = (color, cos_s * INV_PI, cos_s * INV_PI);
+                    if kind == KIND_CONDUCTOR {
+                        let alpha = mat[8];
+                        let a2 = alpha * alpha;
+                        let h = wl.sub(d).normalize();
+                        let (ch, coh) = (h.dot(ns), -d.dot(h));
+                        let dm = beckmann(a2, ch);
+                        let g = smith_g1(alpha, cos_o, coh) * smith_g1(alpha, cos_s, wl.dot(h));
+                        fc = v3(schlick(color.x, coh), schlick(color.y, coh), schlick(color.z, coh));
+                        fs = dm * g / (4.0 * cos_o);
+                        bsdf_pdf_l = dm * ch / (4.0 * coh);
                     }
-                    let g = cos_s * INV_PI / light_pdf * wgt;
-                    l = l.add(beta.mul(color).mul(le).scale(g));
+                    if fs > 0.0 && self.trace(hitp, wl, cam.eps, dist - cam.eps, true, counts).is_none() {
+                        let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
+                        let light_pdf = dist2 / (cos_l * s.light_area);
+                        let mut wgt = 1.0;
+                        if integrator != Integrator::Nee {
+                            wgt = self.mis_weight(light_pdf, bsdf_pdf_l);
+                        }
+                        let g = fs / light_pdf * wgt;
+                        l = l.add(beta.mul(fc).mul(le).scale(g));
+                    }
                 }
             }
             if bounce == p.max_bounces {
                 break;
             }
+            // the next direction, and the bounce's mask f cos / p
+            let mut wgt = color;
             if kind == KIND_DIFFUSE {
                 let y1 = rng(key, dim + 3);
                 let r = y1.sqrt();
@@ -376,6 +392,51 @@ impl Tracer<'_> {
                 d = b1.scale(r * cs).add(b2.scale(r * sn)).add(ns.scale(lz));
                 bsdf_pdf = lz * INV_PI;
                 count_emission = false;
+            } else if kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS {
+                let alpha = mat[8];
+                let a2 = alpha * alpha;
+                let tan2 = a2 * -ln(1.0 - rng(key, dim + 3));
+                let cm = 1.0 / (1.0 + tan2).sqrt();
+                let sm = tan2.sqrt() * cm;
+                let (cs, sn) = azimuth(rng(key, dim + 4));
+                let (b1, b2) = basis(ns);
+                let mh = b1.scale(sm * cs).add(b2.scale(sm * sn)).add(ns.scale(cm));
+                let co = -d.dot(mh);
+                if !(co > 0.0) {
+                    break;
+                }
+                let mut next = d.add(mh.scale(2.0 * co));
+                let mut scale = 1.0f32;
+                let mut refracted = false;
+                if kind == KIND_CONDUCTOR {
+                    wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
+                    bsdf_pdf = beckmann(a2, cm) * cm / (4.0 * co);
+                    count_emission = false;
+                } else {
+                    let ior = mat[7];
+                    let into = cos_d < 0.0;
+                    let eta = if into { 1.0 / ior } else { ior };
+                    let k = 1.0 - eta * eta * (1.0 - co * co);
+                    if k > 0.0 {
+                        let cos_t = k.sqrt();
+                        let r0 = (1.0 - ior) / (1.0 + ior);
+                        let fr = schlick(r0 * r0, if into { co } else { cos_t });
+                        if !(rng(key, dim + 6) < fr) {
+                            next = d.scale(eta).add(mh.scale(eta * co - cos_t));
+                            scale = eta * eta;
+                            refracted = true;
+                        }
+                    }
+                    count_emission = true;
+                }
+                let ci = next.dot(ns);
+                if if refracted { !(ci < 0.0) } else { !(ci > 0.0) } {
+                    break;
+                }
+                let g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, next.dot(mh));
+                let f = g * co / (cos_o * cm) * scale;
+                wgt = wgt.scale(f);
+                d = next;
             } else {
                 let cos_i = -d.dot(ns);
                 let mut next = d.add(ns.scale(2.0 * cos_i));
@@ -400,14 +461,14 @@ impl Tracer<'_> {
                 d = next;
                 count_emission = true;
             }
-            let q = fmax(fmax(color.x, color.y), color.z);
+            let q = fmax(fmax(wgt.x, wgt.y), wgt.z);
             if q < 1.0 {
                 if !(rng(key, dim + 5) < q) {
                     break;
                 }
-                beta = v3(beta.x * (color.x / q), beta.y * (color.y / q), beta.z * (color.z / q));
+                beta = v3(beta.x * (wgt.x / q), beta.y * (wgt.y / q), beta.z * (wgt.z / q));
             } else {
-                beta = beta.mul(color);
+                beta = beta.mul(wgt);
             }
             o = hitp;
             bounce += 1;
@@ -457,10 +518,133 @@ fn box_exit(b: &[f32; 8], o: V3, inv: V3) -> f32 {
     fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z))
 }
 
+/// ln x for a normal positive `x`: the kernel's `ln` (x = 2^e m, m in
+/// [√½, √2), 2 atanh((m − 1)/(m + 1)) by its series to s^11).
+pub fn ln(x: f32) -> f32 {
+    let bits = x.to_bits() as i32;
+    let mut e = ((bits >> 23) & 255) - 127;
+    let mut m = f32::from_bits(((bits & 0x7f_ffff) | 0x3f80_0000) as u32);
+    if m > std::f32::consts::SQRT_2 {
+        m *= 0.5;
+        e += 1;
+    }
+    let sv = (m - 1.0) / (m + 1.0);
+    let s2 = sv * sv;
+    let poly = 1.0 + s2 * (1.0 / 3.0 + s2 * (0.2 + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0 + s2 * (1.0 / 11.0)))));
+    e as f32 * std::f32::consts::LN_2 + 2.0 * sv * poly
+}
+
+/// e^x for x ≤ 0 (0 below −87): the kernel's `exp_neg` (Cody-Waite
+/// reduction by two parts of ln 2, Taylor series to r^7).
+pub fn exp_neg(x: f32) -> f32 {
+    if x < -87.0 {
+        return 0.0;
+    }
+    let n = (x * std::f32::consts::LOG2_E + 0.5).floor();
+    let r = x - n * 0.693_145_751_953_125 - n * 1.428_606_820_309_417_2e-6;
+    let poly = 1.0
+        + r * (1.0
+            + r * 0.5 * (1.0 + r / 3.0 * (1.0 + r * 0.25 * (1.0 + r * 0.2 * (1.0 + r / 6.0 * (1.0 + r / 7.0))))));
+    poly * f32::from_bits(((n as i32 + 127) << 23) as u32)
+}
+
+/// Beckmann's distribution for α² = `a2` at a microfacet normal of cosine
+/// `cm` with the macro normal: the kernel's `beckmann`.
+pub fn beckmann(a2: f32, cm: f32) -> f32 {
+    if !(cm > 0.0) {
+        return 0.0;
+    }
+    let c2 = cm * cm;
+    let tan2 = (1.0 - c2) / c2;
+    exp_neg(-tan2 / a2) / (std::f32::consts::PI * a2 * (c2 * c2))
+}
+
+/// Smith's masking by Walter et al. 2007's rational approximation for
+/// Beckmann: the kernel's `smith_g1` (`cv`, `cvm` the direction's cosines
+/// with the macro and the microfacet normal).
+pub fn smith_g1(alpha: f32, cv: f32, cvm: f32) -> f32 {
+    if !(cvm * cv > 0.0) {
+        return 0.0;
+    }
+    let acv = cv.abs();
+    let a = acv / (alpha * fmax(1.0 - acv * acv, 0.0).sqrt());
+    if a >= 1.6 {
+        return 1.0;
+    }
+    (3.535 * a + 2.181 * (a * a)) / (1.0 + 2.276 * a + 2.577 * (a * a))
+}
+
+/// Schlick's Fresnel term: the kernel's `schlick`.
+pub fn schlick(r0: f32, c: f32) -> f32 {
+    let x = 1.0 - c;
+    let x2 = x * x;
+    r0 + (1.0 - r0) * (x2 * x2 * x)
+}
+
 /// Duff et al.'s orthonormal basis around the unit `n`.
 fn basis(n: V3) -> (V3, V3) {
     let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
     (v3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), v3(b, sign + n.y * n.y * a, -n.y))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The kernel's ln and e^x (no SFU instruction) are within a few float
+    /// ulps of f64's over the ranges the shading uses.
+    #[test]
+    fn ln_and_exp_neg_agree_with_f64() {
+        for k in 1..=(1 << 12) {
+            let x = k as f32 / 4096.0; // (0, 1]: 1 - y of the Beckmann sample
+            let want = (x as f64).ln();
+            assert!((ln(x) as f64 - want).abs() <= 2e-7 * want.abs().max(1.0), "ln {x}: {} vs {want}", ln(x));
+        }
+        assert_eq!(ln(1.0), 0.0);
+        assert!((ln(2.0f32.powi(-24)) as f64 + 24.0 * std::f64::consts::LN_2).abs() < 1e-5);
+        for k in 0..=4000 {
+            let x = -(k as f32) * 0.0215; // [0, -86]
+            let want = (x as f64).exp();
+            assert!((exp_neg(x) as f64 - want).abs() <= 4e-7 * want, "exp {x}: {} vs {want}", exp_neg(x));
+        }
+        assert_eq!(exp_neg(0.0), 1.0);
+        assert_eq!(exp_neg(-100.0), 0.0);
+    }
+
+    /// Beckmann's D is normalised: ∫ D(m) cos θ_m dω_m = 1 (midpoint rule in θ).
+    #[test]
+    fn beckmann_projects_to_one() {
+        for alpha in [0.05f32, 0.2, 0.5, 1.0] {
+            let a2 = alpha * alpha;
+            let n = 20_000;
+            let h = std::f64::consts::FRAC_PI_2 / n as f64;
+            let integral: f64 = (0..n)
+                .map(|i| {
+                    let th = (i as f64 + 0.5) * h;
+                    beckmann(a2, th.cos() as f32) as f64 * th.cos() * th.sin() * 2.0 * std::f64::consts::PI * h
+                })
+                .sum();
+            assert!((integral - 1.0).abs() < 2e-3, "alpha {alpha}: {integral}");
+        }
+    }
+
+    /// Smith's G1 by Walter et al.'s approximation: 1 at normal incidence,
+    /// 0 seen from a microfacet's back, falling toward grazing, and the
+    /// printed rational function at a = 1 (3.535 + 2.181) / (1 + 2.276 + 2.577).
+    #[test]
+    fn smith_g1_follows_walter() {
+        assert_eq!(smith_g1(0.3, 1.0, 1.0), 1.0);
+        assert_eq!(smith_g1(0.3, 0.5, -0.1), 0.0);
+        let (g_mid, g_low) = (smith_g1(0.5, 0.3, 0.3), smith_g1(0.5, 0.1, 0.1));
+        assert!(g_low < g_mid && g_mid < 1.0, "{g_low} {g_mid}");
+        // a = cos / (alpha sin) = 1 at cos = alpha / sqrt(1 + alpha^2)
+        let alpha = 0.5f32;
+        let c = alpha / (1.0 + alpha * alpha).sqrt();
+        let want = (3.535 + 2.181) / (1.0 + 2.276 + 2.577);
+        assert!((smith_g1(alpha, c, c) - want).abs() < 1e-5);
+        assert_eq!(schlick(1.0, 0.2), 1.0, "R0 = 1 reflects everything (the Mitsuba comparison's case)");
+        assert!((schlick(0.04, 0.0) - 1.0).abs() < 1e-6 && schlick(0.04, 1.0) == 0.04);
+    }
 }
