@@ -27,7 +27,7 @@ fn rays(s: &Scene, side: u32) -> Vec<TraceRay> {
     let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
     let mut cam: Camera = s.camera;
     cam.resolution = [side, side];
-    scene_bvh::frame_rays(&Caster::new(s, &tree), &cam).rays
+    scene_bvh::frame_rays(&Caster::new(s, &tree), &cam, scene_bvh::Rays::WithReflections).rays
 }
 
 /// The closest hit over all triangles (Alg. 3.3 as the kernels run it), or
@@ -136,7 +136,7 @@ fn part_a_baseline_stacks_t_a_for_primary_rays_only_and_its_bytes_follow() {
     let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
     let mut cam: Camera = s.camera;
     cam.resolution = [16, 16];
-    let fr = scene_bvh::primary_shadow_rays(&Caster::new(&s, &tree), &cam);
+    let fr = scene_bvh::frame_rays(&Caster::new(&s, &tree), &cam, scene_bvh::Rays::PrimaryShadow);
     // one primary ray a pixel, at most one shadow ray (one point light), no reflection rays
     assert_eq!(fr.stats.primary, 256);
     assert_eq!(fr.stats.reflection, 0);

@@ -298,39 +298,27 @@ fn shadow_rays(caster: &Caster, ray: &Ray, h: &Hit, out: &mut Vec<TraceRay>, st:
     }
 }
 
-/// Table 6.5 (a)'s rays of `cam` (L2829: "one primary ray and, if a surface
-/// is hit, one shadow ray per pixel"): each primary ray and, where it hits a
-/// diffuse surface facing the light, the shadow ray toward the hit, as the
-/// caster shades it.
-pub fn primary_shadow_rays(caster: &Caster, cam: &Camera) -> FrameRays {
-    let [w, h] = cam.resolution;
-    let mut out = FrameRays::default();
-    let st = &mut out.stats;
-    let eps = caster.eps();
-    for y in 0..h {
-        for x in 0..w {
-            let ray = cam.ray(x, y);
-            st.primary += 1;
-            out.rays.push(TraceRay {
-                origin: ray.origin.to_array(),
-                dir: ray.dir.to_array(),
-                t_min: eps,
-                t_max: f32::INFINITY,
-                any: false,
-            });
-            if let Some(hit) = caster.intersect(&ray, eps, f32::INFINITY, false, st) {
-                shadow_rays(caster, &ray, &hit, &mut out.rays, st);
-            }
-        }
-    }
-    out
+/// Which rays a frame casts per pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rays {
+    /// Table 6.5 (a) (L2829: "one primary ray and, if a surface is hit, one
+    /// shadow ray per pixel"): the primary ray and, where it hits a diffuse
+    /// surface facing the light, the shadow ray toward the hit.
+    PrimaryShadow,
+    /// Table 6.5 (b), up to four rays per pixel (§A.1, L2845 "primary,
+    /// reflection and shadow rays"): as [`Rays::PrimaryShadow`], plus a mirror
+    /// reflection ray where the surface seen reflects and the shadow ray
+    /// toward its diffuse hit.
+    WithReflections,
 }
 
-/// Up to four rays per pixel of `cam` (§A.1, L2845 "primary, reflection and
-/// shadow rays"): the primary ray, a mirror reflection ray where the surface
-/// seen reflects, and a shadow ray from the light toward each diffuse hit;
-/// the hits that spawn rays come from the kd-tree caster.
-pub fn frame_rays(caster: &Caster, cam: &Camera) -> FrameRays {
+fn trace_ray(r: &Ray, eps: f32) -> TraceRay {
+    TraceRay { origin: r.origin.to_array(), dir: r.dir.to_array(), t_min: eps, t_max: f32::INFINITY, any: false }
+}
+
+/// The rays `which` of every pixel of `cam`, row by row; the hits that spawn
+/// shadow and reflection rays come from the kd-tree caster, as it shades them.
+pub fn frame_rays(caster: &Caster, cam: &Camera, which: Rays) -> FrameRays {
     let [w, h] = cam.resolution;
     let mut out = FrameRays::default();
     let st = &mut out.stats;
@@ -339,29 +327,19 @@ pub fn frame_rays(caster: &Caster, cam: &Camera) -> FrameRays {
         for x in 0..w {
             let ray = cam.ray(x, y);
             st.primary += 1;
-            let prim = TraceRay {
-                origin: ray.origin.to_array(),
-                dir: ray.dir.to_array(),
-                t_min: eps,
-                t_max: f32::INFINITY,
-                any: false,
-            };
-            out.rays.push(prim);
+            out.rays.push(trace_ray(&ray, eps));
             let Some(hit) = caster.intersect(&ray, eps, f32::INFINITY, false, st) else { continue };
             shadow_rays(caster, &ray, &hit, &mut out.rays, st);
+            if which == Rays::PrimaryShadow {
+                continue;
+            }
             let refl = caster.scene.reflectance(caster.scene.triangles[hit.tri as usize].material);
             if refl.iter().any(|&c| c > 0.0) {
                 let n = caster.normal(hit.tri, ray.dir);
                 let p = ray.origin + ray.dir * hit.t;
                 let r = Ray { origin: p, dir: (ray.dir - 2.0 * ray.dir.dot(n) * n).normalize() };
                 st.reflection += 1;
-                out.rays.push(TraceRay {
-                    origin: r.origin.to_array(),
-                    dir: r.dir.to_array(),
-                    t_min: eps,
-                    t_max: f32::INFINITY,
-                    any: false,
-                });
+                out.rays.push(trace_ray(&r, eps));
                 if let Some(h2) = caster.intersect(&r, eps, f32::INFINITY, false, st) {
                     shadow_rays(caster, &r, &h2, &mut out.rays, st);
                 }

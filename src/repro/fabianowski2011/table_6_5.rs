@@ -25,7 +25,7 @@
 //! 4·(t_a words) and C as in (b).
 
 use super::pm_layout::{self, Layout, change};
-use super::scene_bvh::{self, SceneBvh, Traversal};
+use super::scene_bvh::{self, Rays, SceneBvh, Traversal};
 use super::scenes_of;
 use super::spills;
 use crate::host::kdtree::Heuristic;
@@ -220,20 +220,20 @@ const PART_A: Part = Part { group: SCENE_BVH_A, variants: [("B", Traversal::Comp
 /// (primary, reflection and shadow), the traversal's counts, the traffic,
 /// the warp instructions and the spill traffic under the register cap.
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
-    measure_part(ws, tick, PART_B, scene_bvh::frame_rays)
+    measure_part(ws, tick, PART_B, Rays::WithReflections)
 }
 
 /// Measurement group [`SCENE_BVH_A`]: as [`measure`] for part (a): primary
 /// rays and a shadow ray where one hits, the baseline stacking t_a.
 pub fn measure_a(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
-    measure_part(ws, tick, PART_A, scene_bvh::primary_shadow_rays)
+    measure_part(ws, tick, PART_A, Rays::PrimaryShadow)
 }
 
 fn measure_part(
     ws: &mut Workspace,
     tick: &mut dyn FnMut(Tick),
     part: Part,
-    rays: fn(&Caster, &crate::host::camera::Camera) -> scene_bvh::FrameRays,
+    rays: Rays,
 ) -> Result<Vec<Sample>, MeasureError> {
     ws.build(Heuristic::Siroh);
     let tree = ws.tree(Heuristic::Siroh);
@@ -244,7 +244,7 @@ fn measure_part(
     let mut out = Vec::new();
     for f in ws.frames.clone() {
         let cam = super::flight::camera(ws.scene, f, ws.resolution);
-        let fr = rays(&caster, &cam);
+        let fr = scene_bvh::frame_rays(&caster, &cam, rays);
         for (name, traversal) in part.variants {
             tick(Tick { frame: Some(f), variant: name });
             let t = scene_bvh::trace_kernel_with(&mut dev, &module, &bvh, traversal, &fr.rays)
