@@ -32,6 +32,7 @@ pub struct RenderArgs {
     /// Renderer: `native` (the Rust reference ray caster), or a kernel variant run
     /// on the emulator: stack, stackless, push-down, short-stack, push-down+short-stack,
     /// node-cache-1, stack-cache-1, node-cache-1+stack-cache-1, node-cache-2+stack-cache-2.
+    /// `--method purcell --variant error`: seed 004's error charts instead of images (see --method).
     #[arg(long, default_value = "native")]
     pub variant: String,
     /// Device profile of the emulated kernels (every method's): their memory
@@ -62,6 +63,11 @@ pub struct RenderArgs {
     /// path tracer), `photon-map` (thesis 000 ch. 5; `--estimator`) or `purcell`
     /// (seed 004's GPU photon map on both grid maps: OUT-bitonic.png, OUT-stencil.png;
     /// `--json` the convergence chart); the last three take `--variant native` or `emulated`.
+    /// `--method purcell --variant error -o OUT.png`: the error of both maps' images against a
+    /// converged native reference (64x the stated photons, 8x k) over photons stored
+    /// (OUT-photons.svg) and pass by pass at the stated photons over counted instructions
+    /// (OUT-time.svg) and over passes (OUT-passes.svg, full vs visual convergence), each with
+    /// its JSON, and OUT-summary.json (the reference's own error, when each display settles).
     #[arg(long, default_value = "raycast")]
     pub method: String,
     /// Path tracer: pt, nee, mis (balance heuristic) or mis-power.

@@ -28,7 +28,9 @@ Examples:
   warplight tables 4.5 --protocol thesis --frames 0..25 --out a.json   one shard ...
   warplight tables 4.5 --protocol thesis --frames 25..50 --out b.json  ... and the other
   warplight tables merge a.json b.json             prints what the unsplit run prints
-  warplight chart table fabianowski:4.5 --from a.json -o t45.svg")]
+  warplight chart table fabianowski:4.5 --from a.json -o t45.svg
+  warplight render --method purcell --variant error --scene glass-ball --resolution 32x24 -o gb.png
+                                                   seed 004's error charts (not a table: see render --help)")]
 pub struct TablesArgs {
     /// Tables: `thesis:id` (`fabianowski:4.5`), a bare id while unambiguous (`4.5`),
     /// `thesis:all` or `all`. `merge FILE...` merges result files instead.

@@ -1,7 +1,7 @@
 //! Image error against a converged reference (issue 14, item 8): the
 //! emulated renders of a scene at a ladder of photon counts on both maps,
-//! each against a reference render with many more photons (the bitonic map,
-//! which loses no photon), and the progressive display of the stated count
+//! each against a native reference with many more photons and a larger k
+//! ([`super::reference`]), and the progressive display of the stated count
 //! against the same reference pass by pass.
 //!
 //! - *Error against photons*: the relative RMS error of each map's final
@@ -11,13 +11,21 @@
 //!   counted for building the map and the estimate up to that pass (a
 //!   counted proxy of GPU time: the paper's kernels are compute-bound,
 //!   004:L188; not seconds).
+//! - *Error against passes*: the same running images over the pass number,
+//!   the paper's full against visual convergence (004:L182).
 //!
-//! The reference is the same estimator (the same k and r_max) with more
-//! photons, so it carries the kNN estimate's own bias at that count; the
-//! charts show how far each render is from it, not from the exact radiance.
+//! Every image has the same direct light (the same shadow rays), the
+//! reference's bit for bit: the error is the photon map's estimate's. The
+//! reference's own error is measured by a second reference with other
+//! photons ([`ErrorCharts::reference_noise`]) and by one with a quarter of
+//! its photons and half its k ([`ErrorCharts::reference_step`]).
+
+use serde::Serialize;
 
 use super::image::{self, Rendered};
 use super::native::MapData;
+use super::photons::Geometry;
+use super::reference::{self, REFERENCE_SEED, SECOND_SEED};
 use super::scenes::Fixture;
 use crate::chart::{Scatter, Series};
 use crate::host::image::FrameBuffer;
@@ -51,36 +59,100 @@ pub fn with_photons(f: &Fixture, factor: f64) -> Fixture {
     Fixture { stated_photons: ((f.stated_photons as f64 * factor).round() as u32).max(1), ..*f }
 }
 
-/// The two charts of one scene.
+/// The reference's settings, as multiples of the fixture's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ReferenceSpec {
+    /// Stored photons, times the stated count.
+    pub photons: f64,
+    /// Photons sought, times the stated k.
+    pub k: f64,
+}
+
+/// The pass from which a progressive display stays within 1 % (relative) of
+/// its final error against the reference.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Settling {
+    /// The map: 0 bitonic, 1 stencil.
+    pub map: usize,
+    /// Passes of the estimate.
+    pub passes: usize,
+    /// The final image's relative RMS error against the reference.
+    pub final_error: f64,
+    /// First pass (from 1) from which every later error is within 1 % of the final one.
+    pub within_1_percent: usize,
+    /// Its error at pass `passes / 4` (a quarter of the way).
+    pub error_at_quarter: f64,
+}
+
+/// The charts of one scene and the numbers beside them.
 #[derive(Debug, Clone)]
 pub struct ErrorCharts {
     /// Error of the final images against photons stored, per map.
     pub photons: Scatter,
     /// Error of the running image against counted instructions, per map, at `f`'s photons.
     pub time: Scatter,
-    /// Photons the reference stored.
-    pub reference_stored: usize,
+    /// Error of the running image against passes, per map, at `f`'s photons.
+    pub passes: Scatter,
+    /// The reference's settings.
+    pub spec: ReferenceSpec,
+    /// Photons the reference emitted and stored, and its k.
+    pub reference: (usize, usize, u32),
+    /// Relative RMS error between the reference and a second one with other photons.
+    pub reference_noise: f64,
+    /// Relative RMS error of a reference with a quarter of the photons and half the k against the reference.
+    pub reference_step: f64,
+    /// The norm of the reference's estimate (the reference less the direct
+    /// light) over the reference image's: the largest error an image with
+    /// the right direct light and no estimate at all could have.
+    pub indirect_share: f64,
+    /// The progressive display's settling on each map.
+    pub settling: [Settling; 2],
 }
 
-/// Renders `scene` `width` pixels wide at `factors` × `f`'s stated photons
-/// (1.0 among them: the time chart's run) and the reference at
-/// `reference_factor` × them, and measures both charts. `progress` hears
-/// each render as it starts (its factor).
+fn settling(map: usize, errors: &[f64]) -> Settling {
+    let last = errors.last().copied().unwrap_or(f64::NAN);
+    let within = errors.iter().rposition(|e| (e - last).abs() > 0.01 * last).map_or(1, |i| i + 2);
+    Settling {
+        map,
+        passes: errors.len(),
+        final_error: last,
+        within_1_percent: within.min(errors.len()),
+        error_at_quarter: errors.get((errors.len() / 4).max(1) - 1).copied().unwrap_or(f64::NAN),
+    }
+}
+
+/// Renders `scene` `width` pixels wide on the emulator at `factors` × `f`'s
+/// stated photons (1.0 among them: the time chart's run) and natively the
+/// reference `spec`, and measures the charts. `progress` hears each step as
+/// it starts.
 pub fn charts(
     scene: &Scene,
     f: &Fixture,
     width: u32,
     factors: &[f64],
-    reference_factor: f64,
-    progress: &mut dyn FnMut(f64),
+    spec: ReferenceSpec,
+    progress: &mut dyn FnMut(&str),
 ) -> Result<ErrorCharts, MeasureError> {
-    progress(reference_factor);
-    let reference = image::render(scene, &with_photons(f, reference_factor), width)?;
-    let want = image::images(&reference)[0].clone();
+    let geo = Geometry::of(scene);
+    let k_ref = ((f.k as f64 * spec.k).round() as u32).max(1);
+    let stated_ref = with_photons(f, spec.photons).stated_photons;
+    progress("reference: calibration");
+    let emitted = reference::emitted(&geo, f, stated_ref);
+    progress(&format!("reference: {emitted} photons emitted, k = {k_ref}"));
+    let refr = reference::render(scene, f, width, emitted, k_ref, REFERENCE_SEED);
+    let want = refr.image.clone();
+    progress("second reference (other photons)");
+    let second = reference::render(scene, f, width, emitted, k_ref, SECOND_SEED);
+    let reference_noise = rel_rmse(&second.image, &want);
+    progress("coarser reference (a quarter of the photons, half the k)");
+    let coarse = reference::render(scene, f, width, emitted.div_ceil(4), (k_ref / 2).max(1), SECOND_SEED);
+    let reference_step = rel_rmse(&coarse.image, &want);
     let mut photon_series = [Vec::new(), Vec::new()];
     let mut time_series = [Vec::new(), Vec::new()];
+    let mut pass_series = [Vec::new(), Vec::new()];
+    let mut indirect_share = f64::NAN;
     for &factor in factors {
-        progress(factor);
+        progress(&format!("emulated render at {factor} x the stated photons"));
         let timed = factor == 1.0;
         let r = image::render_with(scene, &with_photons(f, factor), width, timed)?;
         let n = stored(&r) as f64;
@@ -88,40 +160,60 @@ pub fn charts(
             photon_series[m].push((n, rel_rmse(img, &want)));
         }
         if timed {
-            for (m, series) in time_series.iter_mut().enumerate() {
+            let [w, h] = r.camera.resolution;
+            let direct =
+                FrameBuffer { width: w, height: h, pixels: r.direct.iter().map(|d| [d[0], d[1], d[2]]).collect() };
+            indirect_share = rel_rmse(&direct, &want);
+            for m in 0..2 {
                 let build = r.build_instructions[m] as f64;
-                for (frame, &inst) in r.progress[m].iter().zip(&r.estimate_instructions[m]) {
-                    series.push((build + inst as f64, rel_rmse(frame, &want)));
+                for (i, (frame, &inst)) in r.progress[m].iter().zip(&r.estimate_instructions[m]).enumerate() {
+                    let e = rel_rmse(frame, &want);
+                    time_series[m].push((build + inst as f64, e));
+                    pass_series[m].push(((i + 1) as f64, e));
                 }
             }
         }
     }
+    let settle = [0, 1].map(|m| settling(m, &pass_series[m].iter().map(|p| p.1).collect::<Vec<_>>()));
     let series = |s: [Vec<(f64, f64)>; 2]| {
         let [a, b] = s;
         vec![Series { name: "bitonic map".into(), points: a }, Series { name: "stencil map".into(), points: b }]
     };
-    let reference_stored = stored(&reference);
-    let what = format!("against the bitonic map with {reference_stored} photons");
+    let what = format!("against a native reference ({} photons, k = {k_ref})", refr.stored);
+    let scatter = |title: String, x_label: &str, log_x: bool, s| Scatter {
+        title,
+        x_label: x_label.into(),
+        y_label: "relative RMS error".into(),
+        log_x,
+        log_y: true,
+        connect: true,
+        series: series(s),
+    };
     Ok(ErrorCharts {
-        photons: Scatter {
-            title: format!("{}: error of the final image {what}", scene.name),
-            x_label: "photons stored".into(),
-            y_label: "relative RMS error".into(),
-            log_x: true,
-            log_y: true,
-            connect: true,
-            series: series(photon_series),
-        },
-        time: Scatter {
-            title: format!("{}: progressive display at {} stored photons, error {what}", scene.name, f.stated_photons),
-            x_label: "thread instructions, map build + estimate so far (counted, not seconds)".into(),
-            y_label: "relative RMS error".into(),
-            log_x: true,
-            log_y: true,
-            connect: true,
-            series: series(time_series),
-        },
-        reference_stored,
+        photons: scatter(
+            format!("{}: error of the final image {what}", scene.name),
+            "photons stored",
+            true,
+            photon_series,
+        ),
+        time: scatter(
+            format!("{}: progressive display at {} photons, error {what}", scene.name, f.stated_photons),
+            "thread instructions, map build + estimate so far (counted, not seconds)",
+            true,
+            time_series,
+        ),
+        passes: scatter(
+            format!("{}: full vs visual convergence (004:L182), error {what}", scene.name),
+            "radiance-estimate passes",
+            false,
+            pass_series,
+        ),
+        spec,
+        reference: (refr.emitted, refr.stored, k_ref),
+        reference_noise,
+        reference_step,
+        indirect_share,
+        settling: settle,
     })
 }
 

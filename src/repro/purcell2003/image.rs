@@ -319,14 +319,17 @@ pub fn run_cli(
 
 /// Photon counts of the error chart, as multiples of the stated count.
 pub const ERROR_FACTORS: [f64; 4] = [0.125, 0.25, 0.5, 1.0];
-/// The error charts' reference, as a multiple of the stated count.
-pub const ERROR_REFERENCE: f64 = 4.0;
+/// The error charts' reference: 64 times the stated photons and 8 times the
+/// stated k, natively ([`super::reference`]; `docs/fixtures.md`).
+pub const ERROR_REFERENCE: super::error::ReferenceSpec = super::error::ReferenceSpec { photons: 64.0, k: 8.0 };
 
-/// `warplight render --method purcell --variant error -o out.svg`: the error
-/// of both maps against a reference with [`ERROR_REFERENCE`] times the stated
-/// photons, at [`ERROR_FACTORS`] times them (`out-photons.svg`) and pass by
-/// pass at the stated count (`out-time.svg`), each chart's data beside it as
-/// JSON ([`super::error`]).
+/// `warplight render --method purcell --variant error -o out.png`: the error
+/// of both maps against a native reference ([`ERROR_REFERENCE`]), at
+/// [`ERROR_FACTORS`] times the stated photons (`out-photons.svg`), and pass
+/// by pass at the stated count over counted instructions (`out-time.svg`)
+/// and over passes (`out-passes.svg`), each chart's data beside it as JSON,
+/// and the reference's own error and the displays' settling in
+/// `out-summary.json` ([`super::error`]).
 pub fn run_error_charts(
     a: &crate::cli::render::RenderArgs,
     scene: &Scene,
@@ -335,18 +338,40 @@ pub fn run_error_charts(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let t = std::time::Instant::now();
     let c = super::error::charts(scene, f, width, &ERROR_FACTORS, ERROR_REFERENCE, &mut |x| {
-        eprintln!("{}: {x} x the stated photons ({:.0} s)", scene.name, t.elapsed().as_secs_f64());
+        eprintln!("{}: {x} ({:.0} s)", scene.name, t.elapsed().as_secs_f64());
     })
     .map_err(|e| e.to_string())?;
     let stem = a.output.with_extension("");
-    for (name, chart) in [("photons", c.photons), ("time", c.time)] {
+    for (name, chart) in [("photons", &c.photons), ("time", &c.time), ("passes", &c.passes)] {
         let json = std::path::PathBuf::from(format!("{}-{name}.json", stem.display()));
-        crate::cli::write_atomically(&json, serde_json::to_string_pretty(&chart)?.as_bytes())?;
+        crate::cli::write_atomically(&json, serde_json::to_string_pretty(chart)?.as_bytes())?;
         let svg = std::path::PathBuf::from(format!("{}-{name}.svg", stem.display()));
-        let chart = crate::chart::Chart::Scatter(chart);
+        let chart = crate::chart::Chart::Scatter(chart.clone());
         crate::cli::write_atomically(&svg, chart.svg(chart.default_size())?.as_bytes())?;
         println!("{}: {} and {}", chart.title(), svg.display(), json.display());
     }
-    println!("reference: {} photons stored; {:.1} s", c.reference_stored, t.elapsed().as_secs_f64());
+    let (emitted, stored, k) = c.reference;
+    let summary = serde_json::json!({
+        "scene": scene.name,
+        "resolution": pipeline::camera(scene, f, width).resolution,
+        "reference": { "spec": c.spec, "emitted": emitted, "stored": stored, "k": k,
+            "noise_against_second_reference": c.reference_noise,
+            "error_of_quarter_photons_half_k": c.reference_step,
+            "estimate_share_of_norm": c.indirect_share },
+        "final_error": {
+            "bitonic": c.photons.series[0].points, "stencil": c.photons.series[1].points },
+        "settling": c.settling,
+        "seconds": t.elapsed().as_secs_f64(),
+    });
+    let file = std::path::PathBuf::from(format!("{}-summary.json", stem.display()));
+    crate::cli::write_atomically(&file, serde_json::to_string_pretty(&summary)?.as_bytes())?;
+    println!(
+        "reference: {emitted} emitted, {stored} stored, k = {k}; against a second reference {:.4}, \
+         a quarter of the photons and half the k {:.4}; summary {}; {:.1} s",
+        c.reference_noise,
+        c.reference_step,
+        file.display(),
+        t.elapsed().as_secs_f64()
+    );
     Ok(())
 }

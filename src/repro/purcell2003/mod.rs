@@ -10,6 +10,7 @@
 //! - [`native`]: the per-pixel passes in Rust, bit for bit as the kernels;
 //! - [`image`]: Fig. 7's images (direct light + either map's estimate), emulated and native;
 //! - [`error`]: image error against a converged reference, over photons and over counted time;
+//! - [`reference`]: that reference, natively (photons traced in Rust, many more of them, a larger k);
 //! - [`dataflow`]: Table 2's instruction classes (TEX, Addr, Pack) read off the PTX;
 //! - [`pipeline`], [`table_1`], [`table_2`]: the measurement groups and tables.
 
@@ -24,6 +25,7 @@ pub mod native;
 pub mod passes;
 pub mod photons;
 pub mod pipeline;
+pub mod reference;
 pub mod scenes;
 pub mod stencil;
 pub mod table_1;
