@@ -394,3 +394,33 @@ fn vkde_and_knn_images_agree_at_matched_settings() {
     assert!(r > 0.8, "pixel correlation {r}");
     assert!(v.indirect.pixels.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
 }
+
+/// Table 5.1's counts are the emulator's (`photons.cu`, `vkde.cu`), and the
+/// native references count the same: interactions, discarded, clamped and
+/// the kernels' axes of one pass, and query points, contributions, nodes and
+/// retrievals of a frame.
+#[test]
+fn table_5_1_counts_on_the_emulator_equal_the_native_ones() {
+    use warplight::repro::fabianowski2011::table_5_1::{photon_stats, query_stats};
+    let c = cornell();
+    let o = Options {
+        photons: PHOTONS,
+        spread: SPREAD,
+        h_max: 1.0,
+        estimator: Estimator::Vkde,
+        shape: Shape::Uniform,
+        emulated: true,
+    };
+    let (native_maps, native) = photon_stats(&c.scene, &c.tree, &o, None).unwrap();
+    let mut dev = Device::new();
+    let (maps, emulated) = photon_stats(&c.scene, &c.tree, &o, Some(&mut dev)).unwrap();
+    assert_eq!(emulated, native);
+    assert_eq!(maps.launches.len(), 2, "photons.cu and vkde.cu's construction ran");
+    assert!(native.interactions > 400 && native.kernels + native.discarded == native.interactions, "{native:?}");
+    let caster = Caster::new(&c.scene, &c.tree);
+    let cam = camera(&c, 12);
+    let want = query_stats(&native_maps, &caster, &cam, &o, None).unwrap();
+    let got = query_stats(&maps, &caster, &cam, &o, Some(&mut dev)).unwrap();
+    assert_eq!(got, want);
+    assert!(want.queries > 50 && want.contributions > 100, "{want:?}");
+}

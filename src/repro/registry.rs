@@ -225,7 +225,8 @@ pub fn entries_of(theses: &[&'static Thesis]) -> Vec<Entry> {
 /// Fabianowski's cache tables (4.8–4.10) read texture-cache hits, and so do
 /// his frame-rate tables (4.1, 4.6: the GTX 280 timing model charges a
 /// texture miss more latency than a hit); his other emulated tables read
-/// instructions and transactions, not hits; Lin's
+/// instructions and transactions, not hits, and Table 5.1 only what its
+/// kernels write; Lin's
 /// Fig. 3 reads instructions; tables that run no kernel need nothing. Any
 /// other emulated table gets the full model.
 pub fn lowest_fidelity(e: &Entry) -> crate::sim::Fidelity {
@@ -233,6 +234,8 @@ pub fn lowest_fidelity(e: &Entry) -> crate::sim::Fidelity {
     match (e.thesis.short, e.table.id) {
         _ if e.table.render.is_none() => Fidelity::Functional,
         ("fabianowski", "4.2" | "4.3" | "4.4" | "4.5" | "4.7") => Fidelity::Memory,
+        // Table 5.1 reads what its kernels write (interactions, kernels, contributions), no counter
+        ("fabianowski", "5.1") => Fidelity::Functional,
         ("lin", "fig3") => Fidelity::Instructions,
         _ => Fidelity::Caches,
     }

@@ -1,25 +1,35 @@
 //! Thesis 000 Table 5.1: photon tracing and density estimation statistics
-//! (seed 000, L2452–2464), measured by the native photon tracer, kernel
-//! construction and VKDE (bit for bit the emulated kernels', `tests/photons.rs`,
-//! `tests/vkde.rs`) on our scenes with the table's own parameters: photons
-//! emitted and spread s per scene, f = 1/20, h_max = 1 (L2466–2470).
+//! (seed 000, L2452–2464), counted on the emulator: photons traced with
+//! photon differentials and kernels built by `photons.cu` and `vkde.cu`, and
+//! VKDE by `vkde.cu`'s estimation kernel, on our scenes with the table's own
+//! parameters: photons emitted and spread s per scene, f = 1/20, h_max = 1
+//! (L2466–2470). The native references give the same counts bit for bit
+//! (`tests/photons.rs`, `tests/vkde.rs`, and [`photon_stats`] and
+//! [`query_stats`] in `tests/vkde.rs`).
 //!
 //! Interactions, Discarded and Clamped are counted over one photon tracing
 //! pass (the light is static in chapter 5); k_VK is the mean number of
 //! kernels contributing per query point over the camera flight (queries at
 //! the primary and reflection hits, uniform kernel). Emissions and s are the
 //! table's parameters, not measurements; k_kNN was chosen by eye (L2472) and
-//! is not reproducible.
+//! is not reproducible. The query points come from the native caster
+//! (chapter 4's tests show it hits bit for bit as the emulated ray tracer
+//! does) and the BVH photon map over the kernels is built on the host
+//! (chapter 5 does not say what gathers the kernels; `docs/photon-mapping.md`).
 
-use super::photon_image::{self, Estimator, Options};
+use super::photon_image::{self, Estimator, Options, PhotonImageError, PhotonMaps};
+use super::photons::PhotonError;
 use super::scenes_of;
-use super::vkde::{self, Constructed, Shape};
+use super::vkde::{self, Shape};
+use crate::host::camera::Camera;
+use crate::host::kdtree::KdTree;
 use crate::host::raycast::Caster;
 use crate::host::scene::Scene;
 use crate::repro::compare::{Printed as P, Tolerance, mean_sd};
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Check, Column, Published, PublishedRow, Table, Unit};
+use crate::sim::Device;
 
 /// Group: one photon tracing pass per scene with the table's parameters.
 pub const PHOTON_STATS: &str = "fabianowski/photon-stats";
@@ -86,7 +96,80 @@ fn options(scene: &Scene) -> Result<Options, MeasureError> {
         h_max: vkde::H_MAX,
         estimator: Estimator::Vkde,
         shape: Shape::Uniform,
-        emulated: false,
+        emulated: true,
+    })
+}
+
+/// Table 5.1's counts of one photon tracing pass.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PhotonStats {
+    /// Stored 2nd and 3rd diffuse interactions, before the discard rule.
+    pub interactions: usize,
+    /// Interactions discarded by eq. 5.33 (f = 1/20).
+    pub discarded: usize,
+    /// Kernels with an axis clamped to h_max.
+    pub clamped: usize,
+    /// Kernels kept.
+    pub kernels: usize,
+    /// Σ ‖M‖ over the kernels (Fig. 5.2's major axes).
+    pub major_sum: f64,
+    /// Σ ‖m'‖ over the kernels (Fig. 5.2's minor axes).
+    pub minor_sum: f64,
+}
+
+/// Traces `o.photons` photons from `scene`'s light and builds their kernels,
+/// on `dev` when given (`photons.cu`, `vkde.cu`), else by the native
+/// references: the maps and Table 5.1's counts of them.
+pub fn photon_stats(
+    scene: &Scene,
+    tree: &KdTree,
+    o: &Options,
+    dev: Option<&mut Device>,
+) -> Result<(PhotonMaps, PhotonStats), PhotonError> {
+    let maps = photon_image::photon_maps(scene, tree, o, dev)?;
+    let c = &maps.constructed;
+    let len = super::photons::len;
+    let stats = PhotonStats {
+        interactions: c.interactions,
+        discarded: c.discarded,
+        clamped: c.clamped,
+        kernels: c.kernels.len(),
+        major_sum: c.kernels.iter().map(|k| len(k.major) as f64).sum(),
+        minor_sum: c.kernels.iter().map(|k| len(k.m_prime) as f64).sum(),
+    };
+    Ok((maps, stats))
+}
+
+/// Table 5.1's counts of the density estimates of one frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct QueryStats {
+    /// Query points (pixels seeing a diffuse surface directly or in a mirror).
+    pub queries: u64,
+    /// Contributions summed over the query points.
+    pub contributions: u64,
+    /// Nodes tested, summed.
+    pub nodes: u64,
+    /// Interactions retrieved from leaves, summed.
+    pub retrieved: u64,
+}
+
+/// VKDE at the query points of `cam` through `maps`, on `dev` when given
+/// (`vkde.cu`'s estimation kernel; the counts are what it writes), else by
+/// the native reference.
+pub fn query_stats(
+    maps: &PhotonMaps,
+    caster: &Caster,
+    cam: &Camera,
+    o: &Options,
+    dev: Option<&mut Device>,
+) -> Result<QueryStats, PhotonImageError> {
+    let q = photon_image::queries(caster, cam);
+    let (est, _) = photon_image::estimates(maps, &q, o, dev)?;
+    Ok(QueryStats {
+        queries: q.iter().flatten().count() as u64,
+        contributions: est.iter().map(|e| e.contributions as u64).sum(),
+        nodes: est.iter().map(|e| e.nodes as u64).sum(),
+        retrieved: est.iter().map(|e| e.retrieved as u64).sum(),
     })
 }
 
@@ -100,18 +183,15 @@ fn sample(group: &str, scene: &Scene, frame: Option<u32>, counters: &[(&str, f64
     }
 }
 
-/// Measurement group [`PHOTON_STATS`]: emitted, stored, discarded and clamped interactions.
+/// Measurement group [`PHOTON_STATS`]: emitted, stored, discarded and
+/// clamped interactions, photons and kernels on the emulator.
 pub fn measure_photons(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let o = options(ws.scene)?;
     tick(Tick { frame: None, variant: "vkde" });
     ws.build(crate::host::kdtree::Heuristic::Siroh);
-    let maps = photon_image::photon_maps(ws.scene, ws.tree(crate::host::kdtree::Heuristic::Siroh), &o, None)?;
-    let c: &Constructed = &maps.constructed;
-    let (mut major, mut minor) = (0.0f64, 0.0f64);
-    for k in &c.kernels {
-        major += crate::repro::fabianowski2011::photons::len(k.major) as f64;
-        minor += crate::repro::fabianowski2011::photons::len(k.m_prime) as f64;
-    }
+    let tree = ws.tree(crate::host::kdtree::Heuristic::Siroh);
+    let mut dev = Device::new();
+    let (_, c) = photon_stats(ws.scene, tree, &o, Some(&mut dev))?;
     Ok(vec![sample(
         PHOTON_STATS,
         ws.scene,
@@ -122,35 +202,37 @@ pub fn measure_photons(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result
             ("interactions", c.interactions as f64),
             ("discarded", c.discarded as f64),
             ("clamped", c.clamped as f64),
-            ("kernels", c.kernels.len() as f64),
-            ("major_sum", major),
-            ("minor_sum", minor),
+            ("kernels", c.kernels as f64),
+            ("major_sum", c.major_sum),
+            ("minor_sum", c.minor_sum),
         ],
     )])
 }
 
-/// Measurement group [`VKDE_QUERIES`]: query points and contributions per frame.
+/// Measurement group [`VKDE_QUERIES`]: query points and contributions per
+/// frame, the photons, kernels and estimates on the emulator.
 pub fn measure_queries(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let o = options(ws.scene)?;
     ws.build(crate::host::kdtree::Heuristic::Siroh);
     let tree = ws.tree(crate::host::kdtree::Heuristic::Siroh);
-    let maps = photon_image::photon_maps(ws.scene, tree, &o, None)?;
+    let mut dev = Device::new();
+    let (maps, _) = photon_stats(ws.scene, tree, &o, Some(&mut dev))?;
     let caster = Caster::new(ws.scene, tree);
     let mut out = Vec::new();
     for f in ws.frames.clone() {
         tick(Tick { frame: Some(f), variant: "vkde" });
         let cam = super::flight::camera(ws.scene, f, ws.resolution);
-        let q = photon_image::queries(&caster, &cam);
-        let (est, _) = photon_image::estimates(&maps, &q, &o, None)?;
-        let queries = q.iter().flatten().count() as f64;
-        let contributions: f64 = est.iter().map(|e| e.contributions as f64).sum();
-        let nodes: f64 = est.iter().map(|e| e.nodes as f64).sum();
-        let retrieved: f64 = est.iter().map(|e| e.retrieved as f64).sum();
+        let q = query_stats(&maps, &caster, &cam, &o, Some(&mut dev))?;
         out.push(sample(
             VKDE_QUERIES,
             ws.scene,
             Some(f),
-            &[("queries", queries), ("contributions", contributions), ("nodes", nodes), ("retrieved", retrieved)],
+            &[
+                ("queries", q.queries as f64),
+                ("contributions", q.contributions as f64),
+                ("nodes", q.nodes as f64),
+                ("retrieved", q.retrieved as f64),
+            ],
         ));
     }
     Ok(out)
@@ -231,8 +313,8 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     t.notes.push(super::run_note(
         r,
         &scenes,
-        "native photon tracer, kernel construction and VKDE (bit for bit the emulated kernels' on the Cornell box), \
-         one photon tracing pass per scene with the light static, query points at primary and reflection hits of each \
+        "photons.cu, vkde.cu's construction and its VKDE estimation on the emulator (the native references give the \
+         same counts bit for bit), one photon tracing pass per scene with the light static, query points at primary and reflection hits of each \
          frame, uniform kernel, BVH photon map (object median, leaves of 8)",
     ));
     t.notes.push(
