@@ -541,7 +541,7 @@ pub fn exp_neg(x: f32) -> f32 {
         return 0.0;
     }
     let n = (x * std::f32::consts::LOG2_E + 0.5).floor();
-    let r = x - n * 0.693_145_751_953_125 - n * 1.428_606_820_309_417_2e-6;
+    let r = x - n * 0.693_145_75 - n * 1.428_606_8e-6; // the kernel's two parts of ln 2, as f32
     let poly = 1.0
         + r * (1.0
             + r * 0.5 * (1.0 + r / 3.0 * (1.0 + r * 0.25 * (1.0 + r * 0.2 * (1.0 + r / 6.0 * (1.0 + r / 7.0))))));
