@@ -21,20 +21,37 @@ pub fn sectors(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64) -> Vec<u64> {
 }
 
 /// [`sectors`] into `v` (cleared first), so that a caller reusing `v` allocates nothing.
+///
+/// Lanes of a warp mostly touch their sectors in ascending order, several
+/// lanes one sector: a sector equal to the last one pushed is not pushed
+/// again, and when every sector came in ascending order the list is already
+/// sorted and free of duplicates, so the sort is skipped (the result is the
+/// same sorted set either way).
 pub fn sectors_into(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64, v: &mut Vec<u64>) {
     v.clear();
-    for l in 0..32 {
-        if mask >> l & 1 == 0 {
-            continue;
-        }
+    let span = bytes.max(1) as u64 - 1;
+    let mut sorted = true;
+    let mut m = mask;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
         let a = addr(l);
-        let (first, last) = (a / SECTOR, (a + bytes.max(1) as u64 - 1) / SECTOR);
+        let (first, last) = (a / SECTOR, (a + span) / SECTOR);
         for s in first..=last {
-            v.push(s);
+            match v.last() {
+                Some(&p) if p == s => {}
+                Some(&p) => {
+                    sorted &= p < s;
+                    v.push(s);
+                }
+                None => v.push(s),
+            }
         }
     }
-    v.sort_unstable();
-    v.dedup();
+    if !sorted {
+        v.sort_unstable();
+        v.dedup();
+    }
 }
 
 /// Sectors of a local-memory access (interleaved layout, see [`local_physical`]).
@@ -87,6 +104,31 @@ mod tests {
         let n = sectors(u32::MAX, 16, |l| l as u64 * 16).len();
         assert_eq!(n, 16);
         assert_eq!(sectors(1, 16, |_| 24).len(), 2, "a misaligned span crosses a sector boundary");
+    }
+
+    #[test]
+    fn sectors_come_sorted_and_distinct_in_any_lane_order() {
+        // ascending, descending, repeated and scattered lane addresses, partial masks
+        let layouts: [fn(usize) -> u64; 5] = [
+            |l| 0x1000 + 4 * l as u64,
+            |l| 0x2000 - 8 * l as u64,
+            |l| 0x3000 + 64 * (l as u64 % 3),
+            |l| 0x4000 + (l as u64 * 7919 % 31) * 40,
+            |_| 0x5010,
+        ];
+        for addr in layouts {
+            for mask in [u32::MAX, 0x8000_0001, 0x0F0F_F0F0, 1, 0] {
+                for bytes in [1, 4, 8, 16] {
+                    let mut want: Vec<u64> = (0..32)
+                        .filter(|l| mask >> l & 1 != 0)
+                        .flat_map(|l| addr(l) / SECTOR..=(addr(l) + bytes as u64 - 1) / SECTOR)
+                        .collect();
+                    want.sort_unstable();
+                    want.dedup();
+                    assert_eq!(sectors(mask, bytes, addr), want, "mask {mask:#x}, {bytes} bytes");
+                }
+            }
+        }
     }
 
     #[test]

@@ -238,3 +238,80 @@ impl<'a> Stepper<'a> {
         self.run.counters_so_far()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::device::{Arg, Device, LaunchConfig};
+    use super::super::warp::WarpState;
+
+    /// Arguments of a test kernel, allocated on the device.
+    type Args = fn(&mut Device) -> Vec<Arg>;
+
+    fn floats(d: &mut Device) -> Arg {
+        Arg::Ptr(d.alloc_from(&(0..64).map(|i| i as f32 / 64.0).collect::<Vec<f32>>()))
+    }
+
+    /// An output buffer (some kernels write 1024 ints past their thread index).
+    fn zeros(d: &mut Device) -> Arg {
+        Arg::Ptr(d.alloc_zeroed::<i32>(8192))
+    }
+
+    /// `exec::step` checks for reconvergence only after an instruction (and
+    /// only when the top path stands at its reconvergence point), not before
+    /// the next one too: between two instructions of a warp nothing but the
+    /// executor moves its stack or frames. This steps kernels with nested
+    /// divergence, loops with `break`/`continue`, early `return`, divergent,
+    /// recursive and indirect calls (per-lane targets) one warp instruction
+    /// at a time and checks between every two instructions that a check
+    /// before the next instruction would pop nothing, and that stepping
+    /// counts as many reconvergences as a launch.
+    #[test]
+    fn the_stack_between_instructions_is_reconverged() {
+        let cases: [(&str, &str, Args); 9] = [
+            ("divergence", "if_else", |d| vec![zeros(d), zeros(d)]),
+            ("divergence", "nested_if", |d| vec![zeros(d), zeros(d), zeros(d)]),
+            ("divergence", "loop_break_continue", |d| {
+                let limit: Vec<i32> = (0..64).map(|i| (i * 7) % 30).collect();
+                vec![zeros(d), Arg::Ptr(d.alloc_from(&limit))]
+            }),
+            ("divergence", "early_return", |d| vec![zeros(d), Arg::I32(41)]),
+            ("calls", "call_divergent", |d| vec![zeros(d)]),
+            ("calls", "recursive_fib", |d| vec![zeros(d)]),
+            ("indirect", "call_table", |d| vec![floats(d), floats(d), zeros(d), Arg::I32(60)]),
+            ("indirect", "call_select", |d| vec![floats(d), zeros(d), Arg::I32(60)]),
+            ("indirect", "call_virtual", |d| vec![floats(d), zeros(d), Arg::I32(60)]),
+        ];
+        let mut total = 0;
+        for (file, kernel, args) in cases {
+            let src = match file {
+                "divergence" => include_str!("../../kernels/tests/divergence.ptx"),
+                "calls" => include_str!("../../kernels/tests/calls.ptx"),
+                _ => include_str!("../../kernels/tests/indirect.ptx"),
+            };
+            let mut dev = Device::new();
+            let m = dev.load_ptx(src, file).unwrap();
+            let args = args(&mut dev);
+            let cfg = LaunchConfig::linear(1, 64);
+            let mut st = dev.stepper(&m, kernel, cfg, &args).unwrap();
+            let mut steps = 0;
+            while st.step().unwrap().is_some() {
+                steps += 1;
+                for cta in &st.run.resident {
+                    for w in cta.warps.iter().filter(|w| w.state != WarpState::Done && !w.stack.entries.is_empty()) {
+                        let mut s = w.stack.clone();
+                        let popped = s.reconverge(w.frame().stack_base);
+                        assert_eq!(popped, 0, "{kernel}, warp {} after step {steps}: {:?}", w.id, w.stack.entries);
+                    }
+                }
+            }
+            let stepped = st.counters().reconvergences;
+            let launched = dev.launch(&m, kernel, cfg, &args).unwrap().totals.reconvergences;
+            assert_eq!(stepped, launched, "{kernel}");
+            if kernel == "if_else" || kernel == "nested_if" || kernel == "call_table" {
+                assert!(stepped > 0, "{kernel} reconverges");
+            }
+            total += stepped;
+        }
+        assert!(total > 10, "{total} reconvergences in all");
+    }
+}

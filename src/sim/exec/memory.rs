@@ -272,6 +272,9 @@ fn vector_access(
     let n = vals.len() as u32;
     let mut first = None;
     if space == MemSpace::Global {
+        if let Some(first) = global_in_one(ctx, ty, addrs, exec, vals, store, touched) {
+            return Ok(Some(first));
+        }
         // Global space named in the instruction: no per-lane resolution, and
         // consecutive lanes mostly hit one allocation.
         let mut last = None;
@@ -318,6 +321,71 @@ fn vector_access(
         }
     }
     Ok(first)
+}
+
+/// The common global access at once: when every active lane's whole access
+/// (`vals.len()` elements of `ty`) is aligned to its size and all of them lie
+/// in one allocation, no lane can fault, and the accesses are made with one
+/// bounds check and one allocation search for the warp instead of per lane
+/// and element. Returns `None`, having touched nothing, otherwise (the
+/// per-lane path then finds the faulting lane). Values, the lanes' order
+/// (lowest lane first, its elements in order: what overlapping stores
+/// leave) and what `touched` records are those of the per-lane path: with
+/// the access aligned to its power-of-two size every element is aligned to
+/// its own, and the one allocation holding the lowest to the highest byte is
+/// the one each element's search would find (allocations do not overlap).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn global_in_one(
+    ctx: &Ctx,
+    ty: Ty,
+    addrs: &Lanes,
+    exec: u32,
+    vals: &mut [Lanes],
+    store: bool,
+    touched: &mut Touched,
+) -> Option<Resolved> {
+    let size = ty.bytes();
+    let total = size * vals.len() as u32;
+    if exec == 0 || !total.is_power_of_two() {
+        return None;
+    }
+    // lowest and highest address, and the OR of the low bits (alignment)
+    let (mut lo, mut hi, mut low_bits) = (u64::MAX, 0u64, 0u64);
+    let mut m = exec;
+    while m != 0 {
+        let a = addrs[m.trailing_zeros() as usize];
+        m &= m - 1;
+        lo = lo.min(a);
+        hi = hi.max(a);
+        low_bits |= a;
+    }
+    if low_bits & (total as u64 - 1) != 0 {
+        return None;
+    }
+    let span = (hi - lo).checked_add(total as u64)?;
+    let (al, lo_off) = ctx.mem.find(lo, span)?;
+    let first = exec.trailing_zeros() as usize;
+    touched.first = Some(MemSpace::Global);
+    touched.lanes |= exec;
+    let mut m = exec;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let a = addrs[l];
+        touched.space[l] = Some(MemSpace::Global);
+        touched.addr[l] = a;
+        let off = lo_off + (a - lo);
+        for (k, v) in vals.iter_mut().enumerate() {
+            let ok = off + (k as u32 * size) as u64;
+            if store {
+                al.store(ok, size, v[l] & ty.mask());
+            } else {
+                v[l] = ty.extend(al.load(ok, size));
+            }
+        }
+    }
+    Some(Resolved::Global(addrs[first]))
 }
 
 /// Vector accesses must be aligned to their whole size.

@@ -305,16 +305,31 @@ fn special(ctx: &Ctx, w: &Warp, cta: &CtaMut, sr: SpecialReg) -> Lanes {
 
 /// Executes the next instruction of warp `w`. Returns its function and PC (for
 /// fault reports and stepping) and its effect.
+///
+/// Reconvergence is checked once per instruction, after it, and only when the
+/// running path stands at its reconvergence point. Both are the same as
+/// popping before and after every instruction:
+/// - `SimtStack::reconverge` pops nothing unless the top entry's `pc` equals
+///   its `rpc` (its loop stops at the first entry where they differ), so
+///   testing that first changes nothing.
+/// - Before an instruction there is nothing to pop: the stack and the frames
+///   of a warp change only inside this function (branches, exits, calls and
+///   returns; barriers, atomics and the scheduler change the warp's state and
+///   registers, not its stack), and the previous instruction of the warp
+///   ended with the check below, which pops until the top entry is not at
+///   its reconvergence point or is its frame's first; a warp starts with one
+///   entry. `stepper::tests::the_stack_between_instructions_is_reconverged`
+///   checks this between every two instructions of divergent kernels.
 pub fn step(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut) -> (u32, u32, Result<Effect, Box<ExecFault>>) {
-    let base = w.frame().stack_base;
-    cta.counters.reconvergences += w.stack.reconverge(base) as u64;
     let top = *w.stack.top().expect("running warp has a path");
     let func = w.frame().func;
     let pc = top.pc;
     let r = exec(ctx, w, cta, func, top);
     // Pop paths that reached their reconvergence point now, so that the stack
     // seen between instructions is the one the next instruction runs on.
-    if !w.stack.entries.is_empty() {
+    if let Some(t) = w.stack.top()
+        && t.pc == t.rpc
+    {
         let base = w.frame().stack_base;
         cta.counters.reconvergences += w.stack.reconverge(base) as u64;
     }
