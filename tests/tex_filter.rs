@@ -164,9 +164,9 @@ fn linear_filtering_equals_the_h200() {
         let (mut differ, mut worst) = (0, 0f64);
         for i in 0..c.count() {
             let got = texture::sample(&desc, &read, c.coords(i), c.dims);
-            for ch in 0..4 {
-                let (g, w) = (f32::from_bits(got[ch]), f32::from_bits(c.out[4 * i + ch]));
-                if got[ch] != c.out[4 * i + ch] {
+            for (&gb, &wb) in got.iter().zip(&c.out[4 * i..4 * i + 4]) {
+                let (g, w) = (f32::from_bits(gb), f32::from_bits(wb));
+                if gb != wb {
                     differ += 1;
                     worst = worst.max((g as f64 - w as f64).abs());
                 }

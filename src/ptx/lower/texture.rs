@@ -127,6 +127,11 @@ pub(super) fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             _ => unsupported(pos, d.full.clone()),
         };
     };
+    // mipmapped fetches (`tex.level`, `tex.grad`) take extra operands: not
+    // supported, whatever their count
+    if d.op == Opcode::Tex && (m.has("level") || m.has("grad")) {
+        return unsupported(pos, format!("{} (mipmapped fetch)", d.full));
+    }
     operands(i, 2)?;
     match d.op {
         Opcode::Tex | Opcode::Tld4 => {
