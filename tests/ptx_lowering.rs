@@ -200,8 +200,14 @@ fn validation_names_what_is_wrong() {
         ("tex.2d.v4.f32.f32 {%f1, %f1, %f1, %f1}, [%rd1, {%f1}];", "takes 2 coordinate(s), found 1"),
         ("sust.p.2d.b32.trap [%rd1, {%r1, %r2}], {%r3};", "`sust.p.2d.b32.trap (modifier .p)`"),
         ("sured.p.add.1d.u32.trap [%rd1, {%r1}], %r3;", "`sured.p.add.1d.u32.trap (modifier .p)`"),
+        (
+            "tex.level.2d.v4.f32.f32 {%f1, %f1, %f1, %f1}, [%rd1, {%f1, %f1}], %f1;",
+            "`tex.level.2d.v4.f32.f32 (mipmapped fetch)`",
+        ),
         ("sured.b.xor.1d.b32.trap [%rd1, {%r1}], %r3;", "`sured.b.xor.1d.b32.trap (modifier .xor)`"),
-        ("sured.b.add.1d.b32.trap [%rd1, {%r1}], %r3;", "invalid: `sured.b.add.1d.b32.trap`: .add .min .max take"),
+        ("sured.b.add.1d.b32.trap [%rd1, {%r1}], %r3;", "invalid: `sured.b.add.1d.b32.trap`: ptxas takes .add on"),
+        ("sured.b.min.1d.u64.trap [%rd1, {%r1}], %rd3;", "invalid: `sured.b.min.1d.u64.trap`: ptxas takes"),
+        ("sured.b.or.1d.b64.trap [%rd1, {%r1}], %rd3;", "invalid: `sured.b.or.1d.b64.trap`: ptxas takes"),
         ("sured.b.add.1d.u32.trap [%rd1, {%r1}], {%r3, %r3};", "takes an address and one value"),
         (
             "set.lt.f32.f16x2 %r1, %r2, %r3;",

@@ -253,3 +253,34 @@ fn global_loads_under_divergent_control_flow_are_varying() {
     let (f, u) = uniformity(&ptx.replace("%tid.x", "%ctaid.x"));
     assert!(u.regs[reg(&f, "%r1")]);
 }
+
+/// Warp reductions, carry chains and `bar.red` touch no memory: a function
+/// holding them is planned like any other (adjacent 4-byte shared accesses
+/// from an 8-aligned base merge into `STS.64`/`LDS.64`); `bar.red` ends a
+/// run as `bar.sync` does.
+#[test]
+fn redux_carry_and_bar_red_do_not_stop_the_plan() {
+    let ptx = ".version 7.8\n.target sm_90\n.address_size 64\n\
+        .visible .entry k(.param .u64 out)\n{\n\
+        .reg .b32 %r<14>;\n.reg .b64 %rd<3>;\n.reg .pred %p<2>;\n\
+        .shared .align 16 .b8 sm[1024];\n\
+        mov.u32 %r1, %tid.x;\nshl.b32 %r2, %r1, 3;\nmov.u32 %r3, sm;\nadd.u32 %r4, %r3, %r2;\n\
+        st.shared.u32 [%r4], %r1;\nst.shared.u32 [%r4+4], %r1;\n\
+        redux.sync.add.u32 %r5, %r1, -1;\nadd.cc.u32 %r6, %r5, %r1;\naddc.u32 %r7, %r5, 0;\n\
+        match.any.sync.b32 %r12, %r1, -1;\n\
+        ld.shared.u32 %r8, [%r4];\nld.shared.u32 %r9, [%r4+4];\n\
+        setp.ne.u32 %p1, %r8, 0;\nbar.red.popc.u32 %r10, 0, %p1;\n\
+        ld.shared.u32 %r13, [%r4];\n\
+        add.u32 %r11, %r8, %r9;\nadd.u32 %r11, %r11, %r6;\nadd.u32 %r11, %r11, %r7;\nadd.u32 %r11, %r11, %r10;\n\
+        add.u32 %r11, %r11, %r12;\nadd.u32 %r11, %r11, %r13;\n\
+        ld.param.u64 %rd1, [out];\nmul.wide.u32 %rd2, %r1, 4;\nadd.s64 %rd1, %rd1, %rd2;\n\
+        st.global.u32 [%rd1], %r11;\nret;\n}\n";
+    let args = |d: &mut Device| vec![Arg::Ptr(d.alloc_zeroed::<u32>(32))];
+    let cfg = LaunchConfig::linear(1, 32);
+    let on = counters(ptx, "k", cfg, &args, true, Profile::Hopper);
+    // one STS.64; one LDS.64, then the load after bar.red on its own
+    assert_eq!(on.shared_st.instructions, 1);
+    assert_eq!(on.shared_ld.instructions, 2);
+    let off = counters(ptx, "k", cfg, &args, false, Profile::Hopper);
+    assert_eq!((off.shared_st.instructions, off.shared_ld.instructions), (2, 3));
+}

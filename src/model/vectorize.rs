@@ -35,9 +35,12 @@
 //!   one lane's `RED`/`ATOM`; the old value handed back by `SHFL`): `add`,
 //!   `min`, `max`, `and`, `or`, `xor` whose result is unused, in any lanes;
 //!   `add` whose result is used, in any lanes when its operand is uniform,
-//!   and only in a full warp when it varies. Not merged: floats, `inc`/`dec`,
-//!   `exch`, `cas`, `min`/`max`/logic whose result is used. Counted as one
-//!   lane's access on the hopper profile (1 L1 sector instead of 1 per lane).
+//!   and only in a full warp when it varies. A 64-bit one (`REDUX` has no
+//!   64-bit form) only when it is an `add` of a uniform operand, its result
+//!   used or not (`kernels/validation/uniform_atomics64.cu`). Not merged:
+//!   floats, `inc`/`dec`, `exch`, `cas`, `min`/`max`/logic whose result is
+//!   used, 64-bit operations on a varying operand. Counted as one lane's
+//!   access on the hopper profile (1 L1 sector instead of 1 per lane).
 //!
 //! The rules were read off the SASS that ptxas 13.0 makes for sm_90 of the
 //! validation suite (`kernels/validation/suite.cu`, `docs/validation.md`):
@@ -125,7 +128,8 @@ enum Effect {
     Access,
     /// Ends every run: control flow, barriers, fences, calls.
     Boundary,
-    /// An instruction the pass does not know: the function is left as written.
+    /// Any other instruction (textures, surfaces): ends every run as a
+    /// boundary does.
     Unknown,
 }
 
@@ -144,6 +148,10 @@ fn effect(k: &Kind) -> Effect {
         | Kind::Cvt { d, .. }
         | Kind::Cvta { d, .. } => Effect::Writes(dst_regs([d.reg])),
         Kind::Unpack { ds, .. } => Effect::Writes(dst_regs(ds.iter().map(|d| d.reg))),
+        // warp reductions and carry arithmetic touch no memory (REDUX,
+        // MATCH, IADD3 with a carry)
+        Kind::Redux { .. } | Kind::Carry { .. } => Effect::Writes(k.writes()),
+        Kind::Match { .. } => Effect::WritesPred(k.writes()),
         Kind::Setp { .. } | Kind::PredLogic { .. } => Effect::WritesPred(Vec::new()),
         Kind::Vote { d, .. } => Effect::WritesPred(dst_regs(d.iter().map(|d| d.reg))),
         Kind::Shfl { d, .. } => Effect::WritesPred(dst_regs([d.reg])),
@@ -155,17 +163,11 @@ fn effect(k: &Kind) -> Effect {
         | Kind::Ret
         | Kind::Exit
         | Kind::Bar { .. }
+        | Kind::BarRed { .. }
         | Kind::WarpSync { .. }
-        | Kind::Membar => Effect::Boundary,
+        | Kind::Membar
+        | Kind::Trap => Effect::Boundary,
         _ => Effect::Unknown,
-    }
-}
-
-/// Data registers an instruction reads (None: an instruction the pass does not know).
-fn reads(k: &Kind) -> Option<Vec<RegId>> {
-    match k {
-        Kind::BarRed { .. } | Kind::Redux { .. } | Kind::Match { .. } | Kind::Carry { .. } | Kind::Trap => None,
-        _ => Some(k.reads()),
     }
 }
 
@@ -174,9 +176,8 @@ fn tz_imm(v: u64) -> u32 {
     v.trailing_zeros()
 }
 
-/// Known trailing zeros of every data register of `f` (see the module comment);
-/// None when `f` holds an instruction the pass does not know.
-fn trailing_zeros(f: &Function) -> Option<Vec<u32>> {
+/// Known trailing zeros of every data register of `f` (see the module comment).
+fn trailing_zeros(f: &Function) -> Vec<u32> {
     let n = f.reg_masks.len();
     let mut tz = vec![64u32; n];
     let width = |r: RegId| f.reg_masks.get(r as usize).map_or(64, |m| m.count_ones());
@@ -209,16 +210,9 @@ fn trailing_zeros(f: &Function) -> Option<Vec<u32>> {
                     };
                     (vec![d.reg], v)
                 }
-                k => match effect(k) {
-                    Effect::Writes(ds) | Effect::WritesPred(ds) => (ds, 0),
-                    Effect::Access => match k {
-                        Kind::Ld { ds, .. } => (ds.iter().map(|d| d.reg).collect(), 0),
-                        Kind::Atom { d: Some(d), .. } => (vec![d.reg], 0),
-                        _ => (Vec::new(), 0),
-                    },
-                    Effect::Boundary => (Vec::new(), 0),
-                    Effect::Unknown => return None,
-                },
+                // anything else: what it writes is unaligned as far as the
+                // pass knows
+                k => (k.writes(), 0),
             };
             for r in regs {
                 if r == Dst::SINK || r as usize >= n {
@@ -232,7 +226,7 @@ fn trailing_zeros(f: &Function) -> Option<Vec<u32>> {
             }
         }
         if !changed {
-            return Some(tz);
+            return tz;
         }
     }
 }
@@ -334,12 +328,11 @@ fn settle(run: &mut Vec<Pending>, loads: bool, actions: &mut [Action]) {
 /// Plans one function.
 fn plan_function(f: &Function) -> Vec<Action> {
     let mut actions = vec![Action::Count; f.insts.len()];
-    let Some(tz) = trailing_zeros(f) else { return actions };
+    let tz = trailing_zeros(f);
     // registers some instruction reads (for atomics without a used result)
     let mut read = vec![false; f.reg_masks.len()];
     for inst in &f.insts {
-        let Some(rs) = reads(&inst.kind) else { return actions };
-        for r in rs {
+        for r in inst.kind.reads() {
             if let Some(x) = read.get_mut(r as usize) {
                 *x = true;
             }
@@ -359,16 +352,19 @@ fn plan_function(f: &Function) -> Vec<Action> {
     for (pc, inst) in f.insts.iter().enumerate() {
         if let Kind::Atom { space: space @ (MemSpace::Global | MemSpace::Generic), op, ty, d, addr, b, .. } = &inst.kind
         {
-            if !ty.is_int() || ty.bits() != 32 || !uniform.src(&addr.base) {
+            if !ty.is_int() || !matches!(ty.bits(), 32 | 64) || !uniform.src(&addr.base) {
                 continue;
             }
             let unused = d.is_none_or(|d| d.reg == Dst::SINK || !read.get(d.reg as usize).copied().unwrap_or(true));
             let red = unused && *space == MemSpace::Global;
-            actions[pc] = match (op, unused) {
-                (AtomOp::Add | AtomOp::Min | AtomOp::Max | AtomOp::And | AtomOp::Or | AtomOp::Xor, true) => {
+            actions[pc] = match (op, unused, ty.bits()) {
+                (AtomOp::Add | AtomOp::Min | AtomOp::Max | AtomOp::And | AtomOp::Or | AtomOp::Xor, true, 32) => {
                     Action::Uniform { red, full_warp_only: false }
                 }
-                (AtomOp::Add, false) => Action::Uniform { red, full_warp_only: !uniform.src(b) },
+                (AtomOp::Add, false, 32) => Action::Uniform { red, full_warp_only: !uniform.src(b) },
+                // 64 bits: no REDUX, so only an add of a uniform operand
+                // (`UPOPC` × operand), its result used or not
+                (AtomOp::Add, _, 64) if uniform.src(b) => Action::Uniform { red, full_warp_only: false },
                 _ => continue,
             };
         }
@@ -393,7 +389,7 @@ fn plan_function(f: &Function) -> Vec<Action> {
             Effect::Boundary | Effect::Unknown => {
                 settle(&mut loads, true, &mut actions);
                 settle(&mut stores, false, &mut actions);
-                Vec::new()
+                inst.kind.writes()
             }
             Effect::WritesPred(ds) => {
                 pred_epoch += 1;

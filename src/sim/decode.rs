@@ -319,6 +319,8 @@ impl Default for FloatOptions {
 pub struct Code {
     /// One per function of the program.
     pub funcs: Vec<FnCode>,
+    /// How the special functions are computed (interpreted instructions too).
+    pub sfu: SfuModel,
 }
 
 impl Code {
@@ -374,7 +376,7 @@ impl Code {
                 FnCode { ops, insts, consts, fused, alloc }
             })
             .collect();
-        Code { funcs }
+        Code { funcs, sfu: opts.sfu }
     }
 }
 
@@ -571,7 +573,7 @@ lanefn2!(div_full_ftz, |x, y| sfu::div_full(x as u32, y as u32, true) as u64);
 
 /// The H200 table model's function of an f32 approximation, when `sfu` asks
 /// for it and the form has one (no `.sat`, no rounding modifier).
-fn resolve_sfu(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<LaneFn> {
+pub fn resolve_sfu(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<LaneFn> {
     if sfu != SfuModel::Sm90 || ty != Ty::F32 || !mode.approx || mode.sat || mode.rnd.is_some() {
         return None;
     }

@@ -207,12 +207,94 @@ fn fetch(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, idx: [i64; 3]) -> [u32
 }
 
 /// The linear-filtering footprint along one dimension: the first texel and
-/// the weight of the second, 8 fractional bits (1.8 fixed point, rounded
-/// half up, as the H200 does).
-fn footprint(x: f64) -> (i64, f64) {
-    let q = ((x - 0.5) * 256.0 + 0.5).floor() / 256.0;
-    let i = q.floor();
-    (i as i64, q - i)
+/// the weight of the second in 256ths (1.8 fixed point: `256 (x − 0.5)`
+/// rounded half up, as the H200 does).
+fn footprint(x: f64) -> (i64, u32) {
+    let q = ((x - 0.5) * 256.0 + 0.5).floor() as i64;
+    (q >> 8, (q & 255) as u32)
+}
+
+/// The weights (in 256ths) of the corners of a linear footprint whose
+/// second texels weigh `w` along each dimension; corner `c` takes the second
+/// texel along dimension `d` when bit `d` of `c` is set. The H200 rounds
+/// each product of weights to 256ths (half up) and derives the corners from
+/// them by inclusion and exclusion, so that they sum to 256: in 2-D,
+/// `w11 = round(wx·wy)`, `w10 = wx − w11`, `w01 = wy − w11`,
+/// `w00 = 256 − wx − wy + w11` (one and two dimensions, measured; the
+/// same rule for more is not the H200's 3-D filter).
+fn corner_weights(w: &[u32]) -> Vec<i64> {
+    let n = w.len();
+    // the rounded product of the weights of the dimensions in `set`
+    let product = |set: usize| -> i64 {
+        let ws: Vec<i64> = (0..n).filter(|d| set >> d & 1 == 1).map(|d| w[d] as i64).collect();
+        match ws.len() {
+            0 => 256,
+            1 => ws[0],
+            k => {
+                let shift = 8 * (k as u32 - 1);
+                (ws.iter().product::<i64>() + (1 << (shift - 1))) >> shift
+            }
+        }
+    };
+    (0..1usize << n)
+        .map(|corner| {
+            (0..1usize << n)
+                .filter(|set| set & corner == corner)
+                .map(|set| {
+                    let sign = if (set ^ corner).count_ones() % 2 == 0 { 1 } else { -1 };
+                    sign * product(set)
+                })
+                .sum()
+        })
+        .collect()
+}
+
+/// Bits of significand the texture unit filters a format in: half
+/// precision for `f16` texels, single for the rest.
+fn filter_precision(f: TexelFormat) -> u32 {
+    if f == TexelFormat::F16 { 11 } else { 24 }
+}
+
+/// One channel of a linear filter's result, as the H200 computes it: the
+/// texels (with weights in 256ths, border texels as zeros) aligned to the
+/// largest exponent among those that weigh something, keeping `p + 4` bits
+/// from there (the rest cut off toward zero), summed exactly, and the sum
+/// rounded to `p` bits, ties away from zero. Non-finite texels: the weighted
+/// sum in f64 (not measured).
+fn filter_channel(terms: &[(i64, f32)], p: u32) -> f32 {
+    if terms.iter().any(|(_, v)| !v.is_finite()) {
+        let s: f64 = terms.iter().map(|&(w, v)| w as f64 / 256.0 * v as f64).sum();
+        return s as f32;
+    }
+    let Some(e) = terms.iter().filter(|(_, v)| *v != 0.0).map(|&(_, v)| exponent(v as f64)).max() else {
+        return 0.0;
+    };
+    // the grid: 2^(e − (p − 1) − 4); |v| / grid < 2^(p + 4), exact in f64
+    let g = e - (p as i32 - 1) - 4;
+    let sum: i64 = terms.iter().map(|&(w, v)| w * (v as f64 * 2f64.powi(-g)).trunc() as i64).sum();
+    // the sum is `sum · 2^(g − 8)`: round to p bits, ties away from zero
+    let mut m = sum.unsigned_abs();
+    let mut k = g - 8;
+    let bits = 64 - m.leading_zeros();
+    if bits > p {
+        let sh = bits - p;
+        m = (m + (1 << (sh - 1))) >> sh;
+        k += sh as i32;
+    }
+    let v = m as f64 * 2f64.powi(k);
+    (if sum < 0 { -v } else { v }) as f32
+}
+
+/// The binary exponent of a finite nonzero `v` (`floor(log2 |v|)`).
+fn exponent(v: f64) -> i32 {
+    let bits = v.abs().to_bits();
+    let e = (bits >> 52) as i32;
+    if e == 0 {
+        // subnormal in f64 (no f32 value is)
+        -1074 + 63 - (bits.leading_zeros() as i32)
+    } else {
+        e - 1023
+    }
 }
 
 /// `tex` with float coordinates (`dims` of them used).
@@ -227,7 +309,7 @@ pub fn sample(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [f32; 3],
     }
     // A 1-D texture filters as a 2-D one of height 1 sampled at y = 0: the
     // footprint's other row is row -1, which the border mode reads as zeros
-    // (the H200 returns half the value there).
+    // (so the H200 returns about half the value there).
     let mut x = x;
     let dims = if dims == 1 {
         x.push(0.0);
@@ -235,15 +317,44 @@ pub fn sample(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [f32; 3],
     } else {
         dims
     };
-    let fp: Vec<(i64, f64)> = x.iter().map(|&v| footprint(v)).collect();
+    let fp: Vec<(i64, u32)> = x.iter().map(|&v| footprint(v)).collect();
+    let ws: Vec<u32> = fp.iter().map(|f| f.1).collect();
+    if dims == 3 {
+        return sample_3d(t, read, &fp);
+    }
+    let mut terms: Vec<(i64, [u32; 4])> = Vec::with_capacity(4);
+    for (corner, w) in corner_weights(&ws).into_iter().enumerate() {
+        if w == 0 {
+            continue;
+        }
+        let mut idx = [0i64; 3];
+        for d in 0..dims {
+            idx[d] = fp[d].0 + (corner >> d & 1) as i64;
+        }
+        terms.push((w, fetch(t, read, idx)));
+    }
+    let p = filter_precision(t.format);
+    let mut out = [0u32; 4];
+    for (c, o) in out.iter_mut().enumerate() {
+        let ch: Vec<(i64, f32)> = terms.iter().map(|(w, v)| (*w, f32::from_bits(v[c]))).collect();
+        *o = filter_channel(&ch, p).to_bits();
+    }
+    out
+}
+
+/// Trilinear filtering: the product of the three weights (in 256ths) per
+/// corner, the weighted sum in f64 rounded to f32. Not the H200's bits: its
+/// 3-D weights follow neither this nor the 2-D rule (`docs/semantics.md`).
+fn sample_3d(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, fp: &[(i64, u32)]) -> [u32; 4] {
     let mut acc = [0f64; 4];
-    for corner in 0..(1usize << dims) {
+    for corner in 0..8usize {
         let mut idx = [0i64; 3];
         let mut w = 1.0;
-        for d in 0..dims {
+        for d in 0..3 {
             let hi = corner >> d & 1 == 1;
             idx[d] = fp[d].0 + hi as i64;
-            w *= if hi { fp[d].1 } else { 1.0 - fp[d].1 };
+            let wd = fp[d].1 as f64 / 256.0;
+            w *= if hi { wd } else { 1.0 - wd };
         }
         if w == 0.0 {
             continue;
@@ -433,9 +544,40 @@ mod tests {
 
     #[test]
     fn footprint_weights_have_eight_fractional_bits() {
-        assert_eq!(footprint(1.0), (0, 0.5));
-        assert_eq!(footprint(0.5 + 1.0 / 1024.0), (0, 0.0));
-        assert_eq!(footprint(0.5 + 2.0 / 1024.0), (0, 1.0 / 256.0));
-        assert_eq!(footprint(0.5 + 3.0 / 1024.0), (0, 1.0 / 256.0));
+        assert_eq!(footprint(1.0), (0, 128));
+        assert_eq!(footprint(0.5 + 1.0 / 1024.0), (0, 0));
+        assert_eq!(footprint(0.5 + 2.0 / 1024.0), (0, 1));
+        assert_eq!(footprint(0.5 + 3.0 / 1024.0), (0, 1));
+        assert_eq!(footprint(-0.5 + 2.0 / 1024.0), (-1, 1));
+    }
+
+    #[test]
+    fn corner_weights_round_the_product_and_sum_to_one() {
+        // 1-D: the two weights
+        assert_eq!(corner_weights(&[3]), vec![253, 3]);
+        // 2-D: w11 = round(232 · 176 / 256) = round(159.5) = 160 (half up)
+        assert_eq!(corner_weights(&[232, 176]), vec![8, 72, 16, 160]);
+        for ws in [[0u32, 0], [255, 255], [1, 128], [77, 200]] {
+            let c = corner_weights(&ws);
+            assert_eq!(c.iter().sum::<i64>(), 256, "{ws:?}");
+            assert!(c.iter().all(|&w| (0..=256).contains(&w)), "{ws:?}: {c:?}");
+        }
+    }
+
+    #[test]
+    fn filtering_aligns_to_the_largest_texel_and_rounds_ties_away() {
+        // weights 1/256 and 255/256 of 1.0 and 2^-30: the small texel is cut
+        // off entirely (below the grid 2^-27 of the larger one)
+        let r = filter_channel(&[(1, 1.0), (255, 2f32.powi(-30))], 24);
+        assert_eq!(r, 1.0 / 256.0);
+        // alone, a small texel keeps all its bits (`sample` leaves out the
+        // corners that weigh nothing, so they never set the grid)
+        assert_eq!(filter_channel(&[(256, 2f32.powi(-30))], 24), 2f32.powi(-30));
+        // a tie rounds away from zero: 1 + 2^-24 (exactly between two f32)
+        let v = 1.0 + 2f32.powi(-23);
+        assert_eq!(filter_channel(&[(128, 1.0), (128, v)], 24), v);
+        assert_eq!(filter_channel(&[(128, -1.0), (128, -v)], 24), -v);
+        // half precision: 11 bits
+        assert_eq!(filter_channel(&[(128, 1.0), (128, 1.0 + 2f32.powi(-10))], 11), 1.0 + 2f32.powi(-10));
     }
 }

@@ -4,7 +4,8 @@ kernels/validation/suite.cu, as the clang PTX (suite.ptx) and the nvcc PTX
 (suite.nvcc.ptx), each loaded through the driver's JIT (CuPy RawModule), and
 records the output buffers; Nsight Compute (tools/device/validation_run.sh)
 measures the same launches. VALIDATION_SUITE=uniform_atomics does the same
-for kernels/validation/uniform_atomics.cu (ptxas's warp-uniform atomics).
+for kernels/validation/uniform_atomics.cu (ptxas's warp-uniform atomics),
+VALIDATION_SUITE=uniform_atomics64 for their 64-bit forms.
 
   validation.py plan               the cases as JSON (buffers, inits, launches)
   validation.py run OUT            run them on the GPU; OUT/outputs.json, OUT/launches.txt
@@ -77,6 +78,8 @@ def I(v):
 def cases():
     if SUITE == "uniform_atomics":
         return uniform_atomics_cases()
+    if SUITE == "uniform_atomics64":
+        return uniform_atomics64_cases()
     cs = []
     n = 16384
     cs.append({"name": "reduce_shfl", "buffers": [
@@ -176,8 +179,36 @@ def uniform_atomics_cases():
     return cs
 
 
+def uniform_atomics64_cases():
+    """kernels/validation/uniform_atomics64.cu: every kernel takes (c, in, out);
+    c holds four 64-bit words, a 64-bit operand is two input words."""
+    cs = []
+
+    def case(name, kernel, grid, block, init_in):
+        cs.append({"name": name, "buffers": [
+            {"name": "c", "n": 8, "init": {"kind": "zero"}, "output": True},
+            {"name": "in", "n": 512, "init": init_in},
+            {"name": "out", "n": 256, "init": {"kind": "zero"}, "output": True}],
+            "launches": [L(kernel, [grid], [block], [B("c"), B("in"), B("out")])]})
+
+    h = {"kind": "hash", "seed": 21}
+    # result unused: 2 CTAs of 2 full warps; and 48 threads (a full and a half warp)
+    for k in ("ua64_inc", "ua64_add_val", "ua64_min", "ua64_max_u", "ua64_and", "ua64_or", "ua64_xor",
+              "ua64_block", "ua64_cond", "ua64_lane"):
+        case(k, k, 2, 64, h)
+    case("ua64_f64", "ua64_f64", 1, 32, h)
+    for k in ("ua64_inc", "ua64_add_val", "ua64_cond"):
+        case(k + "_48", k, 1, 48, h)
+    # result used, or the order of the lanes matters: one warp, and 24 lanes of one
+    for k in ("ua64_exch", "ua64_inc_ret", "ua64_add_val_ret", "ua64_min_ret", "ua64_cas"):
+        case(k, k, 1, 32, h)
+    for k in ("ua64_inc_ret", "ua64_add_val_ret"):
+        case(k + "_24", k, 1, 24, h)
+    return cs
+
+
 import os
-# The suite: `suite` (kernels/validation/suite.cu) or `uniform_atomics`.
+# The suite: `suite` (kernels/validation/suite.cu), `uniform_atomics` or `uniform_atomics64`.
 SUITE = os.environ.get("VALIDATION_SUITE", "suite")
 DIALECTS = [("clang", f"kernels/validation/{SUITE}.ptx"), ("nvcc", f"kernels/validation/{SUITE}.nvcc.ptx")]
 # The committed nvcc PTX says `.version 9.5` (nvcc 13.5); a CUDA 13.0 driver

@@ -127,6 +127,11 @@ pub(super) fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
             _ => unsupported(pos, d.full.clone()),
         };
     };
+    // mipmapped fetches (`tex.level`, `tex.grad`) take extra operands: not
+    // supported, whatever their count
+    if d.op == Opcode::Tex && (m.has("level") || m.has("grad")) {
+        return unsupported(pos, format!("{} (mipmapped fetch)", d.full));
+    }
     operands(i, 2)?;
     match d.op {
         Opcode::Tex | Opcode::Tld4 => {
@@ -168,14 +173,20 @@ pub(super) fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
                 [t] => *t,
                 _ => return invalid(pos, format!("`{}` needs one type", d.full)),
             };
+            // the forms ptxas accepts for sm_90 (the ISA's type list is wider;
+            // ptxas 13 rejects the rest: "Unexpected instruction types")
             let ok = match op {
-                AtomOp::And | AtomOp::Or => matches!(t, Ty::B32 | Ty::B64),
-                _ => matches!(t, Ty::U32 | Ty::U64 | Ty::S32 | Ty::S64),
+                AtomOp::Add => matches!(t, Ty::U32 | Ty::S32 | Ty::U64),
+                AtomOp::Min | AtomOp::Max => matches!(t, Ty::U32 | Ty::S32),
+                _ => t == Ty::B32,
             };
             if !ok {
                 return invalid(
                     pos,
-                    format!("`{}`: .add .min .max take .u32 .u64 .s32 .s64, .and .or .b32 .b64", d.full),
+                    format!(
+                        "`{}`: ptxas takes .add on .u32 .s32 .u64, .min .max on .u32 .s32, .and .or on .b32",
+                        d.full
+                    ),
                 );
             }
             if i.operands.len() != 2 || matches!(i.operands[1], Operand::Vector(_)) {

@@ -82,7 +82,17 @@ pub(super) fn arith(
     } else {
         [0; 32]
     };
-    let r = map3(&va, &vb, &vc, |x, y, z| alu::arith(op, ty, mode, x, y, z));
+    // the special functions take the unit's bits from the same model as the
+    // compact form (an instruction is interpreted when its function is too
+    // large to compact, for one)
+    let r = match crate::sim::decode::resolve_sfu(op, ty, mode, ctx.code.sfu) {
+        Some(f) => {
+            let mut r = [0u64; 32];
+            f(&va, &vb, &vc, &mut r);
+            r
+        }
+        None => map3(&va, &vb, &vc, |x, y, z| alu::arith(op, ty, mode, x, y, z)),
+    };
     write(w.frames.last_mut().expect("frame"), d, &r, exec);
 }
 

@@ -158,7 +158,8 @@ fn call_rets(ctx: &Ctx, caller: u32, pc: u32, callee: u32) -> Vec<(u32, u32, u32
         Kind::CallIndirect { rets, .. } => rets
             .iter()
             .zip(&ctx.prog.functions[callee as usize].returns)
-            .map(|(&(off, size), r)| (r.offset, off, size.min(r.size)))
+            // the sizes are equal: `call_indirect` faults otherwise
+            .map(|(&(off, size), r)| (r.offset, off, size))
             .collect(),
         _ => unreachable!("call_pc names a call"),
     }

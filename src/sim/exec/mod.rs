@@ -460,8 +460,8 @@ fn exec_ir(
     exec: u32,
 ) -> Result<Effect, Box<ExecFault>> {
     // Control transfers move the stack themselves (and run with no lane active too).
+    // (`bra` always has a compact form: `exec` runs it)
     match &inst.kind {
-        Kind::Bra { target, .. } => return Ok(control::branch(ctx, w, cta, func, pc, *target, exec)),
         // `ret` in the kernel's own frame (no caller to return to) ends the
         // thread, as `exit` does; the front end already lowers a kernel's
         // `ret` to `exit`, this covers hand-built programs.
@@ -543,14 +543,14 @@ fn exec_ir(
             arith::carry(ctx, w, cta, (*op, *cin, *cout, *ty), *d, [*a, *b, *c], *cc, exec)
         }
         Kind::Tex { geom, gather, cty, ds, handle, coords, .. } => {
-            texture::tex(ctx, w, cta, *geom, *gather, *cty, ds, *handle, coords, exec)?
+            texture::tex(ctx, w, cta, (func, pc), *geom, *gather, *cty, ds, *handle, coords, exec)?
         }
         Kind::Txq { query, d, handle } => texture::txq(ctx, w, cta, *query, *d, *handle, exec)?,
         Kind::Suld { geom, ty, ds, handle, coords, clamp } => {
-            texture::suld(ctx, w, cta, *geom, *ty, ds, *handle, coords, *clamp, exec)?
+            texture::suld(ctx, w, cta, (func, pc), *geom, *ty, ds, *handle, coords, *clamp, exec)?
         }
         Kind::Sust { geom, ty, vals, handle, coords, clamp, red } => {
-            texture::sust(ctx, w, cta, (*geom, *ty, *red), vals, *handle, coords, *clamp, exec)?
+            texture::sust(ctx, w, cta, (func, pc), (*geom, *ty, *red), vals, *handle, coords, *clamp, exec)?
         }
         Kind::WarpSync { membermask } => control::warp_sync(ctx, w, cta, *membermask, exec)?,
         Kind::Membar => return Ok(control::membar(w, cta)),

@@ -60,12 +60,9 @@ type Footprint = Vec<(u64, u32, u32)>;
 /// Hands one instruction's texture-path accesses (`per_lane[l]`: lane `l`'s)
 /// to the CTA's observer: the k-th access of every lane in one event per
 /// access size ([`crate::sim::observer::MemObserver::texture_access`]).
-fn observe(cta: &mut CtaMut, w: &Warp, op: MemOp, per_lane: &[Footprint]) {
+fn observe(cta: &mut CtaMut, w: &Warp, (func, pc): (u32, u32), op: MemOp, per_lane: &[Footprint]) {
     let cta_linear = cta.cta_linear;
     let Some(obs) = cta.observer.as_deref_mut() else { return };
-    // `exec` moved the running path past this instruction before running it
-    let func = w.frame().func;
-    let pc = w.stack.top().map_or(0, |t| t.pc.wrapping_sub(1));
     let rounds = per_lane.iter().map(Vec::len).max().unwrap_or(0);
     for k in 0..rounds {
         let mut left = (0..per_lane.len()).filter(|&l| per_lane[l].len() > k).fold(0u32, |m, l| m | 1 << l);
@@ -97,12 +94,13 @@ fn observe(cta: &mut CtaMut, w: &Warp, op: MemOp, per_lane: &[Footprint]) {
     }
 }
 
-/// `tex` / `tld4`.
+/// `tex` / `tld4` at instruction `at` (function, pc).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn tex(
     ctx: &Ctx,
     w: &mut Warp,
     cta: &mut CtaMut,
+    at: (u32, u32),
     geom: TexGeom,
     gather: Option<u8>,
     cty: Ty,
@@ -152,7 +150,7 @@ pub(super) fn tex(
         }
         per_lane[l] = texels.take();
     }
-    observe(cta, w, MemOp::Load, &per_lane);
+    observe(cta, w, at, MemOp::Load, &per_lane);
     let f = w.frames.last_mut().expect("frame");
     for (d, v) in ds.iter().zip(&out) {
         write(f, *d, v, exec);
@@ -230,12 +228,13 @@ fn surf_addr(
     Ok(a)
 }
 
-/// `suld.b`.
+/// `suld.b` at instruction `at` (function, pc).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn suld(
     ctx: &Ctx,
     w: &mut Warp,
     cta: &mut CtaMut,
+    at: (u32, u32),
     geom: TexGeom,
     ty: Ty,
     ds: &[Dst],
@@ -261,7 +260,7 @@ pub(super) fn suld(
             per_lane[l].push((a, eb * ds.len() as u32, eb));
         }
     }
-    observe(cta, w, MemOp::Load, &per_lane);
+    observe(cta, w, at, MemOp::Load, &per_lane);
     let f = w.frames.last_mut().expect("frame");
     for (d, v) in ds.iter().zip(&out) {
         write(f, *d, v, exec);
@@ -272,12 +271,14 @@ pub(super) fn suld(
 /// `sust.b`, and with `red` the reduction `sured.b`: every lane's element is
 /// checked now (out of range, outside every allocation: the lowest such lane
 /// faults) and the operation applied with the CTA's global atomics at the
-/// round's end, in lane order (`atomic::apply_pending`).
+/// round's end, in lane order (`atomic::apply_pending`). `inst`: the
+/// instruction (function, pc).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn sust(
     ctx: &Ctx,
     w: &mut Warp,
     cta: &mut CtaMut,
+    inst: (u32, u32),
     (geom, ty, red): (TexGeom, Ty, Option<AtomOp>),
     vals: &[Src],
     handle: Src,
@@ -310,14 +311,14 @@ pub(super) fn sust(
             let &(l, _, a) = at.iter().find(|&&(_, _, a)| a % eb as u64 != 0).expect("found");
             return Err(fault(FaultKind::Misaligned { space: MemSpace::Global, addr: a, size: eb }, Some(l)));
         }
-        observe(cta, w, MemOp::Reduction, &per_lane);
+        observe(cta, w, inst, MemOp::Reduction, &per_lane);
         let lanes = at.iter().map(|&(l, k, a)| (l as u8, a, vs[k][l], 0)).collect::<Vec<_>>();
         if !lanes.is_empty() {
             cta.pending.push(super::atomic::PendingAtomic { warp: w.id, op, ty, d: None, lanes });
         }
         return Ok(());
     }
-    observe(cta, w, MemOp::Store, &per_lane);
+    observe(cta, w, inst, MemOp::Store, &per_lane);
     // lanes storing to one element: the lowest lane's value stays (the H200's order)
     for &(l, k, ak) in at.iter().rev() {
         if let Some((al, off)) = ctx.mem.find(ak, eb as u64) {
