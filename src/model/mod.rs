@@ -688,6 +688,7 @@ impl ModelStats {
                 ("l1tex__t_requests_pipe_tex_mem_texture.sum", core.textures.requests),
                 ("smsp__inst_executed_op_surface_ld.sum", core.textures.surface_loads),
                 ("smsp__inst_executed_op_surface_st.sum", core.textures.surface_stores),
+                ("smsp__inst_executed_op_surface_red.sum", core.textures.surface_reductions),
                 ("smsp__sass_inst_executed_op_global_ld.sum", m.global_ld.instructions),
                 ("smsp__sass_inst_executed_op_global_st.sum", m.global_st.instructions),
                 ("smsp__sass_inst_executed_op_shared_ld.sum", m.shared_ld.instructions),
