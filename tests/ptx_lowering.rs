@@ -201,7 +201,17 @@ fn validation_names_what_is_wrong() {
         ("sust.p.2d.b32.trap [%rd1, {%r1, %r2}], {%r3};", "`sust.p.2d.b32.trap (modifier .p)`"),
         ("sured.p.add.1d.u32.trap [%rd1, {%r1}], %r3;", "`sured.p.add.1d.u32.trap (modifier .p)`"),
         ("sured.b.xor.1d.b32.trap [%rd1, {%r1}], %r3;", "`sured.b.xor.1d.b32.trap (modifier .xor)`"),
-        ("sured.b.add.1d.b32.trap [%rd1, {%r1}], %r3;", "invalid: `sured.b.add.1d.b32.trap`: .add .min .max take"),
+        (
+            "sured.b.add.1d.b32.trap [%rd1, {%r1}], %r3;",
+            "invalid: `sured.b.add.1d.b32.trap`: .add takes .u32 .u64 .s32,",
+        ),
+        (
+            "sured.b.add.1d.s64.trap [%rd1, {%r1}], %rd1;",
+            "invalid: `sured.b.add.1d.s64.trap`: .add takes .u32 .u64 .s32,",
+        ),
+        ("sured.b.and.1d.b64.trap [%rd1, {%r1}], %rd1;", "invalid: `sured.b.and.1d.b64.trap`: .add takes"),
+        ("sured.b.or.1d.b64.trap [%rd1, {%r1}], %rd1;", "invalid: `sured.b.or.1d.b64.trap`: .add takes"),
+        ("sured.b.min.1d.b32.trap [%rd1, {%r1}], %r3;", "invalid: `sured.b.min.1d.b32.trap`: .add takes"),
         ("sured.b.add.1d.u32.trap [%rd1, {%r1}], {%r3, %r3};", "takes an address and one value"),
         (
             "set.lt.f32.f16x2 %r1, %r2, %r3;",

@@ -168,14 +168,16 @@ pub(super) fn validate(d: &Decoded, i: &ast::Instruction) -> LResult<()> {
                 [t] => *t,
                 _ => return invalid(pos, format!("`{}` needs one type", d.full)),
             };
+            // the PTX ISA's types per operation (`.b64` is `sured.p`'s alone)
             let ok = match op {
-                AtomOp::And | AtomOp::Or => matches!(t, Ty::B32 | Ty::B64),
+                AtomOp::And | AtomOp::Or => t == Ty::B32,
+                AtomOp::Add => matches!(t, Ty::U32 | Ty::U64 | Ty::S32),
                 _ => matches!(t, Ty::U32 | Ty::U64 | Ty::S32 | Ty::S64),
             };
             if !ok {
                 return invalid(
                     pos,
-                    format!("`{}`: .add .min .max take .u32 .u64 .s32 .s64, .and .or .b32 .b64", d.full),
+                    format!("`{}`: .add takes .u32 .u64 .s32, .min .max .u32 .u64 .s32 .s64, .and .or .b32", d.full),
                 );
             }
             if i.operands.len() != 2 || matches!(i.operands[1], Operand::Vector(_)) {
