@@ -434,13 +434,11 @@ impl CtaModel {
                 let one = MemEvent { op, mask: 1 << ev.mask.trailing_zeros(), ..*ev };
                 return self.count_as_written(&one);
             }
-            vectorize::Action::Uniform { red: true, .. }
-                if self.profile == Profile::Hopper && ev.op == MemOp::Atomic =>
-            {
-                let red = MemEvent { op: MemOp::Reduction, ..*ev };
-                return self.count_as_written(&red);
+            // `red` comes only with `full_warp_only: false`, and an atomic event has an
+            // active lane, so every hopper `red` atomic took the arm above
+            vectorize::Action::Uniform { red, full_warp_only } => {
+                debug_assert!(!(red && full_warp_only), "a uniform reduction for full warps only");
             }
-            vectorize::Action::Uniform { .. } => {}
         }
         self.count_as_written(ev)
     }
