@@ -538,6 +538,10 @@ fn render_refuses_options_that_do_not_apply() {
         (vec!["--method", "path", "--estimator", "knn"], "--estimator applies to --method photon-map only"),
         (vec!["--method", "path", "--heuristic", "siroh"], "--heuristic applies to --method raycast only"),
         (vec!["--method", "path", "--json", "x.json"], "--json applies to --method raycast and purcell"),
+        (
+            vec!["--method", "photon-map", "--json", "x.json"],
+            "--json applies to --method raycast and purcell (photon-map",
+        ),
         (vec!["--fmad", "false"], "--fmad applies to emulated kernels; --method raycast --variant native runs none"),
         (vec!["--method", "path", "--device", "hopper"], "--device applies to emulated kernels"),
         (vec!["--method", "path", "--fidelity", "functional"], "--fidelity applies to emulated kernels"),

@@ -240,3 +240,82 @@ fn local_array_per_thread() {
         assert!(s.totals.loads.local + s.totals.stores.local > 0, "{d:?}: the array lives in local memory");
     }
 }
+
+/// Even lanes call `fa`, odd lanes `fb`, through one indirect `call`
+/// preceded by an `st.param` (as clang emits it).
+const ICALL: &str = include_str!("fixtures/icall_divergent.ptx");
+
+/// A divergent indirect call issues the `call` once per target group. Each
+/// issue is counted on the `call`'s line (32 lanes, then the 16 that call
+/// the other target), so the per-line counts add up to the totals.
+#[test]
+fn divergent_indirect_call_counts_every_issue_per_line() {
+    let mut dev = device(2);
+    let m = dev.load_ptx(ICALL, "icall.ptx").unwrap_or_else(|e| panic!("{e}"));
+    let out = dev.alloc_zeroed::<i32>(32);
+    let s = dev.launch(&m, "k", LaunchConfig::linear(1, 32), &[Arg::Ptr(out)]).unwrap();
+    let got = dev.read::<i32>(out, 32);
+    for t in 0..32 {
+        assert_eq!(got[t], t as i32 + if t % 2 == 0 { 1 } else { 2 }, "t={t}");
+    }
+    let lines = s.per_ptx_line(&m.prog);
+    let warp: u64 = lines.iter().map(|l| l.counts.warp_instructions).sum();
+    let thread: u64 = lines.iter().map(|l| l.counts.thread_instructions).sum();
+    assert_eq!((warp, thread), (s.totals.warp_instructions, s.totals.thread_instructions));
+    let call_line = ICALL.lines().position(|l| l.starts_with("call ")).unwrap() as u32 + 1;
+    let call = lines.iter().find(|l| l.line == call_line).expect("the call is counted");
+    assert_eq!((call.counts.warp_instructions, call.counts.thread_instructions), (2, 48));
+}
+
+/// The per-PTX-line warp and thread counts add up to the launch's totals.
+fn assert_lines_add_up(s: &warplight::sim::LaunchStats, m: &warplight::sim::Module, what: &str) {
+    let lines = s.per_ptx_line(&m.prog);
+    let warp: u64 = lines.iter().map(|l| l.counts.warp_instructions).sum();
+    let thread: u64 = lines.iter().map(|l| l.counts.thread_instructions).sum();
+    let pred_on: u64 = lines.iter().map(|l| l.counts.thread_instructions_pred_on).sum();
+    let t = &s.totals;
+    assert_eq!(
+        (warp, thread, pred_on),
+        (t.warp_instructions, t.thread_instructions, t.thread_instructions_pred_on),
+        "{what}"
+    );
+}
+
+/// Over the control-flow kernels in both dialects (divergence, early
+/// returns, loops, direct, recursive and indirect calls with lanes calling
+/// different functions), every issued instruction is on some line.
+#[test]
+fn per_line_counts_add_up_to_the_totals() {
+    for d in BOTH {
+        let mut dev = device(2);
+        let m = load(&mut dev, "divergence", d);
+        let [a, b, c] = [0; 3].map(|_| dev.alloc_zeroed::<i32>(2048));
+        let lim = dev.alloc_from(&(0..64).map(|i| i % 9).collect::<Vec<i32>>());
+        for (k, args) in [
+            ("if_else", vec![Arg::Ptr(a), Arg::Ptr(b)]),
+            ("nested_if", vec![Arg::Ptr(a), Arg::Ptr(b), Arg::Ptr(c)]),
+            ("loop_break_continue", vec![Arg::Ptr(a), Arg::Ptr(lim)]),
+            ("early_return", vec![Arg::Ptr(a), Arg::I32(70)]),
+        ] {
+            let s = dev.launch(&m, k, LaunchConfig::linear(2, 64), &args).unwrap();
+            assert_lines_add_up(&s, &m, &format!("{k} {d:?}"));
+        }
+        let m = load(&mut dev, "calls", d);
+        for k in ["call_divergent", "recursive_fib"] {
+            let s = dev.launch(&m, k, LaunchConfig::linear(2, 32), &[Arg::Ptr(a)]).unwrap();
+            assert_lines_add_up(&s, &m, &format!("{k} {d:?}"));
+        }
+        let m = load(&mut dev, "indirect", d);
+        let x = dev.alloc_from(&(0..64).map(|i| i as f32 * 0.5).collect::<Vec<f32>>());
+        let out = dev.alloc_zeroed::<f32>(64);
+        for (k, args) in [
+            ("call_table", vec![Arg::Ptr(x), Arg::Ptr(x), Arg::Ptr(out), Arg::I32(64)]),
+            ("call_select", vec![Arg::Ptr(x), Arg::Ptr(out), Arg::I32(64)]),
+            ("call_virtual", vec![Arg::Ptr(x), Arg::Ptr(out), Arg::I32(64)]),
+        ] {
+            let s = dev.launch(&m, k, LaunchConfig::linear(2, 32), &args).unwrap();
+            assert!(s.totals.calls > 2, "{k}: lanes call different functions");
+            assert_lines_add_up(&s, &m, &format!("{k} {d:?}"));
+        }
+    }
+}

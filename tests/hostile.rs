@@ -501,3 +501,30 @@ fn an_unsized_first_dimension_comes_from_the_initializer() {
     let u = p.globals.iter().find(|g| g.name == "u").unwrap();
     assert_eq!((u.size, &u.init[..]), (8, &[1u8, 0, 2, 0, 3, 0, 4, 0][..]));
 }
+
+/// Nested braces with fewer elements than their row are padded with zeros
+/// row by row, as C pads them (`t[2][2] = {{1},{2}}` is `{1, 0, 2, 0}`),
+/// also under an unsized first dimension; a row with more elements than it
+/// holds is an error naming the variable, not a reshape.
+#[test]
+fn nested_initializer_braces_are_padded_per_row() {
+    let ptx = module(
+        ".global .u32 t[2][2] = {{1},{2}};\n.global .u32 s[][2] = {{1},{2}};\n\
+         .global .u16 u[2][2][2] = {{{1}, {2, 3}}, {{4}}};\n.global .f32 f[2][2] = {{1.0}, {2.0}};\n\
+         .visible .entry k()\n{\nret;\n}\n",
+    );
+    let p = warplight::ptx::load(&ptx, "nested.ptx").unwrap();
+    let words = |name: &str| {
+        let g = p.globals.iter().find(|g| g.name == name).unwrap();
+        (g.size, g.init.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().unwrap())).collect::<Vec<u32>>())
+    };
+    assert_eq!(words("t"), (16, vec![1, 0, 2, 0]));
+    assert_eq!(words("s"), (16, vec![1, 0, 2, 0]));
+    assert_eq!(words("f"), (16, vec![1.0f32.to_bits(), 0, 2.0f32.to_bits(), 0]));
+    let u = p.globals.iter().find(|g| g.name == "u").unwrap();
+    let halves: Vec<u16> = u.init.chunks_exact(2).map(|b| u16::from_le_bytes(b.try_into().unwrap())).collect();
+    assert_eq!((u.size, halves), (16, vec![1, 0, 2, 3, 4, 0, 0, 0]));
+    let bad = module(".global .u32 t[2][2] = {{1, 2, 3}, {4}};\n.visible .entry k()\n{\nret;\n}\n");
+    let e = warplight::ptx::load(&bad, "bad.ptx").unwrap_err().to_string();
+    assert!(e.contains("`t` holds 3 elements; it has room for 2"), "{e}");
+}

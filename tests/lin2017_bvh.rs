@@ -193,3 +193,15 @@ fn the_emulated_refit_with_atomics_equals_the_serial_refit_with_two_arrivals_per
     let e = bvh::refit_kernel(&mut dev, &module, &b, &REST[..1]).unwrap_err();
     assert!(e.to_string().contains("belongs to object 1"), "{e}");
 }
+
+/// Object ids number the objects densely from 0: a sparse id (`u32::MAX`,
+/// which would ask for 2^32 translations) is a typed error naming the
+/// triangle, not an abort.
+#[test]
+fn a_sparse_object_id_is_refused() {
+    let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let e = Bvh::build(&[tri, tri], &[0, u32::MAX]).unwrap_err();
+    assert!(matches!(e, bvh::BvhError::SparseObject { triangle: 1, object: u32::MAX, triangles: 2 }), "{e}");
+    assert!(e.to_string().contains("triangle 1 belongs to object 4294967295"), "{e}");
+    Bvh::build(&[tri, tri], &[1, 0]).unwrap();
+}

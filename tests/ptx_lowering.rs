@@ -208,6 +208,9 @@ fn validation_names_what_is_wrong() {
         ("sured.b.add.1d.b32.trap [%rd1, {%r1}], %r3;", "invalid: `sured.b.add.1d.b32.trap`: ptxas takes .add on"),
         ("sured.b.min.1d.u64.trap [%rd1, {%r1}], %rd3;", "invalid: `sured.b.min.1d.u64.trap`: ptxas takes"),
         ("sured.b.or.1d.b64.trap [%rd1, {%r1}], %rd3;", "invalid: `sured.b.or.1d.b64.trap`: ptxas takes"),
+        ("sured.b.add.1d.s64.trap [%rd1, {%r1}], %rd1;", "invalid: `sured.b.add.1d.s64.trap`: ptxas takes"),
+        ("sured.b.and.1d.b64.trap [%rd1, {%r1}], %rd1;", "invalid: `sured.b.and.1d.b64.trap`: ptxas takes"),
+        ("sured.b.min.1d.b32.trap [%rd1, {%r1}], %r3;", "invalid: `sured.b.min.1d.b32.trap`: ptxas takes"),
         ("sured.b.add.1d.u32.trap [%rd1, {%r1}], {%r3, %r3};", "takes an address and one value"),
         (
             "set.lt.f32.f16x2 %r1, %r2, %r3;",

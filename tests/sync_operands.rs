@@ -330,6 +330,190 @@ fn redux_and_match_compute_each_member_group() {
     // lanes 0-15 name the whole warp, lanes 16-31 only themselves: undefined, a fault naming lane 16
     let e = groups(16, u32::MAX, 0xFFFF_0000).unwrap_err();
     let SimError::Fault(f) = e else { panic!("{e:?}") };
-    assert!(matches!(f.kind, FaultKind::MemberMask { mask: 0xFFFF_0000, .. }), "{f}");
+    assert_eq!(
+        f.kind,
+        FaultKind::MemberMaskDiffers { mask: 0xFFFF_0000, other: 0, other_mask: u32::MAX, active: u32::MAX },
+        "{f}"
+    );
     assert_eq!((f.lane, f.ptx_line), (Some(16), 18), "{f}");
+    let msg = f.to_string();
+    assert!(msg.contains("differs from the mask 0xffffffff of lane 0"), "{msg}");
+    assert!(!msg.contains("lane 32") && !msg.contains("leaves out"), "{msg}");
+}
+
+/// Lane 1 holds member mask 3, every other lane the whole warp (which names
+/// lane 1): a fault naming lane 1 and the mask that differs, as the fault
+/// and as synccheck's finding (one message, no run of spaces).
+#[test]
+fn a_member_mask_differing_from_the_mask_naming_its_lane_is_named_as_such() {
+    let src = format!("{HEAD}{GROUPS}").replace("setp.lt.u32 %p1, %r1, %r2;", "setp.eq.u32 %p1, %r1, 1;");
+    let mut dev = device();
+    let m = dev.load_ptx(&src, "groups.ptx").unwrap();
+    let out = dev.alloc_zeroed::<u32>(64);
+    let args = [Arg::Ptr(out), Arg::U32(0), Arg::U32(3), Arg::U32(u32::MAX)];
+    let f = fault_of(dev.launch(&m, "groups", LaunchConfig::linear(1, 32), &args));
+    assert_eq!(f.lane, Some(1), "{f}");
+    assert!(matches!(f.kind, FaultKind::MemberMaskDiffers { mask: 3, other: 0, .. }), "{f}");
+    let msg = f.to_string();
+    assert!(msg.contains("member mask 0x00000003 differs from the mask 0xffffffff of lane 0"), "{msg}");
+    // through `warplight check`
+    let reports = checked(&src, "groups", &args[1..], 64);
+    assert_eq!(reports.len(), 1, "{reports:?}");
+    let note = &reports[0].note;
+    assert!(note.contains("of lane 1 of warp 0 differs from the mask 0xffffffff of lane 0"), "{note}");
+    assert!(!note.contains("  "), "{note}");
+}
+
+/// Runs `kernel` of `src` (its first parameter a `u32` output of `n`
+/// elements, then `args`) on one warp under every checking tool; the reports.
+fn checked(src: &str, kernel: &str, args: &[Arg], n: usize) -> Vec<warplight::check::Report> {
+    let mut dev = device();
+    let m = dev.load_ptx(src, "checked.ptx").unwrap();
+    let out = dev.alloc_zeroed::<u32>(n);
+    let mut all = vec![Arg::Ptr(out)];
+    all.extend_from_slice(args);
+    let opts = warplight::check::CheckOptions {
+        tools: warplight::check::Tools::ALL,
+        uninit: Vec::new(),
+        elem_sizes: Vec::new(),
+    };
+    let c =
+        warplight::check::launch_checked(&mut dev, &m, kernel, LaunchConfig::linear(1, 32), &all, &opts, None).unwrap();
+    c.reports
+}
+
+/// Each lane writes `s[tid]`, passes `bar.warp.sync` under `lo` (lanes
+/// 0-15) or `hi` (lanes 16-31), and reads its neighbour's `s[tid ^ 1]`.
+const SYNC_PAIRS: &str = "
+.visible .entry pairs(.param .u64 out, .param .u32 lo, .param .u32 hi)
+{
+.reg .pred %p<2>;
+.reg .b32 %r<12>;
+.reg .b64 %rd<8>;
+.shared .align 4 .b32 s[32];
+ld.param.u64 %rd1, [out];
+ld.param.u32 %r10, [lo];
+ld.param.u32 %r11, [hi];
+mov.u32 %r1, %tid.x;
+setp.lt.u32 %p1, %r1, 16;
+selp.b32 %r2, %r10, %r11, %p1;
+shl.b32 %r3, %r1, 2;
+mov.u32 %r4, s;
+add.u32 %r5, %r4, %r3;
+st.shared.u32 [%r5], %r1;
+bar.warp.sync %r2;
+xor.b32 %r6, %r1, 1;
+shl.b32 %r7, %r6, 2;
+add.u32 %r8, %r4, %r7;
+ld.shared.u32 %r9, [%r8];
+mul.wide.u32 %rd2, %r1, 4;
+add.s64 %rd3, %rd1, %rd2;
+st.global.u32 [%rd3], %r9;
+ret;
+}
+";
+
+/// `__syncwarp(0x0000ffff)` in lanes 0-15 and `__syncwarp(0xffff0000)` in
+/// lanes 16-31, in one instruction, order each half's writes before its
+/// reads: no race. Masks that leave the pairs' order to the hardware race.
+#[test]
+fn per_half_warp_syncs_order_each_halfs_accesses_for_racecheck() {
+    let src = format!("{HEAD}{SYNC_PAIRS}");
+    let reports = checked(&src, "pairs", &[Arg::U32(0xFFFF), Arg::U32(0xFFFF_0000)], 32);
+    assert!(reports.is_empty(), "{reports:?}");
+    let reports = checked(&src, "pairs", &[Arg::U32(u32::MAX), Arg::U32(u32::MAX)], 32);
+    assert!(reports.is_empty(), "{reports:?}");
+    // each lane in a group of its own (lanes 0-15 under 0x1ffff pass with the others of
+    // that mask; lane 16 with lanes 17-31): lanes 15 and 16 are not a pair, nothing races
+    let reports = checked(&src, "pairs", &[Arg::U32(0x1_FFFF), Arg::U32(0xFFFF_0000)], 32);
+    assert!(reports.is_empty(), "{reports:?}");
+    // the same kernel without the sync: every read races with its neighbour's write
+    let unsynced = src.replace("bar.warp.sync %r2;", "");
+    let reports = checked(&unsynced, "pairs", &[Arg::U32(0xFFFF), Arg::U32(0xFFFF_0000)], 32);
+    assert!(reports.iter().any(|r| r.hazard == warplight::check::Hazard::ReadAfterWrite), "{reports:?}");
+}
+
+/// Lanes 0-15 pass `__syncwarp(0xffff)`; all lanes read `s[0]` in one
+/// instruction; the whole warp passes `__syncwarp()`; lane 31 writes `s[0]`:
+/// every read is ordered before the write.
+const LANE_CLOCKS: &str = "
+.visible .entry lclock(.param .u64 out)
+{
+.reg .pred %p<3>;
+.reg .b32 %r<12>;
+.reg .b64 %rd<8>;
+.shared .align 4 .b32 s[1];
+ld.param.u64 %rd1, [out];
+mov.u32 %r1, %tid.x;
+mov.u32 %r4, s;
+setp.eq.u32 %p2, %r1, 0;
+@%p2 st.shared.u32 [%r4], 5;
+bar.sync 0;
+setp.lt.u32 %p1, %r1, 16;
+@!%p1 bra SKIP;
+bar.warp.sync 65535;
+SKIP:
+ld.shared.u32 %r9, [%r4];
+bar.warp.sync -1;
+setp.eq.u32 %p2, %r1, 31;
+@%p2 st.shared.u32 [%r4], 7;
+mul.wide.u32 %rd2, %r1, 4;
+add.s64 %rd3, %rd1, %rd2;
+st.global.u32 [%rd3], %r9;
+ret;
+}
+";
+
+#[test]
+fn a_read_after_a_partial_warp_sync_is_ordered_by_a_full_one() {
+    let src = format!("{HEAD}{LANE_CLOCKS}");
+    let reports = checked(&src, "lclock", &[], 32);
+    assert!(reports.is_empty(), "{reports:?}");
+    // without the full sync, lane 31's write races with the other lanes' reads
+    let reports = checked(&src.replace("bar.warp.sync -1;", ""), "lclock", &[], 32);
+    assert!(reports.iter().any(|r| r.hazard == warplight::check::Hazard::WriteAfterRead), "{reports:?}");
+}
+
+/// `vote.sync.ballot` with lanes 0-15 naming `0x0000ffff` and lanes 16-31
+/// `0xffff0000`: two ballots, each of its own lanes' votes.
+const VOTE_GROUPS: &str = "
+.visible .entry vote_groups(.param .u64 out, .param .u32 lo, .param .u32 hi)
+{
+.reg .pred %p<3>;
+.reg .b32 %r<8>;
+.reg .b64 %rd<4>;
+ld.param.u64 %rd1, [out];
+ld.param.u32 %r3, [lo];
+ld.param.u32 %r4, [hi];
+mov.u32 %r1, %tid.x;
+setp.lt.u32 %p1, %r1, 16;
+selp.b32 %r5, %r3, %r4, %p1;
+and.b32 %r6, %r1, 1;
+setp.eq.u32 %p2, %r6, 1;
+vote.sync.ballot.b32 %r2, %p2, %r5;
+mul.wide.u32 %rd2, %r1, 4;
+add.s64 %rd3, %rd1, %rd2;
+st.global.u32 [%rd3], %r2;
+ret;
+}
+";
+
+#[test]
+fn vote_ballots_over_each_member_group_and_faults_on_differing_masks() {
+    let run = |lo: u32, hi: u32| {
+        let mut dev = device();
+        let m = dev.load_ptx(&format!("{HEAD}{VOTE_GROUPS}"), "vote.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(32);
+        let r =
+            dev.launch(&m, "vote_groups", LaunchConfig::linear(1, 32), &[Arg::Ptr(out), Arg::U32(lo), Arg::U32(hi)]);
+        r.map(|_| dev.read::<u32>(out, 32))
+    };
+    let want: Vec<u32> = (0..32).map(|l| if l < 16 { 0xAAAA } else { 0xAAAA_0000 }).collect();
+    assert_eq!(run(0xFFFF, 0xFFFF_0000).unwrap(), want);
+    assert_eq!(run(u32::MAX, u32::MAX).unwrap(), vec![0xAAAA_AAAA; 32]);
+    // lanes 0-15 name the whole warp, lanes 16-31 only themselves: undefined, a fault at lane 16
+    let e = run(u32::MAX, 0xFFFF_0000).unwrap_err();
+    let SimError::Fault(f) = e else { panic!("{e:?}") };
+    assert!(matches!(f.kind, FaultKind::MemberMaskDiffers { mask: 0xFFFF_0000, other: 0, .. }), "{f}");
+    assert_eq!(f.lane, Some(16));
 }

@@ -531,6 +531,52 @@ fn texture_spec_errors_name_the_key() {
     assert!(e.to_string().contains("`args[0]`: `tex` is a texture or surface object: it takes no offset"), "{e}");
 }
 
+/// The launch spec refuses exactly the read modes and filters the API
+/// refuses (one rule, `read_setting_error`), naming the setting at fault.
+#[test]
+fn spec_and_api_agree_on_read_modes_and_filters() {
+    use warplight::launch_spec::Spec;
+    use warplight::sim::texture::{ReadSetting, read_setting_error};
+    use {FilterMode::*, ReadMode::*, TexelFormat::*};
+    let formats =
+        [(U8, "u8"), (S8, "s8"), (U16, "u16"), (S16, "s16"), (U32, "u32"), (S32, "s32"), (F16, "f16"), (F32, "f32")];
+    for (format, fname) in formats {
+        for (filter, filter_name) in [(Point, "point"), (Linear, "linear")] {
+            for (read, read_name) in [(ElementType, "element"), (NormalizedFloat, "normalized")] {
+                let desc = TextureDesc {
+                    data: DevicePtr(0x1000),
+                    format,
+                    channels: 1,
+                    dims: [8, 0, 0],
+                    row_pitch: 0,
+                    linear: false,
+                    addr: [AddressMode::Clamp; 3],
+                    filter,
+                    read,
+                    normalized: false,
+                };
+                let api = desc.validate(|_, _| true).err();
+                let spec = format!(
+                    "ptx = \"a.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\nargs = [\"tex\"]\n\
+                     [[buffer]]\nname = \"t\"\ntype = \"f32\"\nlen = 8\n[[texture]]\nname = \"tex\"\n\
+                     buffer = \"t\"\nformat = \"{fname}\"\nwidth = 8\nfilter = \"{filter_name}\"\nread = \"{read_name}\"\n"
+                );
+                let spec = Spec::parse(&spec, std::path::Path::new("s.toml")).err().map(|e| e.to_string());
+                let case = format!("{fname} {filter_name} {read_name}");
+                match read_setting_error(format, filter, read) {
+                    None => assert_eq!((api, spec), (None, None), "{case}"),
+                    Some((setting, why)) => {
+                        let key = if setting == ReadSetting::Read { "read" } else { "filter" };
+                        assert_eq!(api.as_deref(), Some(why), "{case}");
+                        let spec = spec.unwrap_or_else(|| panic!("{case}: the spec accepts it"));
+                        assert!(spec.contains(&format!("`texture[0].{key}`: {why}")), "{case}: {spec}");
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// `sured.b` on a 2-D surface of 4 × 4 words: each of 64 threads applies
 /// its value at (tid % 4, tid / 4 % 4), so every element takes four
 /// lanes' values (two warps); compared with the operation in Rust.
@@ -559,7 +605,10 @@ fn surface_reductions_combine_every_lane_in_place() {
         let m = dev.load_ptx(&ptx(op, ty), "sured.ptx").unwrap();
         let data = dev.alloc_from(&init);
         let h = dev.create_surface(SurfaceDesc { data, elem_bytes: 4, dims: [4, 4, 0], row_pitch: 0 }).unwrap();
-        dev.launch(&m, "k", LaunchConfig::linear(1, 64), &[Arg::U64(h)]).unwrap();
+        let s = dev.launch(&m, "k", LaunchConfig::linear(1, 64), &[Arg::U64(h)]).unwrap();
+        // one reduction per warp, counted apart from the stores
+        let t = &s.totals.textures;
+        assert_eq!((t.surface_reductions, t.surface_stores), (2, 0), "sured.b.{op}.{ty}");
         let mut want = init.clone();
         for t in 0..64u32 {
             let e = (t / 4 % 4 * 4 + t % 4) as usize;

@@ -113,8 +113,9 @@ pub enum Hazard {
     BarrierDeadlock,
     /// A warp-synchronous instruction (`bar.warp.sync`, `shfl.sync`,
     /// `vote.sync`, `redux.sync`, `match.sync`) whose member mask leaves out
-    /// a lane executing it, names a live lane not executing it, or differs
-    /// between lanes it names: undefined in PTX.
+    /// a lane executing it, or (all but `bar.warp.sync`, which does not wait
+    /// for lanes on another path) names a live lane not executing it or
+    /// differs between lanes it names: undefined in PTX.
     InvalidMemberMask,
 }
 

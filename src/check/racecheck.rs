@@ -26,8 +26,8 @@ pub struct Acc {
     pub lanes: u32,
     /// The warp's own clock when it accessed.
     pub clock: u32,
-    /// The largest of the lanes' own clocks among their warp's lanes when
-    /// they accessed ([`Clocks::lane_clock`]).
+    /// The lanes' own clock among their warp's lanes when they accessed
+    /// ([`Clocks::lane_clock`]; the same for every lane of a slot).
     pub lane_clock: u32,
     /// The warp's memory-instruction count (same value: same instruction).
     pub seq: u32,
@@ -233,19 +233,22 @@ pub enum Kind {
 }
 
 /// Records the read `x` (one lane) among a byte's reads: the same
-/// instruction's other lanes take it in, reads ordered before it are
+/// instruction's other lanes at the same lane clock take it in (so a slot's
+/// `lane_clock` is exact for each of its lanes), reads ordered before it are
 /// forgotten (whatever races with them races with `x` or was reported), and
 /// the oldest read is merged into [`Lost`] when both slots hold reads that
-/// may still race.
+/// may still race. The same instruction's lanes at another lane clock (a
+/// partial `__syncwarp` before it) are kept, not forgotten: they are not
+/// ordered before `x`, only not racing with it.
 fn add_read(clocks: &Clocks, cell: &mut Cell, x: Acc) {
     let (warp, lane) = (x.warp as u32, x.lanes.trailing_zeros());
-    if let Some(g) = cell.reads.iter_mut().find(|g| g.is_some() && g.warp == x.warp && g.seq == x.seq) {
+    let same_inst = |g: &Acc| g.is_some() && g.warp == x.warp && g.seq == x.seq;
+    if let Some(g) = cell.reads.iter_mut().find(|g| same_inst(g) && g.lane_clock == x.lane_clock) {
         g.lanes |= x.lanes;
-        g.lane_clock = g.lane_clock.max(x.lane_clock);
         return;
     }
     for g in &mut cell.reads {
-        if clocks.concurrent(g, warp, lane, x.seq) == 0 {
+        if !same_inst(g) && clocks.concurrent(g, warp, lane, x.seq) == 0 {
             *g = Acc::EMPTY;
         }
     }
@@ -440,6 +443,31 @@ mod tests {
         }
         c.warp_sync(0, u32::MAX);
         assert_eq!(access(&c, &mut cell, Kind::Write, acc(0, 31, &c, 2)), [None, None]);
+    }
+
+    #[test]
+    fn a_read_by_lanes_at_different_lane_clocks_orders_each_before_a_full_warp_sync() {
+        // lanes 0-15 pass __syncwarp(0xFFFF); all 32 lanes read s[0] in one instruction;
+        // the whole warp passes __syncwarp(); lane 31 writes: every read is ordered before it
+        let mut c = Clocks::new(1);
+        let mut cell = Cell::default();
+        c.warp_sync(0, 0xFFFF);
+        for lane in 0..32 {
+            assert_eq!(access(&c, &mut cell, Kind::Read, acc(0, lane, &c, 1)), [None, None]);
+        }
+        c.warp_sync(0, u32::MAX);
+        assert_eq!(access(&c, &mut cell, Kind::Write, acc(0, 31, &c, 2)), [None, None]);
+        // the read takes one slot per lane clock, each exact for its lanes
+        let mut c = Clocks::new(1);
+        let mut cell = Cell::default();
+        c.warp_sync(0, 0xFFFF);
+        for lane in 0..32 {
+            access(&c, &mut cell, Kind::Read, acc(0, lane, &c, 1));
+        }
+        assert_eq!(cell.reads.map(|r| (r.lanes, r.lane_clock)), [(0xFFFF, 2), (0xFFFF_0000, 1)]);
+        // without the full sync, lane 31 has learnt of no other lane's read: they race
+        let h = access(&c, &mut cell, Kind::Write, acc(0, 31, &c, 2));
+        assert_eq!(war(h), Some((0, 0xFFFF)));
     }
 
     #[test]

@@ -76,16 +76,29 @@ pub fn from_fault(f: &Fault, names: &Names, at: Pc, cta: u32) -> Option<Report> 
             let lane = f.lane.unwrap_or(active.trailing_zeros());
             let why = if mask >> lane & 1 == 0 {
                 format!("leaves out lane {lane}, which executes it")
-            } else if mask & live & !active != 0 {
-                format!("names lanes {} that do not execute it with the others", lanes_of(mask & live & !active))
             } else {
-                "differs from the masks of lanes it names".to_string()
+                format!("names lanes {} that do not execute it with the others", lanes_of(mask & live & !active))
             };
             (
                 Hazard::InvalidMemberMask,
                 *active,
                 format!(
-                    "member mask {mask:#010x} of lane {lane} of warp {} {why} (executing lanes {});                      undefined in PTX (warplight stops here)",
+                    "member mask {mask:#010x} of lane {lane} of warp {} {why} (executing lanes {}); \
+                     undefined in PTX (warplight stops here)",
+                    f.warp,
+                    lanes_of(*active)
+                ),
+            )
+        }
+        FaultKind::MemberMaskDiffers { mask, other, other_mask, active } => {
+            let lane = f.lane.unwrap_or(active.trailing_zeros());
+            (
+                Hazard::InvalidMemberMask,
+                *active,
+                format!(
+                    "member mask {mask:#010x} of lane {lane} of warp {} differs from the mask {other_mask:#010x} \
+                     of lane {other}, which names lane {lane} (executing lanes {}); undefined in PTX (warplight \
+                     stops here)",
                     f.warp,
                     lanes_of(*active)
                 ),

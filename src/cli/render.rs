@@ -216,8 +216,8 @@ fn check_applicable(a: &RenderArgs) -> Result<(), String> {
     if m != "raycast" && a.heuristic != "sah" {
         return Err(format!("--heuristic applies to --method raycast only ({m} builds its own tree)"));
     }
-    if m == "path" && a.json.is_some() {
-        return Err("--json applies to --method raycast and purcell (the path tracer writes no counters)".into());
+    if !matches!(m, "raycast" | "purcell") && a.json.is_some() {
+        return Err(format!("--json applies to --method raycast and purcell ({m} writes no counters)"));
     }
     // natively, raycast and path run no kernel (purcell's native variant still emulates the map passes)
     if matches!(m, "raycast" | "path") && a.variant == "native" {

@@ -28,7 +28,9 @@
 
 use super::{BufferSpec, Ctx, SpecError};
 use crate::sim::DevicePtr;
-use crate::sim::texture::{AddressMode, FilterMode, Object, ReadMode, SurfaceDesc, TexelFormat, TextureDesc};
+use crate::sim::texture::{
+    AddressMode, FilterMode, Object, ReadMode, ReadSetting, SurfaceDesc, TexelFormat, TextureDesc, read_setting_error,
+};
 
 /// The keys of a `[[texture]]` table.
 const TEXTURE_KEYS: [&str; 13] = [
@@ -260,15 +262,12 @@ impl Ctx<'_> {
                 "wrap and mirror need normalized_coords = true (CUDA supports them with normalized coordinates only)",
             );
         }
-        if read == ReadMode::NormalizedFloat && !lay.format.is_small_int() {
-            return self.err(&k("read"), "normalized reads are for 8- and 16-bit integer formats");
-        }
-        if filter == FilterMode::Linear && !lay.format.is_float() && read != ReadMode::NormalizedFloat {
-            return self.err(
-                &k("filter"),
-                "linear filtering needs float texels: an f16 or f32 format, or read = \"normalized\" \
-                 (CUDA rejects linear filtering of a non-float texture)",
-            );
+        if let Some((setting, why)) = read_setting_error(lay.format, filter, read) {
+            let key = match setting {
+                ReadSetting::Read => "read",
+                ReadSetting::Filter => "filter",
+            };
+            return self.err(&k(key), why);
         }
         if linear && lay.dims[1] != 0 {
             return self.err(&k("linear"), "a linear-memory texture is 1-D (no height)");

@@ -434,13 +434,11 @@ impl CtaModel {
                 let one = MemEvent { op, mask: 1 << ev.mask.trailing_zeros(), ..*ev };
                 return self.count_as_written(&one);
             }
-            vectorize::Action::Uniform { red: true, .. }
-                if self.profile == Profile::Hopper && ev.op == MemOp::Atomic =>
-            {
-                let red = MemEvent { op: MemOp::Reduction, ..*ev };
-                return self.count_as_written(&red);
+            // `red` comes only with `full_warp_only: false`, and an atomic event has an
+            // active lane, so every hopper `red` atomic took the arm above
+            vectorize::Action::Uniform { red, full_warp_only } => {
+                debug_assert!(!(red && full_warp_only), "a uniform reduction for full warps only");
             }
-            vectorize::Action::Uniform { .. } => {}
         }
         self.count_as_written(ev)
     }
@@ -688,6 +686,7 @@ impl ModelStats {
                 ("l1tex__t_requests_pipe_tex_mem_texture.sum", core.textures.requests),
                 ("smsp__inst_executed_op_surface_ld.sum", core.textures.surface_loads),
                 ("smsp__inst_executed_op_surface_st.sum", core.textures.surface_stores),
+                ("smsp__inst_executed_op_surface_red.sum", core.textures.surface_reductions),
                 ("smsp__sass_inst_executed_op_global_ld.sum", m.global_ld.instructions),
                 ("smsp__sass_inst_executed_op_global_st.sum", m.global_st.instructions),
                 ("smsp__sass_inst_executed_op_shared_ld.sum", m.shared_ld.instructions),

@@ -387,7 +387,14 @@ impl<'a> Parser<'a> {
         let mut init_syms = Vec::new();
         if self.eat_punct('=') {
             let mut vals = Vec::new();
-            self.initializer(&mut vals, &mut init_syms)?;
+            // the elements a brace at each depth stands for: the whole array (left to the
+            // layout), a row of the dimensions after it, ..., one vector, one element
+            let mut rows: Vec<Option<u64>> = vec![None];
+            let levels: Vec<Option<u64>> = dims.iter().skip(1).copied().chain(vector.map(|n| Some(n as u64))).collect();
+            for k in 0..levels.len() {
+                rows.push(levels[k..].iter().try_fold(1u64, |a, d| a.checked_mul((*d)?)));
+            }
+            self.initializer(&mut vals, &mut init_syms, (&name, &rows, 0))?;
             // `t[] = {..}`, `t[][2] = {..}`: the first dimension from the initializer's
             // elements over the other dimensions' (the last row filled with zeros)
             if dims.first() == Some(&None) && dims[1..].iter().all(Option::is_some) {
@@ -401,18 +408,48 @@ impl<'a> Parser<'a> {
         Ok(VarDecl { space, align, vector, ty, name, range, dims, init, init_syms, is_extern: false, pos })
     }
 
-    fn initializer(&mut self, out: &mut Vec<Literal>, syms: &mut Vec<(usize, String)>) -> PResult<()> {
+    /// Reads an initializer into `out`, flattened. A nested brace at depth
+    /// `d` stands for `rows[d]` elements (one beyond the list: a single
+    /// element): fewer are padded with zeros, as C pads `t[2][2] = {{1},{2}}`
+    /// to `{1, 0, 2, 0}`; more are an error. `(name, rows, depth)`.
+    fn initializer(
+        &mut self,
+        out: &mut Vec<Literal>,
+        syms: &mut Vec<(usize, String)>,
+        (name, rows, depth): (&str, &[Option<u64>], usize),
+    ) -> PResult<()> {
         let pos = self.pos();
         if self.eat_punct('{') {
+            let start = out.len();
             self.nested(pos, "initializer braces", |p| {
                 if !p.is_punct('}') {
-                    p.initializer(out, syms)?;
+                    p.initializer(out, syms, (name, rows, depth + 1))?;
                     while p.eat_punct(',') {
-                        p.initializer(out, syms)?;
+                        p.initializer(out, syms, (name, rows, depth + 1))?;
                     }
                 }
                 p.expect_punct('}')
-            })
+            })?;
+            let Some(n) = (if depth == 0 { None } else { rows.get(depth).copied().unwrap_or(Some(1)) }) else {
+                return Ok(());
+            };
+            let got = (out.len() - start) as u64;
+            if got > n {
+                return Err((
+                    pos,
+                    PtxErrorKind::Invalid(format!(
+                        "an initializer brace of `{name}` holds {got} elements; it has room for {n}"
+                    )),
+                ));
+            }
+            let len = start as u64 + n;
+            crate::limits::check_memory(
+                || format!("the initializer of `{name}` padded to whole rows"),
+                len.saturating_mul(std::mem::size_of::<Literal>() as u64),
+            )
+            .map_err(|e| (pos, PtxErrorKind::Limit(e.to_string())))?;
+            out.resize(len as usize, Literal::Int(0));
+            Ok(())
         } else {
             let pos = self.pos();
             // a symbol's address (`{_Z4addfff, ...}`): resolved by the lowering

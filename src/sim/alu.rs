@@ -607,7 +607,9 @@ pub fn compare(cmp: Cmp, ty: Ty, ftz: bool, a: u64, b: u64) -> bool {
             (in32(a, ftz) as f64, in32(b, ftz) as f64)
         } else if half::is_half(ty) {
             let bf = ty == Ty::BF16;
-            (half::to_f64(a as u16, bf), half::to_f64(b as u16, bf))
+            // `.ftz` flushes subnormal `.f16` inputs to signed zero, as the half arithmetic does
+            let h = |x: u64| if ftz && !bf && half::is_subnormal(x as u16, bf) { x as u16 & 0x8000 } else { x as u16 };
+            (half::to_f64(h(a), bf), half::to_f64(h(b), bf))
         } else {
             (f64::from_bits(a), f64::from_bits(b))
         };

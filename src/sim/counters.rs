@@ -86,6 +86,9 @@ pub struct TextureCounts {
     pub surface_loads: u64,
     /// `sust` (`smsp__inst_executed_op_surface_st`).
     pub surface_stores: u64,
+    /// `sured` (`smsp__inst_executed_op_surface_red`): surface reductions,
+    /// not counted as stores.
+    pub surface_reductions: u64,
 }
 
 /// Counts per memory space (generic accesses are counted in the space they resolve to
@@ -133,6 +136,7 @@ impl Counters {
         add!(textures.queries);
         add!(textures.surface_loads);
         add!(textures.surface_stores);
+        add!(textures.surface_reductions);
         add!(ctas);
         add!(warps);
     }
@@ -292,6 +296,7 @@ pub const NCU_ALIASES: &[(&str, &str)] = &[
     ("l1tex__t_requests_pipe_tex_mem_texture.sum", "textures.requests"),
     ("smsp__inst_executed_op_surface_ld.sum", "textures.surface_loads"),
     ("smsp__inst_executed_op_surface_st.sum", "textures.surface_stores"),
+    ("smsp__inst_executed_op_surface_red.sum", "textures.surface_reductions"),
 ];
 
 impl Counters {

@@ -211,7 +211,9 @@ impl Op {
 /// targets, the instruction after a branch, `ret`, `exit` or `trap`; every
 /// reconvergence point is a branch target's or a fall-through's block), and
 /// also the instruction after a `call`, where a callee's `exit` may have
-/// removed lanes. Nothing else changes a running path's lanes: divergence
+/// removed lanes. Every indirect `call` starts a block too: lanes whose
+/// target differs issue it again, each group as its own block entry.
+/// Nothing else changes a running path's lanes: divergence
 /// and reconvergence happen at branches and at block starts.
 pub fn counting_leaders(insts: &[Inst]) -> Vec<bool> {
     let n = insts.len();
@@ -227,8 +229,11 @@ pub fn counting_leaders(insts: &[Inst]) -> Vec<bool> {
                 }
                 leader[pc + 1] = true;
             }
-            Kind::Ret | Kind::Exit | Kind::Trap | Kind::Call { .. } | Kind::CallIndirect { .. } => {
-                leader[pc + 1] = true
+            Kind::Ret | Kind::Exit | Kind::Trap | Kind::Call { .. } => leader[pc + 1] = true,
+            // lanes calling other targets issue the call again (`call_indirect`)
+            Kind::CallIndirect { .. } => {
+                leader[pc] = true;
+                leader[pc + 1] = true;
             }
             _ => {}
         }

@@ -49,9 +49,11 @@ pub enum FaultKind {
         /// The CTA's threads in whole warps (the most a count may be).
         cta_threads: u32,
     },
-    /// A `shfl.sync`/`vote.sync` whose member mask leaves out a lane that
-    /// executes it, or names live lanes of the warp that do not execute it
-    /// with it (on another path, or predicated off): undefined on the GPU.
+    /// A warp-synchronous instruction (`shfl.sync`, `vote.sync`,
+    /// `redux.sync`, `match.sync`, `bar.warp.sync`) whose member mask leaves
+    /// out a lane that executes it, or (not `bar.warp.sync`) names live lanes
+    /// of the warp that do not execute it with it (on another path, or
+    /// predicated off): undefined on the GPU.
     MemberMask {
         /// The member mask (of the first lane in error).
         mask: u32,
@@ -59,6 +61,19 @@ pub enum FaultKind {
         active: u32,
         /// Lanes alive in the warp (not exited).
         live: u32,
+    },
+    /// A warp-synchronous instruction where lane `other`'s member mask names
+    /// an executing lane (the fault's lane) that holds another mask: the
+    /// lanes a mask names must all pass the same mask, undefined otherwise.
+    MemberMaskDiffers {
+        /// The member mask of the fault's lane.
+        mask: u32,
+        /// The lane whose mask names the fault's lane.
+        other: u32,
+        /// That lane's member mask.
+        other_mask: u32,
+        /// Lanes that execute the instruction.
+        active: u32,
     },
     /// Every warp of a CTA is waiting at barriers that can never complete.
     BarrierDeadlock {
@@ -140,6 +155,11 @@ impl fmt::Display for FaultKind {
                     )
                 }
             }
+            FaultKind::MemberMaskDiffers { mask, other, other_mask, active } => write!(
+                f,
+                "member mask {mask:#010x} differs from the mask {other_mask:#010x} of lane {other}, which names this \
+                 lane (active lanes {active:#010x}; the lanes a mask names must hold the same mask, undefined on the GPU)"
+            ),
             FaultKind::BarrierDeadlock { waiting } => {
                 write!(f, "barrier deadlock: warps wait at barriers that cannot complete (warp, barrier): {waiting:?}")
             }

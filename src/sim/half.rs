@@ -29,7 +29,8 @@ pub fn to_f64(x: u16, bf: bool) -> f64 {
     if bf { bf16::from_bits(x).to_f64() } else { f16::from_bits(x).to_f64() }
 }
 
-fn is_subnormal(x: u16, bf: bool) -> bool {
+/// Whether `x` (`.bf16` bits when `bf`, else `.f16`) is subnormal.
+pub(crate) fn is_subnormal(x: u16, bf: bool) -> bool {
     let exp = if bf { (x >> 7) & 0xFF } else { (x >> 10) & 0x1F };
     exp == 0 && x & 0x7FFF != 0
 }

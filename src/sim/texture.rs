@@ -452,21 +452,44 @@ impl TextureDesc {
         Ok(())
     }
 
-    /// What CUDA rejects in the read mode and filter of this format: a
-    /// normalized read of anything but an 8- or 16-bit integer format, or
-    /// linear filtering of texels that do not read as floats. `None`: fine.
+    /// What CUDA rejects in the read mode and filter of this format
+    /// ([`read_setting_error`]). `None`: fine.
     pub fn read_error(&self) -> Option<&'static str> {
-        if self.read == ReadMode::NormalizedFloat && !self.format.is_small_int() {
-            return Some("normalized reads are for 8- and 16-bit integer formats");
-        }
-        if self.filter == FilterMode::Linear && !self.format.is_float() && self.read != ReadMode::NormalizedFloat {
-            return Some(
-                "linear filtering needs float texels: an f16 or f32 format, or read = normalized \
-                 (CUDA: a non-float texture accessed with linear filtering)",
-            );
-        }
-        None
+        read_setting_error(self.format, self.filter, self.read).map(|(_, why)| why)
     }
+}
+
+/// The texture setting a [`read_setting_error`] is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReadSetting {
+    /// The read mode.
+    Read,
+    /// The filter mode.
+    Filter,
+}
+
+/// What CUDA rejects in the read mode and filter of a texture of `format`
+/// (the one place these rules are written; the API and launch specs both
+/// ask it): a normalized read of anything but an 8- or 16-bit integer format
+/// (`cudaErrorInvalidNormSetting`), or linear filtering of texels that do not
+/// read as floats (`cudaErrorInvalidFilterSetting`). The setting at fault
+/// and why; `None`: fine.
+pub fn read_setting_error(
+    format: TexelFormat,
+    filter: FilterMode,
+    read: ReadMode,
+) -> Option<(ReadSetting, &'static str)> {
+    if read == ReadMode::NormalizedFloat && !format.is_small_int() {
+        return Some((ReadSetting::Read, "normalized reads are for 8- and 16-bit integer formats"));
+    }
+    if filter == FilterMode::Linear && !format.is_float() && read != ReadMode::NormalizedFloat {
+        return Some((
+            ReadSetting::Filter,
+            "linear filtering needs float texels: an f16 or f32 format, or read = \"normalized\" \
+             (CUDA rejects linear filtering of a non-float texture)",
+        ));
+    }
+    None
 }
 
 impl SurfaceDesc {

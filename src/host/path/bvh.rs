@@ -99,6 +99,18 @@ pub enum BvhError {
     /// No triangle to build over.
     #[error("a BVH needs at least one triangle")]
     Empty,
+    /// An object id past the number of triangles: ids number the objects
+    /// from 0 (a translation per id up to the largest), so a sparse id such
+    /// as `u32::MAX` would ask for billions of translations.
+    #[error("triangle {triangle} belongs to object {object}; object ids must be below the {triangles} triangles")]
+    SparseObject {
+        /// The triangle.
+        triangle: usize,
+        /// Its object.
+        object: u32,
+        /// Triangles.
+        triangles: usize,
+    },
     /// More nodes or references than the 30-bit index fields reach.
     #[error("{0} nodes or references: the node's 30-bit index reaches 2^30")]
     TooLarge(usize),
@@ -252,6 +264,9 @@ impl Bvh {
         let tri_obj: Vec<u32> = if objects.is_empty() { vec![0; tris.len()] } else { objects.to_vec() };
         if tri_obj.len() != tris.len() {
             return Err(BvhError::Objects { objects: objects.len(), triangles: tris.len() });
+        }
+        if let Some(t) = tri_obj.iter().position(|&o| o as usize >= tris.len()) {
+            return Err(BvhError::SparseObject { triangle: t, object: tri_obj[t], triangles: tris.len() });
         }
         let tbox: Vec<Box3> = tris
             .iter()

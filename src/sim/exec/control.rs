@@ -86,12 +86,13 @@ pub(super) fn member_mask(ctx: &Ctx, w: &Warp, cta: &CtaMut, mask: Src, exec: u3
     Ok(())
 }
 
-/// The groups of lanes a `redux.sync`/`match.sync` computes over: the
+/// The groups of lanes a `redux.sync`/`match.sync`/`vote.sync` computes
+/// over (and `shfl.sync` checks): the
 /// executing lanes split by the member mask each one holds (lanes 0–15 may
 /// name 0x0000ffff and lanes 16–31 0xffff0000: two reductions), lowest lane's
 /// group first. Every lane of a group must hold the same mask — a lane whose
 /// mask names an executing lane holding another mask is undefined in PTX
-/// and faults ([`FaultKind::MemberMask`], naming that lane). The forms
+/// and faults ([`FaultKind::MemberMaskDiffers`], naming that lane). The forms
 /// without a mask compute over all executing lanes. [`member_mask`] has
 /// checked the masks against the executing lanes before.
 pub(super) fn member_groups(
@@ -112,7 +113,9 @@ pub(super) fn member_groups(
         let ml = m[l] as u32;
         let group = exec & ml;
         if let Some(k) = (0..32).find(|&k| group >> k & 1 != 0 && m[k] as u32 != ml) {
-            return Err(fault(FaultKind::MemberMask { mask: m[k] as u32, active: exec, live: w.live }, Some(k)));
+            let kind =
+                FaultKind::MemberMaskDiffers { mask: m[k] as u32, other: l as u32, other_mask: ml, active: exec };
+            return Err(fault(kind, Some(k)));
         }
         groups.push(group);
         rest &= !group;
@@ -121,11 +124,14 @@ pub(super) fn member_groups(
 }
 
 /// `bar.warp.sync`: the lanes run together already; an observer (the race
-/// checker) learns which of the member lanes passed it together. Lanes of the
-/// mask that are not executing it (divergent code) are not waited for. An
-/// executing lane that its own mask leaves out is undefined in PTX: a
-/// [`FaultKind::MemberMask`] fault naming the lane (`warplight check`
-/// reports it as synccheck's invalid member mask, at the instruction's line).
+/// checker) learns which of the member lanes passed it together: the
+/// executing lanes holding the same mask, one group at a time (lanes 0–15
+/// may sync under 0x0000ffff and lanes 16–31 under 0xffff0000 in one
+/// instruction). Lanes of the mask that are not executing it (divergent
+/// code) are not waited for. An executing lane that its own mask leaves out
+/// is undefined in PTX: a [`FaultKind::MemberMask`] fault naming the lane
+/// (`warplight check` reports it as synccheck's invalid member mask, at the
+/// instruction's line).
 pub(super) fn warp_sync(ctx: &Ctx, w: &Warp, cta: &mut CtaMut, mask: Src, exec: u32) -> Result<(), Box<ExecFault>> {
     if exec == 0 {
         return Ok(());
@@ -134,9 +140,14 @@ pub(super) fn warp_sync(ctx: &Ctx, w: &Warp, cta: &mut CtaMut, mask: Src, exec: 
     if let Some(l) = (0..32).find(|&l| exec >> l & 1 != 0 && (m[l] as u32) >> l & 1 == 0) {
         return Err(fault(FaultKind::MemberMask { mask: m[l] as u32, active: exec, live: w.live }, Some(l)));
     }
-    let m = m[exec.trailing_zeros() as usize] as u32;
     if let Some(obs) = cta.observer.as_deref_mut() {
-        obs.warp_sync(w.id, exec & m);
+        let mut rest = exec;
+        while rest != 0 {
+            let ml = m[rest.trailing_zeros() as usize] as u32;
+            let group = (0..32).filter(|&k| rest >> k & 1 != 0 && m[k] as u32 == ml).fold(0u32, |g, k| g | 1 << k);
+            obs.warp_sync(w.id, group);
+            rest &= !group;
+        }
     }
     Ok(())
 }

@@ -516,10 +516,13 @@ fn exec_ir(
         Kind::Bar { id, count } => return control::bar(ctx, w, cta, *id, *count, exec),
         Kind::Vote { mode, d, p, a, membermask } => {
             control::member_mask(ctx, w, cta, *membermask, exec)?;
-            arith::vote(w, *mode, *d, *p, *a, exec)
+            for members in control::member_groups(ctx, w, cta, *membermask, exec)? {
+                arith::vote(w, *mode, *d, *p, *a, members)
+            }
         }
         Kind::Shfl { mode, d, p, a, b, c, membermask } => {
             control::member_mask(ctx, w, cta, *membermask, exec)?;
+            control::member_groups(ctx, w, cta, *membermask, exec)?;
             arith::shfl(ctx, w, cta, *mode, *d, *p, [*a, *b, *c], exec)
         }
         Kind::BarRed { op, d, p, id, count, a } => {

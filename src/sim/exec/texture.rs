@@ -286,7 +286,8 @@ pub(super) fn sust(
     clamp: SurfClamp,
     exec: u32,
 ) -> Result<(), Box<ExecFault>> {
-    cta.counters.textures.surface_stores += 1;
+    let t = &mut cta.counters.textures;
+    *if red.is_some() { &mut t.surface_reductions } else { &mut t.surface_stores } += 1;
     let h = read(ctx, w, cta, handle);
     let cs: Vec<Lanes> = coords.iter().map(|c| read(ctx, w, cta, *c)).collect();
     let vs: Vec<Lanes> = vals.iter().map(|v| read(ctx, w, cta, *v)).collect();
