@@ -97,7 +97,7 @@ fn cosine_dir(n: V3, u1: f32, u2: f32) -> V3 {
     let a = if n[0].abs() > 0.5 { [0.0, 1.0, 0.0] } else { [1.0, 0.0, 0.0] };
     let t = normalize(cross(a, n));
     let b = cross(n, t);
-    let (r, phi) = (u1.sqrt(), 6.283_185_3_f32 * u2);
+    let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
     let z = (1.0 - u1).max(0.0).sqrt();
     add(add(mul(t, r * phi.cos()), mul(b, r * phi.sin())), mul(n, z))
 }
@@ -151,7 +151,7 @@ fn emit(geo: &Geometry, i: u32, seed: u32) -> (V3, V3) {
         let cone = geo.cone;
         let z = 1.0 - u[0] * (1.0 - cone[3]);
         let r = (1.0 - z * z).max(0.0).sqrt();
-        let phi = 6.283_185_3_f32 * u[1];
+        let phi = std::f32::consts::TAU * u[1];
         let a = [cone[0], cone[1], cone[2]];
         let (mut t, mut b) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
         if a[2] < 0.999_999 {
