@@ -80,7 +80,7 @@ fn the_native_photons_are_the_renders_and_their_render_is_near_map_as_image() {
     let geo = Geometry::of(&scene);
     // the emulated pipeline's calibration, natively: the same emitted count
     let emitted = reference::emitted(&geo, &f, f.stated_photons);
-    let MapData::Bitonic { first, sorted, pos, pow, .. } = &r.maps[0] else { panic!("map A") };
+    let MapData::Bitonic { pos, pow, .. } = &r.maps[0] else { panic!("map A") };
     assert_eq!(emitted, pos.len() / (f.bounces + 1), "calibrated emitted count");
     let photons = reference::trace(&geo, emitted, f.bounces, SEED);
     assert_eq!(photons.len(), error::stored(&r), "stored photons");
