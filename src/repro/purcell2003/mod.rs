@@ -17,6 +17,7 @@
 pub mod bitonic;
 pub mod dataflow;
 pub mod error;
+mod geometry;
 pub mod grid;
 pub mod image;
 pub mod knn;

@@ -6,106 +6,11 @@
 //! and these are bit for bit alike. It starts from the photon maps' arrays
 //! (built and tested on their own: `tests/purcell2003.rs`).
 
+use super::geometry::{add, at, cross, dot, intersect, mul, normalize, specular, sub, tri_normal};
 use super::grid::Grid;
 use super::knn::{Params, State};
 use super::photons::{Geometry, camera_array, rng_unit};
 use crate::host::camera::Camera;
-
-#[derive(Debug, Clone, Copy)]
-struct V3 {
-    x: f32,
-    y: f32,
-    z: f32,
-}
-
-fn v3(x: f32, y: f32, z: f32) -> V3 {
-    V3 { x, y, z }
-}
-fn add(a: V3, b: V3) -> V3 {
-    v3(a.x + b.x, a.y + b.y, a.z + b.z)
-}
-fn sub(a: V3, b: V3) -> V3 {
-    v3(a.x - b.x, a.y - b.y, a.z - b.z)
-}
-fn mul(a: V3, s: f32) -> V3 {
-    v3(a.x * s, a.y * s, a.z * s)
-}
-fn dot(a: V3, b: V3) -> f32 {
-    a.x * b.x + a.y * b.y + a.z * b.z
-}
-fn cross(a: V3, b: V3) -> V3 {
-    v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x)
-}
-fn normalize(v: V3) -> V3 {
-    mul(v, 1.0 / dot(v, v).sqrt())
-}
-fn at(t: &[f32], i: usize) -> V3 {
-    v3(t[i], t[i + 1], t[i + 2])
-}
-
-/// The kernels' `intersect`: nearest (t, triangle) with t in (eps, inf), triangle -1 for none.
-fn intersect(tris: &[f32], o: V3, d: V3, eps: f32) -> (f32, i32) {
-    let (mut ht, mut hi) = (3.0e38f32, -1);
-    for i in 0..tris.len() / 12 {
-        let t = &tris[12 * i..12 * i + 12];
-        let (v0, e1, e2) = (at(t, 0), at(t, 3), at(t, 6));
-        let p = cross(d, e2);
-        let det = dot(e1, p);
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let inv = 1.0 / det;
-        let s = sub(o, v0);
-        let u = dot(s, p) * inv;
-        if !(0.0..=1.0).contains(&u) {
-            continue;
-        }
-        let q = cross(s, e1);
-        let v = dot(d, q) * inv;
-        if v < 0.0 || u + v > 1.0 {
-            continue;
-        }
-        let tt = dot(e2, q) * inv;
-        if tt > eps && tt < ht {
-            ht = tt;
-            hi = i as i32;
-        }
-    }
-    (ht, hi)
-}
-
-fn tri_normal(tris: &[f32], i: usize) -> V3 {
-    normalize(cross(at(tris, 12 * i + 3), at(tris, 12 * i + 6)))
-}
-
-fn reflect(d: V3, n: V3) -> V3 {
-    sub(d, mul(n, 2.0 * dot(d, n)))
-}
-
-/// The kernels' `specular` (mirror reflection; glass: Schlick's Fresnel choice by `u`).
-fn specular(d: V3, n: V3, kind: i32, ior: f32, u: f32) -> V3 {
-    if kind == 1 {
-        return reflect(d, n);
-    }
-    let mut c = dot(d, n);
-    let mut eta = 1.0 / ior;
-    let mut nn = n;
-    if c > 0.0 {
-        eta = ior;
-        nn = mul(n, -1.0);
-    } else {
-        c = -c;
-    }
-    let k = 1.0 - eta * eta * (1.0 - c * c);
-    let mut r0 = (1.0 - ior) / (1.0 + ior);
-    r0 = r0 * r0;
-    let m = 1.0 - c;
-    let fr = r0 + (1.0 - r0) * m * m * m * m * m;
-    if k < 0.0 || u < fr {
-        return reflect(d, nn);
-    }
-    normalize(add(mul(d, eta), mul(nn, eta * c - k.sqrt())))
-}
 
 /// Per pixel query point, normal and albedo (as the kernel `eye_rays` writes them).
 #[derive(Debug, Clone, PartialEq)]
@@ -132,11 +37,7 @@ pub fn eye_rays(geo: &Geometry, camera: &Camera, depth: u32) -> QueryPoints {
         let mut o = at(&cam, 0);
         let mut d = normalize(add(at(&cam, 3), add(mul(at(&cam, 6), sx), mul(at(&cam, 9), sy))));
         for _ in 0..=depth {
-            let (t, tri) = intersect(&geo.tris, o, d, eps);
-            if tri < 0 {
-                break;
-            }
-            let tri = tri as usize;
+            let Some((t, tri)) = intersect(&geo.tris, o, d, eps) else { break };
             let x = add(o, mul(d, t));
             let m = geo.tris[12 * tri + 9].to_bits() as usize;
             let c = &geo.mats[8 * m..8 * m + 4];
@@ -146,8 +47,8 @@ pub fn eye_rays(geo: &Geometry, camera: &Camera, depth: u32) -> QueryPoints {
                 if dot(nrm, d) > 0.0 {
                     nrm = mul(nrm, -1.0);
                 }
-                out.query[i] = [x.x, x.y, x.z, 1.0];
-                out.normal[i] = [nrm.x, nrm.y, nrm.z, 0.0];
+                out.query[i] = [x[0], x[1], x[2], 1.0];
+                out.normal[i] = [nrm[0], nrm[1], nrm[2], 0.0];
                 out.albedo[i] = [c[0], c[1], c[2], 0.0];
                 break;
             }
@@ -171,13 +72,13 @@ pub fn shadow_rays(geo: &Geometry, q: &QueryPoints, samples: u32, seed: u32) -> 
             if q4[3] == 0.0 {
                 return [0.0; 4];
             }
-            let (x, n) = (v3(q4[0], q4[1], q4[2]), v3(q.normal[i][0], q.normal[i][1], q.normal[i][2]));
-            let mut acc = v3(0.0, 0.0, 0.0);
+            let (x, n) = ([q4[0], q4[1], q4[2]], [q.normal[i][0], q.normal[i][1], q.normal[i][2]]);
+            let mut acc = [0.0, 0.0, 0.0];
             for s in 0..samples {
                 let pass = 16 + s;
-                let mut l = v3(geo.point.x, geo.point.y, geo.point.z);
+                let mut l = geo.point.to_array();
                 let mut weight = 1.0f32;
-                let mut nl = v3(0.0, 0.0, 0.0);
+                let mut nl = [0.0, 0.0, 0.0];
                 if nl_count > 0 {
                     let k = ((rng_unit(seed, i as u32, pass, 0) * nl_count as f32) as i32).min(nl_count - 1);
                     let t = &geo.tris[12 * geo.lights[k as usize] as usize..];
@@ -202,17 +103,16 @@ pub fn shadow_rays(geo: &Geometry, q: &QueryPoints, samples: u32, seed: u32) -> 
                     continue;
                 }
                 let cl = if nl_count > 0 { dot(nl, wi).abs() } else { 1.0 };
-                let (t, tri) = intersect(&geo.tris, x, wi, eps);
-                if tri >= 0 && t < dist - eps {
+                if intersect(&geo.tris, x, wi, eps).is_some_and(|(t, _)| t < dist - eps) {
                     continue;
                 }
                 let g = cx * cl * weight / d2;
                 let r = geo.radiance;
-                acc = v3(acc.x + r[0] * g, acc.y + r[1] * g, acc.z + r[2] * g);
+                acc = [acc[0] + r[0] * g, acc[1] + r[1] * g, acc[2] + r[2] * g];
             }
             let a4 = q.albedo[i];
             let f = 1.0 / (std::f32::consts::PI * samples as f32);
-            [acc.x * a4[0] * f, acc.y * a4[1] * f, acc.z * a4[2] * f, 0.0]
+            [acc[0] * a4[0] * f, acc[1] * a4[1] * f, acc[2] * a4[2] * f, 0.0]
         })
         .collect()
 }

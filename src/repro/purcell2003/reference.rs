@@ -17,6 +17,7 @@
 
 use rayon::prelude::*;
 
+use super::geometry::{V3, add, at, cosine_dir, cross, dot, intersect, mul, normalize, specular, sub, tri_normal};
 use super::grid::Grid;
 use super::image;
 use super::knn::{Params, State};
@@ -32,103 +33,6 @@ pub const REFERENCE_SEED: u32 = 7001;
 /// Seed of a second, independent reference: the two references' difference
 /// measures the reference's own noise.
 pub const SECOND_SEED: u32 = 7002;
-
-type V3 = [f32; 3];
-
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn mul(a: V3, s: f32) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn normalize(v: V3) -> V3 {
-    mul(v, 1.0 / dot(v, v).sqrt())
-}
-fn at(t: &[f32], i: usize) -> V3 {
-    [t[i], t[i + 1], t[i + 2]]
-}
-
-/// The kernels' `intersect`: nearest (t, triangle) with t in (eps, inf).
-fn intersect(tris: &[f32], o: V3, d: V3, eps: f32) -> Option<(f32, usize)> {
-    let mut hit = None;
-    let mut ht = 3.0e38f32;
-    for (i, t) in tris.chunks_exact(12).enumerate() {
-        let (v0, e1, e2) = (at(t, 0), at(t, 3), at(t, 6));
-        let p = cross(d, e2);
-        let det = dot(e1, p);
-        if det.abs() < 1e-12 {
-            continue;
-        }
-        let inv = 1.0 / det;
-        let s = sub(o, v0);
-        let u = dot(s, p) * inv;
-        if !(0.0..=1.0).contains(&u) {
-            continue;
-        }
-        let q = cross(s, e1);
-        let v = dot(d, q) * inv;
-        if v < 0.0 || u + v > 1.0 {
-            continue;
-        }
-        let tt = dot(e2, q) * inv;
-        if tt > eps && tt < ht {
-            ht = tt;
-            hit = Some((tt, i));
-        }
-    }
-    hit
-}
-
-fn tri_normal(tris: &[f32], i: usize) -> V3 {
-    normalize(cross(at(tris, 12 * i + 3), at(tris, 12 * i + 6)))
-}
-
-/// The kernels' `cosine_dir`: a cosine-weighted direction about `n`.
-fn cosine_dir(n: V3, u1: f32, u2: f32) -> V3 {
-    let a = if n[0].abs() > 0.5 { [0.0, 1.0, 0.0] } else { [1.0, 0.0, 0.0] };
-    let t = normalize(cross(a, n));
-    let b = cross(n, t);
-    let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
-    let z = (1.0 - u1).max(0.0).sqrt();
-    add(add(mul(t, r * phi.cos()), mul(b, r * phi.sin())), mul(n, z))
-}
-
-fn reflect(d: V3, n: V3) -> V3 {
-    sub(d, mul(n, 2.0 * dot(d, n)))
-}
-
-/// The kernels' `specular` (mirror; glass by Schlick's Fresnel choice with `u`).
-fn specular(d: V3, n: V3, kind: i32, ior: f32, u: f32) -> V3 {
-    if kind == 1 {
-        return reflect(d, n);
-    }
-    let mut c = dot(d, n);
-    let mut eta = 1.0 / ior;
-    let mut nn = n;
-    if c > 0.0 {
-        eta = ior;
-        nn = mul(n, -1.0);
-    } else {
-        c = -c;
-    }
-    let k = 1.0 - eta * eta * (1.0 - c * c);
-    let r0 = ((1.0 - ior) / (1.0 + ior)).powi(2);
-    let m = 1.0 - c;
-    let fr = r0 + (1.0 - r0) * m * m * m * m * m;
-    if k < 0.0 || u < fr {
-        return reflect(d, nn);
-    }
-    normalize(add(mul(d, eta), mul(nn, eta * c - k.sqrt())))
-}
 
 /// One stored photon: position, power, incoming direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
