@@ -98,43 +98,14 @@ fn the_suite_matches_the_h200() {
 /// one address costs one L1 sector per warp where it is merged, 32 where not.
 #[test]
 fn uniform_atomics_match_the_h200() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let r = compare(&root.join("tests/fixtures/validation/h200_uniform_atomics.json"), root).unwrap();
-    if std::env::var_os("WARPLIGHT_PRINT_SUITE").is_some() {
-        println!("{}\n{}", r.summary_markdown(), r.differences_markdown());
-    }
-    assert_eq!(r.outputs.len(), 52, "26 cases, 2 dialects");
-    let differ: Vec<String> = r
-        .outputs
-        .iter()
-        .filter(|o| !o.differ.is_empty())
-        .map(|o| format!("{} {}: {:?}", o.case, o.dialect, o.differ))
-        .collect();
-    assert!(differ.is_empty(), "outputs differ from the GPU's:\n{}", differ.join("\n"));
-    let unexpected: Vec<String> = r
-        .exact_differences()
-        .iter()
-        .map(|x| format!("{} {} {}: H200 {} warplight {}", x.case, x.dialect, x.metric, x.measured, x.emulated))
-        .collect();
-    assert!(unexpected.is_empty(), "{} differences:\n{}", unexpected.len(), unexpected.join("\n"));
-    let sectors = |case: &str, op: &str| {
-        let m = format!("l1tex__t_sectors_pipe_lsu_mem_global_op_{op}.sum");
-        let rows: Vec<_> = r.rows.iter().filter(|x| x.case == case && x.metric == m).collect();
-        assert_eq!(rows.len(), 2, "{case} {m}");
-        rows[0].emulated
-    };
+    let r = uniform_atomics_report("h200_uniform_atomics.json", 52);
     // merged: 4 warps, one sector each; a full warp's varying operand with the result used: 1
-    assert_eq!(sectors("ua_inc", "red"), 4);
-    assert_eq!(sectors("ua_add_val_ret", "atom"), 1);
+    assert_eq!(sectors(&r, "ua_inc", "red"), 4);
+    assert_eq!(sectors(&r, "ua_add_val_ret", "atom"), 1);
     // not merged: 24 lanes with varying operands, floats, lane-dependent addresses
-    assert_eq!(sectors("ua_add_val_ret_24", "atom"), 24);
-    assert_eq!(sectors("ua_f32", "red"), 128);
-    assert_eq!(sectors("ua_warp", "red"), 128);
-    let doc = std::fs::read_to_string(root.join("docs/validation.md")).unwrap();
-    assert!(
-        doc.contains(&r.summary_markdown()),
-        "docs/validation.md is stale: WARPLIGHT_PRINT_SUITE=1 cargo test --release --test validation_suite -- --nocapture"
-    );
+    assert_eq!(sectors(&r, "ua_add_val_ret_24", "atom"), 24);
+    assert_eq!(sectors(&r, "ua_f32", "red"), 128);
+    assert_eq!(sectors(&r, "ua_warp", "red"), 128);
 }
 
 /// The 64-bit forms of ptxas's warp-uniform atomics
@@ -145,12 +116,30 @@ fn uniform_atomics_match_the_h200() {
 /// used or not. Every output and every exact metric equal.
 #[test]
 fn uniform_atomics_64_bit_match_the_h200() {
+    let r = uniform_atomics_report("h200_uniform_atomics64.json", 42);
+    // merged: a uniform operand, result unused (4 warps) or used (1 warp, 24 lanes)
+    assert_eq!(sectors(&r, "ua64_inc", "red"), 4);
+    assert_eq!(sectors(&r, "ua64_cond", "red"), 4);
+    assert_eq!(sectors(&r, "ua64_inc_ret", "atom"), 1);
+    assert_eq!(sectors(&r, "ua64_inc_ret_24", "atom"), 1);
+    // not merged: a varying operand (no 64-bit REDUX), doubles, exch, cas
+    assert_eq!(sectors(&r, "ua64_add_val", "red"), 128);
+    assert_eq!(sectors(&r, "ua64_min", "red"), 128);
+    assert_eq!(sectors(&r, "ua64_add_val_ret", "atom"), 32);
+    assert_eq!(sectors(&r, "ua64_f64", "red"), 32);
+    assert_eq!(sectors(&r, "ua64_cas", "atom"), 32);
+}
+
+/// A ptxas uniform-atomic fixture compared: `outputs` outputs (cases ×
+/// dialects), every output and every exact metric equal to the H200's, and
+/// docs/validation.md holding its summary.
+fn uniform_atomics_report(fixture: &str, outputs: usize) -> Report {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let r = compare(&root.join("tests/fixtures/validation/h200_uniform_atomics64.json"), root).unwrap();
+    let r = compare(&root.join("tests/fixtures/validation").join(fixture), root).unwrap();
     if std::env::var_os("WARPLIGHT_PRINT_SUITE").is_some() {
         println!("{}\n{}", r.summary_markdown(), r.differences_markdown());
     }
-    assert_eq!(r.outputs.len(), 42, "21 cases, 2 dialects");
+    assert_eq!(r.outputs.len(), outputs, "{fixture}: cases × 2 dialects");
     let differ: Vec<String> = r
         .outputs
         .iter()
@@ -164,26 +153,19 @@ fn uniform_atomics_64_bit_match_the_h200() {
         .map(|x| format!("{} {} {}: H200 {} warplight {}", x.case, x.dialect, x.metric, x.measured, x.emulated))
         .collect();
     assert!(unexpected.is_empty(), "{} differences:\n{}", unexpected.len(), unexpected.join("\n"));
-    let sectors = |case: &str, op: &str| {
-        let m = format!("l1tex__t_sectors_pipe_lsu_mem_global_op_{op}.sum");
-        let rows: Vec<_> = r.rows.iter().filter(|x| x.case == case && x.metric == m).collect();
-        assert_eq!(rows.len(), 2, "{case} {m}");
-        rows[0].emulated
-    };
-    // merged: a uniform operand, result unused (4 warps) or used (1 warp, 24 lanes)
-    assert_eq!(sectors("ua64_inc", "red"), 4);
-    assert_eq!(sectors("ua64_cond", "red"), 4);
-    assert_eq!(sectors("ua64_inc_ret", "atom"), 1);
-    assert_eq!(sectors("ua64_inc_ret_24", "atom"), 1);
-    // not merged: a varying operand (no 64-bit REDUX), doubles, exch, cas
-    assert_eq!(sectors("ua64_add_val", "red"), 128);
-    assert_eq!(sectors("ua64_min", "red"), 128);
-    assert_eq!(sectors("ua64_add_val_ret", "atom"), 32);
-    assert_eq!(sectors("ua64_f64", "red"), 32);
-    assert_eq!(sectors("ua64_cas", "atom"), 32);
     let doc = std::fs::read_to_string(root.join("docs/validation.md")).unwrap();
     assert!(
         doc.contains(&r.summary_markdown()),
         "docs/validation.md is stale: WARPLIGHT_PRINT_SUITE=1 cargo test --release --test validation_suite -- --nocapture"
     );
+    r
+}
+
+/// The L1 sectors warplight counts for `case`'s global `op` (`atom`/`red`),
+/// the same in both dialects' rows.
+fn sectors(r: &Report, case: &str, op: &str) -> u64 {
+    let m = format!("l1tex__t_sectors_pipe_lsu_mem_global_op_{op}.sum");
+    let rows: Vec<_> = r.rows.iter().filter(|x| x.case == case && x.metric == m).collect();
+    assert_eq!(rows.len(), 2, "{case} {m}");
+    rows[0].emulated
 }
