@@ -67,6 +67,17 @@ fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32, ref
     welch_holm(&ours, reference, ALPHA).expect("same block grid")
 }
 
+/// The emulated kernel's 4 frames (functional fidelity) against `reference`.
+fn emulated_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, reference: &Estimate) -> Outcome {
+    let mut cfg = kernel::sim_config(&p);
+    cfg.fidelity = Fidelity::Functional;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev).expect("load PTX");
+    let r = kernel::render(&mut dev, &module, ps, cam, p, 4, true, |_| {}).expect("launch");
+    let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
+    welch_holm(&ours, reference, ALPHA).expect("same block grid")
+}
+
 #[test]
 fn every_integrator_natively_agrees_with_mitsuba() {
     let (reference, size) = reference();
@@ -99,14 +110,7 @@ fn a_light_ten_percent_too_bright_fails() {
 fn the_emulated_kernel_agrees_with_mitsuba() {
     let (reference, size) = reference();
     let (_, ps, cam) = cornell(size);
-    let p = params(size, Integrator::Nee, 11);
-    let mut cfg = kernel::sim_config(&p);
-    cfg.fidelity = Fidelity::Functional;
-    let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev).expect("load PTX");
-    let r = kernel::render(&mut dev, &module, &ps, &cam, p, 4, true, |_| {}).expect("launch");
-    let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
-    let o = welch_holm(&ours, &reference, ALPHA).expect("same block grid");
+    let o = emulated_outcome(&ps, &cam, params(size, Integrator::Nee, 11), &reference);
     eprintln!("emulated: {o:?}");
     assert!(o.passed(), "the emulated kernel disagrees with Mitsuba: {o:?}");
 }
@@ -126,14 +130,7 @@ fn the_rough_mirror_box_agrees_with_mitsuba() {
         assert!(o.passed(), "{integrator:?} disagrees with Mitsuba on the rough mirror: {o:?}");
         assert!(o.mean_rel_diff.abs() < 0.02, "{integrator:?}: mean off by {:.3}", o.mean_rel_diff);
     }
-    let p = params(size, Integrator::MisPower, 13);
-    let mut cfg = kernel::sim_config(&p);
-    cfg.fidelity = Fidelity::Functional;
-    let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev).expect("load PTX");
-    let r = kernel::render(&mut dev, &module, &ps, &cam, p, 4, true, |_| {}).expect("launch");
-    let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
-    let o = welch_holm(&ours, &reference, ALPHA).expect("same block grid");
+    let o = emulated_outcome(&ps, &cam, params(size, Integrator::MisPower, 13), &reference);
     eprintln!("rough emulated: {o:?}");
     assert!(o.passed(), "the emulated kernel disagrees with Mitsuba on the rough mirror: {o:?}");
 }
