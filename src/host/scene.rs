@@ -171,6 +171,10 @@ pub struct Scene {
     /// 003's path tracer makes a rough mirror a Cook-Torrance conductor and a
     /// rough glass a Walter dielectric; the other renderers treat them as smooth.
     pub roughness: Vec<f32>,
+    /// An equirectangular environment map (a scene file's `environment`, an
+    /// OpenEXR file): radiance from every direction no triangle covers. Only
+    /// thesis 003's path tracer reads it.
+    pub environment: Option<PathBuf>,
 }
 
 impl Scene {
@@ -235,6 +239,7 @@ impl Scene {
             surfaces: Vec::new(),
             uvs: kept_uvs,
             roughness: Vec::new(),
+            environment: None,
         }
     }
 

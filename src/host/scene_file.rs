@@ -260,6 +260,14 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     scene.textures = extra.textures;
     scene.surfaces = extra.surfaces;
     scene.roughness = roughness;
+    if let Some(e) = t.get("environment") {
+        let Some(rel) = e.as_str() else { return cx.err("environment", "expected the file name of an OpenEXR map") };
+        let file = dir.join(rel);
+        if !file.is_file() {
+            return cx.err("environment", format!("no such file {}", file.display()));
+        }
+        scene.environment = Some(file);
+    }
     scene.variant = t.get("variant").and_then(|v| v.as_str()).unwrap_or("").to_string();
     if let Some(th) = cx.table(&t, "thesis")? {
         let triangles = match th.get("triangles").and_then(|v| v.as_integer()) {
