@@ -33,6 +33,7 @@ pub struct RenderArgs {
     /// on the emulator: stack, stackless, push-down, short-stack, push-down+short-stack,
     /// node-cache-1, stack-cache-1, node-cache-1+stack-cache-1, node-cache-2+stack-cache-2.
     /// `--method purcell --variant error`: seed 004's error charts instead of images (see --method).
+    /// `--method photon-map --variant error`: thesis 000's estimators against a converged reference (charts).
     #[arg(long, default_value = "native")]
     pub variant: String,
     /// Device profile of the emulated kernels (every method's): their memory
@@ -482,7 +483,8 @@ fn run_photon_map(
     let emulated = match a.variant.as_str() {
         "native" => false,
         "emulated" => true,
-        v => return Err(format!("--method photon-map --variant {v}: expected native or emulated").into()),
+        "error" => return crate::repro::fabianowski2011::accuracy::run_cli(scene, cam, &a.output),
+        v => return Err(format!("--method photon-map --variant {v}: expected native, emulated or error").into()),
     };
     let (photons, spread) = render_parameters(&scene.name);
     let o = Options { photons, spread, h_max: vkde::H_MAX, estimator, shape, emulated };

@@ -276,6 +276,20 @@ pub fn estimate_kernel(
     h_max: f32,
     shape: Shape,
 ) -> Result<(Vec<Estimate>, LaunchStats), KnnError> {
+    estimate_kernel_observed(dev, module, map, queries, (k, h_max, shape), None)
+}
+
+/// As [`estimate_kernel`] with (k, h_max, shape) in `search`, the launch
+/// observed by `model` when given (a memory model for the timing model).
+pub fn estimate_kernel_observed(
+    dev: &mut Device,
+    module: &Module,
+    map: &KdMap,
+    queries: &[Option<Query>],
+    search: (usize, f32, Shape),
+    model: Option<&crate::model::Model>,
+) -> Result<(Vec<Estimate>, LaunchStats), KnnError> {
+    let (k, h_max, shape) = search;
     if k == 0 || k > K_MAX {
         return Err(KnnError::BadK(k));
     }
@@ -293,7 +307,9 @@ pub fn estimate_kernel(
     let out = dev.alloc_zeroed::<f32>(ESTIMATE_FLOATS * n.max(1));
     let args: Vec<Arg> = [pp, nodes, qb, out].into_iter().map(Arg::Ptr).collect();
     let ctas = (n.div_ceil(super::vkde::THREADS as usize) as u32).clamp(1, super::vkde::MAX_CTAS);
-    let launch = dev.launch(module, ESTIMATE, LaunchConfig::linear(ctas, super::vkde::THREADS), &args)?;
+    let observer = model.map(|m| m as &dyn crate::sim::ObserverFactory);
+    let launch =
+        dev.launch_observed(module, ESTIMATE, LaunchConfig::linear(ctas, super::vkde::THREADS), &args, observer)?;
     let raw = dev.read::<f32>(out, ESTIMATE_FLOATS * n);
     Ok((raw.chunks_exact(ESTIMATE_FLOATS).map(Estimate::from_floats).collect(), launch))
 }

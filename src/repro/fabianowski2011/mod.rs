@@ -10,6 +10,7 @@
 //! - [`SHADOW_LIGHT`]: shadow rays from a light inside and outside (Table 4.2 (b));
 //! - [`BUILDS`]: timed SAH and SIROH builds (Table 4.4).
 
+pub mod accuracy;
 pub mod caches;
 pub mod flight;
 pub mod knn;

@@ -593,6 +593,18 @@ pub fn estimate_kernel(
     queries: &[Option<Query>],
     shape: Shape,
 ) -> Result<(Vec<Estimate>, LaunchStats), PhotonError> {
+    estimate_kernel_observed(dev, module, map, queries, shape, None)
+}
+
+/// As [`estimate_kernel`], the launch observed by `model` when given (a memory model for the timing model).
+pub fn estimate_kernel_observed(
+    dev: &mut Device,
+    module: &Module,
+    map: &PhotonMap,
+    queries: &[Option<Query>],
+    shape: Shape,
+    model: Option<&crate::model::Model>,
+) -> Result<(Vec<Estimate>, LaunchStats), PhotonError> {
     let n = queries.len();
     if n > i32::MAX as usize {
         return Err(PhotonError::TooMany(n));
@@ -607,7 +619,8 @@ pub fn estimate_kernel(
     let qb = up(dev, &to_bytes(&q), "queries")?;
     let out = dev.alloc_zeroed::<f32>(ESTIMATE_FLOATS * n.max(1));
     let args: Vec<Arg> = [pp, nodes, kernels, qb, out].into_iter().map(Arg::Ptr).collect();
-    let launch = dev.launch(module, ESTIMATE, LaunchConfig::linear(ctas(n), THREADS), &args)?;
+    let observer = model.map(|m| m as &dyn crate::sim::ObserverFactory);
+    let launch = dev.launch_observed(module, ESTIMATE, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?;
     let raw = dev.read::<f32>(out, ESTIMATE_FLOATS * n);
     Ok((raw.chunks_exact(ESTIMATE_FLOATS).map(Estimate::from_floats).collect(), launch))
 }
