@@ -48,6 +48,26 @@ fn every_material_kind_traces_the_same_bits_emulated_and_native() {
     same_frames((scene, ps), &[Integrator::Pt, Integrator::Nee, Integrator::MisPower]);
 }
 
+/// The environment-lit scene (no area light; a diffuse and a mirror ball
+/// under the forest map): the kernel's lookup of the map equals the native
+/// one's bit for bit, whatever the integrator (none samples the map).
+#[test]
+fn the_environment_map_traces_the_same_bits_emulated_and_native() {
+    let (scene, ps) = load("env-spheres");
+    let env = ps.env.as_ref().expect("env-spheres has an environment");
+    assert_eq!((env.width, env.height, ps.lights.len()), (128, 64, 0));
+    same_frames((scene, ps), &[Integrator::Pt, Integrator::MisPower]);
+}
+
+/// Glass with the exact Fresnel equations (`fresnel = "exact"`), rough and
+/// smooth, under the environment: emulated and native agree bit for bit.
+#[test]
+fn exact_fresnel_glass_traces_the_same_bits_emulated_and_native() {
+    let (scene, ps) = load("env-glass");
+    assert_eq!(ps.mats.iter().filter(|m| m[9] > 0.0).count(), 2, "two exact-Fresnel glasses");
+    same_frames((scene, ps), &[Integrator::Pt, Integrator::MisPower]);
+}
+
 fn same_frames((scene, ps): (Scene, PathScene), integrators: &[Integrator]) {
     let (w, h) = (12, 10);
     let cam = camera(&scene, w, h);
@@ -111,5 +131,34 @@ fn render_takes_each_traversal_and_names_a_wrong_one() {
         "bvh",
     ]);
     assert!(!ok && stderr.contains("unknown traversal `bvh`"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The path tracer's scene keys are checked: `fresnel` only on glass and
+/// only "schlick" or "exact", `environment` an existing file, and a scene
+/// with neither an area light nor an environment is refused by the layout.
+#[test]
+fn environment_and_fresnel_keys_are_checked() {
+    let dir = std::env::temp_dir().join(format!("warplight-lin2017-keys-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    std::fs::write(dir.join("t.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("obj");
+    let scene = |extra: &str, mat: &str| {
+        let f = dir.join("t.toml");
+        std::fs::write(&f, format!("obj = \"t.obj\"\n{extra}\n[[material]]\nname = \"m\"\n{mat}\n")).expect("toml");
+        scene_file::load(&f)
+    };
+    let err = |r: Result<Scene, scene_file::SceneError>| r.err().map(|e| e.to_string()).unwrap_or_default();
+    let e = err(scene("", "kind = \"diffuse\"\nfresnel = \"exact\""));
+    assert!(e.contains("material[0].fresnel") && e.contains("only glass"), "{e}");
+    let e = err(scene("", "kind = \"glass\"\nfresnel = \"fast\""));
+    assert!(e.contains("expected \"schlick\" or \"exact\""), "{e}");
+    let e = err(scene("environment = \"nowhere.exr\"", "kind = \"diffuse\""));
+    assert!(e.contains("environment") && e.contains("no such file"), "{e}");
+    let s = scene("", "kind = \"glass\"\nfresnel = \"exact\"").expect("an exact glass");
+    assert_eq!(s.exact_fresnel, [true]);
+    let tris: Vec<[glam::Vec3; 3]> = s.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+    let e = PathScene::new(&s, &tree).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(e.contains("no emitting triangle and no environment"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }

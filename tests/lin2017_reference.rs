@@ -12,70 +12,25 @@
 //! 7's scene; Cook-Torrance with Beckmann α 0.2 against Mitsuba's
 //! `roughconductor`, `cornell-rough-32`), where a mirror of α 0.3 fails.
 
-use std::path::Path;
+mod lin2017_mitsuba;
 
+use lin2017_mitsuba::{emulated_outcome, native_outcome, params, reference_of, scene_of};
 use warplight::host::camera::Camera;
-use warplight::host::kdtree::{BuildParams, Heuristic, build};
+use warplight::host::path::Integrator;
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::stats::{Estimate, Outcome, from_frames, from_reference, read_exr, welch_holm};
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::path::stats::Estimate;
 use warplight::host::scene::{MaterialKind, Scene};
-use warplight::host::scene_file;
-use warplight::sim::{Device, Fidelity};
 
 const FIXTURE: &str = "tests/fixtures/mitsuba/cornell-lambert-32";
 const ROUGH_FIXTURE: &str = "tests/fixtures/mitsuba/cornell-rough-32";
-const BLOCK: u32 = 4;
-const ALPHA: f64 = 0.01;
 
 fn reference() -> (Estimate, u32) {
-    reference_of(FIXTURE)
-}
-
-fn reference_of(fixture: &str) -> (Estimate, u32) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mean = read_exr(&root.join(format!("{fixture}.exr"))).expect("reference mean");
-    let var = read_exr(&root.join(format!("{fixture}-var.exr"))).expect("reference variance");
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(root.join(format!("{fixture}.json"))).expect("reference json"))
-            .expect("json");
-    let batches = meta["batches"].as_u64().expect("batches") as u32;
-    assert_eq!(meta["size"].as_u64(), Some(mean.width as u64));
-    (from_reference(&mean, &var, BLOCK, batches), mean.width)
+    let (e, size, _) = reference_of(FIXTURE);
+    (e, size)
 }
 
 fn cornell(size: u32) -> (Scene, PathScene, Camera) {
     scene_of("cornell-lambert", size)
-}
-
-fn scene_of(name: &str, size: u32) -> (Scene, PathScene, Camera) {
-    let scene = scene_file::load(&scene_file::resolve(name)).expect("a scene of scenes/");
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(&scene, &tree).expect("layout");
-    let cam = Camera { resolution: [size, size], ..scene.camera };
-    (scene, ps, cam)
-}
-
-fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
-    FrameParams { width: size, height: size, integrator, max_bounces: 16, seed, traversal: Traversal::ShortStack }
-}
-
-fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32, reference: &Estimate) -> Outcome {
-    let r = render_native(ps, cam, p, frames, true, |_| {});
-    let ours = from_frames(&r.frame_images, BLOCK).expect("two frames or more");
-    welch_holm(&ours, reference, ALPHA).expect("same block grid")
-}
-
-/// The emulated kernel's 4 frames (functional fidelity) against `reference`.
-fn emulated_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, reference: &Estimate) -> Outcome {
-    let mut cfg = kernel::sim_config(&p);
-    cfg.fidelity = Fidelity::Functional;
-    let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev).expect("load PTX");
-    let r = kernel::render(&mut dev, &module, ps, cam, p, 4, true, |_| {}).expect("launch");
-    let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
-    welch_holm(&ours, reference, ALPHA).expect("same block grid")
 }
 
 #[test]
@@ -120,7 +75,7 @@ fn the_emulated_kernel_agrees_with_mitsuba() {
 /// Mitsuba's `roughconductor` (Beckmann α 0.2, F = 1).
 #[test]
 fn the_rough_mirror_box_agrees_with_mitsuba() {
-    let (reference, size) = reference_of(ROUGH_FIXTURE);
+    let (reference, size, _) = reference_of(ROUGH_FIXTURE);
     let (_, ps, cam) = scene_of("cornell-rough", size);
     let kinds: Vec<u32> = ps.mats.iter().map(|m| m[3].to_bits()).collect();
     assert!(kinds.contains(&warplight::host::path::layout::KIND_CONDUCTOR), "no rough mirror: {kinds:?}");
@@ -138,7 +93,7 @@ fn the_rough_mirror_box_agrees_with_mitsuba() {
 /// The test sees the BSDF: the back wall with α 0.3 instead of 0.2 fails.
 #[test]
 fn a_rougher_mirror_fails() {
-    let (reference, size) = reference_of(ROUGH_FIXTURE);
+    let (reference, size, _) = reference_of(ROUGH_FIXTURE);
     let (_, mut ps, cam) = scene_of("cornell-rough", size);
     for m in ps.mats.iter_mut() {
         if m[3].to_bits() == warplight::host::path::layout::KIND_CONDUCTOR {

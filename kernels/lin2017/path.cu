@@ -19,12 +19,15 @@
 //
 // Shading (§4.4-4.5, §5.1): Lambertian diffuse with cosine sampling, perfect
 // mirror, a glass whose Fresnel switch (Schlick, (1 - c)^5 by repeated
-// multiplication) picks reflection or refraction, a rough mirror
+// multiplication; per material the exact equations instead, fresnel_exact())
+// picks reflection or refraction, a rough mirror
 // (Cook-Torrance: Beckmann D, Walter et al.'s approximation of Smith's G,
 // Schlick's F with R0 the colour; microfacet normals sampled from D cos) and
 // rough glass (Walter et al. 2007: the same D and G, Schlick's F as the
 // switch between the reflected and the refracted microfacet direction);
-// emitters are one-sided (front = the winding's normal) and black.
+// emitters are one-sided (front = the winding's normal) and black. A ray
+// that misses every triangle sees the equirectangular environment map, if
+// any (§5.4; env()), which no light sample covers.
 // Integrators: pt (BSDF sampling only), nee (a light sample and shadow ray at
 // diffuse and rough-mirror hits, emission after such a bounce not counted,
 // 003:L249), mis (both, balance or power heuristic, §4.6). Rough glass is
@@ -75,6 +78,7 @@ struct Params {
   float lo[3], hi[3];
   float eps, tan_half, aspect, light_area;
   int width, height, num_paths, frame, integrator, max_bounces, num_lights, seed, traversal;
+  int env_w, env_h;   // the environment map's texels across and down (0: none)
 };
 
 struct V3 { float x, y, z; };
@@ -96,9 +100,10 @@ struct Scene {
   const unsigned *refs;    // the concatenated leaf triangle lists
   const float4 *tris;      // 3 float4 per triangle: the affine rows (§6.4)
   const float4 *tri_data;  // per triangle: unit geometric normal, material index (int bits)
-  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior], [alpha 0 0 0]
+  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior], [alpha, exact Fresnel (1) or Schlick's (0), 0, 0]
   const float4 *lights;    // per emitting triangle: [v0, cdf], [e1, triangle (int bits)], [e2, 0]
   const float4 *boxes;     // per node (kd-backtrack): [box lo, parent (int bits)], [box hi, 0]
+  const float4 *env;       // the environment map (§5.4): env_w x env_h texels [r g b 0], row 0 the zenith
 };
 
 // The counter-based generator (two rounds of a 32-bit integer hash per draw).
@@ -192,6 +197,36 @@ static __device__ __forceinline__ float schlick(float r0, float c) {
   float x = 1.0f - c;
   float x2 = x * x;
   return r0 + (1.0f - r0) * (x2 * x2 * x);
+}
+
+// atan s for |s| <= tan(pi/8) by its series to s^15 (error < 2e-8).
+static __device__ __forceinline__ float atan_series(float s) {
+  float s2 = s * s;
+  return s * (1.0f - s2 * (1.0f / 3.0f - s2 * (0.2f - s2 * (1.0f / 7.0f - s2 * (1.0f / 9.0f - s2 * (1.0f / 11.0f - s2 * (1.0f / 13.0f - s2 / 15.0f)))))));
+}
+
+// atan2(y, x) in [-pi, pi] with no SFU instruction: t = min / max of |x|, |y|
+// in [0, 1]; above tan(pi/8), atan t = pi/4 + atan((t - 1) / (t + 1)); then
+// the octant.
+static __device__ __forceinline__ float atan2_series(float y, float x) {
+  float ax = fabsf(x), ay = fabsf(y);
+  float mx = fmaxf(ax, ay), mn = fminf(ax, ay);
+  float t = mx > 0.0f ? mn / mx : 0.0f;
+  float a = t > 0.414213562373095049f ? 0.785398163397448310f + atan_series((t - 1.0f) / (t + 1.0f)) : atan_series(t);
+  if (ay > ax) a = 1.57079632679489662f - a;
+  if (x < 0.0f) a = PI_F - a;
+  return y < 0.0f ? -a : a;
+}
+
+// The exact Fresnel reflectance of a dielectric (unpolarised light: the mean
+// of the s and p reflectances) for the incident cosine ci and the transmitted
+// cosine ct, eta = n_i / n_t, no total internal reflection: r_s = (eta ci -
+// ct) / (eta ci + ct), r_p = (ci - eta ct) / (ci + eta ct). A glass whose
+// scene file says fresnel = "exact" switches on it instead of Schlick's.
+static __device__ __forceinline__ float fresnel_exact(float eta, float ci, float ct) {
+  float rs = (eta * ci - ct) / (eta * ci + ct);
+  float rp = (ci - eta * ct) / (ci + eta * ct);
+  return 0.5f * (rs * rs + rp * rp);
 }
 
 // smallpt's tent warp of a uniform y in [0, 1) to [-1, 1).
@@ -398,6 +433,32 @@ static __device__ __forceinline__ void basis(V3 n, V3 *b1, V3 *b2) {
   *b2 = v3(b, sign + n.y * n.y * a, -n.y);
 }
 
+// The environment's radiance in the unit direction d (§5.4, 003:L411: the
+// "spherical projection map" of an infinitely distant sphere), in Mitsuba 3's
+// envmap conventions (tools/mitsuba/reference.py checks them against it): y
+// up, u = atan2(x, -z) / 2 pi, v = acos(y) / pi; texel column c centred at
+// u = (c + 1/2) / W, row r on v = r / (H - 1); bilinear, periodic in u.
+static __device__ __forceinline__ V3 env(const Scene &s, V3 d) {
+  const Params *p = s.p;
+  int w = p->env_w, h = p->env_h;
+  float u = atan2_series(d.x, -d.z) * (0.5f * INV_PI) - 0.5f / (float)w;
+  float v = atan2_series(sqrtf(d.x * d.x + d.z * d.z), d.y) * INV_PI;
+  u = u - FLOORF(u);
+  v = v - FLOORF(v);
+  float x = u * (float)w, y = v * (float)(h - 1);
+  int px = (int)x, py = (int)y;
+  if (px > w - 1) px = w - 1;
+  if (py > h - 2) py = h - 2;
+  float fx = x - (float)px, fy = y - (float)py;
+  float gx = 1.0f - fx, gy = 1.0f - fy;
+  int qx = px + 1 == w ? 0 : px + 1;
+  const float4 *r0 = s.env + py * w, *r1 = r0 + w;
+  float4 a = r0[px], b = r0[qx], c = r1[px], e = r1[qx];
+  return v3(gy * (gx * a.x + fx * b.x) + fy * (gx * c.x + fx * e.x),
+            gy * (gx * a.y + fx * b.y) + fy * (gx * c.y + fx * e.y),
+            gy * (gx * a.z + fx * b.z) + fy * (gx * c.z + fx * e.z));
+}
+
 // One path's state between bounces (the per-path struct of 003:L534: next
 // ray, mask, pixel, activeness, and what the estimators carry across a bounce).
 struct Path {
@@ -441,7 +502,11 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
   V3 o = P.o, d = P.d;
   float t;
   int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
-  if (tri < 0) return false;
+  if (tri < 0) {
+    // the environment: not light-sampled, so its radiance counts in full after any bounce
+    if (p->env_w > 0) P.L = add3(P.L, mul3(P.beta, env(s, d)));
+    return false;
+  }
   float4 td = s.tri_data[tri];
   V3 n = v3(td.x, td.y, td.z);
   float4 m0 = s.mats[3 * __float_as_int(td.w)];
@@ -469,7 +534,7 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
   float cos_o = -dot3(d, ns);   // the viewer's side, > 0
   unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
   bool sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
-  if (sampled_light && integrator != INTEGRATOR_PT && bounce < p->max_bounces) {
+  if (sampled_light && integrator != INTEGRATOR_PT && p->num_lights > 0 && bounce < p->max_bounces) {
     // next event estimation: a light triangle by area, a point on it uniformly
     float yl = rng(key, dim);
     int l = 0;
@@ -557,7 +622,8 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
       if (k > 0.0f) {   // else total internal reflection
         float cos_t = sqrtf(k);
         float r0 = (1.0f - ior) / (1.0f + ior);
-        float fr = schlick(r0 * r0, into ? co : cos_t);
+        bool exact = s.mats[3 * __float_as_int(td.w) + 2].y > 0.0f;
+        float fr = exact ? fresnel_exact(eta, co, cos_t) : schlick(r0 * r0, into ? co : cos_t);
         if (!(rng(key, dim + 6) < fr)) {
           next = add3(scale3(d, eta), scale3(mh, eta * co - cos_t));
           scale = eta * eta;
@@ -584,11 +650,16 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
       if (k > 0.0f) {   // else total internal reflection
         float cos_t = sqrtf(k);
         V3 tdir = add3(scale3(d, eta), scale3(ns, eta * cos_i - cos_t));
-        float r0 = (1.0f - ior) / (1.0f + ior);
-        r0 = r0 * r0;
-        float c = 1.0f - (into ? cos_i : cos_t);
-        float c2 = c * c;
-        float fr = r0 + (1.0f - r0) * (c2 * c2 * c);
+        float fr;
+        if (s.mats[3 * __float_as_int(td.w) + 2].y > 0.0f) {
+          fr = fresnel_exact(eta, cos_i, cos_t);
+        } else {
+          float r0 = (1.0f - ior) / (1.0f + ior);
+          r0 = r0 * r0;
+          float c = 1.0f - (into ? cos_i : cos_t);
+          float c2 = c * c;
+          fr = r0 + (1.0f - r0) * (c2 * c2 * c);
+        }
         if (!(rng(key, dim + 6) < fr)) next = tdir;
       }
     }
@@ -624,8 +695,9 @@ static __device__ __forceinline__ void finish(float *accum, float *last, int i, 
 // The megakernel: one launch per frame, each thread runs its path to the end.
 extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
                                       const float4 *tris, const float4 *tri_data, const float4 *mats,
-                                      const float4 *lights, const float4 *boxes, float *accum, float *last) {
-  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes};
+                                      const float4 *lights, const float4 *boxes, const float4 *env, float *accum,
+                                      float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
   const Params *p = params;
   int i = (int)WL_TID;
   if (i >= p->num_paths) return;
@@ -667,9 +739,9 @@ extern "C" __global__ void path_init(const Params *params, float4 *states) {
 
 extern "C" __global__ void path_level(const Params *params, const uint4 *nodes, const unsigned *refs,
                                       const float4 *tris, const float4 *tri_data, const float4 *mats,
-                                      const float4 *lights, const float4 *boxes, float4 *states, unsigned n,
-                                      float *accum, float *last) {
-  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes};
+                                      const float4 *lights, const float4 *boxes, const float4 *env, float4 *states,
+                                      unsigned n, float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
   const Params *p = params;
   unsigned j = WL_TID;
   if (j >= n) return;

@@ -175,6 +175,11 @@ pub struct Scene {
     /// OpenEXR file): radiance from every direction no triangle covers. Only
     /// thesis 003's path tracer reads it.
     pub environment: Option<PathBuf>,
+    /// Per material, whether a glass takes the exact dielectric Fresnel
+    /// equations (a scene file's `fresnel = "exact"`) rather than Schlick's
+    /// approximation (a material past the end: Schlick's). Only thesis 003's
+    /// path tracer reads it.
+    pub exact_fresnel: Vec<bool>,
 }
 
 impl Scene {
@@ -240,6 +245,7 @@ impl Scene {
             uvs: kept_uvs,
             roughness: Vec::new(),
             environment: None,
+            exact_fresnel: Vec::new(),
         }
     }
 

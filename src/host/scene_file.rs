@@ -141,8 +141,10 @@ impl Cx<'_> {
     }
 }
 
-/// A material and its Beckmann roughness (`roughness`, mirrors and glass only; 0 is smooth).
-fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32), SceneError> {
+/// A material, its Beckmann roughness (`roughness`, mirrors and glass only; 0
+/// is smooth) and whether its Fresnel term is exact (`fresnel = "exact"`,
+/// glass only; `"schlick"` the default).
+fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32, bool), SceneError> {
     let p = format!("material[{i}].");
     let name = match t.get("name").and_then(|v| v.as_str()) {
         Some(n) => n.to_string(),
@@ -162,13 +164,24 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32), Scene
     if !(0.0..=1.0).contains(&roughness) {
         return cx.err(&format!("{p}roughness"), "expected a Beckmann alpha between 0 and 1");
     }
+    let exact = match t.get("fresnel") {
+        None => false,
+        Some(_) if !matches!(kind, MaterialKind::Glass { .. }) => {
+            return cx.err(&format!("{p}fresnel"), "only glass has a Fresnel term to choose");
+        }
+        Some(v) => match v.as_str() {
+            Some("schlick") => false,
+            Some("exact") => true,
+            _ => return cx.err(&format!("{p}fresnel"), "expected \"schlick\" or \"exact\""),
+        },
+    };
     let m = Material {
         name,
         kind,
         color: cx.vec3(t, "color", &p, Some([0.8; 3]))?,
         emission: cx.vec3(t, "emission", &p, Some([0.0; 3]))?,
     };
-    Ok((m, roughness))
+    Ok((m, roughness, exact))
 }
 
 /// Loads a scene description.
@@ -194,10 +207,12 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     let mut materials: Vec<Material> = Vec::new();
     let mut roughness: Vec<f32> = Vec::new();
+    let mut exact_fresnel: Vec<bool> = Vec::new();
     for (i, m) in cx.tables(&t, "material")?.into_iter().enumerate() {
-        let (m, r) = material(&cx, m, i)?;
+        let (m, r, exact) = material(&cx, m, i)?;
         materials.push(m);
         roughness.push(r);
+        exact_fresnel.push(exact);
     }
     let by_name = |ms: &[Material], n: &str| ms.iter().position(|m| m.name == n).map(|i| i as u32);
     let scale = cx.float(&t, "scale", "", 1.0)?;
@@ -260,6 +275,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     scene.textures = extra.textures;
     scene.surfaces = extra.surfaces;
     scene.roughness = roughness;
+    scene.exact_fresnel = exact_fresnel;
     if let Some(e) = t.get("environment") {
         let Some(rel) = e.as_str() else { return cx.err("environment", "expected the file name of an OpenEXR map") };
         let file = dir.join(rel);

@@ -21,8 +21,26 @@ functions; its F is the colour at every angle, Schlick's only when R0 = 1,
 so a rough mirror whose colour is not white is refused (not comparable).
 Both are made two-sided (warplight's mirrors reflect on both sides).
 Mitsuba samples visible normals, warplight D cos: the same BSDF, other
-pdfs, equal in expectation. Glass (warplight: Schlick's Fresnel; Mitsuba's
-dielectrics: the exact Fresnel equations) is refused: not comparable.
+pdfs, equal in expectation. Glass with the thesis' Schlick Fresnel (the
+default) is refused: Mitsuba's dielectrics use the exact Fresnel equations,
+not comparable. A glass whose scene file says `fresnel = "exact"` (warplight:
+the exact equations, path.cu's fresnel_exact()) is Mitsuba's `dielectric`
+(smooth) or `roughdielectric` (`distribution = "beckmann"`, the same
+`alpha`), `int_ior` its IOR, `ext_ior` 1, both specular weights the colour.
+Neither is two-sided: both renderers take the side from the winding's normal.
+warplight scales refracted radiance by eta^2 only at rough glass; in a closed
+object the factors of entering and leaving cancel, so only closed glass
+objects are comparable (the tool does not check that).
+
+Environment: a scene's `environment` (an equirectangular map, thesis 003
+§5.4) is Mitsuba's `envmap` with the identity `to_world`: warplight's lookup
+(kernels/lin2017/path.cu, env()) is written to Mitsuba's conventions (y up,
+u = atan2(x, -z) / 2 pi, v = acos(y) / pi, texel columns centred half a
+texel right of u = 0, rows on the grid v = row / (H - 1), bilinear, periodic
+in u). Before rendering, the tool checks that: `lookup()` below, the same
+formula in numpy, against the loaded emitter's eval() in 4,096 random
+directions and the 4 horizontal axes (`--check-envmap` checks only). A scene without
+an area light is allowed when it has an environment.
 
 The pixel filter: warplight jitters a tent-distributed sample (radius one
 subpixel) in each of the 2 x 2 subpixels of a pixel (smallpt's filter).
@@ -42,6 +60,12 @@ Usage (the committed fixtures were made by):
   python3 tools/mitsuba/reference.py scenes/cornell-rough.toml \
       --size 32 --batches 16 --spp 512 --bounces 16 \
       --out tests/fixtures/mitsuba/cornell-rough-32
+  python3 tools/mitsuba/reference.py scenes/env-spheres.toml \
+      --size 32 --batches 16 --spp 1024 --bounces 16 \
+      --out tests/fixtures/mitsuba/env-spheres-32
+  python3 tools/mitsuba/reference.py scenes/env-glass.toml \
+      --size 32 --batches 16 --spp 1024 --bounces 16 \
+      --out tests/fixtures/mitsuba/env-glass-32
 writes OUT.exr (mean), OUT-var.exr (variance of the mean) and OUT.json.
 """
 
@@ -108,14 +132,15 @@ def load_scene(toml_path):
     mtl = parse_mtl(mtllib) if mtllib else {}
     own = {m["name"]: m for m in sc.get("material", [])}
     over = {o["group"]: o["material"] for o in sc.get("override", [])}
-    shapes = {}   # material name -> (kind, colour, emission, triangles, roughness)
+    shapes = {}   # material name -> (kind, colour, emission, triangles, roughness, glass: (ior, fresnel))
     for g, m, tris in groups:
         name = over.get(g) or (over.get(m) if m else None) or m or "default"
-        rough = 0.0
+        rough, glass = 0.0, None
         if name in own:
             d = own[name]
             kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.8] * 3), d.get("emission", [0.0] * 3)
             rough = float(d.get("roughness", 0.0))
+            glass = (float(d.get("ior", 1.5)), d.get("fresnel", "schlick"))
         else:
             d = mtl.get(name, {})
             kd, ks, ke = d.get("Kd", [0.75] * 3), d.get("Ks", [0.0] * 3), d.get("Ke", [0.0] * 3)
@@ -125,14 +150,61 @@ def load_scene(toml_path):
                 kind, color, em = "mirror", ks, ke
             else:
                 kind, color, em = "diffuse", kd, ke
-        if kind not in ("diffuse", "emitter", "mirror"):
+        if kind == "glass" and glass[1] != "exact":
+            sys.exit(f"{toml_path}: glass {name} uses Schlick's Fresnel (the thesis'), Mitsuba's dielectrics the exact "
+                     "equations; not exported (fresnel = \"exact\" is comparable)")
+        if kind not in ("diffuse", "emitter", "mirror", "glass"):
             sys.exit(f"{toml_path}: material {name} is {kind}: its Fresnel term (Schlick's) is not Mitsuba's; not exported")
         if kind == "mirror" and rough > 0 and any(c != 1.0 for c in color):
             sys.exit(f"{toml_path}: rough mirror {name} has colour {color}: Schlick's F equals Mitsuba's only for R0 = 1")
         # zero-area triangles are dropped, as warplight's loader does
         keep = [t for t in tris if np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0]))) > 0]
-        shapes.setdefault(name, (kind, color, em, [], rough))[3].extend(keep)
+        shapes.setdefault(name, (kind, color, em, [], rough, glass))[3].extend(keep)
     return sc, shapes
+
+
+def lookup(tex, d):
+    """warplight's environment lookup (path.cu's env()) of directions d (N x 3)
+    in the map tex (H x W x 3), in float64."""
+    h, w, _ = tex.shape
+    u = np.arctan2(d[:, 0], -d[:, 2]) / (2 * math.pi)
+    v = np.arccos(np.clip(d[:, 1], -1.0, 1.0)) / math.pi
+    u = u - 0.5 / w
+    u = u - np.floor(u)
+    v = v - np.floor(v)
+    x, y = u * w, v * (h - 1)
+    px = np.minimum(np.floor(x), w - 1).astype(int)
+    py = np.minimum(np.floor(y), h - 2).astype(int)
+    fx, fy = (x - px)[:, None], (y - py)[:, None]
+    qx = (px + 1) % w
+    top = (1 - fx) * tex[py, px] + fx * tex[py, qx]
+    bottom = (1 - fx) * tex[py + 1, px] + fx * tex[py + 1, qx]
+    return (1 - fy) * top + fy * bottom
+
+
+def check_envmap(mi, path):
+    """The largest relative difference between lookup() and Mitsuba's envmap
+    eval() over random directions and the axes; exits when above 1e-4."""
+    tex = np.array(mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False),
+                   dtype=np.float64)
+    em = mi.load_dict({"type": "envmap", "filename": path})
+    rng = np.random.default_rng(1)
+    d = rng.normal(size=(4096, 3))
+    # the axes but the poles, where v = 1 wraps to 0 or not as acos(-1) / pi rounds
+    d = np.concatenate([d, [[1, 0, 0], [-1, 0, 0], [0, 0, 1], [0, 0, -1]]])
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    ours = lookup(tex, d)
+    worst = 0.0
+    for k in range(len(d)):
+        si = mi.SurfaceInteraction3f()
+        si.wi = mi.Vector3f(*(-d[k]))
+        theirs = np.array(em.eval(si), dtype=np.float64)
+        err = np.max(np.abs(theirs - ours[k]) / np.maximum(np.abs(theirs), 1e-3))
+        worst = max(worst, float(err))
+    print(f"envmap check: {len(d)} directions, largest relative difference {worst:.2e}", file=sys.stderr)
+    if worst > 1e-4:
+        sys.exit(f"{path}: warplight's lookup differs from Mitsuba's envmap (relative {worst:.3g})")
+    return worst
 
 
 def main():
@@ -142,13 +214,20 @@ def main():
     ap.add_argument("--batches", type=int, default=16)
     ap.add_argument("--spp", type=int, default=1024, help="samples per film pixel (subpixel) per batch")
     ap.add_argument("--bounces", type=int, default=16)
-    ap.add_argument("--out", required=True)
+    ap.add_argument("--out")
+    ap.add_argument("--check-envmap", action="store_true", help="only check the environment lookup")
     a = ap.parse_args()
+    if not a.out and not a.check_envmap:
+        ap.error("--out is required")
     import mitsuba as mi
     mi.set_variant("scalar_rgb")
     from mitsuba import ScalarTransform4f as T
 
     sc, shapes = load_scene(a.scene)
+    env = os.path.join(os.path.dirname(a.scene), sc["environment"]) if "environment" in sc else None
+    env_check = check_envmap(mi, env) if env else None
+    if a.check_envmap:
+        return
     cam = sc["camera"]
     pos = cam["position"]
     d = cam["direction"]
@@ -174,7 +253,7 @@ def main():
         },
     }
     triangles, light_area = 0, 0.0
-    for k, (name, (kind, color, em, tris, rough)) in enumerate(sorted(shapes.items())):
+    for k, (name, (kind, color, em, tris, rough, glass)) in enumerate(sorted(shapes.items())):
         if not tris:
             continue
         f = os.path.join(tmp, f"{k}.obj")
@@ -191,6 +270,16 @@ def main():
             shape["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": em}}
             for t in tris:
                 light_area += 0.5 * np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0])))
+        elif kind == "glass":
+            shape["bsdf"] = {
+                "type": "roughdielectric" if rough > 0 else "dielectric",
+                "int_ior": glass[0],
+                "ext_ior": 1.0,
+                "specular_reflectance": {"type": "rgb", "value": color},
+                "specular_transmittance": {"type": "rgb", "value": color},
+            }
+            if rough > 0:
+                shape["bsdf"].update({"distribution": "beckmann", "alpha": rough})
         elif kind == "mirror" and rough > 0:
             shape["bsdf"] = {
                 "type": "twosided",
@@ -217,6 +306,8 @@ def main():
                 "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": color}},
             }
         desc[f"shape_{k}_{name}"] = shape
+    if env:
+        desc["environment"] = {"type": "envmap", "filename": env}
     scene = mi.load_dict(desc)
     t0 = time.time()
     batches = []
@@ -241,6 +332,8 @@ def main():
         "variant": "scalar_rgb",
         "triangles": triangles,
         "light_area": light_area,
+        "environment": sc.get("environment"),
+        "envmap_check_max_rel_diff": env_check,
         "seconds": round(time.time() - t0, 1),
         "command": "python3 tools/mitsuba/reference.py " + " ".join(sys.argv[1:]),
         "mean_rgb": [float(v) for v in mean.reshape(-1, 3).mean(axis=0)],

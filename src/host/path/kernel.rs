@@ -55,6 +55,8 @@ pub fn params_bytes(scene: &PathScene, camera: &Camera, params: &FrameParams, fr
         scene.lights.len() as i32,
         params.seed as i32,
         params.traversal.code(),
+        scene.env.as_ref().map_or(0, |e| e.width as i32),
+        scene.env.as_ref().map_or(0, |e| e.height as i32),
     ] {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
@@ -66,15 +68,16 @@ pub fn params_bytes(scene: &PathScene, camera: &Camera, params: &FrameParams, fr
 pub struct SceneBuffers {
     /// The parameter block (`Params`), rewritten per frame.
     pub params: DevicePtr,
-    /// Nodes, references, triangle rows, triangle data, materials, lights, node boxes.
-    pub data: [DevicePtr; 7],
+    /// Nodes, references, triangle rows, triangle data, materials, lights,
+    /// node boxes, environment texels (one black texel when there is none).
+    pub data: [DevicePtr; 8],
 }
 
 impl SceneBuffers {
-    /// The kernels' first eight arguments: the parameter block, then the scene's data.
-    pub fn scene_args(&self) -> [DevicePtr; 8] {
+    /// The kernels' first nine arguments: the parameter block, then the scene's data.
+    pub fn scene_args(&self) -> [DevicePtr; 9] {
         let d = self.data;
-        [self.params, d[0], d[1], d[2], d[3], d[4], d[5], d[6]]
+        [self.params, d[0], d[1], d[2], d[3], d[4], d[5], d[6], d[7]]
     }
 }
 
@@ -99,7 +102,10 @@ pub fn upload_scene(
     let mb = upload(dev, &to_bytes(&flat(&scene.mats)), "materials")?;
     let lb = upload(dev, &to_bytes(&flat(&scene.lights)), "lights")?;
     let bb = upload(dev, &to_bytes(&flat(&scene.up)), "boxes")?;
-    Ok(SceneBuffers { params: pp, data: [nb, rb, tb, db, mb, lb, bb] })
+    let none = [[0.0f32; 4]];
+    let texels = scene.env.as_ref().map_or(&none[..], |e| &e.texels[..]);
+    let eb = upload(dev, &to_bytes(&flat(texels)), "environment")?;
+    Ok(SceneBuffers { params: pp, data: [nb, rb, tb, db, mb, lb, bb, eb] })
 }
 
 /// An emulated progressive render.

@@ -14,6 +14,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::environment::Environment;
 use crate::host::kdtree::{Aabb, KdTree, Node};
 use crate::host::scene::{MaterialKind, Scene};
 
@@ -33,16 +34,27 @@ pub enum LayoutError {
     /// More nodes than a 24-bit index reaches.
     #[error("the kd-tree has {0} nodes; the thesis' node indexes at most {MAX_NODES} (24 bits)")]
     TooManyNodes(usize),
-    /// No triangle emits: the path tracer needs an area light.
-    #[error("scene `{0}` has no emitting triangle: the path tracer needs an area light (an emitter material)")]
+    /// No triangle emits and there is no environment: the path tracer needs a light.
+    #[error(
+        "scene `{0}` has no emitting triangle and no environment: the path tracer needs an area light (an emitter material) or an `environment` map"
+    )]
     NoLight(String),
+    /// The environment map could not be read or is not one.
+    #[error("environment map {path}: {msg}")]
+    Environment {
+        /// The map's file.
+        path: String,
+        /// What is wrong with it.
+        msg: String,
+    },
 }
 
 /// The kernel's material kind: Lambertian diffuse.
 pub const KIND_DIFFUSE: u32 = 0;
 /// A perfect (smooth) mirror.
 pub const KIND_MIRROR: u32 = 1;
-/// Smooth glass (Schlick's Fresnel switch between reflection and refraction).
+/// Smooth glass (Schlick's Fresnel switch between reflection and refraction;
+/// per material the exact Fresnel equations instead).
 pub const KIND_GLASS: u32 = 2;
 /// An emitter.
 pub const KIND_EMITTER: u32 = 3;
@@ -82,12 +94,15 @@ pub struct PathScene {
     /// Per triangle: unit geometric normal, material index (u32 bits).
     pub tri_data: Vec<[f32; 4]>,
     /// Per material: colour, kind (u32 bits); emission, index of refraction;
-    /// Beckmann α (0 for smooth kinds), 0, 0, 0.
+    /// Beckmann α (0 for smooth kinds), 1 for a glass with the exact Fresnel
+    /// equations (0: Schlick's), 0, 0.
     pub mats: Vec<[f32; 12]>,
     /// Per emitting triangle: v0, cumulative area fraction; e1, triangle (u32 bits); e2, 0.
     pub lights: Vec<[f32; 12]>,
-    /// Total emitting area.
+    /// Total emitting area (0 when no triangle emits).
     pub light_area: f32,
+    /// The environment map seen by rays that miss every triangle (§5.4), if any.
+    pub env: Option<Environment>,
     /// Scene bounds (the root's box).
     pub lo: [f32; 3],
     /// Scene bounds.
@@ -175,7 +190,9 @@ impl PathScene {
                 let alpha = scene.roughness(i as u32);
                 let kind = kind_code(m.kind, alpha);
                 let alpha = if matches!(kind, KIND_CONDUCTOR | KIND_ROUGH_GLASS) { alpha } else { 0.0 };
-                [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, 0.0, 0.0, 0.0]
+                let glass = matches!(kind, KIND_GLASS | KIND_ROUGH_GLASS);
+                let exact = glass && scene.exact_fresnel.get(i).copied().unwrap_or(false);
+                [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, if exact { 1.0 } else { 0.0 }, 0.0, 0.0]
             })
             .collect();
         let emitting: Vec<(usize, f64)> = scene
@@ -186,7 +203,8 @@ impl PathScene {
             .map(|(i, t)| (i, 0.5 * (t.v[1] - t.v[0]).as_dvec3().cross((t.v[2] - t.v[0]).as_dvec3()).length()))
             .collect();
         let total: f64 = emitting.iter().map(|e| e.1).sum();
-        if emitting.is_empty() || total <= 0.0 {
+        let env = scene.environment.as_deref().map(Environment::load).transpose()?;
+        if env.is_none() && (emitting.is_empty() || total <= 0.0) {
             return Err(LayoutError::NoLight(scene.name.clone()));
         }
         let mut acc = 0.0f64;
@@ -211,6 +229,7 @@ impl PathScene {
             mats,
             lights,
             light_area: total as f32,
+            env,
             lo: tree.bounds.lo.into(),
             hi: tree.bounds.hi.into(),
         })

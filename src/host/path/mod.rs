@@ -2,7 +2,8 @@
 //! `kernels/lin2017/path.cu` run on the emulator ([`kernel`]) and its native
 //! mirror ([`native`]): tent-filtered camera rays in 4 subpixels, the
 //! flattened SAH kd-tree with the 8-byte short-stack traversal, the affine
-//! triangle test, Lambertian / mirror / Fresnel-switched glass shading,
+//! triangle test, Lambertian / mirror / Fresnel-switched glass shading, an
+//! equirectangular environment map ([`environment`]),
 //! next-event estimation, multiple importance sampling and Russian roulette,
 //! accumulated progressively over frames (one launch per frame, 4 samples
 //! per pixel per frame). [`stats`] compares renders with a reference by a
@@ -11,6 +12,7 @@
 pub mod build;
 pub mod bvh;
 pub mod counts;
+pub mod environment;
 pub mod kernel;
 pub mod layout;
 pub mod native;

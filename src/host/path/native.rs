@@ -307,7 +307,14 @@ impl Tracer<'_> {
         let mut bsdf_pdf = 0.0f32;
         let mut bounce = 0u32;
         while bounce <= p.max_bounces {
-            let Some((tri, t)) = self.trace(o, d, cam.eps, f32::INFINITY, false, counts) else { break };
+            let Some((tri, t)) = self.trace(o, d, cam.eps, f32::INFINITY, false, counts) else {
+                // the environment: not light-sampled, its radiance counts in full after any bounce
+                if let Some(env) = &s.env {
+                    let e = env.radiance([d.x, d.y, d.z]);
+                    l = l.add(beta.mul(v3(e[0], e[1], e[2])));
+                }
+                break;
+            };
             let td = s.tri_data[tri as usize];
             let n = v3(td[0], td[1], td[2]);
             let mat = &s.mats[td[3].to_bits() as usize];
@@ -334,7 +341,7 @@ impl Tracer<'_> {
             let cos_o = -d.dot(ns);
             let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
             let sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
-            if sampled_light && integrator != Integrator::Pt && bounce < p.max_bounces {
+            if sampled_light && integrator != Integrator::Pt && !s.lights.is_empty() && bounce < p.max_bounces {
                 let yl = rng(key, dim);
                 let mut li = 0usize;
                 while li + 1 < s.lights.len() && !(yl < s.lights[li][3]) {
@@ -420,7 +427,11 @@ impl Tracer<'_> {
                     if k > 0.0 {
                         let cos_t = k.sqrt();
                         let r0 = (1.0 - ior) / (1.0 + ior);
-                        let fr = schlick(r0 * r0, if into { co } else { cos_t });
+                        let fr = if mat[9] > 0.0 {
+                            fresnel_exact(eta, co, cos_t)
+                        } else {
+                            schlick(r0 * r0, if into { co } else { cos_t })
+                        };
                         if !(rng(key, dim + 6) < fr) {
                             next = d.scale(eta).add(mh.scale(eta * co - cos_t));
                             scale = eta * eta;
@@ -448,11 +459,15 @@ impl Tracer<'_> {
                     if k > 0.0 {
                         let cos_t = k.sqrt();
                         let tdir = d.scale(eta).add(ns.scale(eta * cos_i - cos_t));
-                        let mut r0 = (1.0 - ior) / (1.0 + ior);
-                        r0 = r0 * r0;
-                        let cc = 1.0 - if into { cos_i } else { cos_t };
-                        let c2 = cc * cc;
-                        let fr = r0 + (1.0 - r0) * (c2 * c2 * cc);
+                        let fr = if mat[9] > 0.0 {
+                            fresnel_exact(eta, cos_i, cos_t)
+                        } else {
+                            let mut r0 = (1.0 - ior) / (1.0 + ior);
+                            r0 = r0 * r0;
+                            let cc = 1.0 - if into { cos_i } else { cos_t };
+                            let c2 = cc * cc;
+                            r0 + (1.0 - r0) * (c2 * c2 * cc)
+                        };
                         if !(rng(key, dim + 6) < fr) {
                             next = tdir;
                         }
@@ -581,6 +596,15 @@ pub fn schlick(r0: f32, c: f32) -> f32 {
     r0 + (1.0 - r0) * (x2 * x2 * x)
 }
 
+/// The exact Fresnel reflectance of a dielectric for the incident cosine
+/// `ci` and the transmitted cosine `ct`, `eta` = n_i / n_t (the mean of the s
+/// and p reflectances): the kernel's `fresnel_exact`.
+pub fn fresnel_exact(eta: f32, ci: f32, ct: f32) -> f32 {
+    let rs = (eta * ci - ct) / (eta * ci + ct);
+    let rp = (ci - eta * ct) / (ci + eta * ct);
+    0.5 * (rs * rs + rp * rp)
+}
+
 /// Duff et al.'s orthonormal basis around the unit `n`.
 fn basis(n: V3) -> (V3, V3) {
     let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
@@ -646,5 +670,25 @@ mod tests {
         assert!((smith_g1(alpha, c, c) - want).abs() < 1e-5);
         assert_eq!(schlick(1.0, 0.2), 1.0, "R0 = 1 reflects everything (the Mitsuba comparison's case)");
         assert!((schlick(0.04, 0.0) - 1.0).abs() < 1e-6 && schlick(0.04, 1.0) == 0.04);
+    }
+
+    /// The exact dielectric Fresnel term: ((n - 1) / (n + 1))^2 = 0.04 at
+    /// normal incidence for n = 1.5 from either side, 1 at grazing
+    /// incidence, Brewster's angle (tan θ = n) zeroes r_p so F = r_s² / 2,
+    /// and it differs from Schlick's by a few percent between.
+    #[test]
+    fn exact_fresnel_follows_the_equations() {
+        let n = 1.5f32;
+        assert!((fresnel_exact(1.0 / n, 1.0, 1.0) - 0.04).abs() < 1e-7);
+        assert!((fresnel_exact(n, 1.0, 1.0) - 0.04).abs() < 1e-7);
+        assert!((fresnel_exact(1.0 / n, 0.0, (1.0 - 1.0 / (n * n)).sqrt()) - 1.0).abs() < 1e-6);
+        let (ci, eta) = (1.0 / (1.0 + n * n).sqrt(), 1.0 / n);
+        let ct = (1.0 - eta * eta * (1.0 - ci * ci)).sqrt();
+        let rs = (eta * ci - ct) / (eta * ci + ct);
+        assert!((fresnel_exact(eta, ci, ct) - 0.5 * rs * rs).abs() < 1e-7, "Brewster: r_p = 0");
+        let ci = 0.3f32;
+        let ct = (1.0 - eta * eta * (1.0 - ci * ci)).sqrt();
+        let (exact, approx) = (fresnel_exact(eta, ci, ct), schlick(0.04, ci));
+        assert!(exact != approx && (exact - approx).abs() < 0.03, "{exact} vs Schlick {approx}");
     }
 }

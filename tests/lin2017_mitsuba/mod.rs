@@ -1,0 +1,66 @@
+//! What the path tracer's tests against Mitsuba 3 share: the committed
+//! references (`tests/fixtures/mitsuba/`, made by `tools/mitsuba/reference.py`),
+//! the scenes laid out as the renderer does, and the per-block Welch t-test
+//! under Holm's correction of a native or emulated render against them.
+
+use std::path::Path;
+
+use warplight::host::camera::Camera;
+use warplight::host::kdtree::{BuildParams, Heuristic, build};
+use warplight::host::path::layout::PathScene;
+use warplight::host::path::stats::{Estimate, Outcome, from_frames, from_reference, read_exr, welch_holm};
+use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::scene::Scene;
+use warplight::host::scene_file;
+use warplight::sim::{Device, Fidelity};
+
+/// Pixels a block's side.
+pub const BLOCK: u32 = 4;
+/// The family-wise level of Holm's procedure.
+pub const ALPHA: f64 = 0.01;
+
+/// A reference's estimate, its image size and its metadata.
+pub fn reference_of(fixture: &str) -> (Estimate, u32, serde_json::Value) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mean = read_exr(&root.join(format!("{fixture}.exr"))).expect("reference mean");
+    let var = read_exr(&root.join(format!("{fixture}-var.exr"))).expect("reference variance");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root.join(format!("{fixture}.json"))).expect("reference json"))
+            .expect("json");
+    let batches = meta["batches"].as_u64().expect("batches") as u32;
+    assert_eq!(meta["size"].as_u64(), Some(mean.width as u64));
+    (from_reference(&mean, &var, BLOCK, batches), mean.width, meta)
+}
+
+/// Scene `name` of `scenes/`, laid out, and its camera at `size` x `size` pixels.
+pub fn scene_of(name: &str, size: u32) -> (Scene, PathScene, Camera) {
+    let scene = scene_file::load(&scene_file::resolve(name)).expect("a scene of scenes/");
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+    let ps = PathScene::new(&scene, &tree).expect("layout");
+    let cam = Camera { resolution: [size, size], ..scene.camera };
+    (scene, ps, cam)
+}
+
+/// Frames of `size` x `size` pixels, 16 bounces, the short stack.
+pub fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
+    FrameParams { width: size, height: size, integrator, max_bounces: 16, seed, traversal: Traversal::ShortStack }
+}
+
+/// A native render of `frames` frames against `reference`.
+pub fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32, reference: &Estimate) -> Outcome {
+    let r = render_native(ps, cam, p, frames, true, |_| {});
+    let ours = from_frames(&r.frame_images, BLOCK).expect("two frames or more");
+    welch_holm(&ours, reference, ALPHA).expect("same block grid")
+}
+
+/// The emulated kernel's 4 frames (functional fidelity) against `reference`.
+pub fn emulated_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, reference: &Estimate) -> Outcome {
+    let mut cfg = kernel::sim_config(&p);
+    cfg.fidelity = Fidelity::Functional;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev).expect("load PTX");
+    let r = kernel::render(&mut dev, &module, ps, cam, p, 4, true, |_| {}).expect("launch");
+    let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
+    welch_holm(&ours, reference, ALPHA).expect("same block grid")
+}
