@@ -1,15 +1,17 @@
 //! Seed 004's error charts' native reference (`src/repro/purcell2003/reference.rs`)
 //! against the emulated pipeline: the native photon tracer stores the photons
-//! the kernels `emit` and `bounce` store, and the native render over the
-//! renders' own photons and k is the emulated map A's image; the error
-//! measures by hand.
+//! the kernels `emit` and `bounce` store, bit for bit; map A built on the host
+//! from them is the emulated map A element for element, with the same
+//! estimate; the native render over the renders' own photons and k is near
+//! the emulated map A's image; the error measures by hand.
 
 use glam::Vec3;
 use warplight::host::scene_file;
+use warplight::repro::purcell2003::bitonic;
 use warplight::repro::purcell2003::error::{self, rel_rmse};
 use warplight::repro::purcell2003::grid::Grid;
 use warplight::repro::purcell2003::image;
-use warplight::repro::purcell2003::native::MapData;
+use warplight::repro::purcell2003::native::{self, MapData};
 use warplight::repro::purcell2003::passes::Passes;
 use warplight::repro::purcell2003::photons::{self, Geometry};
 use warplight::repro::purcell2003::reference;
@@ -33,25 +35,16 @@ fn native_photon_tracing_stores_the_kernels_photons() {
     let emulated: Vec<usize> = (n..n * frames).filter(|&s| pos[4 * s + 3] != 0.0).collect();
     let native = reference::trace(&geo, n, bounces, 11);
     assert!(emulated.len() > 20, "{} photons stored", emulated.len());
-    // the kernels' __cosf / __sinf against cosf / sinf may turn a rare path:
-    // nearly every slot agrees, and where both store, the photon agrees
+    // the same slots, and each photon bit for bit (__cosf / __sinf as the
+    // emulator computes them: a C library's cosf differs in the last bit
+    // for some angles, which moved photons by an ulp)
     let slots: Vec<usize> = native.iter().map(|q| q.slot).collect();
-    let common: Vec<usize> = emulated.iter().copied().filter(|s| slots.contains(s)).collect();
-    assert!(
-        common.len() * 100 >= 98 * emulated.len().max(slots.len()),
-        "{} common of {} emulated and {} native",
-        common.len(),
-        emulated.len(),
-        slots.len()
-    );
+    assert_eq!(slots, emulated);
     for q in &native {
-        if !common.contains(&q.slot) {
-            continue;
-        }
         let s = q.slot;
         for c in 0..3 {
-            assert!((pos[4 * s + c] - q.pos[c]).abs() < 1e-3, "slot {s}: position {c}");
-            assert!((pow[4 * s + c] - q.power[c]).abs() <= 1e-5 * pow[4 * s + c].abs(), "slot {s}: power {c}");
+            assert_eq!(pos[4 * s + c].to_bits(), q.pos[c].to_bits(), "slot {s}: position {c}");
+            assert_eq!(pow[4 * s + c].to_bits(), q.power[c].to_bits(), "slot {s}: power {c}");
         }
     }
     // photons straight from the light are not stored: none in frame 1
@@ -80,7 +73,7 @@ fn the_native_photons_are_the_renders_and_their_render_is_near_map_as_image() {
     let geo = Geometry::of(&scene);
     // the emulated pipeline's calibration, natively: the same emitted count
     let emitted = reference::emitted(&geo, &f, f.stated_photons);
-    let MapData::Bitonic { pos, pow, .. } = &r.maps[0] else { panic!("map A") };
+    let MapData::Bitonic { pos, pow, sorted, first, .. } = &r.maps[0] else { panic!("map A") };
     assert_eq!(emitted, pos.len() / (f.bounces + 1), "calibrated emitted count");
     let photons = reference::trace(&geo, emitted, f.bounces, SEED);
     assert_eq!(photons.len(), error::stored(&r), "stored photons");
@@ -88,15 +81,61 @@ fn the_native_photons_are_the_renders_and_their_render_is_near_map_as_image() {
         let s = q.slot;
         assert_eq!(pos[s][3], 1.0, "slot {s} stored");
         for c in 0..3 {
-            assert!((pos[s][c] - q.pos[c]).abs() < 1e-4 && (pow[s][c] - q.power[c]).abs() < 1e-6, "slot {s}");
+            assert_eq!(pos[s][c].to_bits(), q.pos[c].to_bits(), "slot {s}: position {c}");
+            assert_eq!(pow[s][c].to_bits(), q.power[c].to_bits(), "slot {s}: power {c}");
         }
     }
-    // the reference render over these photons: near the emulated map A image
-    // (the kNN-grid's accepted set depends on the order within a cell, which
-    // the unstable bitonic sort sets; so not bit for bit)
+    // the host bins the native photons as the kernel `cell_keys` does and
+    // sorts them by Fig. 3's network: the emulated map A element for element
+    // (every cell the same photons, in the same order)
+    let grid = r.grid;
+    let stored: std::collections::HashMap<usize, u32> =
+        photons.iter().map(|q| (q.slot, grid.cell_of(glam::Vec3::from(q.pos)))).collect();
+    let (first_slot, count) = (emitted, emitted * f.bounces);
+    let n = sorted.len();
+    assert_eq!(n, bitonic::padded(count));
+    let mut host: Vec<(u32, u32)> = (0..n)
+        .map(|e| {
+            if e < count {
+                let s = first_slot + e;
+                (stored.get(&s).copied().unwrap_or(grid.cells() as u32), s as u32)
+            } else {
+                (grid.cells() as u32, u32::MAX)
+            }
+        })
+        .collect();
+    for (offset, stepno) in bitonic::schedule(n) {
+        host = bitonic::reference_pass(&host, offset as usize, stepno as usize);
+    }
+    let got: Vec<(u32, u32)> = sorted.iter().map(|e| (e[0], e[1])).collect();
+    assert_eq!(got, host, "map A's sorted elements");
+    for (c, &start) in first.iter().enumerate() {
+        assert_eq!(start as usize, host.partition_point(|e| (e.0 as usize) < c), "first element of cell {c}");
+    }
+    // the native kNN-grid over that host-built map A: the emulated estimate, state for state
+    let slots = pos.len();
+    let (mut hpos, mut hpow, mut hdir) = (vec![[0.0f32; 4]; slots], vec![[0.0f32; 4]; slots], vec![[0.0f32; 4]; slots]);
+    for q in &photons {
+        hpos[q.slot] = [q.pos[0], q.pos[1], q.pos[2], 1.0];
+        hpow[q.slot] = [q.power[0], q.power[1], q.power[2], 1.0];
+        hdir[q.slot] = [q.dir[0], q.dir[1], q.dir[2], 0.0];
+    }
+    let hfirst: Vec<u32> = (0..=grid.cells()).map(|c| host.partition_point(|e| (e.0 as usize) < c) as u32).collect();
+    let map = MapData::Bitonic {
+        first: hfirst,
+        sorted: host.iter().map(|e| [e.0, e.1]).collect(),
+        pos: hpos,
+        pow: hpow,
+        dir: hdir,
+    };
+    assert_eq!(native::estimate(&grid, &map, &r.queries, &r.params), r.states[0], "map A's estimate");
+    // the reference render over these photons: near the emulated map A image,
+    // not bit for bit: its host sort orders a cell's photons by slot, the
+    // bitonic network otherwise, and the kNN-grid's accepted set depends on
+    // the order (measured 12.6 %; the bound is loose)
     let got = reference::render(&scene, &f, 16, emitted, f.k, SEED);
     assert_eq!(got.stored, photons.len());
     let want = &image::images(&r)[0];
     let e = rel_rmse(&got.image, want);
-    assert!(e < 0.5, "relative RMS error {e}");
+    assert!(e < 0.25, "relative RMS error {e}");
 }

@@ -65,6 +65,20 @@ pub(super) fn tri_normal(tris: &[f32], i: usize) -> V3 {
     normalize(cross(at(tris, 12 * i + 3), at(tris, 12 * i + 6)))
 }
 
+/// The kernels' `__cosf` (`cos.approx.f32`) as the emulator executes it:
+/// the cosine in f64, rounded once (`src/sim/alu.rs`). The C library's
+/// `cosf` (`f32::cos`) differs from it in the last bit for some arguments,
+/// which moves a photon by an ulp and can turn its path or its cell.
+pub fn cos_approx(x: f32) -> f32 {
+    (x as f64).cos() as f32
+}
+
+/// The kernels' `__sinf` (`sin.approx.f32`) as the emulator executes it
+/// (see [`cos_approx`]).
+pub fn sin_approx(x: f32) -> f32 {
+    (x as f64).sin() as f32
+}
+
 /// The kernels' `cosine_dir`: a cosine-weighted direction about `n`.
 pub(super) fn cosine_dir(n: V3, u1: f32, u2: f32) -> V3 {
     let a = if n[0].abs() > 0.5 { [0.0, 1.0, 0.0] } else { [1.0, 0.0, 0.0] };
@@ -72,7 +86,7 @@ pub(super) fn cosine_dir(n: V3, u1: f32, u2: f32) -> V3 {
     let b = cross(n, t);
     let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
     let z = (1.0 - u1).max(0.0).sqrt();
-    add(add(mul(t, r * phi.cos()), mul(b, r * phi.sin())), mul(n, z))
+    add(add(mul(t, r * cos_approx(phi)), mul(b, r * sin_approx(phi))), mul(n, z))
 }
 
 pub(super) fn reflect(d: V3, n: V3) -> V3 {

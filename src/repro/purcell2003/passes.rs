@@ -38,6 +38,10 @@ pub struct PhaseCounts {
     /// Lane-level global loads (the texture fetches of a fragment program): the
     /// guard-true lanes of every `ld.global*` instruction.
     pub lane_loads: u64,
+    /// Of those, the loads at addresses that are functions of the thread's
+    /// index alone, once per thread (by data flow: [`dataflow::Class::Stream`]):
+    /// what a pass drawn as one point per element received as vertex attributes.
+    pub stream_loads: u64,
     /// Lane-level global stores.
     pub lane_stores: u64,
     /// Lane-level atomic operations.
@@ -57,6 +61,7 @@ impl PhaseCounts {
         let c = dataflow::count(classes, s);
         self.addr_instructions += c.addr;
         self.pack_instructions += c.pack;
+        self.stream_loads += c.stream;
         self.launches += 1;
         self.warp_instructions += s.totals.warp_instructions;
         self.thread_instructions += s.totals.thread_instructions;
@@ -73,6 +78,7 @@ impl PhaseCounts {
         self.warp_instructions += o.warp_instructions;
         self.thread_instructions += o.thread_instructions;
         self.lane_loads += o.lane_loads;
+        self.stream_loads += o.stream_loads;
         self.lane_stores += o.lane_stores;
         self.lane_atomics += o.lane_atomics;
         self.ctas += o.ctas;
@@ -87,6 +93,7 @@ impl PhaseCounts {
             warp_instructions: later.warp_instructions - self.warp_instructions,
             thread_instructions: later.thread_instructions - self.thread_instructions,
             lane_loads: later.lane_loads - self.lane_loads,
+            stream_loads: later.stream_loads - self.stream_loads,
             lane_stores: later.lane_stores - self.lane_stores,
             lane_atomics: later.lane_atomics - self.lane_atomics,
             ctas: later.ctas - self.ctas,

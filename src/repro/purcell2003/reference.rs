@@ -2,7 +2,8 @@
 //! natively: the photons traced in Rust as the kernels `emit` and `bounce`
 //! trace them (`kernels/purcell2003/photons.cu`: the same emission, Russian
 //! roulette, cosine-weighted bounce, Schlick glass, storage rule and random
-//! numbers; `cosf`/`sinf` where the kernel calls `__cosf`/`__sinf`), sorted
+//! numbers; `__cosf`/`__sinf` as the emulator computes them, so the photons
+//! are the kernels' bit for bit: [`super::geometry::cos_approx`]), sorted
 //! into map A's arrays by a host sort (the cell ranges the bitonic sort and
 //! the binary search give), and estimated by the native kNN-grid
 //! ([`super::native::estimate`]) at the pixels' query points. The emulator
@@ -17,7 +18,9 @@
 
 use rayon::prelude::*;
 
-use super::geometry::{V3, add, at, cosine_dir, cross, dot, intersect, mul, normalize, specular, sub, tri_normal};
+use super::geometry::{
+    V3, add, at, cos_approx, cosine_dir, cross, dot, intersect, mul, normalize, sin_approx, specular, sub, tri_normal,
+};
 use super::grid::Grid;
 use super::image;
 use super::knn::{Params, State};
@@ -62,7 +65,7 @@ fn emit(geo: &Geometry, i: u32, seed: u32) -> (V3, V3) {
             t = normalize(cross([0.0, 0.0, 1.0], a));
             b = cross(a, t);
         }
-        return (p, add(add(mul(t, r * phi.cos()), mul(b, r * phi.sin())), mul(a, z)));
+        return (p, add(add(mul(t, r * cos_approx(phi)), mul(b, r * sin_approx(phi))), mul(a, z)));
     }
     let nl = geo.lights.len();
     let l = ((u[0] * nl as f32) as usize).min(nl - 1);
