@@ -306,6 +306,11 @@ fn vector_access(
     if let Some(first) = local_in_one(w, space, ty, addrs, exec, vals, store, touched) {
         return Ok(Some(first));
     }
+    if space == MemSpace::FrameParam
+        && let Some(first) = params_in_one(w, ty, addrs, exec, vals, store, touched)
+    {
+        return Ok(Some(first));
+    }
     let mut m = exec;
     while m != 0 {
         let l = m.trailing_zeros() as usize;
@@ -464,6 +469,61 @@ fn local_in_one(
         }
     }
     Some(Resolved::Local(addrs[first] - window))
+}
+
+/// The common access to the current frame's parameter area (a call's
+/// arguments and return values, `ld.param`/`st.param` in a function) at
+/// once: when every active lane's whole access is aligned to its
+/// power-of-two size and ends within one lane's parameter area
+/// (`Frame::param_size`), no lane can fault and the lanes' areas are
+/// loaded or stored without checks per lane and element. Returns `None`,
+/// having touched nothing, otherwise (the per-lane path then reports the
+/// faulting lane). Values, order and what `touched` records are the
+/// per-lane path's, for the reasons given at [`local_in_one`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn params_in_one(
+    w: &mut Warp,
+    ty: Ty,
+    addrs: &Lanes,
+    exec: u32,
+    vals: &mut [Lanes],
+    store: bool,
+    touched: &mut Touched,
+) -> Option<Resolved> {
+    let size = ty.bytes();
+    let total = size * vals.len() as u32;
+    if exec == 0 || !total.is_power_of_two() {
+        return None;
+    }
+    let (_, hi, low_bits) = lane_span(addrs, exec);
+    let f = w.frames.last_mut().expect("frame");
+    let ps = f.param_size as u64;
+    // every lane's area is in `params` (32 of them), so no access below can miss
+    if low_bits & (total as u64 - 1) != 0 || hi.checked_add(total as u64).is_none_or(|e| e > ps) {
+        return None;
+    }
+    let first = exec.trailing_zeros() as usize;
+    touched.first = Some(MemSpace::FrameParam);
+    touched.lanes |= exec;
+    let mut m = exec;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let off = addrs[l];
+        touched.space[l] = Some(MemSpace::FrameParam);
+        touched.addr[l] = off;
+        let base = l as u64 * ps + off;
+        for (k, v) in vals.iter_mut().enumerate() {
+            let ok = base + (k as u32 * size) as u64;
+            if store {
+                bytes_store(&mut f.params, ok, size, v[l] & ty.mask()).expect("within the lane's area");
+            } else {
+                v[l] = ty.extend(bytes_load(&f.params, ok, size).expect("within the lane's area"));
+            }
+        }
+    }
+    Some(Resolved::FParam(addrs[first]))
 }
 
 /// Vector accesses must be aligned to their whole size.
@@ -749,5 +809,75 @@ mod tests {
         }
         // the window's own arithmetic: a generic address is its local offset plus the window
         assert_eq!(LOCAL_WINDOW % (1 << 32), 0);
+    }
+
+    /// Threads with `tid % 4 != 1` call `addmul(tid, {tid + 5, 7 tid}, 3)`
+    /// (a scalar, a pair and a 12-byte array's last word as arguments, a
+    /// pair and a scalar back, as the compiler passes them): the calls'
+    /// parameter accesses, under a partial mask, take the per-warp path
+    /// (`params_in_one`).
+    const CALLS: &str = r#".version 7.8
+.target sm_90
+.address_size 64
+.func (.param .align 16 .b8 rv[12]) addmul(.param .b32 a, .param .align 16 .b8 p[12])
+{
+  .reg .b32 %r<8>;
+  ld.param.u32 %r1, [a];
+  ld.param.v2.u32 {%r2, %r3}, [p+0];
+  ld.param.u32 %r6, [p+8];
+  mul.lo.u32 %r4, %r1, %r2;
+  add.u32 %r5, %r4, %r3;
+  st.param.v2.u32 [rv+0], {%r5, %r1};
+  st.param.u32 [rv+8], %r6;
+  ret;
+}
+.visible .entry calls(.param .u64 out)
+{
+  .reg .pred %p1;
+  .reg .b32 %r<12>;
+  .reg .b64 %rd<4>;
+  ld.param.u64 %rd1, [out];
+  mov.u32 %r1, %tid.x;
+  mov.u32 %r6, 99;
+  mov.u32 %r7, 98;
+  mov.u32 %r8, 97;
+  and.b32 %r2, %r1, 3;
+  setp.eq.u32 %p1, %r2, 1;
+  @%p1 bra SKIP;
+  add.u32 %r3, %r1, 5;
+  mul.lo.u32 %r4, %r1, 7;
+  mov.u32 %r5, 3;
+  {
+  .param .b32 param0;
+  st.param.b32 [param0+0], %r1;
+  .param .align 16 .b8 param1[12];
+  st.param.v2.b32 [param1+0], {%r3, %r4};
+  st.param.b32 [param1+8], %r5;
+  .param .align 16 .b8 retval0[12];
+  call.uni (retval0), addmul, (param0, param1);
+  ld.param.v2.b32 {%r6, %r7}, [retval0+0];
+  ld.param.b32 %r8, [retval0+8];
+  }
+SKIP:
+  add.u32 %r9, %r6, %r7;
+  add.u32 %r10, %r9, %r8;
+  mul.wide.u32 %rd2, %r1, 4;
+  add.u64 %rd3, %rd1, %rd2;
+  st.global.u32 [%rd3], %r10;
+  ret;
+}
+"#;
+
+    #[test]
+    fn call_parameters_per_warp_keep_each_lanes_values() {
+        let mut dev = Device::new();
+        let m = dev.load_ptx(CALLS, "calls.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(64);
+        dev.launch(&m, "calls", LaunchConfig::linear(1, 64), &[Arg::Ptr(out)]).unwrap();
+        let got = dev.read::<u32>(out, 64);
+        for t in 0..64u32 {
+            let want = if t % 4 == 1 { 99 + 98 + 97 } else { t * (t + 5) + 7 * t + t + 3 };
+            assert_eq!(got[t as usize], want, "thread {t}");
+        }
     }
 }
