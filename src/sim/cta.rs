@@ -324,15 +324,7 @@ impl Cta {
         self.slice_left = self.slice_left.saturating_sub(1);
         match r {
             Ok(Effect::Continue) => {}
-            Ok(Effect::Blocked) => {
-                self.slice_left = 0;
-                if let (WarpState::Barrier { id, .. }, Some(o)) = (warp.state, self.observer.as_mut()) {
-                    o.barrier_arrive(w as u32, func, pc, id);
-                }
-                if matches!(warp.state, WarpState::Barrier { .. } | WarpState::Done) {
-                    self.try_release();
-                }
-            }
+            Ok(Effect::Blocked) => self.blocked(w, func, pc),
             Err(e) => {
                 let f = CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane };
                 self.fault = Some(f.clone());
@@ -347,16 +339,107 @@ impl Cta {
         if self.finished() { Stall::Finished } else { Stall::WaitingForRound }
     }
 
+    /// What follows an instruction that blocked its warp `w` (at `func`,
+    /// `pc`) or finished it: the scheduler moves on, the observer hears of a
+    /// barrier arrival, and barriers release when they can.
+    fn blocked(&mut self, w: usize, func: u32, pc: u32) {
+        self.slice_left = 0;
+        let state = self.warps[w].state;
+        if let (WarpState::Barrier { id, .. }, Some(o)) = (state, self.observer.as_mut()) {
+            o.barrier_arrive(w as u32, func, pc, id);
+        }
+        if matches!(state, WarpState::Barrier { .. } | WarpState::Done) {
+            self.try_release();
+        }
+    }
+
     /// Issues up to `quantum` warp instructions, stopping early when blocked.
+    ///
+    /// The same instructions in the same order as `quantum` calls of
+    /// [`Cta::step`]: the common case, a ready warp found by the loose
+    /// round robin without releasing a barrier, runs in
+    /// [`Cta::issue_ready`]'s loop (one `CtaMut` for many instructions, no
+    /// `Issued` built); whatever else (the random schedule, a barrier to
+    /// release, no ready warp, a deadlock) goes through `step` as before.
     pub fn run_round(&mut self, ctx: &Ctx, quantum: u64) -> Result<u64, Box<CtaFault>> {
         let mut n = 0;
         while n < quantum {
+            if self.rng.is_none() {
+                let (issued, blocked) = self.issue_ready(ctx, quantum - n)?;
+                n += issued;
+                if let Some((w, func, pc)) = blocked {
+                    self.blocked(w, func, pc);
+                    continue;
+                }
+                if n >= quantum {
+                    break;
+                }
+            }
             match self.step(ctx)? {
                 Some(_) => n += 1,
                 None => break,
             }
         }
         Ok(n)
+    }
+
+    /// Issues up to `quantum` instructions while [`Cta::pick`]'s round robin
+    /// finds a ready warp without releasing a barrier (the random schedule
+    /// is not on): the current warp while its slice lasts, else the next
+    /// ready warp after it, as `pick` chooses. Stops, having issued nothing
+    /// more, when no warp is ready (`pick` then tries the barriers), and
+    /// right after an instruction that blocked or finished its warp,
+    /// returning that warp and the instruction's place for
+    /// [`Cta::blocked`]. Returns how many it issued.
+    #[allow(clippy::type_complexity)]
+    fn issue_ready(&mut self, ctx: &Ctx, quantum: u64) -> Result<(u64, Option<(usize, u32, u32)>), Box<CtaFault>> {
+        let n_warps = self.warps.len();
+        let slice = self.slice;
+        let mut cm = CtaMut {
+            cta_id: self.id,
+            cta_linear: self.linear,
+            shared: &mut self.shared,
+            counters: &mut self.counters,
+            profile: &mut self.profile,
+            pending: &mut self.pending,
+            observer: self.observer.as_mut(),
+        };
+        let mut n = 0;
+        while n < quantum {
+            let mut w = self.cur;
+            if self.slice_left == 0 || self.warps[w].state != WarpState::Ready {
+                // the warps after the current one, wrapping around (`pick`)
+                let mut found = false;
+                for _ in 0..n_warps {
+                    w += 1;
+                    if w == n_warps {
+                        w = 0;
+                    }
+                    if self.warps[w].state == WarpState::Ready {
+                        found = true;
+                        break;
+                    }
+                }
+                if !found {
+                    break;
+                }
+                self.cur = w;
+                self.slice_left = slice;
+            }
+            let (func, pc, r) = exec::step(ctx, &mut self.warps[w], &mut cm);
+            self.slice_left = self.slice_left.saturating_sub(1);
+            n += 1;
+            match r {
+                Ok(Effect::Continue) => {}
+                Ok(Effect::Blocked) => return Ok((n, Some((w, func, pc)))),
+                Err(e) => {
+                    let f = CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane };
+                    self.fault = Some(f.clone());
+                    return Err(Box::new(f));
+                }
+            }
+        }
+        Ok((n, None))
     }
 
     /// The per-instruction counts of what this CTA has issued so far. While
@@ -392,5 +475,108 @@ impl Cta {
     /// Applies this CTA's pending global atomics and wakes their warps.
     pub fn commit_atomics(&mut self, ctx: &Ctx) {
         exec::apply_pending(ctx, &mut self.warps, &mut self.pending);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::sim::access_log::{Access, AccessLog};
+    use crate::sim::device::{Arg, Device, LaunchConfig, SimConfig, SimError};
+    use crate::sim::grid::Schedule;
+
+    /// Arguments of a test kernel, allocated on the device.
+    type Args = fn(&mut Device) -> Vec<Arg>;
+
+    fn ints(d: &mut Device, n: usize) -> Arg {
+        Arg::Ptr(d.alloc_from(&(0..n as i32).map(|i| (i * 37 % 101) - 50).collect::<Vec<i32>>()))
+    }
+
+    fn device(warp_slice: u32, round_quantum: u64) -> Device {
+        let mut config = SimConfig { threads: 1, ..SimConfig::default() };
+        config.schedule = Schedule { warp_slice, round_quantum, ..config.schedule };
+        Device::with_config(config)
+    }
+
+    /// A launch issues its instructions through `Cta::run_round`, whose
+    /// common case (`Cta::issue_ready`) picks warps inline; a stepper issues
+    /// each through `Cta::step` and its `Cta::pick`. The two must issue the
+    /// same instructions in the same order: this compares every memory
+    /// access (CTA, warp, instruction, lanes, addresses, in issue order),
+    /// the counters, or the fault, of a
+    /// launch and a stepped launch of kernels with barriers, shared and
+    /// global atomics (warps waiting for the round's end), divergence,
+    /// early exits and calls, under GT200's schedule (a warp slice of 1)
+    /// and a loose round robin (slices of 3), with rounds that end inside a
+    /// slice (a quantum of 7 warp instructions) and long ones.
+    #[test]
+    fn launching_issues_what_stepping_issues() {
+        let cases: [(&str, &str, u32, u32, Args); 7] = [
+            ("shared", "reduce_sum", 3, 256, |d| vec![Arg::Ptr(d.alloc_zeroed::<i32>(3)), ints(d, 3 * 256)]),
+            ("shared", "histogram", 2, 128, |d| vec![Arg::Ptr(d.alloc_zeroed::<u32>(16)), ints(d, 700), Arg::I32(700)]),
+            ("atomics", "contention", 3, 64, |d| {
+                vec![Arg::Ptr(d.alloc_zeroed::<u32>(1)), Arg::Ptr(d.alloc_zeroed::<u32>(192))]
+            }),
+            ("atomics", "job_queue", 2, 128, |d| {
+                let (next, out, owner) =
+                    (d.alloc_zeroed::<u32>(1), d.alloc_zeroed::<i32>(900), d.alloc_zeroed::<i32>(900));
+                vec![Arg::Ptr(next), Arg::Ptr(out), Arg::Ptr(owner), Arg::I32(900)]
+            }),
+            ("divergence", "early_return", 2, 96, |d| vec![Arg::Ptr(d.alloc_zeroed::<i32>(8192)), Arg::I32(41)]),
+            ("calls", "call_divergent", 2, 64, |d| vec![Arg::Ptr(d.alloc_zeroed::<i32>(8192))]),
+            // thread 37 stores out of bounds: both report the same fault
+            ("memory", "out_of_bounds", 2, 32, |d| vec![Arg::Ptr(d.alloc_zeroed::<i32>(40))]),
+        ];
+        for (file, kernel, ctas, threads, args) in cases {
+            let src = match file {
+                "shared" => include_str!("../../kernels/tests/shared.ptx"),
+                "atomics" => include_str!("../../kernels/tests/atomics.ptx"),
+                "divergence" => include_str!("../../kernels/tests/divergence.ptx"),
+                "calls" => include_str!("../../kernels/tests/calls.ptx"),
+                _ => include_str!("../../kernels/tests/memory.ptx"),
+            };
+            for (slice, quantum) in [(1, 20_000), (1, 7), (3, 20_000), (3, 7)] {
+                let cfg = LaunchConfig::linear(ctas, threads);
+                let what = format!("{kernel}, slice {slice}, quantum {quantum}");
+                // launched
+                let mut dev = device(slice, quantum);
+                let m = dev.load_ptx(src, file).unwrap();
+                let a = args(&mut dev);
+                let log = AccessLog::new();
+                let launched = dev.launch_observed(&m, kernel, cfg, &a, Some(&log));
+                let launched_log = log.take();
+                // stepped
+                let mut dev = device(slice, quantum);
+                let m = dev.load_ptx(src, file).unwrap();
+                let a = args(&mut dev);
+                let log = AccessLog::new();
+                let mut st = dev.stepper_logged(&m, kernel, cfg, &a, &log).unwrap();
+                let mut stepped_log: Vec<Access> = Vec::new();
+                let mut issued = 0u64;
+                let fault = loop {
+                    match st.step() {
+                        Ok(Some(ev)) => {
+                            issued += 1;
+                            stepped_log.extend(ev.accesses);
+                        }
+                        Ok(None) => break None,
+                        Err(f) => break Some(f),
+                    }
+                };
+                stepped_log.extend(log.take());
+                assert!(!launched_log.is_empty(), "{what}");
+                assert_eq!(launched_log, stepped_log, "{what}: the accesses in issue order");
+                match (launched, fault) {
+                    (Ok(s), None) => {
+                        assert_eq!(s.totals.warp_instructions, issued, "{what}");
+                        assert_eq!(s.totals, st.counters(), "{what}");
+                    }
+                    (Err(SimError::Fault(a)), Some(b)) => {
+                        assert_eq!(a, b, "{what}");
+                        assert_eq!(kernel, "out_of_bounds", "{what}: {a}");
+                    }
+                    (a, b) => panic!("{what}: launched {a:?}, stepped {b:?}"),
+                }
+            }
+        }
     }
 }

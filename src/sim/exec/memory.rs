@@ -3,7 +3,7 @@
 //! models observe (one per state space an instruction touched).
 
 use super::super::memory::{
-    Allocation, CONST_WINDOW, GenericTarget, LOCAL_WINDOW, PARAM_WINDOW, SHARED_WINDOW, decode_generic,
+    Allocation, CONST_WINDOW, GenericTarget, LOCAL_WINDOW, PARAM_WINDOW, SHARED_WINDOW, WINDOW_SIZE, decode_generic,
 };
 use super::super::observer::{MemEvent, MemOp};
 use super::super::warp::Warp;
@@ -303,6 +303,14 @@ fn vector_access(
         }
         return Ok(first);
     }
+    if let Some(first) = local_in_one(w, space, ty, addrs, exec, vals, store, touched) {
+        return Ok(Some(first));
+    }
+    if space == MemSpace::FrameParam
+        && let Some(first) = params_in_one(w, ty, addrs, exec, vals, store, touched)
+    {
+        return Ok(Some(first));
+    }
     let mut m = exec;
     while m != 0 {
         let l = m.trailing_zeros() as usize;
@@ -350,16 +358,7 @@ fn global_in_one(
     if exec == 0 || !total.is_power_of_two() {
         return None;
     }
-    // lowest and highest address, and the OR of the low bits (alignment)
-    let (mut lo, mut hi, mut low_bits) = (u64::MAX, 0u64, 0u64);
-    let mut m = exec;
-    while m != 0 {
-        let a = addrs[m.trailing_zeros() as usize];
-        m &= m - 1;
-        lo = lo.min(a);
-        hi = hi.max(a);
-        low_bits |= a;
-    }
+    let (lo, hi, low_bits) = lane_span(addrs, exec);
     if low_bits & (total as u64 - 1) != 0 {
         return None;
     }
@@ -386,6 +385,145 @@ fn global_in_one(
         }
     }
     Some(Resolved::Global(addrs[first]))
+}
+
+/// The lowest and the highest of the active lanes' addresses, and the OR of
+/// all of them (whose low bits tell whether every one is aligned).
+#[inline(always)]
+fn lane_span(addrs: &Lanes, exec: u32) -> (u64, u64, u64) {
+    let (mut lo, mut hi, mut low_bits) = (u64::MAX, 0u64, 0u64);
+    let mut m = exec;
+    while m != 0 {
+        let a = addrs[m.trailing_zeros() as usize];
+        m &= m - 1;
+        lo = lo.min(a);
+        hi = hi.max(a);
+        low_bits |= a;
+    }
+    (lo, hi, low_bits)
+}
+
+/// The common local access (the traversal stack) at once: when the
+/// instruction names the local space, or the generic space and every active
+/// lane's address lies in the local window, and every active lane's whole
+/// access (`vals.len()` elements of `ty`) is aligned to its size and ends
+/// within the thread's local memory in use (`Warp::local_top`), no lane can
+/// fault, and the lanes are loaded or stored without resolving, aligning
+/// and bounding each lane and element. Returns `None`, having touched
+/// nothing, otherwise (the per-lane path then finds the faulting lane, or
+/// resolves lanes of several spaces). Values, lane and element order and
+/// what `touched` records (the local offset, not the generic address) are
+/// those of the per-lane path: the local window is aligned far beyond any
+/// access size, so a generic address and its local offset have the same
+/// alignment; the access aligned to its power-of-two size aligns each
+/// element to its own; and every element's offset lies below the highest
+/// lane's end, below `local_top`, so each element resolves to the local
+/// space as its lane's first does.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn local_in_one(
+    w: &mut Warp,
+    space: MemSpace,
+    ty: Ty,
+    addrs: &Lanes,
+    exec: u32,
+    vals: &mut [Lanes],
+    store: bool,
+    touched: &mut Touched,
+) -> Option<Resolved> {
+    let window = match space {
+        MemSpace::Local => 0,
+        MemSpace::Generic => LOCAL_WINDOW,
+        _ => return None,
+    };
+    let size = ty.bytes();
+    let total = size * vals.len() as u32;
+    if exec == 0 || !total.is_power_of_two() {
+        return None;
+    }
+    let (lo, hi, low_bits) = lane_span(addrs, exec);
+    if lo < window || hi - window >= WINDOW_SIZE || low_bits & (total as u64 - 1) != 0 {
+        return None;
+    }
+    // offsets below the window's size cannot overflow
+    if hi - window + total as u64 > w.local_top as u64 {
+        return None;
+    }
+    let first = exec.trailing_zeros() as usize;
+    touched.first = Some(MemSpace::Local);
+    touched.lanes |= exec;
+    let mut m = exec;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let off = addrs[l] - window;
+        touched.space[l] = Some(MemSpace::Local);
+        touched.addr[l] = off;
+        for (k, v) in vals.iter_mut().enumerate() {
+            let ok = off + (k as u32 * size) as u64;
+            if store {
+                w.local_store(l, ok, size, v[l] & ty.mask());
+            } else {
+                v[l] = ty.extend(w.local_load(l, ok, size));
+            }
+        }
+    }
+    Some(Resolved::Local(addrs[first] - window))
+}
+
+/// The common access to the current frame's parameter area (a call's
+/// arguments and return values, `ld.param`/`st.param` in a function) at
+/// once: when every active lane's whole access is aligned to its
+/// power-of-two size and ends within one lane's parameter area
+/// (`Frame::param_size`), no lane can fault and the lanes' areas are
+/// loaded or stored without checks per lane and element. Returns `None`,
+/// having touched nothing, otherwise (the per-lane path then reports the
+/// faulting lane). Values, order and what `touched` records are the
+/// per-lane path's, for the reasons given at [`local_in_one`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn params_in_one(
+    w: &mut Warp,
+    ty: Ty,
+    addrs: &Lanes,
+    exec: u32,
+    vals: &mut [Lanes],
+    store: bool,
+    touched: &mut Touched,
+) -> Option<Resolved> {
+    let size = ty.bytes();
+    let total = size * vals.len() as u32;
+    if exec == 0 || !total.is_power_of_two() {
+        return None;
+    }
+    let (_, hi, low_bits) = lane_span(addrs, exec);
+    let f = w.frames.last_mut().expect("frame");
+    let ps = f.param_size as u64;
+    // every lane's area is in `params` (32 of them), so no access below can miss
+    if low_bits & (total as u64 - 1) != 0 || hi.checked_add(total as u64).is_none_or(|e| e > ps) {
+        return None;
+    }
+    let first = exec.trailing_zeros() as usize;
+    touched.first = Some(MemSpace::FrameParam);
+    touched.lanes |= exec;
+    let mut m = exec;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let off = addrs[l];
+        touched.space[l] = Some(MemSpace::FrameParam);
+        touched.addr[l] = off;
+        let base = l as u64 * ps + off;
+        for (k, v) in vals.iter_mut().enumerate() {
+            let ok = base + (k as u32 * size) as u64;
+            if store {
+                bytes_store(&mut f.params, ok, size, v[l] & ty.mask()).expect("within the lane's area");
+            } else {
+                v[l] = ty.extend(bytes_load(&f.params, ok, size).expect("within the lane's area"));
+            }
+        }
+    }
+    Some(Resolved::FParam(addrs[first]))
 }
 
 /// Vector accesses must be aligned to their whole size.
@@ -521,4 +659,225 @@ pub(super) fn cvta(
     };
     let r = if to_generic { map1(&va, |x| x.wrapping_add(win)) } else { map1(&va, |x| x.wrapping_sub(win)) };
     write(w.frames.last_mut().expect("frame"), d, &r, exec);
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::sim::DevicePtr;
+    use crate::sim::device::{Arg, Device, LaunchConfig, SimError};
+    use crate::sim::fault::FaultKind;
+    use crate::sim::memory::LOCAL_WINDOW;
+
+    /// Every thread stores `3 * tid` into its local word `(tid % 8) * 4`
+    /// (`st.local`), loads it back through its generic address (`ld`), stores
+    /// a pair at `32 + (tid % 4) * 8` (`st.local.v2`) and loads it back
+    /// generically (`ld.v2`); then a generic load from a per-lane address
+    /// that is local for all lanes but `mix`, whose address is `inp`'s
+    /// (global). Thread `bad` adds `delta` to its first offset; thread `off`
+    /// adds 4096 (past its local memory) to every offset and is predicated
+    /// off the local accesses. `out[tid]` gets the scalar, `out[64 + tid]`
+    /// the pair's sum, `out[128 + tid]` the mixed load.
+    const LANES: &str = r#".version 7.8
+.target sm_90
+.address_size 64
+.visible .entry lanes(.param .u64 out, .param .u64 inp, .param .u32 bad, .param .u32 delta, .param .u32 off, .param .u32 mix)
+{
+  .local .align 8 .b8 depot[64];
+  .reg .pred %p<4>;
+  .reg .b32 %r<20>;
+  .reg .b64 %rd<20>;
+  ld.param.u64 %rd1, [out];
+  ld.param.u64 %rd15, [inp];
+  ld.param.u32 %r1, [bad];
+  ld.param.u32 %r2, [delta];
+  ld.param.u32 %r11, [off];
+  ld.param.u32 %r16, [mix];
+  mov.u32 %r3, %tid.x;
+  and.b32 %r4, %r3, 7;
+  shl.b32 %r4, %r4, 2;
+  setp.eq.u32 %p2, %r3, %r11;
+  selp.b32 %r6, 4096, 0, %p2;
+  add.u32 %r4, %r4, %r6;
+  setp.eq.u32 %p1, %r3, %r1;
+  selp.b32 %r5, %r2, 0, %p1;
+  add.u32 %r12, %r4, %r5;
+  mov.u64 %rd2, depot;
+  cvt.u64.u32 %rd3, %r12;
+  add.u64 %rd4, %rd2, %rd3;
+  mul.lo.u32 %r7, %r3, 3;
+  mov.u32 %r8, 7;
+  @!%p2 st.local.u32 [%rd4], %r7;
+  cvta.local.u64 %rd5, %rd4;
+  @!%p2 ld.u32 %r8, [%rd5];
+  and.b32 %r9, %r3, 3;
+  shl.b32 %r9, %r9, 3;
+  add.u32 %r9, %r9, 32;
+  add.u32 %r9, %r9, %r6;
+  cvt.u64.u32 %rd6, %r9;
+  add.u64 %rd7, %rd2, %rd6;
+  add.u32 %r10, %r7, 1;
+  mov.u32 %r13, 0;
+  mov.u32 %r14, 0;
+  @!%p2 st.local.v2.u32 [%rd7], {%r7, %r10};
+  cvta.local.u64 %rd8, %rd7;
+  @!%p2 ld.v2.u32 {%r13, %r14}, [%rd8];
+  add.u32 %r15, %r13, %r14;
+  setp.eq.u32 %p3, %r3, %r16;
+  cvta.local.u64 %rd16, %rd2;
+  @%p3 mov.u64 %rd16, %rd15;
+  ld.u32 %r17, [%rd16];
+  mul.wide.u32 %rd9, %r3, 4;
+  add.u64 %rd10, %rd1, %rd9;
+  st.global.u32 [%rd10], %r8;
+  st.global.u32 [%rd10+256], %r15;
+  st.global.u32 [%rd10+512], %r17;
+  ret;
+}
+"#;
+
+    struct Run {
+        dev: Device,
+        out: DevicePtr,
+        r: Result<crate::sim::LaunchStats, SimError>,
+    }
+
+    fn run(bad: u32, delta: u32, off: u32, mix: u32) -> Run {
+        let mut dev = Device::new();
+        let m = dev.load_ptx(LANES, "lanes.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(192);
+        let inp = dev.alloc_from(&[0x55u32]);
+        let args = [Arg::Ptr(out), Arg::Ptr(inp), Arg::U32(bad), Arg::U32(delta), Arg::U32(off), Arg::U32(mix)];
+        let r = dev.launch(&m, "lanes", LaunchConfig::linear(1, 64), &args);
+        Run { dev, out, r }
+    }
+
+    /// The local accesses of whole warps take the per-warp path
+    /// (`local_in_one`): the values each lane stored come back, through
+    /// local and generic addresses, scalars and pairs; a lane predicated off
+    /// whose address lies past local memory neither faults nor stops the
+    /// others; a generic load whose lanes are partly global resolves each
+    /// lane; and the instructions count under the local space.
+    #[test]
+    fn local_accesses_per_warp_keep_each_lanes_values() {
+        let Run { dev, out, r } = run(64, 0, 37, 5);
+        let stats = r.unwrap();
+        let got = dev.read::<u32>(out, 192);
+        for t in 0..64u32 {
+            let (scalar, pair, mixed) = (got[t as usize], got[64 + t as usize], got[128 + t as usize]);
+            if t == 37 {
+                assert_eq!((scalar, pair), (7, 0), "thread {t} is predicated off");
+            } else {
+                assert_eq!((scalar, pair), (3 * t, 6 * t + 1), "thread {t}");
+            }
+            // thread 5 reads `inp`; the others their word 0, which thread t % 8 == 0 wrote
+            let want = if t == 5 {
+                0x55
+            } else if t == 37 {
+                0 // never stored
+            } else if t % 8 == 0 {
+                3 * t
+            } else {
+                0
+            };
+            assert_eq!(mixed, want, "thread {t}");
+        }
+        // per warp: 2 local stores, 3 local loads (the mixed one counts
+        // under its first lane's space: lane 0 is local in both warps)
+        assert_eq!((stats.totals.stores.local, stats.totals.loads.local), (4, 6));
+        assert_eq!((stats.totals.stores.global, stats.totals.loads.global), (6, 0));
+    }
+
+    /// A lane whose local access is misaligned or out of bounds makes the
+    /// per-warp path decline: the per-lane path reports that lane, in the
+    /// space and at the address (the local offset) it did before.
+    #[test]
+    fn a_faulting_lane_takes_the_per_lane_path() {
+        for (delta, bad) in [(2u32, 13u32), (4096, 45), (64, 0), (30, 33)] {
+            let Run { r, .. } = run(bad, delta, 99, 99);
+            let Err(SimError::Fault(f)) = r else { panic!("delta {delta}: expected a fault, got {r:?}") };
+            assert_eq!((f.warp, f.lane), (bad / 32, Some(bad % 32)), "delta {delta}: {f}");
+            let want = (bad % 8) * 4 + delta;
+            match f.kind {
+                FaultKind::Misaligned { space, addr, size: 4 } if delta % 4 != 0 => {
+                    assert_eq!((space, addr), (crate::ptx::ir::MemSpace::Local, want as u64), "{f}")
+                }
+                FaultKind::OutOfBounds { space, addr, size: 4 } if delta % 4 == 0 => {
+                    assert_eq!((space, addr), (crate::ptx::ir::MemSpace::Local, want as u64), "{f}")
+                }
+                _ => panic!("delta {delta}: {f}"),
+            }
+        }
+        // the window's own arithmetic: a generic address is its local offset plus the window
+        assert_eq!(LOCAL_WINDOW % (1 << 32), 0);
+    }
+
+    /// Threads with `tid % 4 != 1` call `addmul(tid, {tid + 5, 7 tid}, 3)`
+    /// (a scalar, a pair and a 12-byte array's last word as arguments, a
+    /// pair and a scalar back, as the compiler passes them): the calls'
+    /// parameter accesses, under a partial mask, take the per-warp path
+    /// (`params_in_one`).
+    const CALLS: &str = r#".version 7.8
+.target sm_90
+.address_size 64
+.func (.param .align 16 .b8 rv[12]) addmul(.param .b32 a, .param .align 16 .b8 p[12])
+{
+  .reg .b32 %r<8>;
+  ld.param.u32 %r1, [a];
+  ld.param.v2.u32 {%r2, %r3}, [p+0];
+  ld.param.u32 %r6, [p+8];
+  mul.lo.u32 %r4, %r1, %r2;
+  add.u32 %r5, %r4, %r3;
+  st.param.v2.u32 [rv+0], {%r5, %r1};
+  st.param.u32 [rv+8], %r6;
+  ret;
+}
+.visible .entry calls(.param .u64 out)
+{
+  .reg .pred %p1;
+  .reg .b32 %r<12>;
+  .reg .b64 %rd<4>;
+  ld.param.u64 %rd1, [out];
+  mov.u32 %r1, %tid.x;
+  mov.u32 %r6, 99;
+  mov.u32 %r7, 98;
+  mov.u32 %r8, 97;
+  and.b32 %r2, %r1, 3;
+  setp.eq.u32 %p1, %r2, 1;
+  @%p1 bra SKIP;
+  add.u32 %r3, %r1, 5;
+  mul.lo.u32 %r4, %r1, 7;
+  mov.u32 %r5, 3;
+  {
+  .param .b32 param0;
+  st.param.b32 [param0+0], %r1;
+  .param .align 16 .b8 param1[12];
+  st.param.v2.b32 [param1+0], {%r3, %r4};
+  st.param.b32 [param1+8], %r5;
+  .param .align 16 .b8 retval0[12];
+  call.uni (retval0), addmul, (param0, param1);
+  ld.param.v2.b32 {%r6, %r7}, [retval0+0];
+  ld.param.b32 %r8, [retval0+8];
+  }
+SKIP:
+  add.u32 %r9, %r6, %r7;
+  add.u32 %r10, %r9, %r8;
+  mul.wide.u32 %rd2, %r1, 4;
+  add.u64 %rd3, %rd1, %rd2;
+  st.global.u32 [%rd3], %r10;
+  ret;
+}
+"#;
+
+    #[test]
+    fn call_parameters_per_warp_keep_each_lanes_values() {
+        let mut dev = Device::new();
+        let m = dev.load_ptx(CALLS, "calls.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(64);
+        dev.launch(&m, "calls", LaunchConfig::linear(1, 64), &[Arg::Ptr(out)]).unwrap();
+        let got = dev.read::<u32>(out, 64);
+        for t in 0..64u32 {
+            let want = if t % 4 == 1 { 99 + 98 + 97 } else { t * (t + 5) + 7 * t + t + 3 };
+            assert_eq!(got[t as usize], want, "thread {t}");
+        }
+    }
 }
