@@ -331,8 +331,9 @@ impl Reaching {
         let mut at = vec![Vec::new(); n];
         for (b, blk) in cfg.blocks.iter().enumerate() {
             let mut bits = block_in(b, &out);
-            for pc in blk.start as usize..blk.end as usize {
-                at[pc] = bits.clone();
+            let (start, end) = (blk.start as usize, blk.end as usize);
+            for (pc, reaching) in at.iter_mut().enumerate().take(end).skip(start) {
+                *reaching = bits.clone();
                 step(&mut bits, pc);
             }
         }
