@@ -199,12 +199,12 @@ pub fn reference(
         let est = estimate_native(&bvh, &kd, queries, Method::VkdeEpanechnikov, 0);
         contributions += est.iter().map(|e| e.contributions as u64).sum::<u64>();
         let kn = estimate_native(&bvh, &kd, queries, Method::Knn, REFERENCE_KNN);
-        for i in 0..n {
+        for (((s, q), k), (e, kn)) in sum.iter_mut().zip(&mut sq).zip(&mut knn_sum).zip(est.iter().zip(&kn)) {
             for c in 0..3 {
-                let x = est[i].radiance[c] as f64;
-                sum[i][c] += x;
-                sq[i][c] += x * x;
-                knn_sum[i][c] += kn[i].radiance[c] as f64;
+                let x = e.radiance[c] as f64;
+                s[c] += x;
+                q[c] += x * x;
+                k[c] += kn.radiance[c] as f64;
             }
         }
     }
