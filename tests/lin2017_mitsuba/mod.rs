@@ -56,11 +56,22 @@ pub fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32,
 
 /// The emulated kernel's 4 frames (functional fidelity) against `reference`.
 pub fn emulated_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, reference: &Estimate) -> Outcome {
+    emulated_frames_outcome(ps, cam, p, 4, reference)
+}
+
+/// The emulated kernel's `frames` frames (functional fidelity) against `reference`.
+pub fn emulated_frames_outcome(
+    ps: &PathScene,
+    cam: &Camera,
+    p: FrameParams,
+    frames: u32,
+    reference: &Estimate,
+) -> Outcome {
     let mut cfg = kernel::sim_config(&p);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);
     let module = kernel::load(&mut dev).expect("load PTX");
-    let r = kernel::render(&mut dev, &module, ps, cam, p, 4, true, |_| {}).expect("launch");
+    let r = kernel::render(&mut dev, &module, ps, cam, p, frames, true, |_| {}).expect("launch");
     let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
     welch_holm(&ours, reference, ALPHA).expect("same block grid")
 }
