@@ -360,7 +360,7 @@ fn exponent(v: f64) -> i32 {
 /// changes the other weights; in 1-D and 2-D it changes nothing). Under the
 /// mirror mode, whose edge texels repeat too, it does not (measured in 3-D).
 fn one_texel(t: &TextureDesc, d: usize, i: i64) -> bool {
-    t.addr[d] == AddressMode::Clamp && (i + 1 <= 0 || i >= size(t.dims, d) - 1)
+    t.addr[d] == AddressMode::Clamp && (i < 0 || i >= size(t.dims, d) - 1)
 }
 
 /// `tex` with float coordinates (`dims` of them used).
