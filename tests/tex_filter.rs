@@ -1,14 +1,16 @@
 //! Linear texture filtering and surface reductions against an H200
-//! (`tools/device/issue20_leftovers.sh`; fixtures
-//! `tests/fixtures/validation/h200_tex_filter.{json,bin.z}` and
+//! (`tools/device/issue20_leftovers.sh` and `issue20_tex_bfs.sh`; fixtures
+//! `tests/fixtures/validation/h200_tex_filter{,2}.{json,bin.z}` and
 //! `h200_sured.json`). The textures' texels come from the hash rule of
 //! `tools/device/tex_filter_host.cu` (the fixture maker checked the GPU's
 //! texels against it), the coordinates and results from the fixture.
 //!
-//! `f32` and `f16` texels in 1-D and 2-D filter bit for bit as the H200 does
-//! (`docs/semantics.md`: product weights rounded to 256ths, texels aligned to
-//! the largest, the sum rounded ties away); 8-bit normalized texels and 3-D
-//! textures are compared within their measured error.
+//! `f32`, `f16`, `u8`, `u16` and `s16` texels in 1-D and 2-D, and `u8` ones
+//! in 3-D, filter bit for bit as the H200 does (`docs/semantics.md`: weights
+//! split in 256ths, float texels aligned to the largest and the sum rounded
+//! ties away, normalized integers summed in 16-bit fixed point); float 3-D
+//! textures and `s8` texels are bit for bit but for the listed channels
+//! ([`misses`]), each off by at most the listed amount.
 
 use std::path::Path;
 
@@ -48,6 +50,7 @@ impl Case {
             return match self.format {
                 TexelFormat::F32 => (h & 0x807F_FFFF) | ((120 + hash32(h) % 15) << 23),
                 TexelFormat::F16 => (h & 0x83FF) | ((8 + hash32(h) % 15) << 10),
+                TexelFormat::U16 | TexelFormat::S16 => h & 0xFFFF,
                 _ => h & 0xFF,
             };
         }
@@ -69,7 +72,7 @@ impl Case {
     }
 
     fn desc(&self, data: DevicePtr) -> TextureDesc {
-        let u8 = self.format == TexelFormat::U8;
+        let int = self.format.is_small_int();
         TextureDesc {
             data,
             format: self.format,
@@ -79,7 +82,7 @@ impl Case {
             linear: false,
             addr: [self.addr; 3],
             filter: FilterMode::Linear,
-            read: if u8 { ReadMode::NormalizedFloat } else { ReadMode::ElementType },
+            read: if int { ReadMode::NormalizedFloat } else { ReadMode::ElementType },
             normalized: self.normalized,
         }
     }
@@ -94,17 +97,51 @@ impl Case {
         c
     }
 
-    /// Bit for bit (f32 and f16 texels in 1-D and 2-D).
+    /// Bit for bit.
     fn exact(&self) -> bool {
-        self.dims < 3 && matches!(self.format, TexelFormat::F32 | TexelFormat::F16)
+        misses(&self.name).0 == 0
     }
 }
 
+/// How far warplight's rules miss the H200 on a case: the channels that
+/// differ, and the most one differs by (units in the last place of the f32
+/// result, or steps of 1/32767 for `s8` texels). Float 3-D filters add their
+/// two z slices' sums in a way no rule tried matches on these few channels;
+/// the `s8` rule is not the H200's (`docs/semantics.md`).
+fn misses(name: &str) -> (usize, Miss) {
+    match name {
+        "r3" | "r3b" | "r3w" => (3, Miss::Ulps(1)),
+        "r3m" => (5, Miss::Ulps(1)),
+        // 32,768 channels: mostly one ulp, more where the slices cancel
+        "r3big" => (34, Miss::Ulps(6)),
+        // one ulp of f16 (2^13 of f32's)
+        "h3" => (6, Miss::Ulps(1 << 13)),
+        "n2s8" => (242, Miss::Step),
+        "n1s8b" => (212, Miss::Step),
+        _ => (0, Miss::Ulps(0)),
+    }
+}
+
+/// The most a channel [`misses`] by.
+#[derive(Clone, Copy)]
+enum Miss {
+    /// Units in the last place of the f32 result.
+    Ulps(u32),
+    /// One step of a signed 16-bit normalized value, 1/32767.
+    Step,
+}
+
 fn cases() -> Vec<Case> {
+    let mut all = cases_of("h200_tex_filter");
+    all.extend(cases_of("h200_tex_filter2"));
+    all
+}
+
+fn cases_of(stem: &str) -> Vec<Case> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/validation");
     let meta: Value =
-        serde_json::from_str(&std::fs::read_to_string(root.join("h200_tex_filter.json")).unwrap()).unwrap();
-    let z = std::fs::read(root.join("h200_tex_filter.bin.z")).unwrap();
+        serde_json::from_str(&std::fs::read_to_string(root.join(format!("{stem}.json"))).unwrap()).unwrap();
+    let z = std::fs::read(root.join(format!("{stem}.bin.z"))).unwrap();
     let blob = miniz_oxide::inflate::decompress_to_vec_zlib(&z).unwrap();
     let words: Vec<u32> = blob.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().unwrap())).collect();
     let mut at = 0;
@@ -123,6 +160,9 @@ fn cases() -> Vec<Case> {
             format: match c["format"].as_str().unwrap() {
                 "f32" => TexelFormat::F32,
                 "f16" => TexelFormat::F16,
+                "u16" => TexelFormat::U16,
+                "s16" => TexelFormat::S16,
+                "s8" => TexelFormat::S8,
                 _ => TexelFormat::U8,
             },
             size: [size[0], size[1], size[2]],
@@ -143,13 +183,12 @@ fn cases() -> Vec<Case> {
     out
 }
 
-/// Every kept sample of every case through `texture::sample`: the exact
-/// cases bit for bit, the others within their measured error (the largest
-/// difference from the H200, as a fraction of the largest texel magnitude).
+/// Every kept sample of every case through `texture::sample`: bit for bit
+/// but for the channels each case [`misses`], each within its bound.
 #[test]
 fn linear_filtering_equals_the_h200() {
     let cases = cases();
-    assert_eq!(cases.len(), 15);
+    assert_eq!(cases.len(), 26);
     let mut report = Vec::new();
     for c in &cases {
         let bytes = c.bytes();
@@ -161,26 +200,26 @@ fn linear_filtering_equals_the_h200() {
             u64::from_le_bytes(b)
         };
         let desc = c.desc(DevicePtr(base));
-        let (mut differ, mut worst) = (0, 0f64);
+        let (count, bound) = misses(&c.name);
+        let (mut differ, mut worst_ulps, mut worst_steps) = (0, 0u32, 0f64);
         for i in 0..c.count() {
             let got = texture::sample(&desc, &read, c.coords(i), c.dims);
             for (&gb, &wb) in got.iter().zip(&c.out[4 * i..4 * i + 4]) {
-                let (g, w) = (f32::from_bits(gb), f32::from_bits(wb));
                 if gb != wb {
                     differ += 1;
-                    worst = worst.max((g as f64 - w as f64).abs());
+                    worst_ulps = worst_ulps.max((gb as i32).wrapping_sub(wb as i32).unsigned_abs());
+                    let steps = (f32::from_bits(gb) as f64 - f32::from_bits(wb) as f64).abs() * 32767.0;
+                    worst_steps = worst_steps.max(steps);
                 }
             }
         }
-        if c.exact() {
-            assert_eq!(differ, 0, "{}: {differ} channels differ (largest by {worst:e})", c.name);
-        } else {
-            report.push(format!("{}: {differ} of {} channels differ, by at most {worst:e}", c.name, 4 * c.count()));
-            // the measured error (docs/semantics.md): 8-bit texels within
-            // 2^-17 (a step is 1/255), 3-D textures within 1.0 of texels
-            // of magnitude up to 128
-            let bound = if c.dims == 3 { 1.0 } else { 2f64.powi(-17) };
-            assert!(worst <= bound, "{}: off by {worst:e}", c.name);
+        report.push(format!("{}: {differ} of {} channels differ", c.name, 4 * c.count()));
+        // exactly the measured misses: fewer means the rule improved (update
+        // `misses` and docs/semantics.md), more that it broke
+        assert_eq!(differ, count, "{}: {differ} channels differ ({worst_ulps} ulp, {worst_steps} steps)", c.name);
+        match bound {
+            Miss::Ulps(u) => assert!(worst_ulps <= u, "{}: off by {worst_ulps} ulp", c.name),
+            Miss::Step => assert!(worst_steps <= 1.001, "{}: off by {worst_steps} steps", c.name),
         }
     }
     println!("{}", report.join("\n"));

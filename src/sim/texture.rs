@@ -215,38 +215,39 @@ fn footprint(x: f64) -> (i64, u32) {
 }
 
 /// The weights (in 256ths) of the corners of a linear footprint whose
-/// second texels weigh `w` along each dimension; corner `c` takes the second
-/// texel along dimension `d` when bit `d` of `c` is set. The H200 rounds
-/// each product of weights to 256ths (half up) and derives the corners from
-/// them by inclusion and exclusion, so that they sum to 256: in 2-D,
-/// `w11 = round(wx·wy)`, `w10 = wx − w11`, `w01 = wy − w11`,
-/// `w00 = 256 − wx − wy + w11` (one and two dimensions, measured; the
-/// same rule for more is not the H200's 3-D filter).
+/// second texels weigh `w` along each dimension (one to three); corner `c`
+/// takes the second texel along dimension `d` when bit `d` of `c` is set.
+///
+/// The H200 splits the whole weight, 256, dimension by dimension: in 3-D by
+/// z first (`256 − wz`, `wz`), then each part by x, then each of those by y;
+/// in 2-D by x, then y. Splitting a part `v` along a dimension of weight `w`
+/// gives its second texel `v·w / 256` rounded half up, the first the rest,
+/// except that the y split of a part on the first x texel rounds ties down.
+/// In 2-D that is `w11 = round(wx·wy)`, `w10 = wx − w11`, `w01 = wy − w11`,
+/// `w00 = 256 − wx − wy + w11` (measured on 1-D and 2-D textures); in 3-D
+/// the parts of the two z slices are rounded apart, so that the weights
+/// along x and y need not sum to `wx` and `wy` (measured on a 3-D texture:
+/// the other rules tried were off by up to 2/256).
 fn corner_weights(w: &[u32]) -> Vec<i64> {
     let n = w.len();
-    // the rounded product of the weights of the dimensions in `set`
-    let product = |set: usize| -> i64 {
-        let ws: Vec<i64> = (0..n).filter(|d| set >> d & 1 == 1).map(|d| w[d] as i64).collect();
-        match ws.len() {
-            0 => 256,
-            1 => ws[0],
-            k => {
-                let shift = 8 * (k as u32 - 1);
-                (ws.iter().product::<i64>() + (1 << (shift - 1))) >> shift
-            }
+    // the dimensions in the order they are split: z, x, y
+    let order: Vec<usize> = if n == 3 { vec![2, 0, 1] } else { (0..n).collect() };
+    let mut parts: Vec<(usize, i64)> = vec![(0, 256)];
+    for &d in &order {
+        let mut next = Vec::with_capacity(parts.len() * 2);
+        for &(corner, v) in &parts {
+            let tie_down = d == 1 && corner & 1 == 0;
+            let hi = (v * w[d] as i64 + if tie_down { 127 } else { 128 }) >> 8;
+            next.push((corner, v - hi));
+            next.push((corner | 1 << d, hi));
         }
-    };
-    (0..1usize << n)
-        .map(|corner| {
-            (0..1usize << n)
-                .filter(|set| set & corner == corner)
-                .map(|set| {
-                    let sign = if (set ^ corner).count_ones() % 2 == 0 { 1 } else { -1 };
-                    sign * product(set)
-                })
-                .sum()
-        })
-        .collect()
+        parts = next;
+    }
+    let mut out = vec![0; 1 << n];
+    for (corner, v) in parts {
+        out[corner] = v;
+    }
+    out
 }
 
 /// Bits of significand the texture unit filters a format in: half
@@ -255,34 +256,90 @@ fn filter_precision(f: TexelFormat) -> u32 {
     if f == TexelFormat::F16 { 11 } else { 24 }
 }
 
-/// One channel of a linear filter's result, as the H200 computes it: the
-/// texels (with weights in 256ths, border texels as zeros) aligned to the
-/// largest exponent among those that weigh something, keeping `p + 4` bits
-/// from there (the rest cut off toward zero), summed exactly, and the sum
-/// rounded to `p` bits, ties away from zero. Non-finite texels: the weighted
-/// sum in f64 (not measured).
-fn filter_channel(terms: &[(i64, f32)], p: u32) -> f32 {
-    if terms.iter().any(|(_, v)| !v.is_finite()) {
-        let s: f64 = terms.iter().map(|&(w, v)| w as f64 / 256.0 * v as f64).sum();
+/// One weighted texel of a linear filter: its weight in 256ths, its value,
+/// and the z slice of the footprint it lies in (0 or 1; 0 in 1-D and 2-D).
+type Term = (i64, f32, usize);
+
+/// One channel of a linear filter's result, as the H200 computes it for
+/// float texels: in each z slice of the footprint (the whole footprint in
+/// 1-D and 2-D) the texels (border texels as zeros) aligned to the largest
+/// exponent `e` among those that weigh something, keeping `p + 4` bits from
+/// there (the rest cut off toward zero), multiplied by their weights and
+/// summed exactly; the slices' sums added exactly and the total rounded to
+/// `p` bits, ties away from zero. Non-finite texels: the weighted sum in f64
+/// (not measured).
+fn filter_channel(terms: &[Term], p: u32) -> f32 {
+    if terms.iter().any(|(_, v, _)| !v.is_finite()) {
+        let s: f64 = terms.iter().map(|&(w, v, _)| w as f64 / 256.0 * v as f64).sum();
         return s as f32;
     }
-    let Some(e) = terms.iter().filter(|(_, v)| *v != 0.0).map(|&(_, v)| exponent(v as f64)).max() else {
-        return 0.0;
+    // each slice's sum: `sum · 2^(g − 8)`
+    let mut slices: Vec<(i128, i32)> = Vec::with_capacity(2);
+    for z in 0..2 {
+        let slice = || terms.iter().filter(move |t| t.2 == z && t.0 != 0);
+        let Some(e) = slice().filter(|t| t.1 != 0.0).map(|t| exponent(t.1 as f64)).max() else {
+            continue;
+        };
+        // the grid: 2^(e − (p − 1) − 4); |v| / grid < 2^(p + 4), exact in f64
+        let g = e - (p as i32 - 1) - 4;
+        let sum: i128 = slice().map(|&(w, v, _)| w as i128 * (v as f64 * 2f64.powi(-g)).trunc() as i128).sum();
+        if sum != 0 {
+            slices.push((sum, g - 8));
+        }
+    }
+    let (sum, k) = match slices[..] {
+        [] => return 0.0,
+        [one] => one,
+        [a, b] => add_exact(a, b),
+        _ => unreachable!("two slices at most"),
     };
-    // the grid: 2^(e − (p − 1) − 4); |v| / grid < 2^(p + 4), exact in f64
-    let g = e - (p as i32 - 1) - 4;
-    let sum: i64 = terms.iter().map(|&(w, v)| w * (v as f64 * 2f64.powi(-g)).trunc() as i64).sum();
-    // the sum is `sum · 2^(g − 8)`: round to p bits, ties away from zero
-    let mut m = sum.unsigned_abs();
-    let mut k = g - 8;
-    let bits = 64 - m.leading_zeros();
+    round_ties_away(sum, k, p)
+}
+
+/// `a + b` for `(m, k)` standing for `m · 2^k` (each `|m| < 2^40`): exact,
+/// except that a part more than 80 bits finer than the other's grid becomes
+/// its sign at that depth, which leaves every rounding to 24 bits or fewer
+/// as it was (it is then below 2^-40 of the other part's last bit, so it
+/// decides only ties and exactness).
+fn add_exact(a: (i128, i32), b: (i128, i32)) -> (i128, i32) {
+    let (coarse, fine) = if a.1 >= b.1 { (a, b) } else { (b, a) };
+    let fine = if coarse.1 - fine.1 > 80 { (fine.0.signum(), coarse.1 - 80) } else { fine };
+    ((coarse.0 << (coarse.1 - fine.1)) + fine.0, fine.1)
+}
+
+/// `m · 2^k` rounded to `p` bits, ties away from zero.
+fn round_ties_away(m: i128, k: i32, p: u32) -> f32 {
+    let mut mag = m.unsigned_abs();
+    let mut k = k;
+    let bits = 128 - mag.leading_zeros();
     if bits > p {
         let sh = bits - p;
-        m = (m + (1 << (sh - 1))) >> sh;
+        mag = (mag + (1 << (sh - 1))) >> sh;
         k += sh as i32;
     }
-    let v = m as f64 * 2f64.powi(k);
-    (if sum < 0 { -v } else { v }) as f32
+    let v = mag as f64 * 2f64.powi(k);
+    (if m < 0 { -v } else { v }) as f32
+}
+
+/// One channel of a linear filter of 8- and 16-bit integer texels under the
+/// normalized-float read, as the H200 computes it: from the stored integers
+/// `v` (signed ones sign-extended, −128 and −32768 not clamped to −1) and
+/// weights in 256ths, a 16-bit normalized value `n` rounded half up and
+/// returned as `n / 65535` (unsigned) or `n / 32767` (signed) rounded to f32:
+/// `u8` widened to 16 bits as `v · 257` (`n = round(Σ w·257v / 256)`), `u16`
+/// and `s16` as they are (`n = round(Σ w·v / 256)`), all bit for bit in 1-D,
+/// 2-D and (`u8`) 3-D; `s8` as the exact `n = round(Σ w·v·32767 / (127 · 256))`,
+/// which differs from the H200 by one step (1/32767) on 6 % of the measured
+/// channels (its exact rule was not found).
+fn filter_normalized(terms: &[(i64, i64)], format: TexelFormat) -> f32 {
+    let sum = |k: i64| terms.iter().map(|&(w, v)| w * v * k).sum::<i64>();
+    match format {
+        TexelFormat::U8 => ((sum(257) + 128) >> 8) as f32 / 65535.0,
+        TexelFormat::U16 => ((sum(1) + 128) >> 8) as f32 / 65535.0,
+        TexelFormat::S16 => ((sum(1) + 128) >> 8) as f32 / 32767.0,
+        // round(num / den), half up: floor((2 num + den) / (2 den))
+        _ => (2 * sum(32767) + 127 * 256).div_euclid(2 * 127 * 256) as f32 / 32767.0,
+    }
 }
 
 /// The binary exponent of a finite nonzero `v` (`floor(log2 |v|)`).
@@ -295,6 +352,15 @@ fn exponent(v: f64) -> i32 {
     } else {
         e - 1023
     }
+}
+
+/// Whether texels `i` and `i + 1` of dimension `d` are one texel clamped
+/// at an edge under the clamp mode: the H200 then gives the second no
+/// weight, as if it clamped the coordinate (measured in 3-D, where that
+/// changes the other weights; in 1-D and 2-D it changes nothing). Under the
+/// mirror mode, whose edge texels repeat too, it does not (measured in 3-D).
+fn one_texel(t: &TextureDesc, d: usize, i: i64) -> bool {
+    t.addr[d] == AddressMode::Clamp && (i < 0 || i >= size(t.dims, d) - 1)
 }
 
 /// `tex` with float coordinates (`dims` of them used).
@@ -318,11 +384,11 @@ pub fn sample(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [f32; 3],
         dims
     };
     let fp: Vec<(i64, u32)> = x.iter().map(|&v| footprint(v)).collect();
-    let ws: Vec<u32> = fp.iter().map(|f| f.1).collect();
-    if dims == 3 {
-        return sample_3d(t, read, &fp);
-    }
-    let mut terms: Vec<(i64, [u32; 4])> = Vec::with_capacity(4);
+    let ws: Vec<u32> = fp.iter().enumerate().map(|(d, f)| if one_texel(t, d, f.0) { 0 } else { f.1 }).collect();
+    // normalized integer texels filter from their stored integers
+    let normalized = t.read == ReadMode::NormalizedFloat && t.format.is_small_int();
+    let stored = TextureDesc { read: ReadMode::ElementType, ..t.clone() };
+    let mut texels: Vec<(i64, [u32; 4], usize)> = Vec::with_capacity(8);
     for (corner, w) in corner_weights(&ws).into_iter().enumerate() {
         if w == 0 {
             continue;
@@ -331,40 +397,35 @@ pub fn sample(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [f32; 3],
         for d in 0..dims {
             idx[d] = fp[d].0 + (corner >> d & 1) as i64;
         }
-        terms.push((w, fetch(t, read, idx)));
+        let v = fetch(if normalized { &stored } else { t }, read, idx);
+        texels.push((w, v, corner >> 2 & 1));
     }
-    let p = filter_precision(t.format);
     let mut out = [0u32; 4];
     for (c, o) in out.iter_mut().enumerate() {
-        let ch: Vec<(i64, f32)> = terms.iter().map(|(w, v)| (*w, f32::from_bits(v[c]))).collect();
-        *o = filter_channel(&ch, p).to_bits();
+        *o = if normalized {
+            let ch: Vec<(i64, i64)> = texels.iter().map(|(w, v, _)| (*w, stored_int(t, c, v[c]))).collect();
+            filter_normalized(&ch, t.format).to_bits()
+        } else {
+            let ch: Vec<Term> = texels.iter().map(|(w, v, z)| (*w, f32::from_bits(v[c]), *z)).collect();
+            filter_channel(&ch, filter_precision(t.format)).to_bits()
+        };
     }
     out
 }
 
-/// Trilinear filtering: the product of the three weights (in 256ths) per
-/// corner, the weighted sum in f64 rounded to f32. Not the H200's bits: its
-/// 3-D weights follow neither this nor the 2-D rule (`docs/semantics.md`).
-fn sample_3d(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, fp: &[(i64, u32)]) -> [u32; 4] {
-    let mut acc = [0f64; 4];
-    for corner in 0..8usize {
-        let mut idx = [0i64; 3];
-        let mut w = 1.0;
-        for d in 0..3 {
-            let hi = corner >> d & 1 == 1;
-            idx[d] = fp[d].0 + hi as i64;
-            let wd = fp[d].1 as f64 / 256.0;
-            w *= if hi { wd } else { 1.0 - wd };
-        }
-        if w == 0.0 {
-            continue;
-        }
-        let v = fetch(t, read, idx);
-        for c in 0..4 {
-            acc[c] += w * f32::from_bits(v[c]) as f64;
-        }
+/// Channel `c`'s stored integer from [`texel`]'s element-type read `bits`
+/// (sign-extended for signed formats); the fourth channel of a texel with
+/// fewer channels, which reads 1, is the format's largest value (1.0).
+fn stored_int(t: &TextureDesc, c: usize, bits: u32) -> i64 {
+    if c == 3 && t.channels < 4 && bits == 1 {
+        return match t.format {
+            TexelFormat::U8 => 255,
+            TexelFormat::S8 => 127,
+            TexelFormat::S16 => 32767,
+            _ => 65535,
+        };
     }
-    acc.map(|v| (v as f32).to_bits())
+    bits as i32 as i64
 }
 
 /// `tex` with integer coordinates: the texel, no filtering; out of range a
@@ -591,16 +652,58 @@ mod tests {
     fn filtering_aligns_to_the_largest_texel_and_rounds_ties_away() {
         // weights 1/256 and 255/256 of 1.0 and 2^-30: the small texel is cut
         // off entirely (below the grid 2^-27 of the larger one)
-        let r = filter_channel(&[(1, 1.0), (255, 2f32.powi(-30))], 24);
+        let r = filter_channel(&[(1, 1.0, 0), (255, 2f32.powi(-30), 0)], 24);
         assert_eq!(r, 1.0 / 256.0);
         // alone, a small texel keeps all its bits (`sample` leaves out the
         // corners that weigh nothing, so they never set the grid)
-        assert_eq!(filter_channel(&[(256, 2f32.powi(-30))], 24), 2f32.powi(-30));
+        assert_eq!(filter_channel(&[(256, 2f32.powi(-30), 0)], 24), 2f32.powi(-30));
         // a tie rounds away from zero: 1 + 2^-24 (exactly between two f32)
         let v = 1.0 + 2f32.powi(-23);
-        assert_eq!(filter_channel(&[(128, 1.0), (128, v)], 24), v);
-        assert_eq!(filter_channel(&[(128, -1.0), (128, -v)], 24), -v);
+        assert_eq!(filter_channel(&[(128, 1.0, 0), (128, v, 0)], 24), v);
+        assert_eq!(filter_channel(&[(128, -1.0, 0), (128, -v, 0)], 24), -v);
         // half precision: 11 bits
-        assert_eq!(filter_channel(&[(128, 1.0), (128, 1.0 + 2f32.powi(-10))], 11), 1.0 + 2f32.powi(-10));
+        assert_eq!(filter_channel(&[(128, 1.0, 0), (128, 1.0 + 2f32.powi(-10), 0)], 11), 1.0 + 2f32.powi(-10));
+    }
+
+    #[test]
+    fn each_z_slice_is_aligned_to_its_own_largest_texel() {
+        // the 2^-30 texel in slice 1 keeps its bits beside slice 0's 1.0
+        // (aligned together it would be cut off, leaving 1/256 exactly):
+        // 2^-8 + 255 x 2^-38, rounded to 24 bits
+        let r = filter_channel(&[(1, 1.0, 0), (255, 2f32.powi(-30), 1)], 24);
+        assert_eq!(r, 2f32.powi(-8) + 2f32.powi(-30));
+        // slices far apart: the finer one still decides a tie (1 + 2^-24
+        // rounds away, to 1 + 2^-23, unless a little is taken off it)
+        let v = 1.0 + 2f32.powi(-23);
+        let tie = [(128, 1.0, 0), (128, v, 0)];
+        assert_eq!(filter_channel(&[tie[0], tie[1], (256, 2f32.powi(-120), 1)], 24), v);
+        assert_eq!(filter_channel(&[tie[0], tie[1], (256, -(2f32.powi(-120)), 1)], 24), 1.0);
+    }
+
+    #[test]
+    fn normalized_texels_filter_in_sixteen_bit_fixed_point() {
+        use TexelFormat::*;
+        // 0 and 255 at one half: 257 x 255 x 128 / 256 = 32767.5 -> 32768
+        assert_eq!(filter_normalized(&[(128, 0), (128, 255)], U8), 32768.0 / 65535.0);
+        // full weight on 255 is exactly 1.0; a u16 texel is not widened
+        assert_eq!(filter_normalized(&[(256, 255)], U8), 1.0);
+        assert_eq!(filter_normalized(&[(255, 65535), (1, 0)], U16), 65279.0 / 65535.0);
+        // signed: half up toward +inf, and -32768 / -128 are not clamped to -1
+        assert_eq!(filter_normalized(&[(128, -3), (128, 0)], S16), -1.0 / 32767.0);
+        assert_eq!(filter_normalized(&[(256, -32768)], S16), -32768.0 / 32767.0);
+        assert_eq!(filter_normalized(&[(256, 127)], S8), 1.0);
+        assert_eq!(filter_normalized(&[(256, -128)], S8), -33025.0 / 32767.0);
+    }
+
+    #[test]
+    fn three_d_weights_split_z_then_x_then_y() {
+        // measured on the H200: wx, wy, wz = 165, 202, 127 (corner = x + 2y + 4z)
+        assert_eq!(corner_weights(&[165, 202, 127]), vec![10, 18, 36, 65, 9, 17, 36, 65]);
+        for ws in [[0u32, 0, 0], [255, 255, 255], [1, 128, 77], [64, 105, 26]] {
+            let c = corner_weights(&ws);
+            assert_eq!(c.iter().sum::<i64>(), 256, "{ws:?}");
+            // the z split is exact
+            assert_eq!(c[4..].iter().sum::<i64>(), ws[2] as i64, "{ws:?}");
+        }
     }
 }

@@ -8,12 +8,18 @@ unpacked into DIR): checks that every texture's texels are the hash rule's
       samples' coordinates (f32, dims each) then their results (f32 x 4 each)
   tests/fixtures/validation/h200_sured.json        sured.json as measured
 
-usage: tex_filter_fixture.py DIR ENV_TXT
+usage: tex_filter_fixture.py DIR ENV_TXT [2]
+
+With "2" (tools/device/issue20_tex_bfs.sh's tex2.tgz, the second set of
+cases): h200_tex_filter2.{json,bin.z} instead, no surfaces, and more samples
+kept of the large 3-D case (KEEP_MORE).
 """
 import json, struct, sys, zlib
 
 MASK = 0xFFFFFFFF
 KEEP = 1024
+KEEP_MORE = {"r3big": 8192}
+ESIZE = {"f32": 4, "f16": 2, "u16": 2, "s16": 2, "u8": 1, "s8": 1}
 
 
 def hash32(x):
@@ -35,6 +41,8 @@ def texel_bits(c, e):
             return (h & 0x807FFFFF) | ((120 + hash32(h) % 15) << 23)
         if c["format"] == "f16":
             return (h & 0x83FF) | ((8 + hash32(h) % 15) << 10)
+        if c["format"] in ("u16", "s16"):
+            return h & 0xFFFF
         return h & 0xFF
     w, h_ = c["size"][0], c["size"][1]
     x, y = k % w, (k // w % h_ if h_ else 0)
@@ -47,11 +55,12 @@ def texel_bits(c, e):
     return struct.unpack("<I", struct.pack("<f", float(v)))[0]
 
 
-def main(d, env):
+def main(d, env, second=False):
     cases = json.load(open(f"{d}/tex.json"))
+    stem = "tests/fixtures/validation/h200_tex_filter" + ("2" if second else "")
     blob = b""
     for c in cases:
-        esize = {"f32": 4, "f16": 2, "u8": 1}[c["format"]]
+        esize = ESIZE[c["format"]]
         raw = open(f"{d}/{c['name']}.tex", "rb").read()
         count = len(raw) // esize
         want = b"".join(struct.pack("<I", texel_bits(c, e))[:esize] for e in range(count))
@@ -60,14 +69,17 @@ def main(d, env):
         crd = struct.unpack(f"<{n * dims}I", open(f"{d}/{c['name']}.crd", "rb").read())
         out = struct.unpack(f"<{n * 4}I", open(f"{d}/{c['name']}.out", "rb").read())
         step = max(1, n // KEEP) if c["coords"] == "grid1" else 1
-        keep = list(range(0, n, step))[:KEEP]
+        keep = list(range(0, n, step))[:KEEP_MORE.get(c["name"], KEEP) if second else KEEP]
         c["kept"] = {"first": 0, "step": step, "count": len(keep)}
         words = [crd[i * dims + k] for i in keep for k in range(dims)] + [out[i * 4 + k] for i in keep for k in range(4)]
         blob += struct.pack(f"<{len(words)}I", *words)
-    meta = {"note": "made by tools/device/tex_filter_fixture.py from tools/device/issue20_leftovers.sh",
+    script = "issue20_tex_bfs.sh" if second else "issue20_leftovers.sh"
+    meta = {"note": f"made by tools/device/tex_filter_fixture.py from tools/device/{script}",
             "env": open(env).read().splitlines()[:8], "cases": cases}
-    json.dump(meta, open("tests/fixtures/validation/h200_tex_filter.json", "w"), indent=1)
-    open("tests/fixtures/validation/h200_tex_filter.bin.z", "wb").write(zlib.compress(blob, 9))
+    json.dump(meta, open(f"{stem}.json", "w"), indent=1)
+    open(f"{stem}.bin.z", "wb").write(zlib.compress(blob, 9))
+    if second:
+        return
     s = json.load(open(f"{d}/sured.json"))
     s["note"] = "made by tools/device/tex_filter_host.cu (kernels/validation/sured.cu) on the device"
     s["env"] = meta["env"]
@@ -75,4 +87,4 @@ def main(d, env):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2])
+    main(sys.argv[1], sys.argv[2], len(sys.argv) > 3 and sys.argv[3] == "2")

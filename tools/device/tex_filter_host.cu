@@ -6,6 +6,9 @@
 //   NAME.tex, NAME.crd, NAME.out   texel bytes, f32 coordinates (dims per
 //                        sample), f32 x 4 results per sample
 //   sured.json           every sured case's surface after the launch
+// With a second argument "2", the second set of cases instead (16-bit and
+// signed normalized texels, 3-D textures under every address mode and
+// format) and no surfaces (tools/device/issue20_tex_bfs.sh).
 // Texels and coordinates come from hash32 (tools/device/validation.py), so
 // tests/tex_filter.rs makes the same ones. Build: nvcc -O2 -arch=sm_90 -I. -o
 // probe tools/device/tex_filter_host.cu (from the repository root).
@@ -41,7 +44,7 @@ static const char *OUT;
 struct Case {
   const char *name;
   int dims;            // 1, 2, 3
-  const char *format;  // f32 f16 u8
+  const char *format;  // f32 f16 u8 u16 s8 s16
   int w, h, d;
   const char *addr;    // clamp border wrap mirror
   bool normalized;
@@ -59,6 +62,7 @@ static unsigned texel_bits(const Case &c, int e) {
     unsigned h = hash32((unsigned)e + ((unsigned)c.seed << 20));
     if (!strcmp(c.format, "f32")) return (h & 0x807FFFFFu) | ((120u + hash32(h) % 15u) << 23);
     if (!strcmp(c.format, "f16")) return (h & 0x83FFu) | ((8u + hash32(h) % 15u) << 10);
+    if (!strcmp(c.format, "u16") || !strcmp(c.format, "s16")) return h & 0xFFFFu;
     return h & 0xFFu;
   }
   float v = 0;
@@ -99,15 +103,24 @@ static void write_file(const std::string &name, const void *p, size_t n) {
   fclose(f);
 }
 
+static int elem_size(const char *f) {
+  if (!strcmp(f, "f32")) return 4;
+  if (!strcmp(f, "f16") || !strcmp(f, "u16") || !strcmp(f, "s16")) return 2;
+  return 1;
+}
+
 static void run_case(const Case &c, FILE *J, bool first) {
-  int esize = !strcmp(c.format, "f32") ? 4 : !strcmp(c.format, "f16") ? 2 : 1;
+  int esize = elem_size(c.format);
+  bool is_float = c.format[0] == 'f';
   int count = c.w * (c.h ? c.h : 1) * (c.d ? c.d : 1) * 4;
   std::vector<unsigned char> raw(count * esize);
   for (int e = 0; e < count; e++) {
     unsigned b = texel_bits(c, e);
     memcpy(&raw[e * esize], &b, esize);
   }
-  cudaChannelFormatKind kind = !strcmp(c.format, "u8") ? cudaChannelFormatKindUnsigned : cudaChannelFormatKindFloat;
+  cudaChannelFormatKind kind = is_float           ? cudaChannelFormatKindFloat
+                               : c.format[0] == 's' ? cudaChannelFormatKindSigned
+                                                    : cudaChannelFormatKindUnsigned;
   int bits = esize * 8;
   cudaChannelFormatDesc cd = cudaCreateChannelDesc(bits, bits, bits, bits, kind);
   cudaArray_t a;
@@ -127,7 +140,7 @@ static void run_case(const Case &c, FILE *J, bool first) {
   memset(&td, 0, sizeof td);
   for (int i = 0; i < 3; i++) td.addressMode[i] = addr_mode(c.addr);
   td.filterMode = cudaFilterModeLinear;
-  td.readMode = !strcmp(c.format, "u8") ? cudaReadModeNormalizedFloat : cudaReadModeElementType;
+  td.readMode = is_float ? cudaReadModeElementType : cudaReadModeNormalizedFloat;
   td.normalizedCoords = c.normalized;
   cudaTextureObject_t t;
   CK(cudaCreateTextureObject(&t, &rd, &td, nullptr));
@@ -177,6 +190,23 @@ static const Case CASES[] = {
     {"u2", 2, "u8", 64, 64, 0, "clamp", false, "random", 9, 32768, "uniform", -1, 65},
     {"u2b", 2, "u8", 64, 64, 0, "border", false, "random", 9, 16384, "uniform", -1, 65},
     {"u1b", 1, "u8", 256, 0, 0, "border", false, "random", 10, 16384, "uniform", -1, 257},
+};
+
+// The second set: normalized 16-bit and signed texels in 1-D and 2-D, and
+// 3-D textures of every address mode and of f16 and u8 texels, with one
+// more f32 clamp case of many samples.
+static const Case CASES2[] = {
+    {"n2u16", 2, "u16", 64, 64, 0, "clamp", false, "random", 21, 16384, "uniform", -1, 65},
+    {"n2s8", 2, "s8", 64, 64, 0, "clamp", false, "random", 22, 16384, "uniform", -1, 65},
+    {"n2s16", 2, "s16", 64, 64, 0, "clamp", false, "random", 23, 16384, "uniform", -1, 65},
+    {"n1s8b", 1, "s8", 256, 0, 0, "border", false, "random", 24, 8192, "uniform", -1, 257},
+    {"r3big", 3, "f32", 16, 16, 16, "clamp", false, "random", 25, 65536, "uniform", -1, 17},
+    {"r3b", 3, "f32", 16, 16, 16, "border", false, "random", 26, 16384, "uniform", -1, 17},
+    {"r3w", 3, "f32", 16, 16, 16, "wrap", true, "random", 27, 16384, "uniform", -1.5, 2.5},
+    {"r3m", 3, "f32", 16, 16, 16, "mirror", true, "random", 28, 16384, "uniform", -1.5, 2.5},
+    {"h3", 3, "f16", 16, 16, 16, "clamp", false, "random", 29, 16384, "uniform", -1, 17},
+    {"u3", 3, "u8", 16, 16, 16, "clamp", false, "random", 30, 16384, "uniform", -1, 17},
+    {"u3b", 3, "u8", 16, 16, 16, "border", false, "random", 31, 16384, "uniform", -1, 17},
 };
 
 // ---- surfaces: 4 x 4 elements, initial words hash32(i + (7 << 20))
@@ -234,15 +264,27 @@ static void sured(FILE *J) {
 
 int main(int argc, char **argv) {
   OUT = argc > 1 ? argv[1] : ".";
+  bool second = argc > 2 && !strcmp(argv[2], "2");
   FILE *J = fopen((std::string(OUT) + "/tex.json").c_str(), "w");
   fprintf(J, "[\n");
   bool first = true;
-  for (const Case &c : CASES) {
-    run_case(c, J, first);
-    first = false;
+  if (second) {
+    for (const Case &c : CASES2) {
+      run_case(c, J, first);
+      first = false;
+    }
+  } else {
+    for (const Case &c : CASES) {
+      run_case(c, J, first);
+      first = false;
+    }
   }
   fprintf(J, "]\n");
   fclose(J);
+  if (second) {
+    printf("done\n");
+    return 0;
+  }
   J = fopen((std::string(OUT) + "/sured.json").c_str(), "w");
   sured(J);
   fclose(J);
