@@ -88,7 +88,7 @@ fn roughness_is_zero_or_at_least_the_floor() {
     for r in ["1e-30", "1e-12", "9.9e-5"] {
         let e = load_str(&scene(r));
         assert!(e.contains(".toml: material[0].roughness: material `wall`: "), "{r}: {e}");
-        assert!(e.contains("is below 0.0001"), "{r}: {e}");
+        assert!(e.contains(&format!("`wall`: {r} is below 1e-4, the smallest Beckmann alpha")), "{r}: {e}");
     }
     for r in ["0", "1e-4", "0.2", "1"] {
         assert_eq!(load_str(&scene(r)), "", "{r}");

@@ -170,7 +170,7 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32), Scene
         return cx.err(
             &format!("{p}roughness"),
             format!(
-                "material `{name}`: {roughness} is below {MIN_ROUGHNESS}, the smallest Beckmann alpha \
+                "material `{name}`: {roughness:e} is below {MIN_ROUGHNESS:e}, the smallest Beckmann alpha \
                  (Mitsuba's floor too); use 0 for a smooth surface"
             ),
         );
