@@ -542,6 +542,10 @@ fn render_refuses_options_that_do_not_apply() {
             vec!["--method", "photon-map", "--json", "x.json"],
             "--json applies to --method raycast and purcell (photon-map",
         ),
+        (
+            vec!["--method", "purcell", "--variant", "error", "--json", "x.json"],
+            "--json applies to --method purcell's native and emulated variants (--variant error",
+        ),
         (vec!["--fmad", "false"], "--fmad applies to emulated kernels; --method raycast --variant native runs none"),
         (vec!["--method", "path", "--device", "hopper"], "--device applies to emulated kernels"),
         (vec!["--method", "path", "--fidelity", "functional"], "--fidelity applies to emulated kernels"),

@@ -139,3 +139,20 @@ fn the_native_photons_are_the_renders_and_their_render_is_near_map_as_image() {
     let e = rel_rmse(&got.image, want);
     assert!(e < 0.25, "relative RMS error {e}");
 }
+
+/// The error charts' emulated renders run on the device settings given
+/// (`render --method purcell --variant error` ran them on the default device
+/// whatever `--device`, `--fmad` and `--fidelity` said): a device that
+/// refuses the kernels' CTAs fails the charts.
+#[test]
+fn the_error_charts_render_on_the_device_settings_given() {
+    let f = FIXTURES[0].reduced(DIV);
+    let scene = scene_file::load(&scene_file::resolve(f.scene)).unwrap();
+    let spec = error::ReferenceSpec { photons: 1.0, k: 1.0 };
+    let run =
+        |set: &dyn Fn(&mut warplight::sim::SimConfig)| error::charts(&scene, &f, 16, (&[1.0], spec), set, &mut |_| {});
+    let c = run(&|c| warplight::model::Profile::Hopper.configure(c, Some(false))).unwrap();
+    assert!(c.time.series.iter().all(|s| !s.points.is_empty()));
+    let e = run(&|c| c.max_threads_per_cta = 1).map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains("threads per CTA; at most 1 allowed"), "{e}");
+}

@@ -49,7 +49,13 @@ fn procedural_scenes_match_table_a1_exactly() {
 fn load_str(text: &str) -> String {
     let dir = std::env::temp_dir().join(format!("warplight-scene-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join(format!("s{}.toml", text.len()));
+    // one file per text: tests run in parallel
+    let p = dir.join(format!("s{:016x}.toml", {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        text.hash(&mut h);
+        h.finish()
+    }));
     std::fs::write(&p, text).unwrap();
     scene_file::load(&p).map(|_| String::new()).unwrap_or_else(|e| e.to_string())
 }
@@ -69,6 +75,26 @@ fn scene_errors_name_the_key() {
     assert!(e.contains("camera.direction: must not be zero"), "{e}");
     let e = load_str("obj = \"nope.obj\"\n");
     assert!(e.contains("does not exist"), "{e}");
+}
+
+/// A positive roughness below Mitsuba's floor of 1e-4 gave NaN pixels under
+/// MIS (α² underflows): refused, naming the file, key and material; 0
+/// (smooth) and 1e-4 load.
+#[test]
+fn roughness_is_zero_or_at_least_the_floor() {
+    let scene = |r: &str| {
+        format!("procedural = \"scene6\"\n[[material]]\nname = \"wall\"\nkind = \"mirror\"\nroughness = {r}\n")
+    };
+    for r in ["1e-30", "1e-12", "9.9e-5"] {
+        let e = load_str(&scene(r));
+        assert!(e.contains(".toml: material[0].roughness: material `wall`: "), "{r}: {e}");
+        assert!(e.contains(&format!("`wall`: {r} is below 1e-4, the smallest Beckmann alpha")), "{r}: {e}");
+    }
+    for r in ["0", "1e-4", "0.2", "1"] {
+        assert_eq!(load_str(&scene(r)), "", "{r}");
+    }
+    let e = load_str(&scene("-1e-30"));
+    assert!(e.contains("material[0].roughness: expected a Beckmann alpha between 0 and 1"), "{e}");
 }
 
 #[test]

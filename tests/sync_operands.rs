@@ -146,7 +146,7 @@ fn a_member_mask_naming_lanes_on_another_path_is_a_fault() {
     // lanes 0-15 branch away; 16-31 shuffle naming the whole warp
     let (r, _) = shfl(32, 16, u32::MAX);
     let f = fault_of(r);
-    assert_eq!(f.kind, FaultKind::MemberMask { mask: u32::MAX, active: 0xFFFF_0000, live: u32::MAX });
+    assert_eq!(f.kind, FaultKind::MemberMask { mask: u32::MAX, lane: 16, active: 0xFFFF_0000, live: u32::MAX });
     assert_eq!((f.lane, f.ptx_line), (Some(16), 16), "{f}");
     let msg = f.to_string();
     assert!(msg.contains("names lane 0 that does not execute the instruction"), "{msg}");
@@ -165,6 +165,63 @@ fn a_member_mask_leaving_out_an_executing_lane_is_a_fault() {
     assert!(matches!(f.kind, FaultKind::MemberMask { mask: 0xFFFF, active: u32::MAX, .. }), "{f}");
     assert_eq!(f.lane, Some(16));
     assert!(f.to_string().contains("leaves out lane 16 that executes the instruction"), "{f}");
+}
+
+/// Lanes 16-31 branch away; lanes 0-7 read lane 0 under `lo`, lanes 8-15
+/// read lane 8 under `hi` (two member groups).
+const SHFL_GROUPS: &str = "
+.visible .entry shfl_groups(.param .u64 out, .param .u32 lo, .param .u32 hi)
+{
+.reg .pred %p<3>;
+.reg .b32 %r<7>;
+.reg .b64 %rd<4>;
+ld.param.u64 %rd1, [out];
+ld.param.u32 %r4, [lo];
+ld.param.u32 %r5, [hi];
+mov.u32 %r1, %tid.x;
+setp.ge.u32 %p1, %r1, 16;
+@%p1 bra DONE;
+setp.lt.u32 %p2, %r1, 8;
+selp.b32 %r2, %r4, %r5, %p2;
+and.b32 %r6, %r1, 8;
+shfl.sync.idx.b32 %r3, %r1, %r6, 31, %r2;
+mul.wide.u32 %rd2, %r1, 4;
+add.s64 %rd3, %rd1, %rd2;
+st.global.u32 [%rd3], %r3;
+DONE:
+ret;
+}
+";
+
+/// The fault's message gives the reason of the lane in error, not one about
+/// the lanes of another member group (which leave it out legitimately).
+#[test]
+fn a_member_mask_fault_names_the_reason_of_its_own_lane_beside_other_groups() {
+    let run = |lo: u32, hi: u32| {
+        let mut dev = device();
+        let m = dev.load_ptx(&format!("{HEAD}{SHFL_GROUPS}"), "groups.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(32);
+        let args = [Arg::Ptr(out), Arg::U32(lo), Arg::U32(hi)];
+        let r = dev.launch(&m, "shfl_groups", LaunchConfig::linear(1, 32), &args);
+        (r, dev.read::<u32>(out, 32))
+    };
+    // lane 8's mask names lanes 16-23, which branched away
+    let f = fault_of(run(0xFF, 0x00FF_FF00).0);
+    assert_eq!(f.kind, FaultKind::MemberMask { mask: 0x00FF_FF00, lane: 8, active: 0xFFFF, live: u32::MAX });
+    assert_eq!((f.lane, f.ptx_line), (Some(8), 19), "{f}");
+    let msg = f.to_string();
+    assert!(msg.contains("member mask 0x00ffff00 names lane 16 that does not execute the instruction"), "{msg}");
+    assert!(!msg.contains("leaves out"), "{msg}");
+    // lane 8's mask leaves lane 8 out (lanes 0-7 are in their own group)
+    let f = fault_of(run(0xFF, 0xFE00).0);
+    assert_eq!(f.kind, FaultKind::MemberMask { mask: 0xFE00, lane: 8, active: 0xFFFF, live: u32::MAX });
+    let msg = f.to_string();
+    assert!(msg.contains("member mask 0x0000fe00 leaves out lane 8 that executes the instruction"), "{msg}");
+    // the two groups, each under its own mask: each lane reads the first lane of its group
+    let (r, out) = run(0xFF, 0xFF00);
+    r.unwrap();
+    let want: Vec<u32> = (0..32).map(|l| if (8..16).contains(&l) { 8 } else { 0 }).collect();
+    assert_eq!(out, want);
 }
 
 #[test]

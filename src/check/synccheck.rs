@@ -72,8 +72,7 @@ pub fn from_fault(f: &Fault, names: &Names, at: Pc, cta: u32) -> Option<Report> 
                 waiting.iter().map(|(w, b)| format!("warp {w} at barrier {b}")).collect::<Vec<_>>().join(", ")
             ),
         ),
-        FaultKind::MemberMask { mask, active, live } => {
-            let lane = f.lane.unwrap_or(active.trailing_zeros());
+        FaultKind::MemberMask { mask, lane, active, live } => {
             let why = if mask >> lane & 1 == 0 {
                 format!("leaves out lane {lane}, which executes it")
             } else {

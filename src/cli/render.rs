@@ -220,6 +220,11 @@ fn check_applicable(a: &RenderArgs) -> Result<(), String> {
     if !matches!(m, "raycast" | "purcell") && a.json.is_some() {
         return Err(format!("--json applies to --method raycast and purcell ({m} writes no counters)"));
     }
+    if m == "purcell" && a.variant == "error" && a.json.is_some() {
+        return Err("--json applies to --method purcell's native and emulated variants (--variant error writes \
+                    each chart's data beside -o as JSON)"
+            .into());
+    }
     // natively, raycast and path run no kernel (purcell's native variant still emulates the map passes)
     if matches!(m, "raycast" | "path") && a.variant == "native" {
         let emulated_only = [

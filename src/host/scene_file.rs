@@ -22,6 +22,11 @@ pub struct SceneError {
     pub msg: String,
 }
 
+/// The smallest positive Beckmann α a scene may give (`roughness`; 0 is a
+/// smooth surface). Mitsuba 3 clamps α to it; below it the rough BSDF's
+/// pdf turns NaN or infinite in f32.
+pub const MIN_ROUGHNESS: f32 = 1e-4;
+
 static SCENES_FLAG: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
 
 /// Sets the folder of `--scene-dir DIR`, searched before every other (once, before any work).
@@ -160,6 +165,17 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32, bool),
     let roughness = cx.float(t, "roughness", &p, 0.0)?;
     if t.contains_key("roughness") && !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) {
         return cx.err(&format!("{p}roughness"), "only a mirror or glass has a roughness");
+    }
+    // α² underflows in f32 below about 1e-19 and the pdf squared overflows from
+    // about 1e-11: NaN pixels under MIS. Mitsuba 3 clamps α to 1e-4.
+    if roughness > 0.0 && roughness < MIN_ROUGHNESS {
+        return cx.err(
+            &format!("{p}roughness"),
+            format!(
+                "material `{name}`: {roughness:e} is below {MIN_ROUGHNESS:e}, the smallest Beckmann alpha \
+                 (Mitsuba's floor too); use 0 for a smooth surface"
+            ),
+        );
     }
     if !(0.0..=1.0).contains(&roughness) {
         return cx.err(&format!("{p}roughness"), "expected a Beckmann alpha between 0 and 1");

@@ -442,7 +442,15 @@ impl<'a> Parser<'a> {
                     )),
                 ));
             }
-            let len = start as u64 + n;
+            // `n` is a checked product of the later dimensions and may be near 2^64
+            let Some(len) = (start as u64).checked_add(n) else {
+                return Err((
+                    pos,
+                    PtxErrorKind::Limit(format!(
+                        "the initializer of `{name}` padded to whole rows passes 2^64 elements"
+                    )),
+                ));
+            };
             crate::limits::check_memory(
                 || format!("the initializer of `{name}` padded to whole rows"),
                 len.saturating_mul(std::mem::size_of::<Literal>() as u64),
@@ -831,6 +839,16 @@ mod tests {
         let (pos, kind) = parse(&lex(&init).unwrap()).unwrap_err();
         assert_eq!(pos.col, 21 + n as u32);
         assert!(matches!(kind, PtxErrorKind::Limit(ref m) if m.contains("initializer")), "{kind}");
+    }
+
+    #[test]
+    fn padding_an_initializer_past_2_pow_64_elements_is_an_error_at_the_brace() {
+        // the last seven dimensions multiply to 2^64 - 1 (the Fermat factors of
+        // 2^64 - 1), so the inner brace after one element pads to 1 + (2^64 - 1)
+        let src = ".global .u32 t[2][3][5][17][257][641][65537][6700417]\n  = {1, {2}};\n";
+        let (pos, kind) = parse(&lex(src).unwrap()).unwrap_err();
+        assert_eq!((pos.line, pos.col), (2, 9));
+        assert!(matches!(kind, PtxErrorKind::Limit(ref m) if m.contains("`t`") && m.contains("2^64")), "{kind}");
     }
 
     #[test]

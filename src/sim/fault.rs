@@ -55,8 +55,12 @@ pub enum FaultKind {
     /// of the warp that do not execute it with it (on another path, or
     /// predicated off): undefined on the GPU.
     MemberMask {
-        /// The member mask (of the first lane in error).
+        /// The member mask of the lane in error.
         mask: u32,
+        /// The lane in error (the lowest one), whose mask this is: one its
+        /// own mask leaves out, or one whose mask names the lanes that do not
+        /// execute it. Other lanes may hold other masks (member groups).
+        lane: u32,
         /// Lanes that execute the instruction.
         active: u32,
         /// Lanes alive in the warp (not exited).
@@ -136,14 +140,14 @@ impl fmt::Display for FaultKind {
                     )
                 }
             }
-            FaultKind::MemberMask { mask, active, live } => {
-                let missing = active & !mask;
-                if missing != 0 {
+            FaultKind::MemberMask { mask, lane, active, live } => {
+                // the lane's own reason: lanes of other member groups may
+                // legitimately run the instruction under other masks
+                if mask >> lane & 1 == 0 {
                     write!(
                         f,
-                        "member mask {mask:#010x} leaves out lane {} that executes the instruction \
-                         (active lanes {active:#010x}; undefined on the GPU)",
-                        missing.trailing_zeros()
+                        "member mask {mask:#010x} leaves out lane {lane} that executes the instruction \
+                         (active lanes {active:#010x}; undefined on the GPU)"
                     )
                 } else {
                     write!(

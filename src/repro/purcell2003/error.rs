@@ -123,14 +123,15 @@ fn settling(map: usize, errors: &[f64]) -> Settling {
 
 /// Renders `scene` `width` pixels wide on the emulator at `factors` × `f`'s
 /// stated photons (1.0 among them: the time chart's run) and natively the
-/// reference `spec`, and measures the charts. `progress` hears each step as
-/// it starts.
+/// reference `spec`, and measures the charts. The emulated renders run on a
+/// device whose settings `set` adjusts (profile, FMA contraction, fidelity:
+/// [`image::render_configured`]). `progress` hears each step as it starts.
 pub fn charts(
     scene: &Scene,
     f: &Fixture,
     width: u32,
-    factors: &[f64],
-    spec: ReferenceSpec,
+    (factors, spec): (&[f64], ReferenceSpec),
+    set: &dyn Fn(&mut crate::sim::SimConfig),
     progress: &mut dyn FnMut(&str),
 ) -> Result<ErrorCharts, MeasureError> {
     let geo = Geometry::of(scene);
@@ -154,7 +155,7 @@ pub fn charts(
     for &factor in factors {
         progress(&format!("emulated render at {factor} x the stated photons"));
         let timed = factor == 1.0;
-        let r = image::render_with(scene, &with_photons(f, factor), width, timed)?;
+        let r = image::render_configured(scene, &with_photons(f, factor), width, timed, set)?;
         let n = stored(&r) as f64;
         for (m, img) in image::images(&r).iter().enumerate() {
             photon_series[m].push((n, rel_rmse(img, &want)));

@@ -269,7 +269,7 @@ pub fn run_cli(
     let native = match a.variant.as_str() {
         "native" => true,
         "emulated" => false,
-        "error" => return run_error_charts(a, scene, &f, width),
+        "error" => return run_error_charts(a, scene, &f, width, profile),
         v => return Err(format!("--method purcell --variant {v}: expected native, emulated or error").into()),
     };
     let t = std::time::Instant::now();
@@ -329,15 +329,21 @@ pub const ERROR_REFERENCE: super::error::ReferenceSpec = super::error::Reference
 /// by pass at the stated count over counted instructions (`out-time.svg`)
 /// and over passes (`out-passes.svg`), each chart's data beside it as JSON,
 /// and the reference's own error and the displays' settling in
-/// `out-summary.json` ([`super::error`]).
+/// `out-summary.json` ([`super::error`]). The emulated renders run on the
+/// command's profile, FMA contraction and fidelity, as [`run_cli`]'s do.
 pub fn run_error_charts(
     a: &crate::cli::render::RenderArgs,
     scene: &Scene,
     f: &Fixture,
     width: u32,
+    profile: crate::model::Profile,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let t = std::time::Instant::now();
-    let c = super::error::charts(scene, f, width, &ERROR_FACTORS, ERROR_REFERENCE, &mut |x| {
+    let set = |c: &mut crate::sim::SimConfig| {
+        c.fidelity = a.fidelity;
+        profile.configure(c, a.fmad);
+    };
+    let c = super::error::charts(scene, f, width, (&ERROR_FACTORS, ERROR_REFERENCE), &set, &mut |x| {
         eprintln!("{}: {x} ({:.0} s)", scene.name, t.elapsed().as_secs_f64());
     })
     .map_err(|e| e.to_string())?;

@@ -80,7 +80,7 @@ pub(super) fn member_mask(ctx: &Ctx, w: &Warp, cta: &CtaMut, mask: Src, exec: u3
         bits &= bits - 1;
         let ml = m[l] as u32;
         if ml & (1 << l) == 0 || ml & w.live & !exec != 0 {
-            return Err(fault(FaultKind::MemberMask { mask: ml, active: exec, live: w.live }, Some(l)));
+            return Err(fault(FaultKind::MemberMask { mask: ml, lane: l as u32, active: exec, live: w.live }, Some(l)));
         }
     }
     Ok(())
@@ -138,7 +138,10 @@ pub(super) fn warp_sync(ctx: &Ctx, w: &Warp, cta: &mut CtaMut, mask: Src, exec: 
     }
     let m = read(ctx, w, cta, mask);
     if let Some(l) = (0..32).find(|&l| exec >> l & 1 != 0 && (m[l] as u32) >> l & 1 == 0) {
-        return Err(fault(FaultKind::MemberMask { mask: m[l] as u32, active: exec, live: w.live }, Some(l)));
+        return Err(fault(
+            FaultKind::MemberMask { mask: m[l] as u32, lane: l as u32, active: exec, live: w.live },
+            Some(l),
+        ));
     }
     if let Some(obs) = cta.observer.as_deref_mut() {
         let mut rest = exec;
