@@ -55,6 +55,8 @@ pub fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32,
 }
 
 /// The emulated kernel's 4 frames (functional fidelity) against `reference`.
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
 pub fn emulated_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, reference: &Estimate) -> Outcome {
     emulated_frames_outcome(ps, cam, p, 4, reference)
 }
