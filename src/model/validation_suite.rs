@@ -66,7 +66,20 @@ pub enum Expect {
     /// Shown side by side: SASS instruction counts against PTX ones, divergent
     /// branch targets of SASS, L2 sectors of atomics (not modelled).
     SideBySide,
+    /// Measured differently in repeated identical runs on the H200
+    /// ([`VARIES_BETWEEN_RUNS`]): L1 hits where several warps of an SM load
+    /// the same sectors, a hit depending on which request arrived first;
+    /// the model, which sees the warps' loads in one fixed order, gives an
+    /// upper bound.
+    VariesBetweenRuns,
 }
+
+/// Metrics (case, metric) that the H200 counted differently in identical
+/// repeated runs (five per dialect, `tests/fixtures/validation/h200_bfs_repeat.json`,
+/// docs/validation.md "L1 hit sectors where warps of an SM load the same
+/// sectors"); compared as [`Expect::VariesBetweenRuns`].
+pub const VARIES_BETWEEN_RUNS: &[(&str, &str)] =
+    &[("bfs", "l1tex__t_sectors_pipe_lsu_mem_global_op_ld_lookup_hit.sum")];
 
 /// One metric of one case.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -186,8 +199,11 @@ fn base64(s: &str) -> Result<Vec<u8>, String> {
     Ok(out)
 }
 
-/// How `metric` compares in a case whose launches are `launches` (see [`Expect`]).
-fn expectation(metric: &str, launches: &[Value]) -> Expect {
+/// How `metric` compares in `case`, whose launches are `launches` (see [`Expect`]).
+fn expectation(case: &str, metric: &str, launches: &[Value]) -> Expect {
+    if VARIES_BETWEEN_RUNS.iter().any(|&(c, m)| (c, m) == (case, metric)) {
+        return Expect::VariesBetweenRuns;
+    }
     let shared = metric.starts_with("l1tex__data_pipe_lsu_wavefronts_mem_shared_op_")
         || metric.starts_with("l1tex__data_bank_conflicts_pipe_lsu_mem_shared_op_");
     if shared {
@@ -295,7 +311,7 @@ pub fn compare(fixture: &Path, root: &Path) -> Result<Report, SuiteError> {
                 metric: metric.clone(),
                 measured,
                 emulated: *emulated,
-                expect: expectation(metric, launches),
+                expect: expectation(&case, metric, launches),
             });
         }
     }
@@ -308,15 +324,24 @@ impl Report {
         self.rows.iter().filter(|r| r.expect == Expect::Exact && r.measured != r.emulated).collect()
     }
 
-    /// Timing-dependent metrics the GPU counted fewer of than the model.
-    pub fn below_the_model(&self) -> Vec<&Row> {
-        self.rows.iter().filter(|r| r.expect == Expect::TimingDependent && r.measured < r.emulated).collect()
+    /// Timing-dependent metrics outside the model's bound: shared-memory
+    /// ones the GPU counted fewer of than the model, and ones that vary
+    /// between runs that it counted more of.
+    pub fn outside_the_bound(&self) -> Vec<&Row> {
+        self.rows
+            .iter()
+            .filter(|r| match r.expect {
+                Expect::TimingDependent => r.measured < r.emulated,
+                Expect::VariesBetweenRuns => r.measured > r.emulated,
+                _ => false,
+            })
+            .collect()
     }
 
     /// Per case and dialect: outputs, and how many metrics of each kind agree.
     pub fn summary_markdown(&self) -> String {
         let mut s = String::from(
-            "| case | dialect | outputs | exact metrics equal | timing-dependent: equal / above the model | side by side: equal |\n|---|---|---|---|---|---|\n",
+            "| case | dialect | outputs | exact metrics equal | timing-dependent: equal / within the bound | side by side: equal |\n|---|---|---|---|---|---|\n",
         );
         for o in &self.outputs {
             let rows: Vec<&Row> = self.rows.iter().filter(|r| r.case == o.case && r.dialect == o.dialect).collect();
@@ -335,8 +360,10 @@ impl Report {
             );
             let timed = format!(
                 "{} / {}",
-                count(Expect::TimingDependent, &|r| r.measured == r.emulated),
+                count(Expect::TimingDependent, &|r| r.measured == r.emulated)
+                    + count(Expect::VariesBetweenRuns, &|r| r.measured == r.emulated),
                 count(Expect::TimingDependent, &|r| r.measured > r.emulated)
+                    + count(Expect::VariesBetweenRuns, &|r| r.measured < r.emulated)
             );
             let side = format!(
                 "{} / {}",
@@ -364,6 +391,10 @@ impl Report {
                 (Expect::SideBySide, false) => "SASS vs PTX / unmodelled",
                 (Expect::TimingDependent, false) if r.measured > r.emulated => "timing-dependent (above the model)",
                 (Expect::TimingDependent, false) => "**below the model**",
+                (Expect::VariesBetweenRuns, false) if r.measured < r.emulated => {
+                    "timing-dependent (varies between runs; below the model)"
+                }
+                (Expect::VariesBetweenRuns, false) => "**above the model**",
             };
             s.push_str(&format!(
                 "| {} | {} | `{}` | {} | {} | {} |\n",
