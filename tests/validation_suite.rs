@@ -46,9 +46,7 @@ fn the_suite_matches_the_h200() {
         .collect();
     assert!(differ.is_empty(), "outputs differ from the GPU's:\n{}", differ.join("\n"));
 
-    let known = |c: &str, d: &str, m: &str| {
-        KNOWN.iter().any(|k| (k.0, k.1, k.2) == (c, d, m))
-    };
+    let known = |c: &str, d: &str, m: &str| KNOWN.iter().any(|k| (k.0, k.1, k.2) == (c, d, m));
     let unexpected: Vec<String> = r
         .exact_differences()
         .iter()
