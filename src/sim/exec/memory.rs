@@ -354,14 +354,7 @@ fn global_in_one(
     touched: &mut Touched,
 ) -> Option<Resolved> {
     let size = ty.bytes();
-    let total = size * vals.len() as u32;
-    if exec == 0 || !total.is_power_of_two() {
-        return None;
-    }
-    let (lo, hi, low_bits) = lane_span(addrs, exec);
-    if low_bits & (total as u64 - 1) != 0 {
-        return None;
-    }
+    let (lo, hi, total) = aligned_span(size, vals.len(), addrs, exec)?;
     let span = (hi - lo).checked_add(total as u64)?;
     let (al, lo_off) = ctx.mem.find(lo, span)?;
     let first = exec.trailing_zeros() as usize;
@@ -385,6 +378,24 @@ fn global_in_one(
         }
     }
     Some(Resolved::Global(addrs[first]))
+}
+
+/// The lowest and highest address of the active lanes and the whole access's
+/// size in bytes (`n` elements of `size` bytes per lane), when the warp has an
+/// active lane, the access's size is a power of two and every active lane's
+/// address is aligned to it: the precondition every `*_in_one` fast path
+/// starts from. `None` otherwise.
+#[inline(always)]
+fn aligned_span(size: u32, n: usize, addrs: &Lanes, exec: u32) -> Option<(u64, u64, u32)> {
+    let total = size * n as u32;
+    if exec == 0 || !total.is_power_of_two() {
+        return None;
+    }
+    let (lo, hi, low_bits) = lane_span(addrs, exec);
+    if low_bits & (total as u64 - 1) != 0 {
+        return None;
+    }
+    Some((lo, hi, total))
 }
 
 /// The lowest and the highest of the active lanes' addresses, and the OR of
@@ -437,12 +448,8 @@ fn local_in_one(
         _ => return None,
     };
     let size = ty.bytes();
-    let total = size * vals.len() as u32;
-    if exec == 0 || !total.is_power_of_two() {
-        return None;
-    }
-    let (lo, hi, low_bits) = lane_span(addrs, exec);
-    if lo < window || hi - window >= WINDOW_SIZE || low_bits & (total as u64 - 1) != 0 {
+    let (lo, hi, total) = aligned_span(size, vals.len(), addrs, exec)?;
+    if lo < window || hi - window >= WINDOW_SIZE {
         return None;
     }
     // offsets below the window's size cannot overflow
@@ -492,15 +499,11 @@ fn params_in_one(
     touched: &mut Touched,
 ) -> Option<Resolved> {
     let size = ty.bytes();
-    let total = size * vals.len() as u32;
-    if exec == 0 || !total.is_power_of_two() {
-        return None;
-    }
-    let (_, hi, low_bits) = lane_span(addrs, exec);
+    let (_, hi, total) = aligned_span(size, vals.len(), addrs, exec)?;
     let f = w.frames.last_mut().expect("frame");
     let ps = f.param_size as u64;
     // every lane's area is in `params` (32 of them), so no access below can miss
-    if low_bits & (total as u64 - 1) != 0 || hi.checked_add(total as u64).is_none_or(|e| e > ps) {
+    if hi.checked_add(total as u64).is_none_or(|e| e > ps) {
         return None;
     }
     let first = exec.trailing_zeros() as usize;
