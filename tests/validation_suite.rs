@@ -13,12 +13,7 @@ use warplight::model::validation_suite::{Expect, Report, VARIES_BETWEEN_RUNS, co
 
 /// Exact metrics known to differ: (case, dialect, metric, why). Each is
 /// explained in docs/validation.md.
-const KNOWN: &[(&str, &str, &str, &str)] = &[(
-    "needleman_wunsch",
-    "clang",
-    "smsp__sass_inst_executed_op_shared_ld.sum",
-    "ptxas unrolls clang's anti-diagonal loops and executes 8 more LDS per tile",
-)];
+const KNOWN: &[(&str, &str, &str, &str)] = &[];
 
 fn report() -> Report {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));

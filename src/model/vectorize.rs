@@ -20,7 +20,9 @@
 //!   variables' offsets in warplight's layout, immediates, `shl` by a
 //!   constant, `mul`/`mad` (zeros add up), `add`/`sub`/`or` (the fewer), `and`
 //!   (the more), moves and conversions keep them; anything loaded or
-//!   special is unaligned.
+//!   special is unaligned, and so is a register defined from itself (`add
+//!   %r, %r, k`: an address stepped round a loop), at which ptxas merges
+//!   nothing (`needleman_wunsch` in docs/validation.md).
 //! - **Repeated loads.** A shared load of the same base register (same
 //!   definition), offset and width as an earlier load of the same run is
 //!   dropped (ptxas reuses the register): not counted.
@@ -194,6 +196,14 @@ fn trailing_zeros(f: &Function) -> Vec<u32> {
                 Kind::Cvt { d, a, dty, sty, .. } if !dty.is_float() && !sty.is_float() => (vec![d.reg], of(a, &tz)),
                 Kind::Cvta { d, a, .. } => (vec![d.reg], of(a, &tz)),
                 Kind::Selp { d, a, b, .. } => (vec![d.reg], of(a, &tz).min(of(b, &tz))),
+                // a register updated from itself (`add %r, %r, k`: an
+                // address stepped round a loop): ptxas does not merge at it
+                // (needleman_wunsch, docs/validation.md), so neither does the pass
+                Kind::Arith { d, a, b, c, ty, .. }
+                    if !ty.is_float() && [a, b, c].iter().any(|s| matches!(s, Src::Reg(r) if *r == d.reg)) =>
+                {
+                    (vec![d.reg], 0)
+                }
                 Kind::Arith { op, d, a, b, c, ty, .. } if !ty.is_float() => {
                     let (a, b, c) = (of(a, &tz), of(b, &tz), of(c, &tz));
                     let v = match op {
