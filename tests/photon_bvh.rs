@@ -243,6 +243,11 @@ fn the_emulated_gathers_equal_the_native_ones_and_the_byte_model_holds_on_the_em
         // the @count lines count what the native traversal counts
         assert_eq!(g.walk, walk, "{layout:?}");
         assert!(walk.nodes > 1000, "{walk:?}");
+        // k (Table 6.6): the contributions the `contributed` line counts are the native VKDE's
+        let map = vkde::PhotonMap::build(&c.kernels);
+        let k: u64 = q.iter().flatten().map(|x| vkde::estimate(&map, x, shape).contributions as u64).sum();
+        assert_eq!(g.walk.contributed, k, "{layout:?}");
+        assert!(k > 100 && k < walk.retrieved, "{walk:?}");
         // the memory model's bytes: 32 per node (B) or per pair of nodes (C), 4 per stack access
         let per_node = if layout == Layout::Complete { 32 } else { 16 };
         assert_eq!(g.traffic.nodes, per_node * walk.nodes, "{layout:?}");
