@@ -22,8 +22,8 @@
 //! applied to the emulator's counters of the stage's launches under the gt200
 //! memory model (the Trace stage from the first [`TRACE_SAMPLE`] photons
 //! of the frame, scaled to all), the rendering counts scaled to 512 × 512; FPS = 1000 / Σ ms
-//! as the thesis' rows obey (extract §3.14). Not modelled: the host's radix
-//! sorts of the LBVH (the thesis sorts on the GPU), the OpenGL
+//! as the thesis' rows obey (extract §3.14); the LBVH stage includes its
+//! two radix sorts (kernels, [`lbvh::sort_kernel`]). Not modelled: the OpenGL
 //! visualisation the thesis' Render includes, and the SIROH kd-tree (static,
 //! built once).
 
@@ -380,7 +380,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     ));
     t.notes.push(format!(
         "Columns: Trace ms is photons.cu and vkde.cu (tracing and kernel construction) of 2^14 photons, scaled; \
-         LBVH ms lbvh.cu's launches (Morton codes, runs, levels, merges), the host's sorts not modelled; Render ms \
+         LBVH ms lbvh.cu's launches (Morton codes, the radix sorts by code and by level, runs, levels, merges); Render ms \
          raytrace.cu's stack kernel and pmgather.cu at 512 x 512, the visualisation not modelled; FPS 1000 / (Trace \
          + LBVH + Render). Tolerances: Interactions and k {}; the modelled columns {}.",
         Tolerance::COUNT.describe(),
@@ -390,8 +390,8 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         "Modelled: {}. Each stage's launches are summed and predicted as one persistent launch (30 CTAs x 256 \
          threads, 54 registers; the thesis gives no register count for these kernels); Trace from the first 2^14 \
          photons of each frame on the emulator, scaled to the table's emissions, LBVH at the full kernel count, Render scaled from the run's resolution to 512 x 512. FPS = 1000 / (Trace + LBVH + \
-         Render), as every printed row obeys within 0.3 ms (extract §3.14). Not modelled: the LBVH's two radix sorts \
-         (on the host here, on the GPU in the thesis) and the OpenGL visualisation the thesis' Render includes.",
+         Render), as every printed row obeys within 0.3 ms (extract §3.14). Not modelled: the OpenGL visualisation the \
+         thesis' Render includes.",
         super::timing::describe()
     ));
     t.notes.push(
