@@ -37,6 +37,7 @@
 // src/repro/fabianowski2011/lbvh.rs repeats every operation: the nodes agree
 // bit for bit. Keep the two in step.
 #include "../prelude.h"
+#include "cta_scan.h"
 
 #if defined(__clang__) && !defined(__NVCC__)
 #pragma clang fp contract(off)
@@ -223,17 +224,10 @@ extern "C" __global__ void radix_scan(const SortParams *p, unsigned *counts) {
   unsigned m = RADIX * (unsigned)p->tiles, t = threadIdx.x, carry = 0;
   for (unsigned base = 0; base < m; base += SORT_THREADS) {
     unsigned v = base + t < m ? counts[base + t] : 0u;
-    buf[t] = v;
-    __syncthreads();
-    for (unsigned off = 1; off < SORT_THREADS; off <<= 1) {
-      unsigned x = t >= off ? buf[t - off] : 0u;
-      __syncthreads();
-      buf[t] += x;
-      __syncthreads();
-    }
-    if (base + t < m) counts[base + t] = carry + buf[t] - v;
-    carry += buf[SORT_THREADS - 1];
-    __syncthreads();
+    unsigned total;
+    unsigned ex = cta_scan<SORT_THREADS>(buf, v, &total);
+    if (base + t < m) counts[base + t] = carry + ex;
+    carry += total;
   }
 }
 
