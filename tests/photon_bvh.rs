@@ -166,11 +166,14 @@ fn the_emulated_lbvh_equals_the_native_one_and_holds_every_kernel_once() {
 /// The LBVH's radix sort (`lbvh.cu`'s radix_count, radix_scan,
 /// radix_scatter) against Rust's stable sort: keys with many duplicates,
 /// sizes that are not powers of two (one partial tile of 256, several tiles,
-/// more tiles than CTAs), 5-bit and 30-bit keys; equal keys keep their order.
+/// more tiles than CTAs), 5-bit and 30-bit keys; equal keys keep their order;
+/// the clang-16 and the nvcc PTX alike.
 #[test]
 fn the_radix_sort_kernels_sort_stably_as_rusts_sort() {
     let mut dev = Device::new();
-    let m = lbvh::load(&mut dev).unwrap();
+    let clang = lbvh::load(&mut dev).unwrap();
+    let nvcc_src = std::fs::read_to_string("kernels/fabianowski2011/lbvh.nvcc.ptx").unwrap();
+    let nvcc = dev.load_ptx(&nvcc_src, "kernels/fabianowski2011/lbvh.nvcc.ptx").unwrap();
     let hash = |i: u32| {
         let mut h = i.wrapping_mul(0x9e37_79b9) ^ 0x5bd1_e995;
         h ^= h >> 15;
@@ -180,12 +183,15 @@ fn the_radix_sort_kernels_sort_stably_as_rusts_sort() {
         [(0usize, 30, 1u32 << 30), (1, 30, 1 << 30), (37, 5, 32), (1000, 30, 97), (777, 5, 31), (9000, 30, 1 << 30)]
     {
         let keys: Vec<u32> = (0..n as u32).map(|i| hash(i) % modulo).collect();
-        let s = lbvh::sort_kernel(&mut dev, &m, &keys, bits).unwrap();
         let mut want: Vec<u32> = (0..n as u32).collect();
         want.sort_by_key(|&i| keys[i as usize]);
-        assert_eq!(s.order, want, "n {n}, {bits} bits");
-        assert_eq!(s.keys, want.iter().map(|&i| keys[i as usize]).collect::<Vec<_>>());
-        assert_eq!(s.launches.len() as u32, 3 * bits.div_ceil(lbvh::RADIX_BITS));
+        // both dialects (clang-16 and nvcc PTX)
+        for m in [&clang, &nvcc] {
+            let s = lbvh::sort_kernel(&mut dev, m, &keys, bits).unwrap();
+            assert_eq!(s.order, want, "n {n}, {bits} bits");
+            assert_eq!(s.keys, want.iter().map(|&i| keys[i as usize]).collect::<Vec<_>>());
+            assert_eq!(s.launches.len() as u32, 3 * bits.div_ceil(lbvh::RADIX_BITS));
+        }
     }
 }
 
