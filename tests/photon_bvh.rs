@@ -123,7 +123,20 @@ fn the_emulated_lbvh_equals_the_native_one_and_holds_every_kernel_once() {
     let m = lbvh::load(&mut dev).unwrap();
     let (emulated, launches) = lbvh::build_kernel(&mut dev, &m, &c.kernels, n_auto).unwrap();
     assert_eq!(emulated, native);
-    assert!(launches.len() > 3, "{} launches", launches.len());
+    // both sorts ran as kernels: 8 passes of 4 bits by code, 2 by level, three launches a pass
+    let named = |k: &str| launches.iter().filter(|l| l.kernel == k).count();
+    assert_eq!([lbvh::RADIX_COUNT, lbvh::RADIX_SCAN, lbvh::RADIX_SCATTER].map(named), [10; 3]);
+    assert_eq!([lbvh::CODES, lbvh::GATHER, lbvh::RUNS, lbvh::LEVELS, lbvh::LEVEL_KEYS].map(named), [1; 5]);
+    assert!(named(lbvh::MERGE) > 3, "{} merge launches", named(lbvh::MERGE));
+    // 40 kernels at one point among 10: the stable sort keeps the equal codes in index order
+    let mut ks: Vec<Kernel> = c.kernels[..50].to_vec();
+    for (i, k) in ks.iter_mut().enumerate() {
+        if i % 5 != 0 {
+            k.z = [0.25, 0.25, 0.25];
+        }
+    }
+    let (e, _) = lbvh::build_kernel(&mut dev, &m, &ks, 5).unwrap();
+    assert_eq!(e, lbvh::build(&ks, 5));
     let t = native.tree();
     let s = t.stats();
     assert!(s.inner > 10 && s.leaves == s.inner + 1, "{s:?}");
@@ -148,6 +161,38 @@ fn the_emulated_lbvh_equals_the_native_one_and_holds_every_kernel_once() {
         let size = |r: u32, cnt: u32| if r & LEAF_REF != 0 { cnt } else { n_auto + 1 };
         size(w[0], w[1]) + size(w[2], w[3]) > n_auto
     }));
+}
+
+/// The LBVH's radix sort (`lbvh.cu`'s radix_count, radix_scan,
+/// radix_scatter) against Rust's stable sort: keys with many duplicates,
+/// sizes that are not powers of two (one partial tile of 256, several tiles,
+/// more tiles than CTAs), 5-bit and 30-bit keys; equal keys keep their order;
+/// the clang-16 and the nvcc PTX alike.
+#[test]
+fn the_radix_sort_kernels_sort_stably_as_rusts_sort() {
+    let mut dev = Device::new();
+    let clang = lbvh::load(&mut dev).unwrap();
+    let nvcc_src = std::fs::read_to_string("kernels/fabianowski2011/lbvh.nvcc.ptx").unwrap();
+    let nvcc = dev.load_ptx(&nvcc_src, "kernels/fabianowski2011/lbvh.nvcc.ptx").unwrap();
+    let hash = |i: u32| {
+        let mut h = i.wrapping_mul(0x9e37_79b9) ^ 0x5bd1_e995;
+        h ^= h >> 15;
+        h.wrapping_mul(0x85eb_ca6b) ^ (h >> 13)
+    };
+    for (n, bits, modulo) in
+        [(0usize, 30, 1u32 << 30), (1, 30, 1 << 30), (37, 5, 32), (1000, 30, 97), (777, 5, 31), (9000, 30, 1 << 30)]
+    {
+        let keys: Vec<u32> = (0..n as u32).map(|i| hash(i) % modulo).collect();
+        let mut want: Vec<u32> = (0..n as u32).collect();
+        want.sort_by_key(|&i| keys[i as usize]);
+        // both dialects (clang-16 and nvcc PTX)
+        for m in [&clang, &nvcc] {
+            let s = lbvh::sort_kernel(&mut dev, m, &keys, bits).unwrap();
+            assert_eq!(s.order, want, "n {n}, {bits} bits");
+            assert_eq!(s.keys, want.iter().map(|&i| keys[i as usize]).collect::<Vec<_>>());
+            assert_eq!(s.launches.len() as u32, 3 * bits.div_ceil(lbvh::RADIX_BITS));
+        }
+    }
 }
 
 #[test]
@@ -243,6 +288,11 @@ fn the_emulated_gathers_equal_the_native_ones_and_the_byte_model_holds_on_the_em
         // the @count lines count what the native traversal counts
         assert_eq!(g.walk, walk, "{layout:?}");
         assert!(walk.nodes > 1000, "{walk:?}");
+        // k (Table 6.6): the contributions the `contributed` line counts are the native VKDE's
+        let map = vkde::PhotonMap::build(&c.kernels);
+        let k: u64 = q.iter().flatten().map(|x| vkde::estimate(&map, x, shape).contributions as u64).sum();
+        assert_eq!(g.walk.contributed, k, "{layout:?}");
+        assert!(k > 100 && k < walk.retrieved, "{walk:?}");
         // the memory model's bytes: 32 per node (B) or per pair of nodes (C), 4 per stack access
         let per_node = if layout == Layout::Complete { 32 } else { 16 };
         assert_eq!(g.traffic.nodes, per_node * walk.nodes, "{layout:?}");

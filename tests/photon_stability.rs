@@ -107,3 +107,53 @@ fn re_emission_at_grazing_angles_and_dark_roulette_stay_finite_and_clamped() {
         Construction::Discarded => panic!("a scaled footprint keeps its shape and is not discarded"),
     }
 }
+
+/// The extract's §2.8 item 9: the normal derivative needs ‖n'(λ)‖ ≠ 0, and
+/// vertex normals that cancel make it vanish. At the midpoint of an edge whose
+/// end normals are opposite the interpolated normal is undefined
+/// (`normal_at` is `None`) and the mirror falls back to the geometric normal
+/// with ∂n/∂p = 0 (fixture); beside it the normal exists and the reflected
+/// differentials are finite, however large.
+#[test]
+fn cancelling_vertex_normals_fall_back_to_the_flat_mirror_and_stay_finite() {
+    let t = photons::ShadingTriangle {
+        v: [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        n: [[0.3, 0.0, 1.0], [-0.3, 0.0, -1.0], [0.0, 0.5, 1.0]],
+    };
+    let geo = [0.0, 0.0, 1.0];
+    let beam = |x: f32| {
+        let mut p = Differentials {
+            z: [x, 0.0, 1.0],
+            w: [0.0, 0.0, -1.0],
+            dz: [[0.01, 0.0, 0.0], [0.0, 0.01, 0.0]],
+            dw: [[0.0; 3]; 2],
+        };
+        photons::propagate(&mut p, 1.0, geo);
+        p
+    };
+    // n1 = −n0: n0 + ½(n1 − n0) = 0 at (½, 0, 0)
+    assert!(t.normal_at([0.5, 0.0, 0.0]).is_none());
+    let mut p = beam(0.5);
+    let mut flat = p;
+    let at = t.normal_at(p.z);
+    photons::reflect_curved(&mut p, at.as_ref(), geo);
+    photons::reflect(&mut flat, geo);
+    assert_eq!(p, flat);
+    // just beside it: defined and finite, but ∂n/∂v = (n'2 − (n'2·n)n)/‖n'(λ)‖
+    // grows as ‖n'(λ)‖ → 0, and with it the reflected ∂ω/∂p2
+    let mut sizes = Vec::new();
+    for x in [0.49, 0.499, 0.4999, 0.51] {
+        let s = t.normal_at([x, 0.0, 0.0]).expect("defined off the cancelling point");
+        let mut p = beam(x);
+        photons::reflect_curved(&mut p, Some(&s), geo);
+        let all = [p.w, p.dw[0], p.dw[1], p.dz[0], p.dz[1]];
+        assert!(all.iter().flatten().all(|v| v.is_finite()), "x {x}: {p:?}");
+        sizes.push(len(p.dw[1]));
+    }
+    // ‖n'(λ)‖ = |1 − 2u| ‖n0‖ on the edge: ten times closer, ten times the differential
+    for w in sizes[..3].windows(2) {
+        assert!((w[1] / w[0] - 10.0).abs() < 1.0, "{sizes:?}");
+    }
+    // past the point the normal flips to −n0 (a back face): the same size as at 0.49
+    assert!((sizes[3] / sizes[0] - 1.0).abs() < 0.05, "{sizes:?}");
+}

@@ -139,3 +139,80 @@ fn re_emission_keeps_the_footprint_scale_through_the_virtual_offset() {
         assert!(v(p.dw[i]).dot(v(p.w)).abs() < 1e-6);
     }
 }
+
+/// A triangle in the plane z = 0 whose vertex normals are those of the inside
+/// of a sphere of radius `r` centred at (0, 0, r) (pointing to the centre, +z
+/// at the origin): the interpolated normal approximates a concave mirror.
+fn sphere_patch(r: f32) -> photons::ShadingTriangle {
+    let v = [[-0.2, -0.2, 0.0], [0.3, -0.1, 0.0], [-0.05, 0.35, 0.0]];
+    let n = v.map(|p: [f32; 3]| (Vec3::new(0.0, 0.0, r) - v3(p)).normalize().to_array());
+    photons::ShadingTriangle { v, n }
+}
+
+fn v3(a: [f32; 3]) -> Vec3 {
+    Vec3::from(a)
+}
+
+/// Eqs. 5.12–5.21: the interpolated normal's derivative along the surface
+/// equals central differences of n(λ); flat vertex normals give ∂n/∂p = 0
+/// and the curved reflection equals the flat one.
+#[test]
+fn the_interpolated_normal_derivative_matches_finite_differences() {
+    let t = sphere_patch(2.0);
+    let z = [0.0, 0.05, 0.0];
+    let s = t.normal_at(z).unwrap();
+    let n_at = |p: Vec3| v3(t.normal_at(p.to_array()).unwrap().n);
+    for d in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.6, -0.8, 0.0]] {
+        let h = 1e-2;
+        let fd = (n_at(v3(z) + v3(d) * h) - n_at(v3(z) - v3(d) * h)) / (2.0 * h);
+        let an = v3(s.dn_dp(d));
+        assert!((fd - an).length() < 2e-3 * an.length().max(1e-3), "d {d:?}: {fd} vs {an}");
+        // inside the sphere ∂n/∂z ≈ −d / r
+        assert!((an + v3(d) / 2.0).length() < 0.05, "{an}");
+    }
+    // (u, v) are the weights of v1 and v2: at v1 the normal is n1
+    assert!((v3(t.normal_at(t.v[1]).unwrap().n) - v3(t.n[1])).length() < 1e-6);
+    // flat vertex normals: no derivative, and the curved mirror is the flat one
+    let flat = photons::ShadingTriangle { n: [[0.0, 0.0, 1.0]; 3], ..t };
+    let s = flat.normal_at(z).unwrap();
+    assert_eq!(s.dn_dp([1.0, 2.0, 0.0]), [0.0; 3]);
+    let mut a = emit([0.0, 0.0, 1.0], -0.8, azimuth(0.3));
+    propagate(&mut a, 1.0 / 0.8, [0.0, 0.0, 1.0]);
+    let mut b = a;
+    reflect(&mut a, [0.0, 0.0, 1.0]);
+    photons::reflect_curved(&mut b, Some(&s), [0.0, 0.0, 1.0]);
+    for i in 0..2 {
+        assert!((v3(a.dw[i]) - v3(b.dw[i])).length() < 1e-6, "{a:?} {b:?}");
+    }
+    assert!((v3(a.w) - v3(b.w)).length() < 1e-6);
+}
+
+/// A concave mirror of radius r focuses a parallel beam at r / 2: a beam
+/// along −z with footprint ∂z/∂p = x hits the sphere patch head on and leaves
+/// with ∂ω'/∂p = −2 ∂n/∂p ≈ −2x / r (converging); a flat mirror leaves ∂ω = 0.
+#[test]
+fn a_curved_mirror_focuses_a_parallel_beam_at_half_its_radius() {
+    let r = 2.0;
+    let t = sphere_patch(r);
+    let mut p = Differentials {
+        z: [0.0, 0.05, 1.0],
+        w: [0.0, 0.0, -1.0],
+        dz: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        dw: [[0.0; 3]; 2],
+    };
+    propagate(&mut p, 1.0, [0.0, 0.0, 1.0]);
+    let s = t.normal_at(p.z).unwrap();
+    let mut flat = p;
+    photons::reflect_curved(&mut p, Some(&s), [0.0, 0.0, 1.0]);
+    reflect(&mut flat, [0.0, 0.0, 1.0]);
+    assert_eq!(flat.dw, [[0.0; 3]; 2]);
+    // the sphere's normal (interpolated) at the hit, nearly +z: the beam returns
+    assert!(v3(p.w).dot(Vec3::Z) > 0.99, "{:?}", p.w);
+    for (i, axis) in [Vec3::X, Vec3::Y].into_iter().enumerate() {
+        let dw = v3(p.dw[i]);
+        // the footprint shrinks to zero after travelling r / 2 (within the interpolation's error)
+        assert!((dw + axis * (2.0 / r)).length() < 0.05 * (2.0 / r), "{dw}");
+        let focus = v3(p.dz[i]) + dw * (r / 2.0);
+        assert!(focus.length() < 0.06, "{focus}");
+    }
+}

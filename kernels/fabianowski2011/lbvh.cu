@@ -3,7 +3,8 @@
 //
 // lbvh_codes: one thread per interaction; the 30-bit Morton code of its
 // kernel's centre quantised to 10 bits per axis within the centres' bounds.
-// (The host sorts the references by code, as the thesis' CUDPP radix sort.)
+// The references are then radix-sorted by code (radix_*, below; L2589) and
+// lbvh_gather puts their AABBs in the sorted order.
 //
 // lbvh_runs: one thread per sorted reference; a reference that starts a run of
 // identical codes [j, k] writes S[j] = S[k] = k - j + 1 and AABB[j] = the union
@@ -11,19 +12,32 @@
 //
 // lbvh_levels: one thread per neighbour pair i, i + 1 with different codes: the
 // merge point's level, the number of leading bits the two codes share (0..29).
-// (The host sorts the merge points by level, Fig. 6.1(b).)
+// lbvh_level_keys makes each merge point's sort key, 29 - level (deepest
+// first), 31 where the codes are equal; the merge points are radix-sorted by
+// it (Fig. 6.1(b)), so the points of one level are contiguous, ascending.
 //
 // lbvh_merge: one launch per level, deepest first; one thread per merge point
-// i of the level: left [a, i], right [i + 1, b] with a = i - S[i] + 1,
+// i of the level (points[first_node + t]: the sorted merge points, deeper
+// levels first, so a point's place in them is its node id): left [a, i], right [i + 1, b] with a = i - S[i] + 1,
 // b = i + S[i + 1]; if S[i] + S[i + 1] > n_auto an inner node is made whose
 // children are N[a] and N[i + 1], or leaves over the intervals where those
 // are null (L2607, L2611); S[a] = S[b] = S[i] + S[i + 1];
 // AABB[a] = AABB[a] u AABB[i + 1]. Merge points of one level have disjoint
 // intervals, so the threads do not race.
 //
+// radix_count, radix_scan, radix_scatter: a stable LSD radix sort of 32-bit
+// keys with 32-bit values, 4 bits a pass (the host launches the three per
+// pass, ping-ponging two buffers). Tiles of SORT_THREADS elements; a tile's
+// per-digit counts come from warp ballots (no atomics, so the order is
+// deterministic and stable): radix_count writes counts[d * tiles + t],
+// radix_scan (one CTA) scans them exclusively in place, radix_scatter puts
+// each element at its digit-and-tile offset plus its rank among the tile's
+// equal digits before it.
+//
 // src/repro/fabianowski2011/lbvh.rs repeats every operation: the nodes agree
 // bit for bit. Keep the two in step.
 #include "../prelude.h"
+#include "cta_scan.h"
 
 #if defined(__clang__) && !defined(__NVCC__)
 #pragma clang fp contract(off)
@@ -110,7 +124,7 @@ extern "C" __global__ void lbvh_levels(const Params *p, const unsigned *codes, u
 extern "C" __global__ void lbvh_merge(const Params *p, const unsigned *points, unsigned *size, float *box,
                                       unsigned *node_of, unsigned *nodes) {
   for (unsigned t = WL_TID; t < (unsigned)p->merges; t += blockDim.x * gridDim.x) {
-    unsigned i = points[t];
+    unsigned i = points[(unsigned)p->first_node + t];
     unsigned sl = size[i], sr = size[i + 1];
     unsigned a = i - sl + 1, b = i + sr;
     if (sl + sr > (unsigned)p->n_auto) {
@@ -133,5 +147,108 @@ extern "C" __global__ void lbvh_merge(const Params *p, const unsigned *points, u
       box[6 * a + k] = lower(box[6 * a + k], box[6 * (i + 1) + k]);
       box[6 * a + k + 3] = upper(box[6 * a + k + 3], box[6 * (i + 1) + k + 3]);
     }
+  }
+}
+
+// sorted boxes: boxes[i] = kernel_boxes[order[i]] (6 floats, lo then hi)
+extern "C" __global__ void lbvh_gather(const Params *p, const unsigned *order, const float *kernel_boxes,
+                                       float *boxes) {
+  for (unsigned i = WL_TID; i < (unsigned)p->count; i += blockDim.x * gridDim.x) {
+    unsigned j = order[i];
+    for (int k = 0; k < 6; k++) boxes[6 * i + k] = kernel_boxes[6 * j + k];
+  }
+}
+
+// the merge points' sort keys: 29 - level (the deepest level first), 31 for equal codes (last)
+extern "C" __global__ void lbvh_level_keys(const Params *p, const unsigned *level, unsigned *keys) {
+  for (unsigned i = WL_TID; i + 1 < (unsigned)p->count; i += blockDim.x * gridDim.x) {
+    unsigned l = level[i];
+    keys[i] = l == 0xffffffffu ? 31u : 29u - l;
+  }
+}
+
+#define SORT_THREADS 256
+#define SORT_WARPS (SORT_THREADS / 32)
+#define RADIX_BITS 4
+#define RADIX (1u << RADIX_BITS)
+
+struct SortParams {
+  int count;  // elements
+  int tiles;  // ceil(count / SORT_THREADS)
+  int shift;  // the pass' digit: bits shift .. shift + RADIX_BITS - 1
+  int iota;   // 1: the values are the indices 0..count-1 (values_in unused)
+};
+
+// The digit of element i of the tile, RADIX when past the end.
+static __device__ __forceinline__ unsigned digit_of(const SortParams *p, const unsigned *keys, unsigned i) {
+  return i < (unsigned)p->count ? (keys[i] >> p->shift) & (RADIX - 1u) : RADIX;
+}
+
+// Within the warp: the rank of this lane's digit d among the lower lanes of
+// the same digit; the lowest lane of each digit writes the warp's count of it
+// to wc[warp * RADIX + d]. All 32 lanes take part.
+static __device__ __forceinline__ unsigned warp_rank(unsigned d, unsigned *wc) {
+  unsigned lane = threadIdx.x & 31u;
+  unsigned same = __ballot_sync(0xffffffffu, d < RADIX);
+  for (unsigned b = 0; b < RADIX_BITS; b++) {
+    unsigned bit = (d >> b) & 1u;
+    unsigned set = __ballot_sync(0xffffffffu, bit);
+    same &= bit ? set : ~set;
+  }
+  unsigned below = same & ((1u << lane) - 1u);
+  if (d < RADIX && below == 0u) wc[(threadIdx.x >> 5) * RADIX + d] = __popc(same);
+  return __popc(below);
+}
+
+// counts[d * tiles + t]: the elements of tile t whose digit is d
+extern "C" __global__ void radix_count(const SortParams *p, const unsigned *keys, unsigned *counts) {
+  __shared__ unsigned wc[SORT_WARPS * RADIX];
+  unsigned tiles = (unsigned)p->tiles;
+  for (unsigned t = blockIdx.x; t < tiles; t += gridDim.x) {
+    if (threadIdx.x < SORT_WARPS * RADIX) wc[threadIdx.x] = 0u;
+    __syncthreads();
+    warp_rank(digit_of(p, keys, t * SORT_THREADS + threadIdx.x), wc);
+    __syncthreads();
+    if (threadIdx.x < RADIX) {
+      unsigned c = 0;
+      for (unsigned w = 0; w < SORT_WARPS; w++) c += wc[w * RADIX + threadIdx.x];
+      counts[threadIdx.x * tiles + t] = c;
+    }
+    __syncthreads();
+  }
+}
+
+// one CTA: the exclusive scan of counts[0 .. RADIX * tiles), in place
+extern "C" __global__ void radix_scan(const SortParams *p, unsigned *counts) {
+  __shared__ unsigned buf[SORT_THREADS];
+  unsigned m = RADIX * (unsigned)p->tiles, t = threadIdx.x, carry = 0;
+  for (unsigned base = 0; base < m; base += SORT_THREADS) {
+    unsigned v = base + t < m ? counts[base + t] : 0u;
+    unsigned total;
+    unsigned ex = cta_scan<SORT_THREADS>(buf, v, &total);
+    if (base + t < m) counts[base + t] = carry + ex;
+    carry += total;
+  }
+}
+
+// every element to offsets[d * tiles + t] + its rank among the tile's equal digits
+extern "C" __global__ void radix_scatter(const SortParams *p, const unsigned *offsets, const unsigned *keys,
+                                         const unsigned *values, unsigned *keys_out, unsigned *values_out) {
+  __shared__ unsigned wc[SORT_WARPS * RADIX];
+  unsigned tiles = (unsigned)p->tiles;
+  for (unsigned t = blockIdx.x; t < tiles; t += gridDim.x) {
+    if (threadIdx.x < SORT_WARPS * RADIX) wc[threadIdx.x] = 0u;
+    __syncthreads();
+    unsigned i = t * SORT_THREADS + threadIdx.x;
+    unsigned d = digit_of(p, keys, i);
+    unsigned r = warp_rank(d, wc);
+    __syncthreads();
+    if (d < RADIX) {
+      for (unsigned w = 0; w < (threadIdx.x >> 5); w++) r += wc[w * RADIX + d];
+      unsigned dst = offsets[d * tiles + t] + r;
+      keys_out[dst] = keys[i];
+      values_out[dst] = p->iota ? i : values[i];
+    }
+    __syncthreads();
   }
 }

@@ -68,7 +68,8 @@ static __device__ __forceinline__ V3 evaluate(const float *k, V3 x, V3 nx, int s
   float dd = qq * qq + dot3(r, r) / dot3(mp, mp);
   if (!(dd < 1.0f)) return sum;
   float w = shape == 0 ? 0.318309886183790672f : (1.0f - dd) * 0.636619772367581343f;
-  V3 f = ld3(k + 9);
+  float f0 = k[9];                     // @count contributed ld.global.f32
+  V3 f = v3(f0, k[10], k[11]);
   return v3(sum.x + w * f.x, sum.y + w * f.y, sum.z + w * f.z);
 }
 

@@ -5,7 +5,8 @@
 //
 //   compact_flag      flags[j] = state j is active (bit PATH_ACTIVE of its last word)
 //   compact_scan      per CTA of COMPACT_THREADS: the exclusive scan of the
-//                     flags (Hillis-Steele in shared memory) and the CTA's total
+//                     flags (Hillis-Steele in shared memory, kernels/cta_scan.h)
+//                     and the CTA's total
 //   compact_scan_sums one CTA: the exclusive scan of the CTA totals, and the
 //                     grand total (the active paths) in sums[blocks]
 //   compact_scatter   the active states, in order, to their scanned places
@@ -13,6 +14,7 @@
 // A state is 4 float4 (64 bytes, kernels/lin2017/path.cu's layout). The
 // compaction is stable: the active states keep their order.
 #include "../prelude.h"
+#include "cta_scan.h"
 
 #define COMPACT_THREADS 256
 #define PATH_ACTIVE 2u   // as kernels/lin2017/path.cu
@@ -23,30 +25,12 @@ extern "C" __global__ void compact_flag(const float4 *states, unsigned n, unsign
   flags[j] = (__float_as_uint(states[4 * j + 3].w) & PATH_ACTIVE) != 0u ? 1u : 0u;
 }
 
-// An exclusive scan of v over the CTA (COMPACT_THREADS threads, all
-// present); returns the CTA's total through *total.
-static __device__ __forceinline__ unsigned cta_scan(unsigned *buf, unsigned v, unsigned *total) {
-  unsigned t = threadIdx.x;
-  buf[t] = v;
-  __syncthreads();
-  for (unsigned off = 1; off < COMPACT_THREADS; off <<= 1) {
-    unsigned x = t >= off ? buf[t - off] : 0u;
-    __syncthreads();
-    buf[t] += x;
-    __syncthreads();
-  }
-  unsigned inclusive = buf[t];
-  *total = buf[COMPACT_THREADS - 1];
-  __syncthreads();
-  return inclusive - v;
-}
-
 extern "C" __global__ void compact_scan(const unsigned *flags, unsigned n, unsigned *offsets, unsigned *sums) {
   __shared__ unsigned buf[COMPACT_THREADS];
   unsigned j = WL_TID;
   unsigned v = j < n ? flags[j] : 0u;
   unsigned total;
-  unsigned ex = cta_scan(buf, v, &total);
+  unsigned ex = cta_scan<COMPACT_THREADS>(buf, v, &total);
   if (j < n) offsets[j] = ex;
   if (threadIdx.x == 0) sums[blockIdx.x] = total;
 }
@@ -58,7 +42,7 @@ extern "C" __global__ void compact_scan_sums(unsigned *sums, unsigned blocks) {
     unsigned k = base + threadIdx.x;
     unsigned v = k < blocks ? sums[k] : 0u;
     unsigned total;
-    unsigned ex = cta_scan(buf, v, &total);
+    unsigned ex = cta_scan<COMPACT_THREADS>(buf, v, &total);
     if (k < blocks) sums[k] = carry + ex;
     carry += total;
   }

@@ -4,11 +4,13 @@
 //!
 //! Steps (extract §3.3, L2581–2619): a 30-bit Morton code per interaction (its
 //! kernel's centre quantised to 10 bits per axis within the centres' bounds,
-//! L2625); the references sorted by code (host, stable: the thesis used a
-//! radix sort from a primitives library, §A.1); runs of identical codes
+//! L2625); the references radix-sorted by code ("radix-sort references
+//! (code, primitive index) by code", L2589; [`sort_kernel`]: a stable LSD
+//! radix sort of 4 bits a pass, as kernels); runs of identical codes
 //! pre-merged (S at both ends, the run's AABB at its first index); a merge
 //! point between every two neighbouring runs at the level of their codes'
-//! first differing bit; the merge points sorted by level (host); then one
+//! first differing bit; the merge points radix-sorted by level, deepest
+//! first (Fig. 6.1(b)); then one
 //! launch per level, deepest first, every merge point of the level in
 //! parallel: an inner node is made only if S\[i\] + S\[i+1\] > n_auto (the dual
 //! termination criterion, L2611), its children being the intervals' nodes or
@@ -27,7 +29,7 @@ use super::pm_layout::{PmKind, PmNode, PmTree};
 use super::vkde::Kernel;
 use crate::host::scene::Scene;
 use crate::sim::device::to_bytes;
-use crate::sim::{Arg, Device, LaunchConfig, LaunchStats, Module, SimError};
+use crate::sim::{Arg, Device, DevicePtr, LaunchConfig, LaunchStats, Module, SimError};
 
 /// The kernels' PTX (clang-16), compiled in.
 pub const PTX: &str = include_str!("../../../kernels/fabianowski2011/lbvh.ptx");
@@ -39,6 +41,22 @@ pub const RUNS: &str = "lbvh_runs";
 pub const LEVELS: &str = "lbvh_levels";
 /// The merge pass of one level.
 pub const MERGE: &str = "lbvh_merge";
+/// The sorted references' AABBs.
+pub const GATHER: &str = "lbvh_gather";
+/// The merge points' sort keys (29 − level; 31 for equal codes).
+pub const LEVEL_KEYS: &str = "lbvh_level_keys";
+/// Radix sort: per-tile digit counts.
+pub const RADIX_COUNT: &str = "radix_count";
+/// Radix sort: the exclusive scan of the counts (one CTA).
+pub const RADIX_SCAN: &str = "radix_scan";
+/// Radix sort: the stable scatter.
+pub const RADIX_SCATTER: &str = "radix_scatter";
+/// Bits of a radix-sort digit (one pass each).
+pub const RADIX_BITS: u32 = 4;
+/// Key bits of the merge points' sort by level (keys 0..=31).
+pub const LEVEL_KEY_BITS: u32 = 5;
+/// Elements per radix-sort tile (the kernels' CTA size).
+const SORT_THREADS: usize = 256;
 /// The constant c of n_auto (L2617: "c = 8").
 pub const C_AUTO: f64 = 8.0;
 /// The smallest n_auto (L2617: "clamped to a minimum of 5").
@@ -250,8 +268,9 @@ fn params(count: usize, n_auto: u32, merges: usize, first: u32) -> Vec<u8> {
     to_bytes(&[count as i32, n_auto as i32, merges as i32, first as i32])
 }
 
-/// Builds the LBVH of `kernels` on the emulator (codes, runs, levels and one
-/// merge launch per level; the two sorts on the host). Returns the launches' counters too.
+/// Builds the LBVH of `kernels` on the emulator (codes, the radix sort by
+/// code, the sorted AABBs, runs, levels, the radix sort by level and one merge
+/// launch per level). Returns the launches' counters too.
 pub fn build_kernel(
     dev: &mut Device,
     module: &Module,
@@ -289,49 +308,118 @@ pub fn build_kernel_observed(
     let codes_out = dev.alloc_zeroed::<u32>(n);
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(codes_out)];
     launches.push(dev.launch_observed(module, CODES, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
-    let codes = dev.read::<u32>(codes_out, n);
-    let (order, codes, boxes) = sorted(&codes, kernels);
-    let cb = up(dev, &to_bytes(&codes), "codes")?;
-    let bb = up(dev, &to_bytes(&boxes.concat()), "boxes")?;
+    // the references radix-sorted by code, their AABBs gathered in that order
+    let (codes_dev, order_dev) = radix_sort(dev, module, codes_out, n, CODE_BITS, observer, &mut launches)?;
+    let kernel_boxes: Vec<f32> =
+        kernels.iter().flat_map(|k| [k.lo[0], k.lo[1], k.lo[2], k.hi[0], k.hi[1], k.hi[2]]).collect();
+    let kb = up(dev, &to_bytes(&kernel_boxes), "kernel boxes")?;
+    let bb = dev.alloc_zeroed::<f32>(6 * n);
+    let pp = up(dev, &params(n, n_auto, 0, 0), "params")?;
+    let args = [Arg::Ptr(pp), Arg::Ptr(order_dev), Arg::Ptr(kb), Arg::Ptr(bb)];
+    launches.push(dev.launch_observed(module, GATHER, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
+    let cb = codes_dev;
     let size = dev.alloc_zeroed::<u32>(n);
     let bx = dev.alloc_zeroed::<f32>(6 * n);
-    let pp = up(dev, &params(n, n_auto, 0, 0), "params")?;
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(bb), Arg::Ptr(size), Arg::Ptr(bx)];
     launches.push(dev.launch_observed(module, RUNS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
     let lv = dev.alloc_zeroed::<u32>(n);
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(lv)];
     launches.push(dev.launch_observed(module, LEVELS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
-    let lv = dev.read::<u32>(lv, n - 1);
-    // the merge points sorted by level, ascending positions within a level
-    let mut by_level = vec![Vec::new(); CODE_BITS as usize];
-    for (i, &l) in lv.iter().enumerate() {
-        if l != u32::MAX {
-            by_level[l as usize].push(i as u32);
-        }
-    }
-    let total: usize = by_level.iter().map(Vec::len).sum();
+    // the merge points radix-sorted by level, deepest first, ascending positions within a level
+    let keys = dev.alloc_zeroed::<u32>(n);
+    let args = [Arg::Ptr(pp), Arg::Ptr(lv), Arg::Ptr(keys)];
+    launches.push(dev.launch_observed(module, LEVEL_KEYS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
+    let (keys, points) = radix_sort(dev, module, keys, n - 1, LEVEL_KEY_BITS, observer, &mut launches)?;
+    // the launches per level: the sorted keys' runs (a point's place is its node id)
+    let keys = dev.read::<u32>(keys, n - 1);
+    let total = keys.iter().take_while(|&&k| k < CODE_BITS).count();
     let nodes = dev.alloc_zeroed::<u32>(NODE_WORDS * total.max(1));
     let node_of = dev.alloc_zeroed::<u32>(n);
-    let mut first = 0u32;
-    for points in by_level.iter().rev().filter(|p| !p.is_empty()) {
-        let pp = up(dev, &params(n, n_auto, points.len(), first), "params")?;
-        let pb = up(dev, &to_bytes(points), "points")?;
-        let args = [Arg::Ptr(pp), Arg::Ptr(pb), Arg::Ptr(size), Arg::Ptr(bx), Arg::Ptr(node_of), Arg::Ptr(nodes)];
-        launches.push(dev.launch_observed(
-            module,
-            MERGE,
-            LaunchConfig::linear(ctas(points.len()), THREADS),
-            &args,
-            observer,
-        )?);
-        first += points.len() as u32;
+    let mut first = 0usize;
+    while first < total {
+        let len = keys[first..total].iter().take_while(|&&k| k == keys[first]).count();
+        let pp = up(dev, &params(n, n_auto, len, first as u32), "params")?;
+        let args = [Arg::Ptr(pp), Arg::Ptr(points), Arg::Ptr(size), Arg::Ptr(bx), Arg::Ptr(node_of), Arg::Ptr(nodes)];
+        launches.push(dev.launch_observed(module, MERGE, LaunchConfig::linear(ctas(len), THREADS), &args, observer)?);
+        first += len;
     }
+    let order = dev.read::<u32>(order_dev, n);
+    let codes = dev.read::<u32>(codes_dev, n);
     let raw = dev.read::<u32>(nodes, NODE_WORDS * total);
     let nodes = raw.chunks_exact(NODE_WORDS).map(|c| std::array::from_fn(|k| c[k])).collect();
     let root = dev.read::<u32>(node_of, 1)[0];
     let b = dev.read::<f32>(bx, 6);
     let root_box = std::array::from_fn(|k| b[k]);
     Ok((Lbvh { order, codes, n_auto, nodes, root, root_box }, launches))
+}
+
+/// Radix-sorts the `n` keys at `keys` (their low `bits` bits) on the
+/// emulator, stably, with the indices 0..n as values: three launches a pass
+/// of [`RADIX_BITS`] bits (counts, scan, scatter), appended to `launches`.
+/// Returns the device buffers of the sorted keys and of their values.
+fn radix_sort(
+    dev: &mut Device,
+    module: &Module,
+    keys: DevicePtr,
+    n: usize,
+    bits: u32,
+    observer: Option<&dyn crate::sim::ObserverFactory>,
+    launches: &mut Vec<LaunchStats>,
+) -> Result<(DevicePtr, DevicePtr), PhotonError> {
+    if n > i32::MAX as usize {
+        return Err(PhotonError::TooMany(n));
+    }
+    let tiles = n.div_ceil(SORT_THREADS);
+    let grid = (tiles as u32).clamp(1, MAX_CTAS);
+    let counts = dev.alloc_zeroed::<u32>((1usize << RADIX_BITS) * tiles.max(1));
+    let (mut k_in, mut v_in) = (keys, dev.alloc_zeroed::<u32>(n.max(1)));
+    let (mut k_out, mut v_out) = (dev.alloc_zeroed::<u32>(n.max(1)), dev.alloc_zeroed::<u32>(n.max(1)));
+    for pass in 0..bits.div_ceil(RADIX_BITS) {
+        let p = [n as i32, tiles as i32, (pass * RADIX_BITS) as i32, (pass == 0) as i32];
+        let pp = crate::host::rt_kernels::upload(dev, &to_bytes(&p), "sort params")?;
+        let cfg = LaunchConfig::linear(grid, SORT_THREADS as u32);
+        let args = [Arg::Ptr(pp), Arg::Ptr(k_in), Arg::Ptr(counts)];
+        launches.push(dev.launch_observed(module, RADIX_COUNT, cfg, &args, observer)?);
+        let args = [Arg::Ptr(pp), Arg::Ptr(counts)];
+        launches.push(dev.launch_observed(
+            module,
+            RADIX_SCAN,
+            LaunchConfig::linear(1, SORT_THREADS as u32),
+            &args,
+            observer,
+        )?);
+        let args = [Arg::Ptr(pp), Arg::Ptr(counts), Arg::Ptr(k_in), Arg::Ptr(v_in), Arg::Ptr(k_out), Arg::Ptr(v_out)];
+        launches.push(dev.launch_observed(module, RADIX_SCATTER, cfg, &args, observer)?);
+        std::mem::swap(&mut k_in, &mut k_out);
+        std::mem::swap(&mut v_in, &mut v_out);
+    }
+    if bits == 0 {
+        // no pass: the values are still to be made
+        let iota: Vec<u32> = (0..n as u32).collect();
+        dev.write(v_in, &iota)?;
+    }
+    Ok((k_in, v_in))
+}
+
+/// What [`sort_kernel`] returns.
+#[derive(Debug, Clone)]
+pub struct Sorted {
+    /// The keys in sorted order.
+    pub keys: Vec<u32>,
+    /// The permutation: sorted position → original index.
+    pub order: Vec<u32>,
+    /// The sort's launches (three a pass).
+    pub launches: Vec<LaunchStats>,
+}
+
+/// Radix-sorts `keys` (their low `bits` bits) on the emulator, stably, as the
+/// LBVH build does.
+pub fn sort_kernel(dev: &mut Device, module: &Module, keys: &[u32], bits: u32) -> Result<Sorted, PhotonError> {
+    let n = keys.len();
+    let kb = crate::host::rt_kernels::upload(dev, &to_bytes(keys), "keys")?;
+    let mut launches = Vec::new();
+    let (k, v) = radix_sort(dev, module, kb, n, bits, None, &mut launches)?;
+    Ok(Sorted { keys: dev.read::<u32>(k, n), order: dev.read::<u32>(v, n), launches })
 }
 
 fn word_box(w: &[u32]) -> ([f32; 3], [f32; 3]) {

@@ -201,6 +201,100 @@ pub fn reflect(p: &mut Differentials, n: [f32; 3]) {
     }
 }
 
+/// A triangle with vertex normals, as §5.1.2 interpolates them (L2247):
+/// n(λ) = normalize(n0 + u n'1 + v n'2) with n'i = ni − n0 and λ = (u, v)
+/// the weights of v1 and v2.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingTriangle {
+    /// Vertices v0, v1, v2.
+    pub v: [[f32; 3]; 3],
+    /// Vertex normals n0, n1, n2 (unit or not: the interpolation normalises).
+    pub n: [[f32; 3]; 3],
+}
+
+/// The interpolated normal at a point and its derivative along the surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingNormal {
+    /// n(λ), unit length.
+    pub n: [f32; 3],
+    /// ∂n/∂λ (eq. 5.13): ∂n/∂u, ∂n/∂v.
+    pub dn_dl: [[f32; 3]; 2],
+    /// ∂λ/∂z (eq. 5.21): the rows ∂u/∂z, ∂v/∂z.
+    pub dl_dz: [[f32; 3]; 2],
+}
+
+impl ShadingNormal {
+    /// ∂n/∂p = (∂n/∂λ)(∂λ/∂z)(∂z/∂p) (eq. 5.12) for the position differential `dz`.
+    pub fn dn_dp(&self, dz: [f32; 3]) -> [f32; 3] {
+        let (du, dv) = (dot(self.dl_dz[0], dz), dot(self.dl_dz[1], dz));
+        add(scale(self.dn_dl[0], du), scale(self.dn_dl[1], dv))
+    }
+}
+
+impl ShadingTriangle {
+    /// The interpolated normal at `z` (on the triangle's plane) with ∂n/∂λ and
+    /// ∂λ/∂z from Wald's projection (eqs. 5.13–5.21): k = argmax |n_geo,k|,
+    /// (i, j) = (k + 1, k + 2) mod 3, e1 = v1 − v0, e2 = v2 − v0,
+    /// e'1 = (−e1j, e1i, det(e1ji, v0ji)) / det(e1ij, e2ij),
+    /// e'2 = (e2j, −e2i, det(e2ij, v0ij)) / det(e1ij, e2ij),
+    /// (u, v) = (e'2xy · z_ij + e'2z, e'1xy · z_ij + e'1z).
+    /// `None` where the derivative is undefined: a degenerate triangle, or
+    /// vertex normals that cancel, ‖n'(λ)‖ = 0 (the extract's §2.8 item 9).
+    pub fn normal_at(&self, z: [f32; 3]) -> Option<ShadingNormal> {
+        let [v0, v1, v2] = self.v;
+        let e1 = [v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]];
+        let e2 = [v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]];
+        let g = cross(e1, e2);
+        let k = (0..3).max_by(|&a, &b| g[a].abs().total_cmp(&g[b].abs())).unwrap_or(2);
+        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+        let det = e1[i] * e2[j] - e1[j] * e2[i];
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let e1p = [-e1[j] / det, e1[i] / det, (e1[j] * v0[i] - e1[i] * v0[j]) / det];
+        let e2p = [e2[j] / det, -e2[i] / det, (e2[i] * v0[j] - e2[j] * v0[i]) / det];
+        let u = e2p[0] * z[i] + e2p[1] * z[j] + e2p[2];
+        let v = e1p[0] * z[i] + e1p[1] * z[j] + e1p[2];
+        let [n0, n1, n2] = self.n;
+        let (d1, d2) = (add(n1, scale(n0, -1.0)), add(n2, scale(n0, -1.0)));
+        let raw = add(n0, add(scale(d1, u), scale(d2, v)));
+        let l = len(raw);
+        if !(l > 0.0 && l.is_finite()) {
+            return None;
+        }
+        let n = scale(raw, 1.0 / l);
+        let col = |d: [f32; 3]| scale(add(d, scale(n, -dot(d, n))), 1.0 / l);
+        let row = |a: [f32; 2]| {
+            let mut r = [0.0; 3];
+            r[i] = a[0];
+            r[j] = a[1];
+            r
+        };
+        let dl_dz = [row([e2p[0], e2p[1]]), row([e1p[0], e1p[1]])];
+        let out = ShadingNormal { n, dn_dl: [col(d1), col(d2)], dl_dz };
+        let finite = |a: &[[f32; 3]; 2]| a.iter().flatten().all(|x| x.is_finite());
+        (finite(&out.dn_dl) && finite(&out.dl_dz)).then_some(out)
+    }
+}
+
+/// Mirror reflection about a curved surface (eqs. 3.10–3.11 with the
+/// extract's erratum): ω' = ω − 2(ω·n)n, ∂z'/∂p = ∂z/∂p and
+/// ∂ω'/∂p = ∂ω/∂p − 2[(ω·n) ∂n/∂p + (∂ω/∂p·n + ω·∂n/∂p) n], with
+/// ∂n/∂p from `s` (eq. 5.12) for each of the photon's position differentials.
+/// Where `s` is `None` (cancelling vertex normals, fixture: the geometric
+/// normal `flat` with ∂n/∂p = 0) it is [`reflect`] about `flat`.
+pub fn reflect_curved(p: &mut Differentials, s: Option<&ShadingNormal>, flat: [f32; 3]) {
+    let Some(s) = s else { return reflect(p, flat) };
+    let n = s.n;
+    let wn = dot(p.w, n);
+    for i in 0..2 {
+        let dn = s.dn_dp(p.dz[i]);
+        let d = dot(p.dw[i], n) + dot(p.w, dn);
+        p.dw[i] = add(p.dw[i], scale(add(scale(dn, wn), scale(n, d)), -2.0));
+    }
+    p.w = add(p.w, scale(n, -2.0 * wn));
+}
+
 /// Diffuse absorption and re-emission about unit normal `n` (eqs. 5.22–5.29):
 /// cos p'1 = √(1−y1), azimuth (cos, sin) `c2`; the virtual offset
 /// t_v = √(2‖∂z/∂p1 × ∂z/∂p2‖) from the incoming position differentials, then

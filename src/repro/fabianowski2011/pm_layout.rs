@@ -27,9 +27,9 @@
 //! traversal moves **Bytes_B = 32·n_T + 4·Stack_B** and **Bytes_C = 16·n_T +
 //! 4·Stack_C** (a 32-byte pair holds two nodes); with B's one push and one pop
 //! per inner node containing x, Stack_B = n_T and Bytes_B = 36·n_T (extract
-//! §3.12). [`gather_kernel`] counts n_T, stack pushes and pops and
-//! retrievals off the emulator's per-instruction counters (the source lines
-//! tagged `@count`), and the bytes off the memory model's read-only and local
+//! §3.12). [`gather_kernel`] counts n_T, stack pushes and pops,
+//! retrievals and contributions (k) off the emulator's per-instruction
+//! counters (the source lines tagged `@count`), and the bytes off the memory model's read-only and local
 //! traffic, independently, so the byte model is checked against the emulator.
 
 use std::collections::BTreeMap;
@@ -290,6 +290,8 @@ pub struct Walk {
     pub pops: u64,
     /// Kernels retrieved from leaves (n_I).
     pub retrieved: u64,
+    /// Retrieved kernels that contributed (facing, ‖d‖ < 1): k summed over the queries.
+    pub contributed: u64,
 }
 
 impl Walk {
@@ -304,11 +306,13 @@ impl Walk {
         self.pushes += o.pushes;
         self.pops += o.pops;
         self.retrieved += o.retrieved;
+        self.contributed += o.contributed;
     }
 }
 
-fn evaluate(k: &Kernel, q: &Query, shape: Shape, sum: &mut [f32; 3]) {
+fn evaluate(k: &Kernel, q: &Query, shape: Shape, sum: &mut [f32; 3], walk: &mut Walk) {
     use std::cmp::Ordering::{Greater, Less};
+    walk.retrieved += 1;
     if super::photons::dot(k.normal, q.n).partial_cmp(&0.0) != Some(Greater) {
         return;
     }
@@ -316,6 +320,7 @@ fn evaluate(k: &Kernel, q: &Query, shape: Shape, sum: &mut [f32; 3]) {
     if d.partial_cmp(&1.0) != Some(Less) {
         return;
     }
+    walk.contributed += 1;
     let w = shape.weight(d);
     for (s, f) in sum.iter_mut().zip(k.flux) {
         *s += w * f;
@@ -362,8 +367,7 @@ fn complete(l: &Layouts, q: &Query, shape: Shape, sum: &mut [f32; 3], w: &mut Wa
                 continue;
             }
             for k in &l.kernels[a as usize..(a + (b & !LEAF_BIT)) as usize] {
-                w.retrieved += 1;
-                evaluate(k, q, shape, sum);
+                evaluate(k, q, shape, sum, w);
             }
         }
         let Some(next) = stack.pop() else { break };
@@ -374,8 +378,7 @@ fn complete(l: &Layouts, q: &Query, shape: Shape, sum: &mut [f32; 3], w: &mut Wa
 
 fn leaf(l: &Layouts, first: u32, q: &Query, shape: Shape, sum: &mut [f32; 3], w: &mut Walk) {
     for (k, &end) in l.kernels[first as usize..].iter().zip(&l.ends[first as usize..]) {
-        w.retrieved += 1;
-        evaluate(k, q, shape, sum);
+        evaluate(k, q, shape, sum, w);
         if end {
             return;
         }
@@ -540,6 +543,7 @@ pub fn gather_kernel(
         pushes: get("push"),
         pops: get("pop"),
         retrieved: get("retrieved"),
+        contributed: get("contributed"),
     };
     let radiance = run.out.chunks_exact(4).map(|r| [r[0], r[1], r[2]]).collect();
     Ok(Gathered { radiance, walk, traffic: run.traffic, memory: run.memory, launch: run.launch })

@@ -652,7 +652,13 @@ pub fn trace_kernel_with(
     let run = pm_layout::run_traversal(dev, module, entry, &buffers, n)?;
     let c = line_counts(&module.prog, &run.launch);
     let get = |k: &str| c.get(k).copied().unwrap_or(0);
-    let walk = Walk { nodes: 2 * get("pairs"), pushes: get("push"), pops: get("pop"), retrieved: get("tested") };
+    let walk = Walk {
+        nodes: 2 * get("pairs"),
+        pushes: get("push"),
+        pops: get("pop"),
+        retrieved: get("tested"),
+        contributed: 0,
+    };
     let hits = run.out.chunks_exact(4).map(|h| Best { t: h[0], u: h[1], v: h[2], tri: h[3].to_bits() }).collect();
     let ta_words = get("push_ta") + get("pop_ta");
     Ok(Traced { hits, walk, traffic: run.traffic, ta_words, launch: run.launch })
