@@ -131,72 +131,33 @@ fn warplight(args: &[&str]) -> (bool, String, String) {
     (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
 }
 
+/// `warplight render --method path --scene cornell-lambert --resolution 8x6` and `extra`.
+fn render_path(extra: &[&str]) -> (bool, String, String) {
+    let mut args = vec!["render", "--method", "path", "--scene", "cornell-lambert", "--resolution", "8x6"];
+    args.extend_from_slice(extra);
+    warplight(&args)
+}
+
 #[test]
 fn render_takes_each_traversal_and_names_a_wrong_one() {
     let dir = std::env::temp_dir().join(format!("warplight-lin2017-traversal-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     for t in ["stack", "restart", "backtrack"] {
         let out = dir.join(format!("{t}.exr"));
-        let (ok, stdout, stderr) = warplight(&[
-            "render",
-            "--method",
-            "path",
-            "--scene",
-            "cornell-lambert",
-            "--resolution",
-            "8x6",
-            "--spp",
-            "4",
-            "--traversal",
-            t,
-            "-o",
-            out.to_str().expect("utf-8 path"),
-        ]);
+        let (ok, stdout, stderr) =
+            render_path(&["--spp", "4", "--traversal", t, "-o", out.to_str().expect("utf-8 path")]);
         assert!(ok, "--traversal {t}: {stderr}");
         let name = if t == "stack" { "short-stack" } else { t };
         assert!(stdout.contains(&format!("({name} traversal)")), "--traversal {t}: {stdout}");
         assert!(out.exists(), "--traversal {t}: no image");
     }
-    let (ok, _, stderr) = warplight(&[
-        "render",
-        "--method",
-        "path",
-        "--scene",
-        "cornell-lambert",
-        "--resolution",
-        "8x6",
-        "--traversal",
-        "bvh",
-    ]);
+    let (ok, _, stderr) = render_path(&["--traversal", "bvh"]);
     assert!(!ok && stderr.contains("unknown traversal `bvh`"), "{stderr}");
     let out = dir.join("bdpt.exr");
-    let (ok, stdout, stderr) = warplight(&[
-        "render",
-        "--method",
-        "path",
-        "--scene",
-        "cornell-lambert",
-        "--resolution",
-        "8x6",
-        "--spp",
-        "4",
-        "--integrator",
-        "bdpt",
-        "-o",
-        out.to_str().expect("utf-8 path"),
-    ]);
+    let (ok, stdout, stderr) =
+        render_path(&["--spp", "4", "--integrator", "bdpt", "-o", out.to_str().expect("utf-8 path")]);
     assert!(ok && stdout.contains("path tracer bdpt") && out.exists(), "--integrator bdpt: {stdout} {stderr}");
-    let (ok, _, stderr) = warplight(&[
-        "render",
-        "--method",
-        "path",
-        "--scene",
-        "cornell-lambert",
-        "--resolution",
-        "8x6",
-        "--integrator",
-        "mlt",
-    ]);
+    let (ok, _, stderr) = render_path(&["--integrator", "mlt"]);
     assert!(!ok && stderr.contains("unknown integrator `mlt`") && stderr.contains("bdpt"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -424,12 +424,20 @@ impl Tracer<'_> {
             if bounce == p.max_bounces {
                 break;
             }
-            let Some(wgt) =
-                self.scatter(mat, kind, ns, color, cos_d, cos_o, key, dim, &mut d, &mut bsdf_pdf, &mut count_emission)
-            else {
-                break;
-            };
-            if !roulette(&mut beta, wgt, key, dim) {
+            if !self.bounce_on(
+                mat,
+                kind,
+                ns,
+                color,
+                cos_d,
+                cos_o,
+                key,
+                dim,
+                &mut d,
+                &mut beta,
+                &mut bsdf_pdf,
+                &mut count_emission,
+            ) {
                 break;
             }
             o = hitp;
@@ -542,12 +550,20 @@ impl Tracer<'_> {
                 break;
             }
             // the next direction, and the bounce's mask f cos / p
-            let Some(wgt) =
-                self.scatter(mat, kind, ns, color, cos_d, cos_o, key, dim, &mut d, &mut bsdf_pdf, &mut count_emission)
-            else {
-                break;
-            };
-            if !roulette(&mut beta, wgt, key, dim) {
+            if !self.bounce_on(
+                mat,
+                kind,
+                ns,
+                color,
+                cos_d,
+                cos_o,
+                key,
+                dim,
+                &mut d,
+                &mut beta,
+                &mut bsdf_pdf,
+                &mut count_emission,
+            ) {
                 break;
             }
             o = hitp;
@@ -657,6 +673,29 @@ impl Tracer<'_> {
             *count_emission = true;
         }
         Some(wgt)
+    }
+
+    /// [`Self::scatter`] then [`roulette`]: false when the path ends at this hit.
+    #[allow(clippy::too_many_arguments)]
+    fn bounce_on(
+        &self,
+        mat: &[f32; 12],
+        kind: u32,
+        ns: V3,
+        color: V3,
+        cos_d: f32,
+        cos_o: f32,
+        key: u32,
+        dim: u32,
+        d: &mut V3,
+        beta: &mut V3,
+        bsdf_pdf: &mut f32,
+        count_emission: &mut bool,
+    ) -> bool {
+        match self.scatter(mat, kind, ns, color, cos_d, cos_o, key, dim, d, bsdf_pdf, count_emission) {
+            Some(wgt) => roulette(beta, wgt, key, dim),
+            None => false,
+        }
     }
 
     /// Traces frame `frame`: adds each path's radiance to `accum` (3 floats
