@@ -16,10 +16,11 @@ mod lin2017_mitsuba;
 
 use lin2017_mitsuba::{emulated_outcome, native_outcome, params, reference_of, scene_of};
 use warplight::host::camera::Camera;
-use warplight::host::path::Integrator;
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::stats::Estimate;
+use warplight::host::path::{Integrator, kernel, render_native};
 use warplight::host::scene::{MaterialKind, Scene};
+use warplight::sim::{Device, Fidelity};
 
 const FIXTURE: &str = "tests/fixtures/mitsuba/cornell-lambert-32";
 const ROUGH_FIXTURE: &str = "tests/fixtures/mitsuba/cornell-rough-32";
@@ -103,4 +104,61 @@ fn a_rougher_mirror_fails() {
     let o = native_outcome(&ps, &cam, params(size, Integrator::MisPower, 17), 96, &reference);
     eprintln!("rougher mirror: {o:?}");
     assert!(!o.passed(), "a mirror of alpha 0.3 passed against alpha 0.2: {o:?}");
+}
+
+/// Bidirectional path tracing (the thesis' uniform weights over the
+/// combinations that can make a path) is unbiased: natively it agrees with
+/// Mitsuba's path-traced references of the Lambertian box and of the
+/// rough-mirror box (the rough mirror is reached by eye-subpath sampling
+/// only); the emulated kernel's frames equal the native ones there.
+#[test]
+fn bdpt_agrees_with_mitsuba() {
+    let (reference, size) = reference();
+    let (_, ps, cam) = cornell(size);
+    let o = native_outcome(&ps, &cam, params(size, Integrator::Bdpt, 300), 96, &reference);
+    eprintln!("bdpt lambert: {o:?}");
+    assert!(o.passed(), "bdpt disagrees with Mitsuba: {o:?}");
+    assert!(o.mean_rel_diff.abs() < 0.02, "bdpt: mean off by {:.3}", o.mean_rel_diff);
+    // The emulated kernel: its 4 frames equal the native ones bit for bit, so
+    // the native pass above covers it. Its own t-test at 4 or 16 frames is not
+    // asserted: uniform weights leave short connections (G ~ 1 / d^2) their
+    // heavy tail, and a few frames underestimate a block's variance
+    // (docs/reproduction-lin2017.md, "Bidirectional path tracing").
+    let p = params(size, Integrator::Bdpt, 301);
+    let native = render_native(&ps, &cam, p, 4, false, |_| {});
+    let mut cfg = kernel::sim_config(&p);
+    cfg.fidelity = Fidelity::Functional;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev).expect("load PTX");
+    let emu = kernel::render(&mut dev, &module, &ps, &cam, p, 4, false, |_| {}).expect("launch");
+    let diff = native.accum.iter().zip(&emu.image.accum).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+    assert_eq!(diff, 0, "bdpt at 32 x 32: {diff} values differ emulated and native");
+    let (reference, size, _) = reference_of(ROUGH_FIXTURE);
+    let (_, ps, cam) = scene_of("cornell-rough", size);
+    // 384 frames: the mirror's image of the light comes from eye subpaths alone
+    // (as pt's), a rare, bright event; at 96 frames seed 302 rejected 3 blocks
+    // there (mean -1.6 %), seed 400 none (+0.5 %), as pt's own runs vary
+    let o = native_outcome(&ps, &cam, params(size, Integrator::Bdpt, 302), 384, &reference);
+    eprintln!("bdpt rough: {o:?}");
+    assert!(o.passed(), "bdpt disagrees with Mitsuba on the rough mirror: {o:?}");
+    assert!(o.mean_rel_diff.abs() < 0.02, "bdpt rough: mean off by {:.3}", o.mean_rel_diff);
+}
+
+/// The test sees bdpt's brightness: its render of a light 10 % too dim
+/// fails (a weighting that divided by impossible combinations too, as the
+/// literal count of 003:L303 would, darkens the image by more).
+#[test]
+fn bdpt_with_a_dim_light_fails() {
+    let (reference, size) = reference();
+    let (scene, mut ps, cam) = cornell(size);
+    for (m, mat) in scene.materials.iter().enumerate() {
+        if mat.kind == MaterialKind::Emitter {
+            for c in 4..7 {
+                ps.mats[m][c] *= 0.9;
+            }
+        }
+    }
+    let o = native_outcome(&ps, &cam, params(size, Integrator::Bdpt, 303), 96, &reference);
+    eprintln!("bdpt dim light: {o:?}");
+    assert!(!o.passed(), "bdpt with a light 10 % too dim passed: {o:?}");
 }

@@ -49,6 +49,7 @@
 #define INTEGRATOR_NEE 1
 #define INTEGRATOR_MIS_BALANCE 2
 #define INTEGRATOR_MIS_POWER 3
+#define INTEGRATOR_BDPT 4   // bdpt_frame's, never path_frame's
 #define KIND_DIFFUSE 0
 #define KIND_MIRROR 1
 #define KIND_GLASS 2
@@ -433,6 +434,17 @@ static __device__ __forceinline__ void basis(V3 n, V3 *b1, V3 *b2) {
   *b2 = v3(b, sign + n.y * n.y * a, -n.y);
 }
 
+// A cosine-weighted direction about the unit n from uniforms y1 (the radius
+// sqrt y1 on the disc) and y2 (the azimuth); *lz its cosine with n.
+static __device__ __forceinline__ V3 cosine_dir(V3 n, float y1, float y2, float *lz) {
+  float r = sqrtf(y1), c, sn;
+  azimuth(y2, &c, &sn);
+  *lz = sqrtf(fmaxf(1.0f - y1, 0.0f));
+  V3 b1, b2;
+  basis(n, &b1, &b2);
+  return add3(add3(scale3(b1, r * c), scale3(b2, r * sn)), scale3(n, *lz));
+}
+
 // The environment's radiance in the unit direction d (§5.4, 003:L411: the
 // "spherical projection map" of an infinitely distant sphere), in Mitsuba 3's
 // envmap conventions (tools/mitsuba/reference.py checks them against it): y
@@ -489,6 +501,107 @@ static __device__ __forceinline__ Path camera_path(const Params *p, int i, unsig
   P.count_emission = true;
   P.bsdf_pdf = 0.0f;
   return P;
+}
+
+// The next direction at a hit (d in, the sampled direction out) and the
+// bounce's mask f cos / p in wgt; false when the path ends there.
+static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 td, int kind, V3 ns, V3 color,
+                                               float cos_d, float cos_o, unsigned key, unsigned dim, V3 &d, V3 &wgt) {
+  wgt = color;
+  if (kind == KIND_DIFFUSE) {
+    float lz;
+    d = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4), &lz);
+    P.bsdf_pdf = lz * INV_PI;
+    P.count_emission = false;
+  } else if (kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS) {
+    // a microfacet normal from Beckmann's D cos: tan^2 = -a2 ln(1 - y), uniform azimuth (§5.1)
+    float alpha = s.mats[3 * __float_as_int(td.w) + 2].x;
+    float a2 = alpha * alpha;
+    float tan2 = a2 * -ln(1.0f - rng(key, dim + 3));
+    float cm = 1.0f / sqrtf(1.0f + tan2);
+    float sm = sqrtf(tan2) * cm;
+    float c, sn;
+    azimuth(rng(key, dim + 4), &c, &sn);
+    V3 b1, b2;
+    basis(ns, &b1, &b2);
+    V3 mh = add3(add3(scale3(b1, sm * c), scale3(b2, sm * sn)), scale3(ns, cm));
+    float co = -dot3(d, mh);
+    if (!(co > 0.0f)) return false;
+    V3 next = add3(d, scale3(mh, 2.0f * co));   // reflected about the microfacet
+    float scale = 1.0f;
+    bool refracted = false;
+    if (kind == KIND_CONDUCTOR) {
+      wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
+      P.bsdf_pdf = beckmann(a2, cm) * cm / (4.0f * co);
+      P.count_emission = false;
+    } else {
+      // the Fresnel switch on the microfacet (Walter et al. 2007): reflect with
+      // probability F, else refract through it; radiance scales by eta^2
+      float ior = s.mats[3 * __float_as_int(td.w) + 1].w;
+      bool into = cos_d < 0.0f;
+      float eta = into ? 1.0f / ior : ior;
+      float k = 1.0f - eta * eta * (1.0f - co * co);
+      if (k > 0.0f) {   // else total internal reflection
+        float cos_t = sqrtf(k);
+        float r0 = (1.0f - ior) / (1.0f + ior);
+        bool exact = s.mats[3 * __float_as_int(td.w) + 2].y > 0.0f;
+        float fr = exact ? fresnel_exact(eta, co, cos_t) : schlick(r0 * r0, into ? co : cos_t);
+        if (!(rng(key, dim + 6) < fr)) {
+          next = add3(scale3(d, eta), scale3(mh, eta * co - cos_t));
+          scale = eta * eta;
+          refracted = true;
+        }
+      }
+      P.count_emission = true;
+    }
+    float ci = dot3(next, ns);
+    if (refracted ? !(ci < 0.0f) : !(ci > 0.0f)) return false;   // on the wrong side
+    float g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, dot3(next, mh));
+    float f = g * co / (cos_o * cm) * scale;
+    wgt = scale3(wgt, f);
+    d = next;
+  } else {
+    float cos_i = -dot3(d, ns);   // > 0: ns faces the ray
+    V3 next = add3(d, scale3(ns, 2.0f * cos_i));
+    if (kind == KIND_GLASS) {
+      // the Fresnel switch (Schlick): reflect with probability R, else refract
+      float ior = s.mats[3 * __float_as_int(td.w) + 1].w;
+      bool into = cos_d < 0.0f;
+      float eta = into ? 1.0f / ior : ior;
+      float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+      if (k > 0.0f) {   // else total internal reflection
+        float cos_t = sqrtf(k);
+        V3 tdir = add3(scale3(d, eta), scale3(ns, eta * cos_i - cos_t));
+        float fr;
+        if (s.mats[3 * __float_as_int(td.w) + 2].y > 0.0f) {
+          fr = fresnel_exact(eta, cos_i, cos_t);
+        } else {
+          float r0 = (1.0f - ior) / (1.0f + ior);
+          r0 = r0 * r0;
+          float c = 1.0f - (into ? cos_i : cos_t);
+          float c2 = c * c;
+          fr = r0 + (1.0f - r0) * (c2 * c2 * c);
+        }
+        if (!(rng(key, dim + 6) < fr)) next = tdir;
+      }
+    }
+    d = next;
+    P.count_emission = true;
+  }
+  return true;
+}
+
+// Russian roulette on the bounce's mask wgt = f cos / p (003:L267-271): continue
+// with q = its max RGB, then divide by q; false when the path ends.
+static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, unsigned key, unsigned dim) {
+  float q = fmaxf(fmaxf(wgt.x, wgt.y), wgt.z);
+  if (q < 1.0f) {
+    if (!(rng(key, dim + 5) < q)) return false;
+    beta = v3(beta.x * (wgt.x / q), beta.y * (wgt.y / q), beta.z * (wgt.z / q));
+  } else {
+    beta = mul3(beta, wgt);
+  }
+  return true;
 }
 
 // One level of the inner loop (003:L119) for one path: trace its ray, gather
@@ -580,100 +693,10 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
   }
   if (bounce == p->max_bounces) return false;
   // the next direction, and the bounce's mask f cos / p
-  V3 wgt = color;
-  if (kind == KIND_DIFFUSE) {
-    float y1 = rng(key, dim + 3);
-    float r = sqrtf(y1), c, sn;
-    azimuth(rng(key, dim + 4), &c, &sn);
-    float lz = sqrtf(fmaxf(1.0f - y1, 0.0f));
-    V3 b1, b2;
-    basis(ns, &b1, &b2);
-    d = add3(add3(scale3(b1, r * c), scale3(b2, r * sn)), scale3(ns, lz));
-    P.bsdf_pdf = lz * INV_PI;
-    P.count_emission = false;
-  } else if (kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS) {
-    // a microfacet normal from Beckmann's D cos: tan^2 = -a2 ln(1 - y), uniform azimuth (§5.1)
-    float alpha = s.mats[3 * __float_as_int(td.w) + 2].x;
-    float a2 = alpha * alpha;
-    float tan2 = a2 * -ln(1.0f - rng(key, dim + 3));
-    float cm = 1.0f / sqrtf(1.0f + tan2);
-    float sm = sqrtf(tan2) * cm;
-    float c, sn;
-    azimuth(rng(key, dim + 4), &c, &sn);
-    V3 b1, b2;
-    basis(ns, &b1, &b2);
-    V3 mh = add3(add3(scale3(b1, sm * c), scale3(b2, sm * sn)), scale3(ns, cm));
-    float co = -dot3(d, mh);
-    if (!(co > 0.0f)) return false;
-    V3 next = add3(d, scale3(mh, 2.0f * co));   // reflected about the microfacet
-    float scale = 1.0f;
-    bool refracted = false;
-    if (kind == KIND_CONDUCTOR) {
-      wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
-      P.bsdf_pdf = beckmann(a2, cm) * cm / (4.0f * co);
-      P.count_emission = false;
-    } else {
-      // the Fresnel switch on the microfacet (Walter et al. 2007): reflect with
-      // probability F, else refract through it; radiance scales by eta^2
-      float ior = s.mats[3 * __float_as_int(td.w) + 1].w;
-      bool into = cos_d < 0.0f;
-      float eta = into ? 1.0f / ior : ior;
-      float k = 1.0f - eta * eta * (1.0f - co * co);
-      if (k > 0.0f) {   // else total internal reflection
-        float cos_t = sqrtf(k);
-        float r0 = (1.0f - ior) / (1.0f + ior);
-        bool exact = s.mats[3 * __float_as_int(td.w) + 2].y > 0.0f;
-        float fr = exact ? fresnel_exact(eta, co, cos_t) : schlick(r0 * r0, into ? co : cos_t);
-        if (!(rng(key, dim + 6) < fr)) {
-          next = add3(scale3(d, eta), scale3(mh, eta * co - cos_t));
-          scale = eta * eta;
-          refracted = true;
-        }
-      }
-      P.count_emission = true;
-    }
-    float ci = dot3(next, ns);
-    if (refracted ? !(ci < 0.0f) : !(ci > 0.0f)) return false;   // on the wrong side
-    float g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, dot3(next, mh));
-    float f = g * co / (cos_o * cm) * scale;
-    wgt = scale3(wgt, f);
-    d = next;
-  } else {
-    float cos_i = -dot3(d, ns);   // > 0: ns faces the ray
-    V3 next = add3(d, scale3(ns, 2.0f * cos_i));
-    if (kind == KIND_GLASS) {
-      // the Fresnel switch (Schlick): reflect with probability R, else refract
-      float ior = s.mats[3 * __float_as_int(td.w) + 1].w;
-      bool into = cos_d < 0.0f;
-      float eta = into ? 1.0f / ior : ior;
-      float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
-      if (k > 0.0f) {   // else total internal reflection
-        float cos_t = sqrtf(k);
-        V3 tdir = add3(scale3(d, eta), scale3(ns, eta * cos_i - cos_t));
-        float fr;
-        if (s.mats[3 * __float_as_int(td.w) + 2].y > 0.0f) {
-          fr = fresnel_exact(eta, cos_i, cos_t);
-        } else {
-          float r0 = (1.0f - ior) / (1.0f + ior);
-          r0 = r0 * r0;
-          float c = 1.0f - (into ? cos_i : cos_t);
-          float c2 = c * c;
-          fr = r0 + (1.0f - r0) * (c2 * c2 * c);
-        }
-        if (!(rng(key, dim + 6) < fr)) next = tdir;
-      }
-    }
-    d = next;
-    P.count_emission = true;
-  }
+  V3 wgt;
+  if (!scatter(s, P, td, kind, ns, color, cos_d, cos_o, key, dim, d, wgt)) return false;
   // Russian roulette on the bounce's mask f cos / p
-  float q = fmaxf(fmaxf(wgt.x, wgt.y), wgt.z);
-  if (q < 1.0f) {
-    if (!(rng(key, dim + 5) < q)) return false;
-    P.beta = v3(P.beta.x * (wgt.x / q), P.beta.y * (wgt.y / q), P.beta.z * (wgt.z / q));
-  } else {
-    P.beta = mul3(P.beta, wgt);
-  }
+  if (!roulette(P.beta, wgt, key, dim)) return false;
   P.o = hitp;
   P.d = d;
   P.bounce = bounce + 1;
@@ -704,6 +727,165 @@ extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, 
   unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
   Path P = camera_path(p, i, key);
   while (step(s, P, key)) {
+  }
+  finish(accum, last, i, P.L);
+}
+
+// ---- Bidirectional path tracing (§4.7, 003:L295-308): bdpt_frame ----
+//
+// Per path one light subpath and one eye subpath. The light subpath starts at
+// a point y0 sampled on the area lights by area (the light sample of nee),
+// leaves it cosine-weighted and continues only through Lambertian surfaces
+// (a glossy, specular or emitting hit ends it), y0 ... y_{n-1}, n <= min(max
+// bounces, LIGHT_VERTICES), each vertex with its throughput alpha (Le A at y0).
+// The eye subpath is the path tracer's (BSDF sampling, Russian roulette);
+// at each Lambertian eye vertex x it connects to every light vertex y_k
+// whose full path has at most max bounces: a shadow ray, the geometry term
+// G = cos_x cos_y / |x - y|^2 (003:L301), both BSDFs (1 at y0); connection
+// through a non-Lambertian vertex is never tried (zero probability, 003:L303).
+// Emission the eye subpath hits counts too (s = 0). The weights are the
+// thesis' uniform ones (003:L303: each contribution divided by the number of
+// combinations that make the same path), with the count taken over the
+// combinations that can make it (the light-side prefix up to the connection
+// all Lambertian, at most LIGHT_VERTICES light vertices): c = 1 + min(m, nl)
+// for m the Lambertian vertices in a row from the light's end. No light
+// vertex is connected to the camera (t = 1: splats, not counted in c).
+#define LIGHT_VERTICES 16
+#define DIMS_LIGHT 0x10000u   // the light subpath's dimensions: 5 at y0, then 8 per bounce
+
+static __device__ __forceinline__ int imin(int a, int b) { return a < b ? a : b; }
+
+struct LightVertex {
+  V3 p, n;     // position; normal on the side the light came from (y0: the light's front)
+  V3 alpha;    // throughput arriving at the vertex (y0: Le times the lights' area)
+  V3 color;    // Lambertian albedo (y0: unused)
+};
+
+// Traces the light subpath of `key` into lv (at most nl vertices); returns its vertex count.
+static __device__ int light_subpath(const Scene &s, unsigned key, int nl, LightVertex *lv) {
+  const Params *p = s.p;
+  float yl = rng(key, DIMS_LIGHT);
+  int l = 0;
+  while (l + 1 < p->num_lights && !(yl < s.lights[3 * l].w)) l++;
+  float4 la = s.lights[3 * l], lb = s.lights[3 * l + 1], lc = s.lights[3 * l + 2];
+  float su = sqrtf(rng(key, DIMS_LIGHT + 1));
+  float yv = rng(key, DIMS_LIGHT + 2);
+  float bu = su * (1.0f - yv), bv = su * yv;
+  V3 o = add3(add3(v3(la.x, la.y, la.z), scale3(v3(lb.x, lb.y, lb.z), bu)), scale3(v3(lc.x, lc.y, lc.z), bv));
+  float4 ld = s.tri_data[__float_as_int(lb.w)];
+  float4 le = s.mats[3 * __float_as_int(ld.w) + 1];
+  V3 alpha = scale3(v3(le.x, le.y, le.z), p->light_area);
+  lv[0].p = o;
+  lv[0].n = v3(ld.x, ld.y, ld.z);
+  lv[0].alpha = alpha;
+  lv[0].color = v3(0.0f, 0.0f, 0.0f);
+  // the emitted direction, cosine-weighted: Le cos / (cos / pi) = pi Le
+  float lz;
+  V3 d = cosine_dir(lv[0].n, rng(key, DIMS_LIGHT + 3), rng(key, DIMS_LIGHT + 4), &lz);
+  alpha = scale3(alpha, PI_F);
+  int count = 1;
+  while (count < nl) {
+    float t;
+    int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
+    if (tri < 0) break;
+    float4 td = s.tri_data[tri];
+    float4 m0 = s.mats[3 * __float_as_int(td.w)];
+    if (__float_as_int(m0.w) != KIND_DIFFUSE) break;
+    V3 n = v3(td.x, td.y, td.z);
+    V3 hitp = add3(o, scale3(d, t));
+    V3 ns = dot3(d, n) < 0.0f ? n : v3(-n.x, -n.y, -n.z);
+    V3 color = v3(m0.x, m0.y, m0.z);
+    lv[count].p = hitp;
+    lv[count].n = ns;
+    lv[count].alpha = alpha;
+    lv[count].color = color;
+    count++;
+    if (count == nl) break;
+    unsigned dim = DIMS_LIGHT + DIMS_PER_BOUNCE * (unsigned)count;
+    d = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4), &lz);
+    if (!roulette(alpha, color, key, dim)) break;
+    o = hitp;
+  }
+  return count;
+}
+
+// One eye vertex of bdpt: trace, count emission with its uniform weight, connect
+// a Lambertian vertex to the light subpath, scatter. run: the Lambertian eye
+// vertices in a row ending at the previous one. False when the path ends.
+static __device__ __forceinline__ bool bdpt_step(const Scene &s, Path &P, unsigned key, const LightVertex *lv, int nl,
+                                                 int nl_max, int &run) {
+  const Params *p = s.p;
+  int bounce = P.bounce;
+  V3 o = P.o, d = P.d;
+  float t;
+  int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
+  if (tri < 0) {
+    if (p->env_w > 0) P.L = add3(P.L, mul3(P.beta, env(s, d)));   // only the eye subpath sees it
+    return false;
+  }
+  float4 td = s.tri_data[tri];
+  V3 n = v3(td.x, td.y, td.z);
+  float4 m0 = s.mats[3 * __float_as_int(td.w)];
+  int kind = __float_as_int(m0.w);
+  float cos_d = dot3(d, n);
+  if (kind == KIND_EMITTER) {
+    if (cos_d < 0.0f) {
+      float4 m1 = s.mats[3 * __float_as_int(td.w) + 1];
+      int c = 1 + imin(run, nl_max);
+      P.L = add3(P.L, scale3(mul3(P.beta, v3(m1.x, m1.y, m1.z)), 1.0f / (float)c));
+    }
+    return false;
+  }
+  V3 hitp = add3(o, scale3(d, t));
+  V3 ns = cos_d < 0.0f ? n : v3(-n.x, -n.y, -n.z);
+  V3 color = v3(m0.x, m0.y, m0.z);
+  float cos_o = -dot3(d, ns);
+  unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
+  if (kind == KIND_DIFFUSE) {
+    int last = p->max_bounces - bounce - 1;   // light vertex k makes a path of k + bounce + 1 bounces
+    if (last > nl - 1) last = nl - 1;
+    for (int k = 0; k <= last; k++) {
+      V3 w = sub3(lv[k].p, hitp);
+      float dist2 = dot3(w, w);
+      float dist = sqrtf(dist2);
+      w = scale3(w, 1.0f / dist);
+      float cos_x = dot3(ns, w), cos_y = -dot3(lv[k].n, w);
+      float ts;
+      if (cos_x > 0.0f && cos_y > 0.0f && trace(s, hitp, w, p->eps, dist - p->eps, true, &ts) < 0) {
+        int c = 1 + imin(k + 1 + run, nl_max);
+        float g = cos_x * cos_y / dist2 * INV_PI / (float)c;
+        V3 f = k == 0 ? v3(1.0f, 1.0f, 1.0f) : scale3(lv[k].color, INV_PI);
+        P.L = add3(P.L, scale3(mul3(mul3(mul3(P.beta, color), f), lv[k].alpha), g));
+      }
+    }
+  }
+  run = kind == KIND_DIFFUSE ? run + 1 : 0;
+  if (bounce == p->max_bounces) return false;
+  V3 wgt;
+  if (!scatter(s, P, td, kind, ns, color, cos_d, cos_o, key, dim, d, wgt)) return false;
+  if (!roulette(P.beta, wgt, key, dim)) return false;
+  P.o = hitp;
+  P.d = d;
+  P.bounce = bounce + 1;
+  return true;
+}
+
+// The bdpt megakernel: one launch per frame, each thread one light and one eye subpath.
+extern "C" __global__ void bdpt_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                      const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                      const float4 *lights, const float4 *boxes, const float4 *env, float *accum,
+                                      float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  const Params *p = params;
+  int i = (int)WL_TID;
+  if (i >= p->num_paths) return;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  LightVertex lv[LIGHT_VERTICES];
+  int nl_max = p->num_lights > 0 ? imin(p->max_bounces, LIGHT_VERTICES) : 0;
+  int nl = nl_max > 0 ? light_subpath(s, key, nl_max, lv) : 0;
+  Path P = camera_path(p, i, key);
+  int run = 0;
+  while (bdpt_step(s, P, key, lv, nl, nl_max, run)) {
   }
   finish(accum, last, i, P.L);
 }

@@ -71,7 +71,8 @@ pub struct RenderArgs {
     /// its JSON, and OUT-summary.json (the reference's own error, when each display settles).
     #[arg(long, default_value = "raycast")]
     pub method: String,
-    /// Path tracer: pt, nee, mis (balance heuristic) or mis-power.
+    /// Path tracer: pt, nee, mis (balance heuristic), mis-power, or bdpt (bidirectional:
+    /// light and eye subpaths, every Lambertian pair connected, the thesis' uniform weights).
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
@@ -427,7 +428,7 @@ fn run_path(
 ) -> Result<(), Box<dyn std::error::Error>> {
     use crate::host::path::{FrameParams, Integrator, Traversal};
     let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
-        format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic) or mis-power", a.integrator)
+        format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic), mis-power or bdpt", a.integrator)
     })?;
     let traversal = Traversal::parse(&a.traversal)
         .ok_or_else(|| format!("unknown traversal `{}`; expected stack, stack12, restart or backtrack", a.traversal))?;
@@ -461,7 +462,10 @@ fn run_path(
         if emulated.is_some() { " (emulated)" } else { " (native)" }
     );
     if let Some((w, t)) = r.instructions {
-        println!("  emulated path_frame: {w} warp instructions, {t} thread instructions");
+        println!(
+            "  emulated {}: {w} warp instructions, {t} thread instructions",
+            crate::host::path::kernel::entry(integrator)
+        );
     }
     println!("  wrote {}", a.output.display());
     Ok(())

@@ -14,8 +14,15 @@ use crate::sim::{Arg, Counters, Device, DevicePtr, Fidelity, LaunchConfig, Modul
 
 /// The kernel's PTX (clang-16), compiled in.
 pub const PTX: &str = include_str!("../../../kernels/lin2017/path.ptx");
-/// The kernel's entry point.
+/// The kernel's entry point (pt, nee, mis).
 pub const KERNEL: &str = "path_frame";
+/// The bidirectional path tracer's entry point.
+pub const BDPT_KERNEL: &str = "bdpt_frame";
+
+/// The entry point that renders `integrator`.
+pub fn entry(integrator: super::Integrator) -> &'static str {
+    if integrator == super::Integrator::Bdpt { BDPT_KERNEL } else { KERNEL }
+}
 /// Threads per CTA.
 pub const THREADS: u32 = 256;
 /// Warp instructions per path the watchdog allows one launch (a path of the
@@ -148,7 +155,7 @@ pub fn render(
     let mut events = Counts::default();
     for f in 0..frames {
         dev.write(pp, &params_bytes(scene, camera, &params, f))?;
-        let st = dev.launch(module, KERNEL, LaunchConfig::linear(ctas, THREADS), &args)?;
+        let st = dev.launch(module, entry(params.integrator), LaunchConfig::linear(ctas, THREADS), &args)?;
         totals.merge(&st.totals);
         if counted {
             events.add(&Counts::from_tags(&counts::tagged(&module.prog, &st.profile, &tags)));

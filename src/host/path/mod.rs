@@ -34,10 +34,15 @@ pub enum Integrator {
     MisBalance,
     /// Both strategies weighted by the power heuristic (§4.6, β = 2).
     MisPower,
+    /// Bidirectional path tracing (§4.7): a light and an eye subpath per
+    /// path, every Lambertian pair connected, the thesis' uniform weights
+    /// over the combinations that can make a path (`bdpt_frame`; the
+    /// megakernel only, not the wavefront form). Not in [`Integrator::ALL`].
+    Bdpt,
 }
 
 impl Integrator {
-    /// Every integrator.
+    /// The unidirectional integrators (those the wavefront form also runs; bdpt is not one).
     pub const ALL: [Integrator; 4] = [Integrator::Pt, Integrator::Nee, Integrator::MisBalance, Integrator::MisPower];
 
     /// The kernel's code.
@@ -47,6 +52,7 @@ impl Integrator {
             Integrator::Nee => 1,
             Integrator::MisBalance => 2,
             Integrator::MisPower => 3,
+            Integrator::Bdpt => 4,
         }
     }
 
@@ -57,6 +63,7 @@ impl Integrator {
             Integrator::Nee => "nee",
             Integrator::MisBalance => "mis",
             Integrator::MisPower => "mis-power",
+            Integrator::Bdpt => "bdpt",
         }
     }
 
@@ -64,6 +71,7 @@ impl Integrator {
     pub fn parse(s: &str) -> Option<Integrator> {
         match s {
             "mis-balance" => Some(Integrator::MisBalance),
+            "bdpt" => Some(Integrator::Bdpt),
             _ => Integrator::ALL.into_iter().find(|i| i.name() == s),
         }
     }

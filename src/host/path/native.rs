@@ -19,6 +19,22 @@ pub const DIMS_CAMERA: u32 = 2;
 /// Random dimensions per bounce.
 pub const DIMS_PER_BOUNCE: u32 = 8;
 const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
+/// bdpt: the most light-subpath vertices (the kernel's `LIGHT_VERTICES`).
+pub const LIGHT_VERTICES: usize = 16;
+/// bdpt: the first random dimension of the light subpath (5 at y0, then 8 per bounce).
+pub const DIMS_LIGHT: u32 = 0x10000;
+
+/// A vertex of bdpt's light subpath (the kernel's `LightVertex`).
+struct LightVertex {
+    /// Position.
+    p: V3,
+    /// Normal on the side the light came from (y0: the light's front).
+    n: V3,
+    /// Throughput arriving at the vertex (y0: Le times the lights' area).
+    alpha: V3,
+    /// Lambertian albedo (y0: unused).
+    color: V3,
+}
 /// Stack entries of the traversal (the builder's depth limit).
 pub const STACK_ENTRIES: usize = 32;
 
@@ -279,6 +295,157 @@ impl Tracer<'_> {
         a / (a + b)
     }
 
+    /// Path `i`'s camera ray (origin, direction): tent-jittered in its
+    /// subpixel of the 2 x 2 grid, the kernel's `camera_path`.
+    fn camera_ray(&self, i: u32, key: u32) -> (V3, V3) {
+        let cam = &self.frame;
+        let (w, h) = (self.params.width, self.params.height);
+        let (pixel, sub) = (i >> 2, i & 3);
+        let (x, y) = (pixel % w, pixel / w);
+        let px = x as f32 + ((sub & 1) as f32 + 0.5 + tent(rng(key, 0))) * 0.5;
+        let py = y as f32 + ((sub >> 1) as f32 + 0.5 + tent(rng(key, 1))) * 0.5;
+        let cx = (px / w as f32 * 2.0 - 1.0) * cam.tan_half * cam.aspect;
+        let cy = (1.0 - py / h as f32 * 2.0) * cam.tan_half;
+        let (fwd, right, up) = (xyz(&cam.fwd, 0), xyz(&cam.right, 0), xyz(&cam.up, 0));
+        (xyz(&cam.pos, 0), fwd.add(right.scale(cx)).add(up.scale(cy)).normalize())
+    }
+
+    /// The light subpath of `key` (at most `nl` vertices): the kernel's `light_subpath`.
+    fn light_subpath(&self, key: u32, nl: usize, c: &mut Counts) -> Vec<LightVertex> {
+        let s = self.scene;
+        let eps = self.frame.eps;
+        let yl = rng(key, DIMS_LIGHT);
+        let mut li = 0usize;
+        while li + 1 < s.lights.len() && !(yl < s.lights[li][3]) {
+            li += 1;
+        }
+        let lg = &s.lights[li];
+        let su = rng(key, DIMS_LIGHT + 1).sqrt();
+        let yv = rng(key, DIMS_LIGHT + 2);
+        let (bu, bv) = (su * (1.0 - yv), su * yv);
+        let mut o = xyz(lg, 0).add(xyz(lg, 4).scale(bu)).add(xyz(lg, 8).scale(bv));
+        let ld = s.tri_data[lg[7].to_bits() as usize];
+        let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
+        let mut alpha = le.scale(s.light_area);
+        let n0 = v3(ld[0], ld[1], ld[2]);
+        let mut lv = Vec::with_capacity(nl);
+        lv.push(LightVertex { p: o, n: n0, alpha, color: v3(0.0, 0.0, 0.0) });
+        // the emitted direction, cosine-weighted: Le cos / (cos / pi) = pi Le
+        let (mut d, _) = cosine_dir(n0, rng(key, DIMS_LIGHT + 3), rng(key, DIMS_LIGHT + 4));
+        alpha = alpha.scale(std::f32::consts::PI);
+        while lv.len() < nl {
+            let Some((tri, t)) = self.trace(o, d, eps, f32::INFINITY, false, c) else {
+                break;
+            };
+            let td = s.tri_data[tri as usize];
+            let mat = &s.mats[td[3].to_bits() as usize];
+            if mat[3].to_bits() != KIND_DIFFUSE {
+                break;
+            }
+            let n = v3(td[0], td[1], td[2]);
+            let hitp = o.add(d.scale(t));
+            let ns = if d.dot(n) < 0.0 { n } else { v3(-n.x, -n.y, -n.z) };
+            let color = xyz(mat, 0);
+            lv.push(LightVertex { p: hitp, n: ns, alpha, color });
+            if lv.len() == nl {
+                break;
+            }
+            let dim = DIMS_LIGHT + DIMS_PER_BOUNCE * lv.len() as u32;
+            (d, _) = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4));
+            if !roulette(&mut alpha, color, key, dim) {
+                break;
+            }
+            o = hitp;
+        }
+        lv
+    }
+
+    /// Radiance of bdpt's path `i` (its light and eye subpaths and their
+    /// connections under the uniform weights): the kernel's `bdpt_frame`.
+    fn bdpt(&self, i: u32, key: u32, counts: &mut Counts) -> [f32; 3] {
+        let s = self.scene;
+        let cam = &self.frame;
+        let p = &self.params;
+        let nl_max = if s.lights.is_empty() { 0 } else { p.max_bounces.min(LIGHT_VERTICES as u32) as i32 };
+        let lv = if nl_max > 0 { self.light_subpath(key, nl_max as usize, counts) } else { Vec::new() };
+        let nl = lv.len() as i32;
+        let (mut o, mut d) = self.camera_ray(i, key);
+        let (mut l, mut beta) = (v3(0.0, 0.0, 0.0), v3(1.0, 1.0, 1.0));
+        let (mut bsdf_pdf, mut count_emission) = (0.0f32, true);
+        let mut run = 0i32;
+        let mut bounce = 0u32;
+        loop {
+            let Some((tri, t)) = self.trace(o, d, cam.eps, f32::INFINITY, false, counts) else {
+                if let Some(env) = &s.env {
+                    let e = env.radiance([d.x, d.y, d.z]);
+                    l = l.add(beta.mul(v3(e[0], e[1], e[2])));
+                }
+                break;
+            };
+            let td = s.tri_data[tri as usize];
+            let n = v3(td[0], td[1], td[2]);
+            let mat = &s.mats[td[3].to_bits() as usize];
+            let kind = mat[3].to_bits();
+            let cos_d = d.dot(n);
+            if kind == KIND_EMITTER {
+                if cos_d < 0.0 {
+                    let c = 1 + run.min(nl_max);
+                    l = l.add(beta.mul(xyz(mat, 4)).scale(1.0 / c as f32));
+                }
+                break;
+            }
+            let hitp = o.add(d.scale(t));
+            let ns = if cos_d < 0.0 { n } else { v3(-n.x, -n.y, -n.z) };
+            let color = xyz(mat, 0);
+            let cos_o = -d.dot(ns);
+            let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
+            if kind == KIND_DIFFUSE {
+                // light vertex k makes a path of k + bounce + 1 bounces
+                let last = (p.max_bounces as i32 - bounce as i32 - 1).min(nl - 1);
+                for k in 0..=last {
+                    let y = &lv[k as usize];
+                    let mut w = y.p.sub(hitp);
+                    let dist2 = w.dot(w);
+                    let dist = dist2.sqrt();
+                    w = w.scale(1.0 / dist);
+                    let (cos_x, cos_y) = (ns.dot(w), -y.n.dot(w));
+                    if cos_x > 0.0
+                        && cos_y > 0.0
+                        && self.trace(hitp, w, cam.eps, dist - cam.eps, true, counts).is_none()
+                    {
+                        let c = 1 + (k + 1 + run).min(nl_max);
+                        let g = cos_x * cos_y / dist2 * INV_PI / c as f32;
+                        let f = if k == 0 { v3(1.0, 1.0, 1.0) } else { y.color.scale(INV_PI) };
+                        l = l.add(beta.mul(color).mul(f).mul(y.alpha).scale(g));
+                    }
+                }
+            }
+            run = if kind == KIND_DIFFUSE { run + 1 } else { 0 };
+            if bounce == p.max_bounces {
+                break;
+            }
+            if !self.bounce_on(
+                mat,
+                kind,
+                ns,
+                color,
+                cos_d,
+                cos_o,
+                key,
+                dim,
+                &mut d,
+                &mut beta,
+                &mut bsdf_pdf,
+                &mut count_emission,
+            ) {
+                break;
+            }
+            o = hitp;
+            bounce += 1;
+        }
+        [l.x, l.y, l.z]
+    }
+
     /// Radiance of path `i` in frame `frame`.
     pub fn path(&self, i: u32, frame: u32) -> [f32; 3] {
         self.path_counted(i, frame, &mut Counts::default())
@@ -289,18 +456,12 @@ impl Tracer<'_> {
         let s = self.scene;
         let cam = &self.frame;
         let p = &self.params;
-        let (w, h) = (p.width, p.height);
-        let (pixel, sub) = (i >> 2, i & 3);
-        let (x, y) = (pixel % w, pixel / w);
         let key = path_key(i, frame, p.seed);
         let integrator = p.integrator;
-        let px = x as f32 + ((sub & 1) as f32 + 0.5 + tent(rng(key, 0))) * 0.5;
-        let py = y as f32 + ((sub >> 1) as f32 + 0.5 + tent(rng(key, 1))) * 0.5;
-        let cx = (px / w as f32 * 2.0 - 1.0) * cam.tan_half * cam.aspect;
-        let cy = (1.0 - py / h as f32 * 2.0) * cam.tan_half;
-        let (fwd, right, up) = (xyz(&cam.fwd, 0), xyz(&cam.right, 0), xyz(&cam.up, 0));
-        let mut o = xyz(&cam.pos, 0);
-        let mut d = fwd.add(right.scale(cx)).add(up.scale(cy)).normalize();
+        if integrator == Integrator::Bdpt {
+            return self.bdpt(i, key, counts);
+        }
+        let (mut o, mut d) = self.camera_ray(i, key);
         let mut l = v3(0.0, 0.0, 0.0);
         let mut beta = v3(1.0, 1.0, 1.0);
         let mut count_emission = true;
@@ -389,106 +550,152 @@ impl Tracer<'_> {
                 break;
             }
             // the next direction, and the bounce's mask f cos / p
-            let mut wgt = color;
-            if kind == KIND_DIFFUSE {
-                let y1 = rng(key, dim + 3);
-                let r = y1.sqrt();
-                let (cs, sn) = azimuth(rng(key, dim + 4));
-                let lz = fmax(1.0 - y1, 0.0).sqrt();
-                let (b1, b2) = basis(ns);
-                d = b1.scale(r * cs).add(b2.scale(r * sn)).add(ns.scale(lz));
-                bsdf_pdf = lz * INV_PI;
-                count_emission = false;
-            } else if kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS {
-                let alpha = mat[8];
-                let a2 = alpha * alpha;
-                let tan2 = a2 * -ln(1.0 - rng(key, dim + 3));
-                let cm = 1.0 / (1.0 + tan2).sqrt();
-                let sm = tan2.sqrt() * cm;
-                let (cs, sn) = azimuth(rng(key, dim + 4));
-                let (b1, b2) = basis(ns);
-                let mh = b1.scale(sm * cs).add(b2.scale(sm * sn)).add(ns.scale(cm));
-                let co = -d.dot(mh);
-                if !(co > 0.0) {
-                    break;
-                }
-                let mut next = d.add(mh.scale(2.0 * co));
-                let mut scale = 1.0f32;
-                let mut refracted = false;
-                if kind == KIND_CONDUCTOR {
-                    wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
-                    bsdf_pdf = beckmann(a2, cm) * cm / (4.0 * co);
-                    count_emission = false;
-                } else {
-                    let ior = mat[7];
-                    let into = cos_d < 0.0;
-                    let eta = if into { 1.0 / ior } else { ior };
-                    let k = 1.0 - eta * eta * (1.0 - co * co);
-                    if k > 0.0 {
-                        let cos_t = k.sqrt();
-                        let r0 = (1.0 - ior) / (1.0 + ior);
-                        let fr = if mat[9] > 0.0 {
-                            fresnel_exact(eta, co, cos_t)
-                        } else {
-                            schlick(r0 * r0, if into { co } else { cos_t })
-                        };
-                        if !(rng(key, dim + 6) < fr) {
-                            next = d.scale(eta).add(mh.scale(eta * co - cos_t));
-                            scale = eta * eta;
-                            refracted = true;
-                        }
-                    }
-                    count_emission = true;
-                }
-                let ci = next.dot(ns);
-                if if refracted { !(ci < 0.0) } else { !(ci > 0.0) } {
-                    break;
-                }
-                let g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, next.dot(mh));
-                let f = g * co / (cos_o * cm) * scale;
-                wgt = wgt.scale(f);
-                d = next;
-            } else {
-                let cos_i = -d.dot(ns);
-                let mut next = d.add(ns.scale(2.0 * cos_i));
-                if kind == KIND_GLASS {
-                    let ior = mat[7];
-                    let into = cos_d < 0.0;
-                    let eta = if into { 1.0 / ior } else { ior };
-                    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-                    if k > 0.0 {
-                        let cos_t = k.sqrt();
-                        let tdir = d.scale(eta).add(ns.scale(eta * cos_i - cos_t));
-                        let fr = if mat[9] > 0.0 {
-                            fresnel_exact(eta, cos_i, cos_t)
-                        } else {
-                            let mut r0 = (1.0 - ior) / (1.0 + ior);
-                            r0 = r0 * r0;
-                            let cc = 1.0 - if into { cos_i } else { cos_t };
-                            let c2 = cc * cc;
-                            r0 + (1.0 - r0) * (c2 * c2 * cc)
-                        };
-                        if !(rng(key, dim + 6) < fr) {
-                            next = tdir;
-                        }
-                    }
-                }
-                d = next;
-                count_emission = true;
-            }
-            let q = fmax(fmax(wgt.x, wgt.y), wgt.z);
-            if q < 1.0 {
-                if !(rng(key, dim + 5) < q) {
-                    break;
-                }
-                beta = v3(beta.x * (wgt.x / q), beta.y * (wgt.y / q), beta.z * (wgt.z / q));
-            } else {
-                beta = beta.mul(wgt);
+            if !self.bounce_on(
+                mat,
+                kind,
+                ns,
+                color,
+                cos_d,
+                cos_o,
+                key,
+                dim,
+                &mut d,
+                &mut beta,
+                &mut bsdf_pdf,
+                &mut count_emission,
+            ) {
+                break;
             }
             o = hitp;
             bounce += 1;
         }
         [l.x, l.y, l.z]
+    }
+
+    /// The next direction at a hit (`d` in, the sampled direction out) and the
+    /// bounce's mask f cos / p: the kernel's `scatter`; `None` when the path ends.
+    #[allow(clippy::too_many_arguments)]
+    fn scatter(
+        &self,
+        mat: &[f32; 12],
+        kind: u32,
+        ns: V3,
+        color: V3,
+        cos_d: f32,
+        cos_o: f32,
+        key: u32,
+        dim: u32,
+        d: &mut V3,
+        bsdf_pdf: &mut f32,
+        count_emission: &mut bool,
+    ) -> Option<V3> {
+        let mut wgt = color;
+        if kind == KIND_DIFFUSE {
+            let lz;
+            (*d, lz) = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4));
+            *bsdf_pdf = lz * INV_PI;
+            *count_emission = false;
+        } else if kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS {
+            let alpha = mat[8];
+            let a2 = alpha * alpha;
+            let tan2 = a2 * -ln(1.0 - rng(key, dim + 3));
+            let cm = 1.0 / (1.0 + tan2).sqrt();
+            let sm = tan2.sqrt() * cm;
+            let (cs, sn) = azimuth(rng(key, dim + 4));
+            let (b1, b2) = basis(ns);
+            let mh = b1.scale(sm * cs).add(b2.scale(sm * sn)).add(ns.scale(cm));
+            let co = -d.dot(mh);
+            if !(co > 0.0) {
+                return None;
+            }
+            let mut next = d.add(mh.scale(2.0 * co));
+            let mut scale = 1.0f32;
+            let mut refracted = false;
+            if kind == KIND_CONDUCTOR {
+                wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
+                *bsdf_pdf = beckmann(a2, cm) * cm / (4.0 * co);
+                *count_emission = false;
+            } else {
+                let ior = mat[7];
+                let into = cos_d < 0.0;
+                let eta = if into { 1.0 / ior } else { ior };
+                let k = 1.0 - eta * eta * (1.0 - co * co);
+                if k > 0.0 {
+                    let cos_t = k.sqrt();
+                    let r0 = (1.0 - ior) / (1.0 + ior);
+                    let fr = if mat[9] > 0.0 {
+                        fresnel_exact(eta, co, cos_t)
+                    } else {
+                        schlick(r0 * r0, if into { co } else { cos_t })
+                    };
+                    if !(rng(key, dim + 6) < fr) {
+                        next = d.scale(eta).add(mh.scale(eta * co - cos_t));
+                        scale = eta * eta;
+                        refracted = true;
+                    }
+                }
+                *count_emission = true;
+            }
+            let ci = next.dot(ns);
+            if if refracted { !(ci < 0.0) } else { !(ci > 0.0) } {
+                return None;
+            }
+            let g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, next.dot(mh));
+            let f = g * co / (cos_o * cm) * scale;
+            wgt = wgt.scale(f);
+            *d = next;
+        } else {
+            let cos_i = -d.dot(ns);
+            let mut next = d.add(ns.scale(2.0 * cos_i));
+            if kind == KIND_GLASS {
+                let ior = mat[7];
+                let into = cos_d < 0.0;
+                let eta = if into { 1.0 / ior } else { ior };
+                let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                if k > 0.0 {
+                    let cos_t = k.sqrt();
+                    let tdir = d.scale(eta).add(ns.scale(eta * cos_i - cos_t));
+                    let fr = if mat[9] > 0.0 {
+                        fresnel_exact(eta, cos_i, cos_t)
+                    } else {
+                        let mut r0 = (1.0 - ior) / (1.0 + ior);
+                        r0 = r0 * r0;
+                        let cc = 1.0 - if into { cos_i } else { cos_t };
+                        let c2 = cc * cc;
+                        r0 + (1.0 - r0) * (c2 * c2 * cc)
+                    };
+                    if !(rng(key, dim + 6) < fr) {
+                        next = tdir;
+                    }
+                }
+            }
+            *d = next;
+            *count_emission = true;
+        }
+        Some(wgt)
+    }
+
+    /// [`Self::scatter`] then [`roulette`]: false when the path ends at this hit.
+    #[allow(clippy::too_many_arguments)]
+    fn bounce_on(
+        &self,
+        mat: &[f32; 12],
+        kind: u32,
+        ns: V3,
+        color: V3,
+        cos_d: f32,
+        cos_o: f32,
+        key: u32,
+        dim: u32,
+        d: &mut V3,
+        beta: &mut V3,
+        bsdf_pdf: &mut f32,
+        count_emission: &mut bool,
+    ) -> bool {
+        match self.scatter(mat, kind, ns, color, cos_d, cos_o, key, dim, d, bsdf_pdf, count_emission) {
+            Some(wgt) => roulette(beta, wgt, key, dim),
+            None => false,
+        }
     }
 
     /// Traces frame `frame`: adds each path's radiance to `accum` (3 floats
@@ -513,6 +720,32 @@ impl Tracer<'_> {
                 a
             })
     }
+}
+
+/// Russian roulette on the bounce's mask `wgt` = f cos / p: the kernel's
+/// `roulette` (continue with q = its max RGB, then divide by q).
+fn roulette(beta: &mut V3, wgt: V3, key: u32, dim: u32) -> bool {
+    let q = fmax(fmax(wgt.x, wgt.y), wgt.z);
+    if q < 1.0 {
+        if !(rng(key, dim + 5) < q) {
+            return false;
+        }
+        *beta = v3(beta.x * (wgt.x / q), beta.y * (wgt.y / q), beta.z * (wgt.z / q));
+    } else {
+        *beta = beta.mul(wgt);
+    }
+    true
+}
+
+/// A cosine-weighted direction about the unit `n` from uniforms `y1` (the
+/// radius √y1 on the disc) and `y2` (the azimuth), and its cosine with `n`:
+/// the kernel's `cosine_dir`.
+fn cosine_dir(n: V3, y1: f32, y2: f32) -> (V3, f32) {
+    let r = y1.sqrt();
+    let (cs, sn) = azimuth(y2);
+    let lz = fmax(1.0 - y1, 0.0).sqrt();
+    let (b1, b2) = basis(n);
+    (b1.scale(r * cs).add(b2.scale(r * sn)).add(n.scale(lz)), lz)
 }
 
 /// PTX min.f32: the non-NaN operand if one is NaN.
