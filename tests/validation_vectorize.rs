@@ -304,7 +304,8 @@ fn loads_at_a_loop_stepped_base_merge_as_ptxas_merges_them() {
     };
     let cfg = LaunchConfig::linear(1, 256);
     // (kernel, clang's (on, off), nvcc's (on, off)); None: no merge, the two equal
-    let cases: [(&str, Option<(u64, u64)>, Option<(u64, u64)>); 8] = [
+    type OnOff = Option<(u64, u64)>;
+    let cases: [(&str, OnOff, OnOff); 8] = [
         ("stepped_pairs", Some((32, 64)), Some((32, 32))),
         ("stepped_quads", Some((32, 128)), Some((32, 32))),
         ("stepped_sub", Some((32, 64)), Some((32, 64))),
