@@ -284,3 +284,48 @@ fn redux_carry_and_bar_red_do_not_stop_the_plan() {
     let off = counters(ptx, "k", cfg, &args, false, Profile::Hopper);
     assert_eq!((off.shared_st.instructions, off.shared_ld.instructions), (2, 3));
 }
+
+/// ptxas merges adjacent shared words at a base stepped round a loop when the
+/// base's first value and its step keep the pair aligned, and not when the
+/// base is 4 mod 8 with the pair at `p - 1, p`: the SASS of
+/// `kernels/validation/loop_stepped.cu` on the H200's ptxas 13.0
+/// (`tests/fixtures/validation/loop_stepped.{clang,nvcc}.sass`,
+/// `tools/device/issue20_s8_stepped.sh`). One CTA of 8 warps, 4 iterations:
+/// shared load instructions (pass on, pass off).
+#[test]
+fn loads_at_a_loop_stepped_base_merge_as_ptxas_merges_them() {
+    let args = |n: Option<i32>| {
+        move |d: &mut Device| {
+            let input: Vec<f32> = (0..2048).map(|i| (i % 7) as f32).collect();
+            let mut a = vec![Arg::Ptr(d.alloc_from(&input)), Arg::Ptr(d.alloc_zeroed::<f32>(256))];
+            a.extend(n.map(Arg::I32));
+            a
+        }
+    };
+    let cfg = LaunchConfig::linear(1, 256);
+    // (kernel, clang's (on, off), nvcc's (on, off)); None: no merge, the two equal
+    type OnOff = Option<(u64, u64)>;
+    let cases: [(&str, OnOff, OnOff); 8] = [
+        ("stepped_pairs", Some((32, 64)), Some((32, 32))),
+        ("stepped_quads", Some((32, 128)), Some((32, 32))),
+        ("stepped_sub", Some((32, 64)), Some((32, 64))),
+        ("stepped_wide", Some((32, 64)), Some((32, 32))),
+        ("stepped_split", Some((64, 96)), Some((64, 64))),
+        ("stepped_odd", Some((64, 64)), Some((32, 32))),
+        ("stepped_guarded", None, None),
+        ("fixed_pairs", Some((64, 128)), Some((64, 64))),
+    ];
+    for dialect in ["clang", "nvcc"] {
+        let p = format!("kernels/validation/loop_stepped{}.ptx", if dialect == "nvcc" { ".nvcc" } else { "" });
+        let ptx = std::fs::read_to_string(&p).unwrap();
+        for (kernel, clang, nvcc) in cases {
+            let a = args((kernel != "fixed_pairs").then_some(4));
+            let on = counters(&ptx, kernel, cfg, &a, true, Profile::Hopper).shared_ld.instructions;
+            let off = counters(&ptx, kernel, cfg, &a, false, Profile::Hopper).shared_ld.instructions;
+            match if dialect == "nvcc" { nvcc } else { clang } {
+                Some(want) => assert_eq!((on, off), want, "{kernel} ({dialect})"),
+                None => assert!(on == off && on > 0, "{kernel} ({dialect}): {on} vs {off}"),
+            }
+        }
+    }
+}

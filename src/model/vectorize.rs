@@ -20,9 +20,12 @@
 //!   variables' offsets in warplight's layout, immediates, `shl` by a
 //!   constant, `mul`/`mad` (zeros add up), `add`/`sub`/`or` (the fewer), `and`
 //!   (the more), moves and conversions keep them; anything loaded or
-//!   special is unaligned, and so is a register defined from itself (`add
-//!   %r, %r, k`: an address stepped round a loop), at which ptxas merges
-//!   nothing (`needleman_wunsch` in docs/validation.md).
+//!   special is unaligned. A register stepped round a loop (`add %r, %r, k`)
+//!   is as aligned as its first value and its step (ptxas merges there:
+//!   `kernels/validation/loop_stepped.cu`). A shared variable's address is
+//!   aligned to its `.align` or to the largest power of two dividing its
+//!   size, whichever is more (ptxas merges nothing at needleman_wunsch's
+//!   `temp[17][17]`, 1,156 bytes, though warplight places it at 0).
 //! - **Repeated loads.** A shared load of the same base register (same
 //!   definition), offset and width as an earlier load of the same run is
 //!   dropped (ptxas reuses the register): not counted.
@@ -103,7 +106,8 @@ impl Plan {
 
     /// Plans every function of `prog`.
     pub fn new(prog: &Program) -> Plan {
-        Plan { actions: prog.functions.iter().map(plan_function).collect() }
+        let vars = shared_var_alignment(prog);
+        Plan { actions: prog.functions.iter().map(|f| plan_function(f, &vars)).collect() }
     }
 }
 
@@ -178,11 +182,31 @@ fn tz_imm(v: u64) -> u32 {
     v.trailing_zeros()
 }
 
-/// Known trailing zeros of every data register of `f` (see the module comment).
-fn trailing_zeros(f: &Function) -> Vec<u32> {
+/// The shared variables whose address ptxas knows less aligned than
+/// warplight's layout makes it: (offset, known trailing zeros). ptxas counts
+/// a variable aligned to its `.align` or to the largest power of two that
+/// divides its size, whichever is more, and no more than 16 bytes matter
+/// here (`As[256]`, `.align 4`, is 16-byte aligned to it: `LDS.128`;
+/// needleman_wunsch's `temp[17][17]`, 1,156 bytes, only 4-byte aligned: no
+/// `LDS.64`; docs/validation.md).
+fn shared_var_alignment(prog: &Program) -> Vec<(u64, u32)> {
+    prog.shared_vars
+        .iter()
+        .filter(|v| v.size > 0)
+        .map(|v| (v.offset as u64, v.align.trailing_zeros().max(v.size.trailing_zeros())))
+        .filter(|&(_, tz)| tz < 4)
+        .collect()
+}
+
+/// Known trailing zeros of every data register of `f` (see the module
+/// comment); `vars`: [`shared_var_alignment`].
+fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
     let n = f.reg_masks.len();
     let mut tz = vec![64u32; n];
     let width = |r: RegId| f.reg_masks.get(r as usize).map_or(64, |m| m.count_ones());
+    // the variables this function names
+    let vars: Vec<(u64, u32)> =
+        vars.iter().filter(|v| f.shared_refs.iter().any(|&o| o as u64 == v.0)).copied().collect();
     loop {
         let mut changed = false;
         for inst in &f.insts {
@@ -191,19 +215,17 @@ fn trailing_zeros(f: &Function) -> Vec<u32> {
                 Src::Imm(v) => tz_imm(*v),
                 _ => 0,
             };
+            // a shared variable's address (an immediate in warplight's
+            // layout) as aligned as ptxas knows it
+            let var = |s: &Src, tz: &[u32]| match s {
+                Src::Imm(v) => vars.iter().find(|x| x.0 == *v).map_or(tz_imm(*v), |x| x.1.min(tz_imm(*v))),
+                _ => of(s, tz),
+            };
             let (regs, value): (Vec<RegId>, u32) = match &inst.kind {
-                Kind::Mov { d, a } => (vec![d.reg], of(a, &tz)),
+                Kind::Mov { d, a } => (vec![d.reg], var(a, &tz)),
                 Kind::Cvt { d, a, dty, sty, .. } if !dty.is_float() && !sty.is_float() => (vec![d.reg], of(a, &tz)),
-                Kind::Cvta { d, a, .. } => (vec![d.reg], of(a, &tz)),
+                Kind::Cvta { d, a, .. } => (vec![d.reg], var(a, &tz)),
                 Kind::Selp { d, a, b, .. } => (vec![d.reg], of(a, &tz).min(of(b, &tz))),
-                // a register updated from itself (`add %r, %r, k`: an
-                // address stepped round a loop): ptxas does not merge at it
-                // (needleman_wunsch, docs/validation.md), so neither does the pass
-                Kind::Arith { d, a, b, c, ty, .. }
-                    if !ty.is_float() && [a, b, c].iter().any(|s| matches!(s, Src::Reg(r) if *r == d.reg)) =>
-                {
-                    (vec![d.reg], 0)
-                }
                 Kind::Arith { op, d, a, b, c, ty, .. } if !ty.is_float() => {
                     let (a, b, c) = (of(a, &tz), of(b, &tz), of(c, &tz));
                     let v = match op {
@@ -336,9 +358,9 @@ fn settle(run: &mut Vec<Pending>, loads: bool, actions: &mut [Action]) {
 }
 
 /// Plans one function.
-fn plan_function(f: &Function) -> Vec<Action> {
+fn plan_function(f: &Function, vars: &[(u64, u32)]) -> Vec<Action> {
     let mut actions = vec![Action::Count; f.insts.len()];
-    let tz = trailing_zeros(f);
+    let tz = trailing_zeros(f, vars);
     // registers some instruction reads (for atomics without a used result)
     let mut read = vec![false; f.reg_masks.len()];
     for inst in &f.insts {

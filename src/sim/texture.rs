@@ -327,18 +327,23 @@ fn round_ties_away(m: i128, k: i32, p: u32) -> f32 {
 /// weights in 256ths, a 16-bit normalized value `n` rounded half up and
 /// returned as `n / 65535` (unsigned) or `n / 32767` (signed) rounded to f32:
 /// `u8` widened to 16 bits as `v · 257` (`n = round(Σ w·257v / 256)`), `u16`
-/// and `s16` as they are (`n = round(Σ w·v / 256)`), all bit for bit in 1-D,
-/// 2-D and (`u8`) 3-D; `s8` as the exact `n = round(Σ w·v·32767 / (127 · 256))`,
-/// which differs from the H200 by one step (1/32767) on 6 % of the measured
-/// channels (its exact rule was not found).
+/// and `s16` as they are (`n = round(Σ w·v / 256)`), `s8` from the sum
+/// `S = Σ w·v` (8 fractional bits) scaled by `1 + 2^-7 + 2^-15` (for the
+/// exact `32767 / 32512`) with the small part taken from `S` cut to a
+/// multiple of 16: `n = S + round(floor(S / 16) · 257 / 2048)`. All bit for
+/// bit on the H200 (`u8` in 1-D, 2-D and 3-D; `u16`, `s16`, `s8` in 2-D;
+/// `s8` in 1-D under border).
 fn filter_normalized(terms: &[(i64, i64)], format: TexelFormat) -> f32 {
     let sum = |k: i64| terms.iter().map(|&(w, v)| w * v * k).sum::<i64>();
     match format {
         TexelFormat::U8 => ((sum(257) + 128) >> 8) as f32 / 65535.0,
         TexelFormat::U16 => ((sum(1) + 128) >> 8) as f32 / 65535.0,
         TexelFormat::S16 => ((sum(1) + 128) >> 8) as f32 / 32767.0,
-        // round(num / den), half up: floor((2 num + den) / (2 den))
-        _ => (2 * sum(32767) + 127 * 256).div_euclid(2 * 127 * 256) as f32 / 32767.0,
+        // S + S (2^-7 + 2^-15), the second part from S >> 4, rounded half up
+        _ => {
+            let s = sum(1);
+            (s + (((s >> 4) * 257 + 1024) >> 11)) as f32 / 32767.0
+        }
     }
 }
 
@@ -693,6 +698,12 @@ mod tests {
         assert_eq!(filter_normalized(&[(256, -32768)], S16), -32768.0 / 32767.0);
         assert_eq!(filter_normalized(&[(256, 127)], S8), 1.0);
         assert_eq!(filter_normalized(&[(256, -128)], S8), -33025.0 / 32767.0);
+        // s8, three channels the H200 returned (n2s8) where the exact scale,
+        // round(S · 32767 / 32512), gives one step more: S = -7586 (-7645.499),
+        // -12676 (-12775.421), 17278 (17413.516)
+        assert_eq!(filter_normalized(&[(22, -47), (234, -28)], S8), -7646.0 / 32767.0);
+        assert_eq!(filter_normalized(&[(188, -28), (68, -109)], S8), -12776.0 / 32767.0);
+        assert_eq!(filter_normalized(&[(2, 3), (254, 68)], S8), 17413.0 / 32767.0);
     }
 
     #[test]

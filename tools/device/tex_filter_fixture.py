@@ -8,11 +8,13 @@ unpacked into DIR): checks that every texture's texels are the hash rule's
       samples' coordinates (f32, dims each) then their results (f32 x 4 each)
   tests/fixtures/validation/h200_sured.json        sured.json as measured
 
-usage: tex_filter_fixture.py DIR ENV_TXT [2]
+usage: tex_filter_fixture.py DIR ENV_TXT [2|3]
 
 With "2" (tools/device/issue20_tex_bfs.sh's tex2.tgz, the second set of
 cases): h200_tex_filter2.{json,bin.z} instead, no surfaces, and more samples
-kept of the large 3-D case (KEEP_MORE).
+kept of the large 3-D case (KEEP_MORE). With "3"
+(tools/device/issue20_s8_stepped.sh's tex3.tgz, signed 8-bit texels):
+h200_tex_filter3.{json,bin.z}, every sample kept.
 """
 import json, struct, sys, zlib
 
@@ -55,9 +57,9 @@ def texel_bits(c, e):
     return struct.unpack("<I", struct.pack("<f", float(v)))[0]
 
 
-def main(d, env, second=False):
+def main(d, env, second=False, third=False):
     cases = json.load(open(f"{d}/tex.json"))
-    stem = "tests/fixtures/validation/h200_tex_filter" + ("2" if second else "")
+    stem = "tests/fixtures/validation/h200_tex_filter" + ("3" if third else "2" if second else "")
     blob = b""
     for c in cases:
         esize = ESIZE[c["format"]]
@@ -69,16 +71,16 @@ def main(d, env, second=False):
         crd = struct.unpack(f"<{n * dims}I", open(f"{d}/{c['name']}.crd", "rb").read())
         out = struct.unpack(f"<{n * 4}I", open(f"{d}/{c['name']}.out", "rb").read())
         step = max(1, n // KEEP) if c["coords"] == "grid1" else 1
-        keep = list(range(0, n, step))[:KEEP_MORE.get(c["name"], KEEP) if second else KEEP]
+        keep = list(range(0, n, step))[:KEEP_MORE.get(c["name"], KEEP) if second else n if third else KEEP]
         c["kept"] = {"first": 0, "step": step, "count": len(keep)}
         words = [crd[i * dims + k] for i in keep for k in range(dims)] + [out[i * 4 + k] for i in keep for k in range(4)]
         blob += struct.pack(f"<{len(words)}I", *words)
-    script = "issue20_tex_bfs.sh" if second else "issue20_leftovers.sh"
+    script = "issue20_s8_stepped.sh" if third else "issue20_tex_bfs.sh" if second else "issue20_leftovers.sh"
     meta = {"note": f"made by tools/device/tex_filter_fixture.py from tools/device/{script}",
             "env": open(env).read().splitlines()[:8], "cases": cases}
     json.dump(meta, open(f"{stem}.json", "w"), indent=1)
     open(f"{stem}.bin.z", "wb").write(zlib.compress(blob, 9))
-    if second:
+    if second or third:
         return
     s = json.load(open(f"{d}/sured.json"))
     s["note"] = "made by tools/device/tex_filter_host.cu (kernels/validation/sured.cu) on the device"
@@ -87,4 +89,4 @@ def main(d, env, second=False):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], len(sys.argv) > 3 and sys.argv[3] == "2")
+    main(sys.argv[1], sys.argv[2], len(sys.argv) > 3 and sys.argv[3] == "2", len(sys.argv) > 3 and sys.argv[3] == "3")

@@ -8,7 +8,8 @@
 //   sured.json           every sured case's surface after the launch
 // With a second argument "2", the second set of cases instead (16-bit and
 // signed normalized texels, 3-D textures under every address mode and
-// format) and no surfaces (tools/device/issue20_tex_bfs.sh).
+// format) and no surfaces (tools/device/issue20_tex_bfs.sh); with "3" the
+// third (signed 8-bit texels, tools/device/issue20_s8_stepped.sh).
 // Texels and coordinates come from hash32 (tools/device/validation.py), so
 // tests/tex_filter.rs makes the same ones. Build: nvcc -O2 -arch=sm_90 -I. -o
 // probe tools/device/tex_filter_host.cu (from the repository root).
@@ -209,6 +210,18 @@ static const Case CASES2[] = {
     {"u3b", 3, "u8", 16, 16, 16, "border", false, "random", 31, 16384, "uniform", -1, 17},
 };
 
+// The third set: signed 8-bit texels only, new seeds, every dimension and
+// address mode (tools/device/issue20_s8_stepped.sh): a held-out check of the
+// s8 rule read off n2s8 and n1s8b (docs/semantics.md).
+static const Case CASES3[] = {
+    {"s1c", 1, "s8", 256, 0, 0, "clamp", false, "random", 41, 4096, "uniform", -1, 257},
+    {"s2w", 2, "s8", 64, 64, 0, "wrap", true, "random", 42, 4096, "uniform", -1.5, 2.5},
+    {"s2m", 2, "s8", 64, 64, 0, "mirror", true, "random", 43, 4096, "uniform", -1.5, 2.5},
+    {"s2b", 2, "s8", 64, 64, 0, "border", false, "random", 44, 4096, "uniform", -1, 65},
+    {"s3c", 3, "s8", 16, 16, 16, "clamp", false, "random", 45, 4096, "uniform", -1, 17},
+    {"s3b", 3, "s8", 16, 16, 16, "border", false, "random", 46, 4096, "uniform", -1, 17},
+};
+
 // ---- surfaces: 4 x 4 elements, initial words hash32(i + (7 << 20))
 struct Sured {
   const char *name;
@@ -265,10 +278,16 @@ static void sured(FILE *J) {
 int main(int argc, char **argv) {
   OUT = argc > 1 ? argv[1] : ".";
   bool second = argc > 2 && !strcmp(argv[2], "2");
+  bool third = argc > 2 && !strcmp(argv[2], "3");
   FILE *J = fopen((std::string(OUT) + "/tex.json").c_str(), "w");
   fprintf(J, "[\n");
   bool first = true;
-  if (second) {
+  if (third) {
+    for (const Case &c : CASES3) {
+      run_case(c, J, first);
+      first = false;
+    }
+  } else if (second) {
     for (const Case &c : CASES2) {
       run_case(c, J, first);
       first = false;
@@ -281,7 +300,7 @@ int main(int argc, char **argv) {
   }
   fprintf(J, "]\n");
   fclose(J);
-  if (second) {
+  if (second || third) {
     printf("done\n");
     return 0;
   }
