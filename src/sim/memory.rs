@@ -68,7 +68,7 @@ pub struct Allocation {
 
 impl Allocation {
     /// Loads `size` (1, 2, 4 or 8) bytes at aligned offset `off`, zero-extended.
-    #[inline]
+    #[inline(always)]
     pub fn load(&self, off: u64, size: u32) -> u64 {
         let w = (off >> 2) as usize;
         match size {
@@ -81,7 +81,7 @@ impl Allocation {
     }
 
     /// Stores the low `size` bytes of `v` at aligned offset `off`.
-    #[inline]
+    #[inline(always)]
     pub fn store(&self, off: u64, size: u32, v: u64) {
         let w = (off >> 2) as usize;
         match size {

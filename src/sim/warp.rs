@@ -153,7 +153,7 @@ impl Warp {
     }
 
     /// Loads `size` bytes at local offset `off` of lane `l` (bounds checked by the caller).
-    #[inline]
+    #[inline(always)]
     pub fn local_load(&self, l: usize, off: u64, size: u32) -> u64 {
         let w = (off >> 2) as usize * 32 + l;
         match size {
@@ -164,7 +164,7 @@ impl Warp {
     }
 
     /// Stores `size` bytes at local offset `off` of lane `l`.
-    #[inline]
+    #[inline(always)]
     pub fn local_store(&mut self, l: usize, off: u64, size: u32, v: u64) {
         let w = (off >> 2) as usize * 32 + l;
         match size {

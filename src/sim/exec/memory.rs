@@ -380,6 +380,46 @@ fn global_in_one(
     Some(Resolved::Global(addrs[first]))
 }
 
+/// [`Ty::extend`] and [`Ty::mask`] with the type's width and signedness
+/// resolved once per warp instruction instead of once per lane and element.
+#[derive(Debug, Clone, Copy)]
+struct Extend {
+    signed: bool,
+    /// 64 less the type's width (for sign extension).
+    sh: u32,
+    /// The type's value bits.
+    mask: u64,
+}
+
+impl Extend {
+    #[inline(always)]
+    fn of(ty: Ty) -> Self {
+        let b = ty.bits().min(64);
+        Extend { signed: ty.is_signed(), sh: 64 - b, mask: if b == 64 { u64::MAX } else { (1u64 << b) - 1 } }
+    }
+
+    /// `ty.extend(v)`.
+    #[inline(always)]
+    fn apply(self, v: u64) -> u64 {
+        // the signed types are 8 bits wide or more, so `sh` < 64 here
+        if self.signed { (((v << self.sh) as i64) >> self.sh) as u64 } else { v & self.mask }
+    }
+}
+
+/// Calls `f(size)` with `size` a constant for the access sizes a per-warp
+/// path meets (1, 2, 4, 8 bytes), so that an inlined `f` is compiled once
+/// per size; any other size is passed as it is.
+#[inline(always)]
+fn by_size(size: u32, mut f: impl FnMut(u32)) {
+    match size {
+        4 => f(4),
+        8 => f(8),
+        2 => f(2),
+        1 => f(1),
+        s => f(s),
+    }
+}
+
 /// The lowest and highest address of the active lanes and the whole access's
 /// size in bytes (`n` elements of `size` bytes per lane), when the warp has an
 /// active lane, the access's size is a power of two and every active lane's
@@ -459,22 +499,26 @@ fn local_in_one(
     let first = exec.trailing_zeros() as usize;
     touched.first = Some(MemSpace::Local);
     touched.lanes |= exec;
-    let mut m = exec;
-    while m != 0 {
-        let l = m.trailing_zeros() as usize;
-        m &= m - 1;
-        let off = addrs[l] - window;
-        touched.space[l] = Some(MemSpace::Local);
-        touched.addr[l] = off;
-        for (k, v) in vals.iter_mut().enumerate() {
-            let ok = off + (k as u32 * size) as u64;
-            if store {
-                w.local_store(l, ok, size, v[l] & ty.mask());
-            } else {
-                v[l] = ty.extend(w.local_load(l, ok, size));
+    let ext = Extend::of(ty);
+    let mut lanes = |size: u32| {
+        let mut m = exec;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let off = addrs[l] - window;
+            touched.space[l] = Some(MemSpace::Local);
+            touched.addr[l] = off;
+            for (k, v) in vals.iter_mut().enumerate() {
+                let ok = off + (k as u32 * size) as u64;
+                if store {
+                    w.local_store(l, ok, size, v[l] & ext.mask);
+                } else {
+                    v[l] = ext.apply(w.local_load(l, ok, size));
+                }
             }
         }
-    }
+    };
+    by_size(size, &mut lanes);
     Some(Resolved::Local(addrs[first] - window))
 }
 
@@ -752,6 +796,42 @@ mod tests {
         let args = [Arg::Ptr(out), Arg::Ptr(inp), Arg::U32(bad), Arg::U32(delta), Arg::U32(off), Arg::U32(mix)];
         let r = dev.launch(&m, "lanes", LaunchConfig::linear(1, 64), &args);
         Run { dev, out, r }
+    }
+
+    /// The per-warp paths' extension, resolved once per instruction, is
+    /// `Ty::extend` and `Ty::mask` for every type and value.
+    #[test]
+    fn extend_resolved_per_warp_is_the_types_own() {
+        use crate::ptx::types::Ty;
+        let tys = [
+            Ty::B8,
+            Ty::U8,
+            Ty::S8,
+            Ty::B16,
+            Ty::U16,
+            Ty::S16,
+            Ty::F16,
+            Ty::BF16,
+            Ty::B32,
+            Ty::U32,
+            Ty::S32,
+            Ty::F32,
+            Ty::F16x2,
+            Ty::BF16x2,
+            Ty::B64,
+            Ty::U64,
+            Ty::S64,
+            Ty::F64,
+            Ty::Pred,
+        ];
+        let vals = [0u64, 1, 0x7F, 0x80, 0xFF, 0x8000, 0xFFFF, 0x8000_0000, 0xFFFF_FFFF, 0x1_8000_0080, u64::MAX];
+        for ty in tys {
+            let e = super::Extend::of(ty);
+            assert_eq!(e.mask, ty.mask(), "{ty:?}");
+            for v in vals {
+                assert_eq!(e.apply(v), ty.extend(v), "{ty:?} {v:#x}");
+            }
+        }
     }
 
     /// The local accesses of whole warps take the per-warp path
