@@ -221,6 +221,63 @@ impl Format {
     }
 }
 
+/// What went wrong writing charts with their data ([`write_charts`]).
+#[derive(Debug, thiserror::Error)]
+pub enum WriteChartsError {
+    /// A chart could not be drawn.
+    #[error(transparent)]
+    Chart(#[from] ChartError),
+    /// A chart's data or the summary could not be turned into JSON.
+    #[error("{file}: {source}")]
+    Json {
+        /// The file it was for.
+        file: String,
+        /// What went wrong.
+        source: serde_json::Error,
+    },
+    /// A file could not be written (the message names it).
+    #[error("{0}")]
+    Write(String),
+}
+
+/// The files [`write_charts`] wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WrittenCharts {
+    /// Per chart, in order: its title, its SVG and its JSON.
+    pub charts: Vec<(String, std::path::PathBuf, std::path::PathBuf)>,
+    /// `STEM-summary.json`.
+    pub summary: std::path::PathBuf,
+}
+
+/// Writes each named scatter chart as `STEM-NAME.svg` with its data beside it
+/// as `STEM-NAME.json` (`warplight chart scatter` redraws it), then `summary`
+/// as `STEM-summary.json`, every file through
+/// [`crate::files::write_atomically`].
+pub fn write_charts<N: std::fmt::Display>(
+    stem: &Path,
+    charts: impl IntoIterator<Item = (N, Scatter)>,
+    summary: &serde_json::Value,
+) -> Result<WrittenCharts, WriteChartsError> {
+    let file = |suffix: &str| std::path::PathBuf::from(format!("{}-{suffix}", stem.display()));
+    fn json_of<T: Serialize>(f: &Path, v: &T) -> Result<String, WriteChartsError> {
+        serde_json::to_string_pretty(v)
+            .map_err(|source| WriteChartsError::Json { file: f.display().to_string(), source })
+    }
+    let mut out = WrittenCharts { charts: Vec::new(), summary: file("summary.json") };
+    for (name, chart) in charts {
+        let json = file(&format!("{name}.json"));
+        crate::files::write_atomically(&json, json_of(&json, &chart)?.as_bytes()).map_err(WriteChartsError::Write)?;
+        let svg = file(&format!("{name}.svg"));
+        let chart = Chart::Scatter(chart);
+        crate::files::write_atomically(&svg, chart.svg(chart.default_size())?.as_bytes())
+            .map_err(WriteChartsError::Write)?;
+        out.charts.push((chart.title().to_string(), svg, json));
+    }
+    crate::files::write_atomically(&out.summary, json_of(&out.summary, summary)?.as_bytes())
+        .map_err(WriteChartsError::Write)?;
+    Ok(out)
+}
+
 impl Chart {
     /// The chart's title.
     pub fn title(&self) -> &str {

@@ -24,6 +24,7 @@ pub mod chart;
 pub mod check;
 pub mod cli;
 pub mod compile;
+pub mod files;
 pub mod host;
 pub mod launch_spec;
 pub mod limits;

@@ -547,6 +547,22 @@ fn render_refuses_options_that_do_not_apply() {
             "--json applies to --method purcell's native and emulated variants (--variant error",
         ),
         (vec!["--fmad", "false"], "--fmad applies to emulated kernels; --method raycast --variant native runs none"),
+        (
+            vec!["--method", "photon-map", "--variant", "error", "--device", "hopper"],
+            "--device does not apply to --method photon-map --variant error: the accuracy charts use the GT200 model",
+        ),
+        (
+            vec!["--method", "photon-map", "--variant", "error", "--fmad", "false"],
+            "--fmad does not apply to --method photon-map --variant error",
+        ),
+        (
+            vec!["--method", "photon-map", "--variant", "error", "--fidelity", "functional"],
+            "--fidelity does not apply to --method photon-map --variant error",
+        ),
+        (
+            vec!["--method", "photon-map", "--variant", "error", "--estimator", "knn"],
+            "--estimator does not apply to --method photon-map --variant error: the accuracy charts use the GT200 model of Table 6.6 and compare every estimator",
+        ),
         (vec!["--method", "path", "--device", "hopper"], "--device applies to emulated kernels"),
         (vec!["--method", "path", "--fidelity", "functional"], "--fidelity applies to emulated kernels"),
     ] {

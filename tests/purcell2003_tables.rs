@@ -17,6 +17,7 @@ use std::process::Command;
 
 use warplight::repro::baseline::Baseline;
 use warplight::repro::protocol::{FrameRange, Protocol};
+use warplight::repro::purcell2003::passes::PhaseCounts;
 use warplight::repro::purcell2003::scenes::FIXTURES;
 use warplight::repro::purcell2003::{pipeline, table_2};
 use warplight::repro::registry::{Workspace, resolve};
@@ -119,4 +120,19 @@ fn the_quick_runs_tables_keep_their_baseline() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("no cell dropped out of tolerance"), "{err}");
+}
+
+/// TEX by how a row's pass was drawn: the routing row (one point per photon)
+/// drops its stream inputs, a quad's row keeps every load, and a label that
+/// is not a row of Table 2 is an error (it was silently read as a quad).
+#[test]
+fn table_2_rows_say_how_their_pass_was_drawn() {
+    let c = PhaseCounts { lane_loads: 4, stream_loads: 3, ..Default::default() };
+    let routing = table_2::sample("stencil-routing", &c, 2.0).unwrap();
+    assert_eq!(routing.counters["tex_per_iteration"], 0.5);
+    assert_eq!((routing.counters["loads_per_iteration"], routing.counters["stream_per_iteration"]), (2.0, 1.5));
+    assert_eq!(table_2::sample("bitonic-sort", &c, 2.0).unwrap().counters["tex_per_iteration"], 2.0);
+    let e = table_2::sample("stencil-route", &c, 2.0).unwrap_err();
+    assert_eq!(e, table_2::UnknownRow("stencil-route".into()));
+    assert!(e.to_string().contains("no row `stencil-route`"), "{e}");
 }

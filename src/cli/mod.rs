@@ -2,7 +2,7 @@
 
 pub mod chart;
 pub mod compile;
-pub mod interrupt;
+pub use crate::files::{interrupt, write_atomically};
 pub mod launch;
 pub mod ptx_info;
 pub mod render;
@@ -160,15 +160,4 @@ pub fn main() -> i32 {
             1
         }
     }
-}
-
-/// Writes `bytes` to `file` through a temporary file beside it
-/// ([`interrupt::Temporary`]), so that neither a failure nor a signal ever
-/// leaves a partial file under the final name, or the temporary file.
-pub fn write_atomically(file: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
-    let err = |e: std::io::Error| format!("{}: {e}", file.display());
-    let mut tmp = interrupt::Temporary::create(file).map_err(err)?;
-    // on failure the temporary file goes too (dropped): nothing half-written is left
-    tmp.write_all(bytes).map_err(err)?;
-    interrupt::commit(vec![(tmp, file)]).map_err(|(_, e)| err(e))
 }

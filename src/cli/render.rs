@@ -226,6 +226,21 @@ fn check_applicable(a: &RenderArgs) -> Result<(), String> {
                     each chart's data beside -o as JSON)"
             .into());
     }
+    // the accuracy charts run fixed models and every estimator (accuracy::run_cli takes none of these)
+    if m == "photon-map" && a.variant == "error" {
+        let fixed = [
+            ("--device", a.device != "gt200"),
+            ("--fmad", a.fmad.is_some()),
+            ("--fidelity", a.fidelity != crate::sim::Fidelity::Caches),
+            ("--estimator", a.estimator != "vkde"),
+        ];
+        if let Some((o, _)) = fixed.iter().find(|x| x.1) {
+            return Err(format!(
+                "{o} does not apply to --method photon-map --variant error: the accuracy charts use the GT200 \
+                 model of Table 6.6 and compare every estimator"
+            ));
+        }
+    }
     // natively, raycast and path run no kernel (purcell's native variant still emulates the map passes)
     if matches!(m, "raycast" | "path") && a.variant == "native" {
         let emulated_only = [

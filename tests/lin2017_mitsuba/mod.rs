@@ -8,7 +8,9 @@ use std::path::Path;
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::stats::{Estimate, Outcome, from_frames, from_reference, read_exr, welch_holm};
+use warplight::host::path::stats::{
+    Estimate, Outcome, from_frames, from_reference, read_exr, welch_holm, welch_holm_floored,
+};
 use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
@@ -58,16 +60,28 @@ pub fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32,
 // each test crate that includes this module uses a part of it
 #[allow(dead_code)]
 pub fn emulated_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, reference: &Estimate) -> Outcome {
-    emulated_frames_outcome(ps, cam, p, 4, reference)
+    emulated_frames_outcome(ps, cam, p, 4, reference, 0.0)
 }
 
-/// The emulated kernel's `frames` frames (functional fidelity) against `reference`.
+/// Samples per pixel behind a reference (its metadata): 2 x 2 subpixels x
+/// spp per subpixel per batch x batches.
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
+pub fn reference_samples(meta: &serde_json::Value) -> f64 {
+    let spp = meta["spp_per_subpixel_per_batch"].as_f64().expect("spp_per_subpixel_per_batch");
+    4.0 * spp * meta["batches"].as_f64().expect("batches")
+}
+
+/// The emulated kernel's `frames` frames (functional fidelity) against
+/// `reference`, each cell's variance floored at `floor` times the
+/// reference's ([`welch_holm_floored`]; 0: none).
 pub fn emulated_frames_outcome(
     ps: &PathScene,
     cam: &Camera,
     p: FrameParams,
     frames: u32,
     reference: &Estimate,
+    floor: f64,
 ) -> Outcome {
     let mut cfg = kernel::sim_config(&p);
     cfg.fidelity = Fidelity::Functional;
@@ -75,5 +89,5 @@ pub fn emulated_frames_outcome(
     let module = kernel::load(&mut dev).expect("load PTX");
     let r = kernel::render(&mut dev, &module, ps, cam, p, frames, true, |_| {}).expect("launch");
     let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
-    welch_holm(&ours, reference, ALPHA).expect("same block grid")
+    welch_holm_floored(&ours, reference, ALPHA, floor).expect("same block grid")
 }

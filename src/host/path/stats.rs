@@ -114,6 +114,8 @@ pub struct Outcome {
     pub worst: (u32, u32, usize, f64),
     /// Relative difference of the overall means (a − b) / b.
     pub mean_rel_diff: f64,
+    /// Cells whose variance of `a` was raised to the floor ([`welch_holm_floored`]).
+    pub floored: usize,
 }
 
 impl Outcome {
@@ -126,19 +128,43 @@ impl Outcome {
 /// Welch's t-test of every cell of `a` against `b`, Holm-corrected at `alpha`.
 /// `None` when the estimates' block grids differ.
 pub fn welch_holm(a: &Estimate, b: &Estimate, alpha: f64) -> Option<Outcome> {
+    welch_holm_floored(a, b, alpha, 0.0)
+}
+
+/// [`welch_holm`] with each cell's variance of `a` taken as at least
+/// `floor` × `b`'s (that cell's variance is then the reference's estimate,
+/// scaled, and carries `b`'s degrees of freedom).
+///
+/// Why: `a`'s variance comes from few frames, and a cell whose value is
+/// heavy-tailed (rare bright paths) looks certain of a low mean when no
+/// frame happened to draw one: its batch variance can be orders of
+/// magnitude below the true one. With `floor` = (the reference's samples
+/// per pixel) / (`a`'s), the floor is the variance `b`'s estimator would
+/// have at `a`'s sample count: a lower bound for `a` whenever `a`'s
+/// estimator is no better per sample than the reference's
+/// (docs/reproduction-lin2017.md, "Glass against Mitsuba"). A floor of 0 is
+/// [`welch_holm`].
+pub fn welch_holm_floored(a: &Estimate, b: &Estimate, alpha: f64, floor: f64) -> Option<Outcome> {
     if (a.blocks_x, a.blocks_y) != (b.blocks_x, b.blocks_y) || a.mean.len() != b.mean.len() {
         return None;
     }
     let n = a.mean.len();
+    let mut floored = 0;
     let mut ps: Vec<(f64, usize, f64)> = (0..n)
         .map(|i| {
             let d = a.mean[i] - b.mean[i];
-            let v = a.var[i] + b.var[i];
+            let (va, dof_a) = if a.var[i] < floor * b.var[i] {
+                floored += 1;
+                (floor * b.var[i], b.dof)
+            } else {
+                (a.var[i], a.dof)
+            };
+            let v = va + b.var[i];
             if v <= 0.0 {
                 return (if d == 0.0 { 1.0 } else { 0.0 }, i, if d == 0.0 { 0.0 } else { f64::INFINITY });
             }
             let t = d / v.sqrt();
-            let dof = v * v / (a.var[i].powi(2) / a.dof + b.var[i].powi(2) / b.dof);
+            let dof = v * v / (va.powi(2) / dof_a + b.var[i].powi(2) / b.dof);
             (t_two_sided_p(t, dof), i, t)
         })
         .collect();
@@ -161,6 +187,7 @@ pub fn welch_holm(a: &Estimate, b: &Estimate, alpha: f64) -> Option<Outcome> {
         min_p,
         worst: (b_cell as u32 % a.blocks_x, b_cell as u32 / a.blocks_x, wi % 3, wt),
         mean_rel_diff: if sb != 0.0 { (sa - sb) / sb } else { 0.0 },
+        floored,
     })
 }
 
@@ -281,5 +308,33 @@ mod tests {
         let off = welch_holm(&mk(0.2), &mk(0.0), 0.01).unwrap();
         assert_eq!(off.rejected, 1);
         assert_eq!((off.worst.0, off.worst.1, off.worst.2), (1, 0, 2));
+    }
+
+    /// A cell whose frames all missed its rare bright paths: its batch
+    /// variance is far below the reference's at the same sample count, and
+    /// the floor (the reference's, scaled by the sample counts) keeps it
+    /// from being rejected; a shift beyond that variance is still rejected.
+    #[test]
+    fn the_floor_raises_an_underestimated_variance_only() {
+        let mk = |m5: f64, v5: f64| Estimate {
+            blocks_x: 4,
+            blocks_y: 1,
+            mean: (0..12).map(|i| if i == 5 { m5 } else { 1.0 }).collect(),
+            var: (0..12).map(|i| if i == 5 { v5 } else { 1e-4 }).collect(),
+            dof: 15.0,
+        };
+        // reference: variance of the mean 1e-6 at 64 times our samples
+        let reference = Estimate { var: vec![1e-6; 12], ..mk(1.0, 1e-6) };
+        // ours: 1e-4 per cell (the floor, 64e-6, is below it), cell 5 low by 0.02 with variance 1e-7
+        let ours = mk(0.98, 1e-7);
+        let plain = welch_holm(&ours, &reference, 0.01).unwrap();
+        assert_eq!((plain.rejected, plain.floored), (1, 0));
+        let floored = welch_holm_floored(&ours, &reference, 0.01, 64.0).unwrap();
+        // t = -0.02 / sqrt(64e-6 + 1e-6) = -2.48: not rejected among 12 cells
+        assert_eq!((floored.rejected, floored.floored), (0, 1));
+        assert!((floored.worst.3 + 0.02 / 65e-6f64.sqrt()).abs() < 1e-9, "{floored:?}");
+        // low by 0.1: t = -12.4 even with the floor
+        let off = welch_holm_floored(&mk(0.9, 1e-7), &reference, 0.01, 64.0).unwrap();
+        assert_eq!((off.rejected, off.floored), (1, 1));
     }
 }

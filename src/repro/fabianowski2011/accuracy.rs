@@ -448,19 +448,12 @@ pub fn run_cli(scene: &Scene, cam: &Camera, output: &std::path::Path) -> Result<
     let t = std::time::Instant::now();
     let a = measure(scene, cam, &mut |x| eprintln!("{}: {x} ({:.0} s)", scene.name, t.elapsed().as_secs_f64()))
         .map_err(|e| e.to_string())?;
-    let stem = output.with_extension("");
-    for (name, chart) in a.charts() {
-        let json = std::path::PathBuf::from(format!("{}-{name}.json", stem.display()));
-        crate::cli::write_atomically(&json, serde_json::to_string_pretty(&chart)?.as_bytes())?;
-        let svg = std::path::PathBuf::from(format!("{}-{name}.svg", stem.display()));
-        let chart = crate::chart::Chart::Scatter(chart);
-        crate::cli::write_atomically(&svg, chart.svg(chart.default_size())?.as_bytes())?;
-        println!("{}", svg.display());
-    }
-    let file = std::path::PathBuf::from(format!("{}-summary.json", stem.display()));
     let mut v = serde_json::to_value(&a)?;
     v["seconds"] = serde_json::json!(t.elapsed().as_secs_f64());
-    crate::cli::write_atomically(&file, serde_json::to_string_pretty(&v)?.as_bytes())?;
+    let written = crate::chart::write_charts(&output.with_extension(""), a.charts(), &v)?;
+    for (_, svg, _) in &written.charts {
+        println!("{}", svg.display());
+    }
     for p in &a.points {
         println!(
             "{:>8} photons {:<18} k {:>7.1}  RMSE {:.4e}  rel {:.4}  {:.2} ms",
@@ -482,7 +475,7 @@ pub fn run_cli(scene: &Scene, cam: &Camera, output: &std::path::Path) -> Result<
         100.0 * a.reference_noise.1,
         a.reference_knn.0,
         a.reference_knn.1,
-        file.display(),
+        written.summary.display(),
         t.elapsed().as_secs_f64()
     );
     Ok(())

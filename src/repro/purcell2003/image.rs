@@ -310,7 +310,7 @@ pub fn run_cli(
     }
     if let Some(j) = &a.json {
         let chart = convergence_chart(&scene.name, &r);
-        crate::cli::write_atomically(j, serde_json::to_string_pretty(&chart)?.as_bytes())?;
+        crate::files::write_atomically(j, serde_json::to_string_pretty(&chart)?.as_bytes())?;
         println!("convergence chart data: {}", j.display());
     }
     println!("{:.1} s", t.elapsed().as_secs_f64());
@@ -347,15 +347,6 @@ pub fn run_error_charts(
         eprintln!("{}: {x} ({:.0} s)", scene.name, t.elapsed().as_secs_f64());
     })
     .map_err(|e| e.to_string())?;
-    let stem = a.output.with_extension("");
-    for (name, chart) in [("photons", &c.photons), ("time", &c.time), ("passes", &c.passes)] {
-        let json = std::path::PathBuf::from(format!("{}-{name}.json", stem.display()));
-        crate::cli::write_atomically(&json, serde_json::to_string_pretty(chart)?.as_bytes())?;
-        let svg = std::path::PathBuf::from(format!("{}-{name}.svg", stem.display()));
-        let chart = crate::chart::Chart::Scatter(chart.clone());
-        crate::cli::write_atomically(&svg, chart.svg(chart.default_size())?.as_bytes())?;
-        println!("{}: {} and {}", chart.title(), svg.display(), json.display());
-    }
     let (emitted, stored, k) = c.reference;
     let summary = serde_json::json!({
         "scene": scene.name,
@@ -369,8 +360,12 @@ pub fn run_error_charts(
         "settling": c.settling,
         "seconds": t.elapsed().as_secs_f64(),
     });
-    let file = std::path::PathBuf::from(format!("{}-summary.json", stem.display()));
-    crate::cli::write_atomically(&file, serde_json::to_string_pretty(&summary)?.as_bytes())?;
+    let charts = [("photons", c.photons.clone()), ("time", c.time.clone()), ("passes", c.passes.clone())];
+    let written = crate::chart::write_charts(&a.output.with_extension(""), charts, &summary)?;
+    for (title, svg, json) in &written.charts {
+        println!("{title}: {} and {}", svg.display(), json.display());
+    }
+    let file = written.summary;
     println!(
         "reference: {emitted} emitted, {stored} stored, k = {k}; against a second reference {:.4}, \
          a quarter of the photons and half the k {:.4}; summary {}; {:.1} s",
