@@ -17,15 +17,22 @@
 //!   16-byte aligned, else 8 where 8-byte aligned.
 //! - **Alignment** comes from a trailing-zero analysis of the registers
 //!   (flow-insensitive, every definition of a register considered): shared
-//!   variables' offsets in warplight's layout, immediates, `shl` by a
-//!   constant, `mul`/`mad` (zeros add up), `add`/`sub`/`or` (the fewer), `and`
-//!   (the more), moves and conversions keep them; anything loaded or
-//!   special is unaligned. A register stepped round a loop (`add %r, %r, k`)
-//!   is as aligned as its first value and its step (ptxas merges there:
-//!   `kernels/validation/loop_stepped.cu`). A shared variable's address is
-//!   aligned to its `.align` or to the largest power of two dividing its
-//!   size, whichever is more (ptxas merges nothing at needleman_wunsch's
-//!   `temp[17][17]`, 1,156 bytes, though warplight places it at 0).
+//!   variables' offsets, immediates, `shl` by a constant, `mul`/`mad` (zeros
+//!   add up), `add`/`sub`/`or` (the fewer), `and` (the more), `neg`, moves
+//!   and conversions keep them; anything loaded or special is unaligned. A
+//!   64-bit `sub` whose subtracted operand is not a constant (an immediate
+//!   or a register only ever set to one), and a 64-bit `neg`, give no
+//!   alignment; 32-bit ones keep it (ptxas 13.5: `arr - 64 tid` in 64 bits
+//!   is two `LDS`, in 32 bits, or as `arr + (-64 tid)`, one `LDS.64`). A
+//!   register stepped round a loop (`add`/`sub %r, %r, k`) is as aligned as
+//!   its first value and its step (`kernels/validation/loop_stepped.cu`). A
+//!   shared variable is as aligned as its offset in ptxas's layout of the
+//!   kernel: the variables the function names, in declaration order, each at
+//!   its `.align` (not warplight's layout of the whole module). The evidence
+//!   (`docs/validation.md`, "Vectorisation: the alignment rule"):
+//!   `tests/fixtures/validation/vectorize_probes.sass` (ptxas 13.5),
+//!   `loop_stepped.*.sass` and the suite (ptxas 13.0, needleman_wunsch's
+//!   `sub.s64` base: no `LDS.64`).
 //! - **Repeated loads.** A shared load of the same base register (same
 //!   definition), offset and width as an earlier load of the same run is
 //!   dropped (ptxas reuses the register): not counted.
@@ -106,8 +113,7 @@ impl Plan {
 
     /// Plans every function of `prog`.
     pub fn new(prog: &Program) -> Plan {
-        let vars = shared_var_alignment(prog);
-        Plan { actions: prog.functions.iter().map(|f| plan_function(f, &vars)).collect() }
+        Plan { actions: prog.functions.iter().map(|f| plan_function(f, &shared_var_alignment(prog, f))).collect() }
     }
 }
 
@@ -182,20 +188,27 @@ fn tz_imm(v: u64) -> u32 {
     v.trailing_zeros()
 }
 
-/// The shared variables whose address ptxas knows less aligned than
-/// warplight's layout makes it: (offset, known trailing zeros). ptxas counts
-/// a variable aligned to its `.align` or to the largest power of two that
-/// divides its size, whichever is more, and no more than 16 bytes matter
-/// here (`As[256]`, `.align 4`, is 16-byte aligned to it: `LDS.128`;
-/// needleman_wunsch's `temp[17][17]`, 1,156 bytes, only 4-byte aligned: no
-/// `LDS.64`; docs/validation.md).
-fn shared_var_alignment(prog: &Program) -> Vec<(u64, u32)> {
-    prog.shared_vars
-        .iter()
-        .filter(|v| v.size > 0)
-        .map(|v| (v.offset as u64, v.align.trailing_zeros().max(v.size.trailing_zeros())))
-        .filter(|&(_, tz)| tz < 4)
-        .collect()
+/// The shared variables `f` names, with the alignment ptxas knows their
+/// addresses by: (warplight's offset, trailing zeros of the offset in
+/// ptxas's layout). ptxas lays out only the variables a kernel uses, in
+/// declaration order, each at its `.align`, from a base aligned far beyond
+/// 16 bytes, and knows the offsets (ptxas 13.5: an unused 4-byte array
+/// declared first takes no room; a `.align 4` array of 1,024 bytes after
+/// one of 1,156 sits at 0x484 and is not read as `LDS.64`; a `.align 4`
+/// array of 1,156 bytes first is;
+/// `tests/fixtures/validation/vectorize_probes.sass`). Warplight's own
+/// layout holds every variable of the module, so its offsets can be
+/// aligned otherwise.
+fn shared_var_alignment(prog: &Program, f: &Function) -> Vec<(u64, u32)> {
+    let mut off: u64 = 0;
+    let mut out = Vec::new();
+    for v in prog.shared_vars.iter().filter(|v| v.size > 0 && f.shared_refs.contains(&v.offset)) {
+        let align = u64::from(v.align.max(1));
+        off = off.div_ceil(align).saturating_mul(align);
+        out.push((u64::from(v.offset), tz_imm(off)));
+        off = off.saturating_add(u64::from(v.size));
+    }
+    out
 }
 
 /// Known trailing zeros of every data register of `f` (see the module
@@ -204,9 +217,21 @@ fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
     let n = f.reg_masks.len();
     let mut tz = vec![64u32; n];
     let width = |r: RegId| f.reg_masks.get(r as usize).map_or(64, |m| m.count_ones());
-    // the variables this function names
-    let vars: Vec<(u64, u32)> =
-        vars.iter().filter(|v| f.shared_refs.iter().any(|&o| o as u64 == v.0)).copied().collect();
+    // registers every definition of which moves an immediate into them
+    let mut constant = vec![true; n];
+    for inst in &f.insts {
+        let imm = matches!(inst.kind, Kind::Mov { a: Src::Imm(_), .. });
+        for r in inst.kind.writes() {
+            if let Some(c) = constant.get_mut(r as usize) {
+                *c &= imm;
+            }
+        }
+    }
+    let is_constant = |s: &Src| match s {
+        Src::Imm(_) => true,
+        Src::Reg(r) => constant.get(*r as usize).copied().unwrap_or(false),
+        _ => false,
+    };
     loop {
         let mut changed = false;
         for inst in &f.insts {
@@ -218,7 +243,7 @@ fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
             // a shared variable's address (an immediate in warplight's
             // layout) as aligned as ptxas knows it
             let var = |s: &Src, tz: &[u32]| match s {
-                Src::Imm(v) => vars.iter().find(|x| x.0 == *v).map_or(tz_imm(*v), |x| x.1.min(tz_imm(*v))),
+                Src::Imm(v) => vars.iter().find(|x| x.0 == *v).map_or(tz_imm(*v), |x| x.1),
                 _ => of(s, tz),
             };
             let (regs, value): (Vec<RegId>, u32) = match &inst.kind {
@@ -226,6 +251,12 @@ fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
                 Kind::Cvt { d, a, dty, sty, .. } if !dty.is_float() && !sty.is_float() => (vec![d.reg], of(a, &tz)),
                 Kind::Cvta { d, a, .. } => (vec![d.reg], var(a, &tz)),
                 Kind::Selp { d, a, b, .. } => (vec![d.reg], of(a, &tz).min(of(b, &tz))),
+                // ptxas 13.5 keeps no alignment through a 64-bit `sub` of a
+                // non-constant or a 64-bit `neg` (32-bit ones keep it)
+                Kind::Arith { op: ArithOp::Sub, d, b, ty, .. } if ty.bytes() == 8 && !is_constant(b) => {
+                    (vec![d.reg], 0)
+                }
+                Kind::Arith { op: ArithOp::Neg, d, ty, .. } if ty.bytes() == 8 && !ty.is_float() => (vec![d.reg], 0),
                 Kind::Arith { op, d, a, b, c, ty, .. } if !ty.is_float() => {
                     let (a, b, c) = (of(a, &tz), of(b, &tz), of(c, &tz));
                     let v = match op {
