@@ -6,8 +6,9 @@
 //! `tools/device/tex_filter_host.cu` (the fixture maker checked the GPU's
 //! texels against it), the coordinates and results from the fixture.
 //!
-//! `f32`, `f16`, `u8`, `u16`, `s8` and `s16` texels in 1-D and 2-D, and `u8`
-//! and `s8` ones in 3-D, filter bit for bit as the H200 does (`docs/semantics.md`:
+//! `f32`, `f16`, `u8` and `s8` texels in 1-D and 2-D, `u16` and `s16` ones in
+//! 2-D (the only measured), and `u8` and `s8` ones in 3-D, filter bit for bit
+//! as the H200 does (`docs/semantics.md`:
 //! weights split in 256ths, float texels aligned to the largest and the sum
 //! rounded ties away, normalized integers summed in 16-bit fixed point);
 //! float 3-D textures are bit for bit but for the listed channels

@@ -331,8 +331,8 @@ fn round_ties_away(m: i128, k: i32, p: u32) -> f32 {
 /// `S = Σ w·v` (8 fractional bits) scaled by `1 + 2^-7 + 2^-15` (for the
 /// exact `32767 / 32512`) with the small part taken from `S` cut to a
 /// multiple of 16: `n = S + round(floor(S / 16) · 257 / 2048)`. All bit for
-/// bit on the H200 (`u8` in 1-D, 2-D and 3-D; `u16`, `s16`, `s8` in 2-D;
-/// `s8` in 1-D under border).
+/// bit on the H200 (`u8` and `s8` in 1-D, 2-D and 3-D; `u16` and `s16` in
+/// 2-D, the only ones measured).
 fn filter_normalized(terms: &[(i64, i64)], format: TexelFormat) -> f32 {
     let sum = |k: i64| terms.iter().map(|&(w, v)| w * v * k).sum::<i64>();
     match format {
