@@ -870,6 +870,33 @@ mod tests {
         assert_eq!((stats.totals.stores.global, stats.totals.loads.global), (6, 0));
     }
 
+    /// The fast paths' common precondition, edge by edge: no active lane, a
+    /// size that is not a power of two, one misaligned active lane (an
+    /// inactive one does not matter), and a `.v4` of words whose first lane
+    /// is 16-aligned but whose last is only 8-aligned decline; otherwise the
+    /// span is the active lanes' lowest and highest address and the whole
+    /// access's size.
+    #[test]
+    fn aligned_span_declines_exactly_the_unaligned_warps() {
+        use super::aligned_span;
+        let mut a = [0u64; 32];
+        for (l, x) in a.iter_mut().enumerate() {
+            *x = 0x1000 + 16 * l as u64;
+        }
+        assert_eq!(aligned_span(4, 1, &a, 0), None, "no active lane");
+        assert_eq!(aligned_span(4, 3, &a, u32::MAX), None, "12 bytes: not a power of two");
+        assert_eq!(aligned_span(4, 1, &a, 1 << 7), Some((0x1070, 0x1070, 4)), "one lane");
+        assert_eq!(aligned_span(4, 4, &a, u32::MAX), Some((0x1000, 0x11f0, 16)), "a .v4 of words");
+        let mut b = a;
+        b[31] += 8;
+        assert_eq!(aligned_span(4, 4, &b, u32::MAX), None, "the last lane only 8-aligned");
+        assert_eq!(aligned_span(4, 4, &b, u32::MAX >> 1), Some((0x1000, 0x11e0, 16)), "lane 31 inactive");
+        assert_eq!(aligned_span(4, 2, &b, u32::MAX), Some((0x1000, 0x11f8, 8)), "a pair: 8-aligned suffices");
+        b[3] += 2;
+        assert_eq!(aligned_span(2, 1, &b, 1 << 3), Some((0x1032, 0x1032, 2)), "a half-word at 2");
+        assert_eq!(aligned_span(4, 1, &b, 1 << 3 | 1), None, "a word at 2");
+    }
+
     /// A lane whose local access is misaligned or out of bounds makes the
     /// per-warp path decline: the per-lane path reports that lane, in the
     /// space and at the address (the local offset) it did before.
