@@ -310,20 +310,30 @@ impl Tracer<'_> {
         (xyz(&cam.pos, 0), fwd.add(right.scale(cx)).add(up.scale(cy)).normalize())
     }
 
+    /// A point on a light, chosen as next-event estimation and bdpt's light
+    /// subpath both choose it (the kernel's code at both places): the light
+    /// by the cumulative areas in `lights[i][3]` from dimension `dim`, the
+    /// point uniform on its triangle from `dim + 1` and `dim + 2`. Needs a
+    /// light.
+    fn light_point(&self, key: u32, dim: u32) -> (&[f32; 12], V3) {
+        let lights = &self.scene.lights;
+        let yl = rng(key, dim);
+        let mut li = 0usize;
+        while li + 1 < lights.len() && !(yl < lights[li][3]) {
+            li += 1;
+        }
+        let lg = &lights[li];
+        let su = rng(key, dim + 1).sqrt();
+        let yv = rng(key, dim + 2);
+        let (bu, bv) = (su * (1.0 - yv), su * yv);
+        (lg, xyz(lg, 0).add(xyz(lg, 4).scale(bu)).add(xyz(lg, 8).scale(bv)))
+    }
+
     /// The light subpath of `key` (at most `nl` vertices): the kernel's `light_subpath`.
     fn light_subpath(&self, key: u32, nl: usize, c: &mut Counts) -> Vec<LightVertex> {
         let s = self.scene;
         let eps = self.frame.eps;
-        let yl = rng(key, DIMS_LIGHT);
-        let mut li = 0usize;
-        while li + 1 < s.lights.len() && !(yl < s.lights[li][3]) {
-            li += 1;
-        }
-        let lg = &s.lights[li];
-        let su = rng(key, DIMS_LIGHT + 1).sqrt();
-        let yv = rng(key, DIMS_LIGHT + 2);
-        let (bu, bv) = (su * (1.0 - yv), su * yv);
-        let mut o = xyz(lg, 0).add(xyz(lg, 4).scale(bu)).add(xyz(lg, 8).scale(bv));
+        let (lg, mut o) = self.light_point(key, DIMS_LIGHT);
         let ld = s.tri_data[lg[7].to_bits() as usize];
         let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
         let mut alpha = le.scale(s.light_area);
@@ -503,16 +513,7 @@ impl Tracer<'_> {
             let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
             let sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
             if sampled_light && integrator != Integrator::Pt && !s.lights.is_empty() && bounce < p.max_bounces {
-                let yl = rng(key, dim);
-                let mut li = 0usize;
-                while li + 1 < s.lights.len() && !(yl < s.lights[li][3]) {
-                    li += 1;
-                }
-                let lg = &s.lights[li];
-                let su = rng(key, dim + 1).sqrt();
-                let yv = rng(key, dim + 2);
-                let (bu, bv) = (su * (1.0 - yv), su * yv);
-                let q = xyz(lg, 0).add(xyz(lg, 4).scale(bu)).add(xyz(lg, 8).scale(bv));
+                let (lg, q) = self.light_point(key, dim);
                 let mut wl = q.sub(hitp);
                 let dist2 = wl.dot(wl);
                 let dist = dist2.sqrt();
