@@ -16,6 +16,23 @@ use super::simt_stack::{SimtEntry, SimtStack};
 use super::warp::{Frame, Warp, WarpState};
 use crate::ptx::ir::{BarRedOp, Dst, PRED_TRUE};
 
+/// The executor's view of CTA `$cta`'s state ([`CtaMut`]), borrowing its
+/// fields one by one so that the warps stay free to borrow beside it (the
+/// one place [`Cta::step`] and [`Cta::issue_ready`] build it).
+macro_rules! cta_mut {
+    ($cta:ident) => {
+        CtaMut {
+            cta_id: $cta.id,
+            cta_linear: $cta.linear,
+            shared: &mut $cta.shared,
+            counters: &mut $cta.counters,
+            profile: &mut $cta.profile,
+            pending: &mut $cta.pending,
+            observer: $cta.observer.as_mut(),
+        }
+    };
+}
+
 /// One executed warp instruction, as reported to a stepper.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Issued {
@@ -304,32 +321,19 @@ impl Cta {
                     .map(|w| (w.id, w.frame().func, w.stack.top().map(|t| t.pc.saturating_sub(1)).unwrap_or(0)))
                     .unwrap_or((0, 0, 0));
                 let f = CtaFault { kind: FaultKind::BarrierDeadlock { waiting }, warp: wi, func, pc, lane: None };
-                self.fault = Some(f.clone());
-                return Err(Box::new(f));
+                return Err(self.record_fault(f));
             }
             Err(_) => return Ok(None),
         };
         let warp = &mut self.warps[w];
         let mask = warp.stack.top().map(|t| t.mask).unwrap_or(0);
-        let mut cm = CtaMut {
-            cta_id: self.id,
-            cta_linear: self.linear,
-            shared: &mut self.shared,
-            counters: &mut self.counters,
-            profile: &mut self.profile,
-            pending: &mut self.pending,
-            observer: self.observer.as_mut(),
-        };
+        let mut cm = cta_mut!(self);
         let (func, pc, r) = exec::step(ctx, warp, &mut cm);
         self.slice_left = self.slice_left.saturating_sub(1);
         match r {
             Ok(Effect::Continue) => {}
             Ok(Effect::Blocked) => self.blocked(w, func, pc),
-            Err(e) => {
-                let f = CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane };
-                self.fault = Some(f.clone());
-                return Err(Box::new(f));
-            }
+            Err(e) => return Err(self.exec_fault(w, func, pc, *e)),
         }
         Ok(Some(Issued { warp: w as u32, func, pc, mask }))
     }
@@ -337,6 +341,21 @@ impl Cta {
     /// Why the CTA cannot issue (meaningful after `step` returned `Ok(None)`).
     pub fn stall(&self) -> Stall {
         if self.finished() { Stall::Finished } else { Stall::WaitingForRound }
+    }
+
+    /// Records the fault `e` of warp `w`'s instruction at `func`, `pc` as the
+    /// CTA's and returns it (the one place [`Cta::step`] and
+    /// [`Cta::issue_ready`] turn an instruction's fault into the CTA's).
+    #[cold]
+    fn exec_fault(&mut self, w: usize, func: u32, pc: u32, e: exec::ExecFault) -> Box<CtaFault> {
+        self.record_fault(CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane })
+    }
+
+    /// Keeps `f` as the CTA's fault and returns it.
+    #[cold]
+    fn record_fault(&mut self, f: CtaFault) -> Box<CtaFault> {
+        self.fault = Some(f.clone());
+        Box::new(f)
     }
 
     /// What follows an instruction that blocked its warp `w` (at `func`,
@@ -395,15 +414,7 @@ impl Cta {
     fn issue_ready(&mut self, ctx: &Ctx, quantum: u64) -> Result<(u64, Option<(usize, u32, u32)>), Box<CtaFault>> {
         let n_warps = self.warps.len();
         let slice = self.slice;
-        let mut cm = CtaMut {
-            cta_id: self.id,
-            cta_linear: self.linear,
-            shared: &mut self.shared,
-            counters: &mut self.counters,
-            profile: &mut self.profile,
-            pending: &mut self.pending,
-            observer: self.observer.as_mut(),
-        };
+        let mut cm = cta_mut!(self);
         let mut n = 0;
         while n < quantum {
             let mut w = self.cur;
@@ -432,11 +443,7 @@ impl Cta {
             match r {
                 Ok(Effect::Continue) => {}
                 Ok(Effect::Blocked) => return Ok((n, Some((w, func, pc)))),
-                Err(e) => {
-                    let f = CtaFault { kind: e.kind, warp: w as u32, func, pc, lane: e.lane };
-                    self.fault = Some(f.clone());
-                    return Err(Box::new(f));
-                }
+                Err(e) => return Err(self.exec_fault(w, func, pc, *e)),
             }
         }
         Ok((n, None))
