@@ -227,25 +227,30 @@ fn footprint(x: f64) -> (i64, u32) {
 /// `w00 = 256 − wx − wy + w11` (measured on 1-D and 2-D textures); in 3-D
 /// the parts of the two z slices are rounded apart, so that the weights
 /// along x and y need not sum to `wx` and `wy` (measured on a 3-D texture:
-/// the other rules tried were off by up to 2/256).
-fn corner_weights(w: &[u32]) -> Vec<i64> {
+/// the other rules tried were off by up to 2/256). The weights are the first
+/// `2^n` entries (the rest are 0).
+fn corner_weights(w: &[u32]) -> [i64; 8] {
     let n = w.len();
     // the dimensions in the order they are split: z, x, y
-    let order: Vec<usize> = if n == 3 { vec![2, 0, 1] } else { (0..n).collect() };
-    let mut parts: Vec<(usize, i64)> = vec![(0, 256)];
-    for &d in &order {
-        let mut next = Vec::with_capacity(parts.len() * 2);
-        for &(corner, v) in &parts {
+    let order: &[usize] = if n == 3 { &[2, 0, 1] } else { &[0, 1][..n] };
+    // corner `c`'s part so far at `out[c]`; splitting along `d` the parts of
+    // the corners made of the dimensions split before moves `hi` of each to
+    // `c | 1 << d` (the remaining entries stay 0)
+    let mut out = [0i64; 8];
+    out[0] = 256;
+    let mut done = 0usize;
+    for &d in order {
+        for corner in 0..1usize << n {
+            if corner & !done != 0 {
+                continue;
+            }
+            let v = out[corner];
             let tie_down = d == 1 && corner & 1 == 0;
             let hi = (v * w[d] as i64 + if tie_down { 127 } else { 128 }) >> 8;
-            next.push((corner, v - hi));
-            next.push((corner | 1 << d, hi));
+            out[corner] = v - hi;
+            out[corner | 1 << d] = hi;
         }
-        parts = next;
-    }
-    let mut out = vec![0; 1 << n];
-    for (corner, v) in parts {
-        out[corner] = v;
+        done |= 1 << d;
     }
     out
 }
@@ -274,7 +279,8 @@ fn filter_channel(terms: &[Term], p: u32) -> f32 {
         return s as f32;
     }
     // each slice's sum: `sum · 2^(g − 8)`
-    let mut slices: Vec<(i128, i32)> = Vec::with_capacity(2);
+    let mut slices = [(0i128, 0i32); 2];
+    let mut n = 0;
     for z in 0..2 {
         let slice = || terms.iter().filter(move |t| t.2 == z && t.0 != 0);
         let Some(e) = slice().filter(|t| t.1 != 0.0).map(|t| exponent(t.1 as f64)).max() else {
@@ -284,10 +290,11 @@ fn filter_channel(terms: &[Term], p: u32) -> f32 {
         let g = e - (p as i32 - 1) - 4;
         let sum: i128 = slice().map(|&(w, v, _)| w as i128 * (v as f64 * 2f64.powi(-g)).trunc() as i128).sum();
         if sum != 0 {
-            slices.push((sum, g - 8));
+            slices[n] = (sum, g - 8);
+            n += 1;
         }
     }
-    let (sum, k) = match slices[..] {
+    let (sum, k) = match slices[..n] {
         [] => return 0.0,
         [one] => one,
         [a, b] => add_exact(a, b),
@@ -370,31 +377,29 @@ fn one_texel(t: &TextureDesc, d: usize, i: i64) -> bool {
 
 /// `tex` with float coordinates (`dims` of them used).
 pub fn sample(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [f32; 3], dims: usize) -> [u32; 4] {
-    let x: Vec<f64> = (0..dims).map(|d| texel_coord(coords[d], size(t.dims, d), t.normalized)).collect();
+    let mut x = [0f64; 3];
+    for d in 0..dims {
+        x[d] = texel_coord(coords[d], size(t.dims, d), t.normalized);
+    }
     if t.filter == FilterMode::Point {
-        let mut idx = [0i64; 3];
-        for d in 0..dims {
-            idx[d] = x[d].floor() as i64;
-        }
-        return fetch(t, read, idx);
+        return fetch(t, read, x.map(|v| v.floor() as i64));
     }
     // A 1-D texture filters as a 2-D one of height 1 sampled at y = 0: the
     // footprint's other row is row -1, which the border mode reads as zeros
     // (so the H200 returns about half the value there).
-    let mut x = x;
-    let dims = if dims == 1 {
-        x.push(0.0);
-        2
-    } else {
-        dims
-    };
-    let fp: Vec<(i64, u32)> = x.iter().map(|&v| footprint(v)).collect();
-    let ws: Vec<u32> = fp.iter().enumerate().map(|(d, f)| if one_texel(t, d, f.0) { 0 } else { f.1 }).collect();
+    let dims = if dims == 1 { 2 } else { dims };
+    let fp = x.map(footprint);
+    let mut ws = [0u32; 3];
+    for d in 0..dims {
+        ws[d] = if one_texel(t, d, fp[d].0) { 0 } else { fp[d].1 };
+    }
     // normalized integer texels filter from their stored integers
     let normalized = t.read == ReadMode::NormalizedFloat && t.format.is_small_int();
     let stored = TextureDesc { read: ReadMode::ElementType, ..t.clone() };
-    let mut texels: Vec<(i64, [u32; 4], usize)> = Vec::with_capacity(8);
-    for (corner, w) in corner_weights(&ws).into_iter().enumerate() {
+    // the texels that weigh something: weight, value, z slice
+    let mut texels = [(0i64, [0u32; 4], 0usize); 8];
+    let mut n = 0;
+    for (corner, w) in corner_weights(&ws[..dims]).into_iter().enumerate().take(1 << dims) {
         if w == 0 {
             continue;
         }
@@ -403,16 +408,24 @@ pub fn sample(t: &TextureDesc, read: &dyn Fn(u64, u32) -> u64, coords: [f32; 3],
             idx[d] = fp[d].0 + (corner >> d & 1) as i64;
         }
         let v = fetch(if normalized { &stored } else { t }, read, idx);
-        texels.push((w, v, corner >> 2 & 1));
+        texels[n] = (w, v, corner >> 2 & 1);
+        n += 1;
     }
+    let texels = &texels[..n];
     let mut out = [0u32; 4];
     for (c, o) in out.iter_mut().enumerate() {
         *o = if normalized {
-            let ch: Vec<(i64, i64)> = texels.iter().map(|(w, v, _)| (*w, stored_int(t, c, v[c]))).collect();
-            filter_normalized(&ch, t.format).to_bits()
+            let mut ch = [(0i64, 0i64); 8];
+            for (k, (w, v, _)) in texels.iter().enumerate() {
+                ch[k] = (*w, stored_int(t, c, v[c]));
+            }
+            filter_normalized(&ch[..n], t.format).to_bits()
         } else {
-            let ch: Vec<Term> = texels.iter().map(|(w, v, z)| (*w, f32::from_bits(v[c]), *z)).collect();
-            filter_channel(&ch, filter_precision(t.format)).to_bits()
+            let mut ch: [Term; 8] = [(0, 0.0, 0); 8];
+            for (k, (w, v, z)) in texels.iter().enumerate() {
+                ch[k] = (*w, f32::from_bits(v[c]), *z);
+            }
+            filter_channel(&ch[..n], filter_precision(t.format)).to_bits()
         };
     }
     out
@@ -643,9 +656,9 @@ mod tests {
     #[test]
     fn corner_weights_round_the_product_and_sum_to_one() {
         // 1-D: the two weights
-        assert_eq!(corner_weights(&[3]), vec![253, 3]);
+        assert_eq!(corner_weights(&[3])[..2], [253, 3]);
         // 2-D: w11 = round(232 · 176 / 256) = round(159.5) = 160 (half up)
-        assert_eq!(corner_weights(&[232, 176]), vec![8, 72, 16, 160]);
+        assert_eq!(corner_weights(&[232, 176])[..4], [8, 72, 16, 160]);
         for ws in [[0u32, 0], [255, 255], [1, 128], [77, 200]] {
             let c = corner_weights(&ws);
             assert_eq!(c.iter().sum::<i64>(), 256, "{ws:?}");
@@ -706,10 +719,49 @@ mod tests {
         assert_eq!(filter_normalized(&[(2, 3), (254, 68)], S8), 17413.0 / 32767.0);
     }
 
+    /// The split as a list of parts (the definition the in-place
+    /// [`corner_weights`] replaced): every part splits into its first and
+    /// its second texel's share along each dimension in turn.
+    fn corner_weights_by_parts(w: &[u32]) -> Vec<i64> {
+        let n = w.len();
+        let order: Vec<usize> = if n == 3 { vec![2, 0, 1] } else { (0..n).collect() };
+        let mut parts: Vec<(usize, i64)> = vec![(0, 256)];
+        for &d in &order {
+            let mut next = Vec::new();
+            for &(corner, v) in &parts {
+                let tie_down = d == 1 && corner & 1 == 0;
+                let hi = (v * w[d] as i64 + if tie_down { 127 } else { 128 }) >> 8;
+                next.push((corner, v - hi));
+                next.push((corner | 1 << d, hi));
+            }
+            parts = next;
+        }
+        let mut out = vec![0; 1 << n];
+        for (corner, v) in parts {
+            out[corner] = v;
+        }
+        out
+    }
+
+    #[test]
+    fn corner_weights_in_place_are_the_split_of_parts() {
+        let ws = [0u32, 1, 2, 77, 127, 128, 129, 200, 254, 255];
+        for &a in &ws {
+            assert_eq!(corner_weights(&[a])[..2], corner_weights_by_parts(&[a])[..], "{a}");
+            assert!(corner_weights(&[a])[2..].iter().all(|&v| v == 0));
+            for &b in &ws {
+                assert_eq!(corner_weights(&[a, b])[..4], corner_weights_by_parts(&[a, b])[..], "{a} {b}");
+                for &c in &ws {
+                    assert_eq!(corner_weights(&[a, b, c])[..], corner_weights_by_parts(&[a, b, c])[..], "{a} {b} {c}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn three_d_weights_split_z_then_x_then_y() {
         // measured on the H200: wx, wy, wz = 165, 202, 127 (corner = x + 2y + 4z)
-        assert_eq!(corner_weights(&[165, 202, 127]), vec![10, 18, 36, 65, 9, 17, 36, 65]);
+        assert_eq!(corner_weights(&[165, 202, 127]), [10, 18, 36, 65, 9, 17, 36, 65]);
         for ws in [[0u32, 0, 0], [255, 255, 255], [1, 128, 77], [64, 105, 26]] {
             let c = corner_weights(&ws);
             assert_eq!(c.iter().sum::<i64>(), 256, "{ws:?}");
