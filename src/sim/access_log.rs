@@ -32,7 +32,8 @@ pub struct Access {
     pub elem_bytes: u32,
     /// Lanes taking part.
     pub mask: u32,
-    /// Per-lane addresses (local memory: the thread's own offset).
+    /// Per-lane addresses (local memory: the thread's own offset); 0 for the
+    /// lanes outside `mask`.
     pub addrs: [u64; 32],
 }
 
@@ -71,7 +72,8 @@ impl MemObserver for Recorder {
             bytes: ev.bytes,
             elem_bytes: ev.elem_bytes,
             mask: ev.mask,
-            addrs: *ev.addrs,
+            // the event's entries outside its mask are not the lanes' own
+            addrs: std::array::from_fn(|l| if ev.mask >> l & 1 != 0 { ev.addrs[l] } else { 0 }),
         };
         self.events.lock().unwrap_or_else(|p| p.into_inner()).push(a);
     }

@@ -39,7 +39,11 @@ pub struct MemEvent<'a> {
     pub elem_bytes: u32,
     /// Lanes taking part.
     pub mask: u32,
-    /// Per-lane addresses in `space` (for local memory: the thread's own offset).
+    /// Per-lane addresses in `space` (for local memory: the thread's own
+    /// offset). Only the lanes in `mask` are meaningful: the entries of the
+    /// other lanes are whatever the executor had there (another space's
+    /// address, an inactive lane's operand), so observers read lanes of
+    /// `mask` only.
     pub addrs: &'a [u64; 32],
     /// Linear CTA index.
     pub cta: u32,

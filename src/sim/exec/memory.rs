@@ -216,27 +216,10 @@ pub(super) fn emit(
     n: u32,
     t: &Touched,
 ) {
-    let (cta_linear, warp) = (cta.cta_linear, w.id);
-    let Some(obs) = cta.observer.as_deref_mut() else { return };
-    let mut send = |space, mask| {
-        obs.access(&MemEvent {
-            func,
-            pc,
-            op,
-            space,
-            nc,
-            bytes: elem * n,
-            elem_bytes: elem,
-            mask,
-            addrs: &t.addr,
-            cta: cta_linear,
-            warp,
-        })
-    };
     if t.uniform {
         // the usual case: every lane in one space
         if let Some(space) = t.first {
-            send(space, t.lanes);
+            emit_one(cta, w, (func, pc), op, nc, elem, n, space, t.lanes, &t.addr);
         }
         return;
     }
@@ -248,13 +231,49 @@ pub(super) fn emit(
         }
         let mask = (0..32).filter(|&k| t.space[k] == Some(space)).fold(0u32, |m, k| m | 1 << k);
         done |= mask;
-        send(space, mask);
+        emit_one(cta, w, (func, pc), op, nc, elem, n, space, mask, &t.addr);
     }
 }
 
+/// Sends the observer one event: the lanes in `mask` accessed `n` elements of
+/// `elem` bytes each in `space` at `addrs` (the other lanes' entries are not
+/// theirs to read: see [`MemEvent::addrs`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn emit_one(
+    cta: &mut CtaMut,
+    w: &Warp,
+    (func, pc): (u32, u32),
+    op: MemOp,
+    nc: bool,
+    elem: u32,
+    n: u32,
+    space: MemSpace,
+    mask: u32,
+    addrs: &Lanes,
+) {
+    let (cta_linear, warp) = (cta.cta_linear, w.id);
+    let Some(obs) = cta.observer.as_deref_mut() else { return };
+    obs.access(&MemEvent {
+        func,
+        pc,
+        op,
+        space,
+        nc,
+        bytes: elem * n,
+        elem_bytes: elem,
+        mask,
+        addrs,
+        cta: cta_linear,
+        warp,
+    })
+}
+
 /// Loads (`store` = None) or stores `vals.len()` consecutive elements of `ty`
-/// for every active lane: loaded values go to `vals`, what every lane touched
-/// to `touched`. Returns the first lane's resolved space (for counting).
+/// for every active lane, lane by lane: loaded values go to `vals`, what
+/// every lane touched to `touched`. Returns the first lane's resolved space
+/// (for counting). The per-lane path: it finds the faulting lane and
+/// resolves lanes of several spaces ([`in_one`] takes the common warps).
 #[allow(clippy::too_many_arguments)]
 fn vector_access(
     ctx: &Ctx,
@@ -272,9 +291,6 @@ fn vector_access(
     let n = vals.len() as u32;
     let mut first = None;
     if space == MemSpace::Global {
-        if let Some(first) = global_in_one(ctx, ty, addrs, exec, vals, store, touched) {
-            return Ok(Some(first));
-        }
         // Global space named in the instruction: no per-lane resolution, and
         // consecutive lanes mostly hit one allocation.
         let mut last = None;
@@ -303,14 +319,6 @@ fn vector_access(
         }
         return Ok(first);
     }
-    if let Some(first) = local_in_one(w, space, ty, addrs, exec, vals, store, touched) {
-        return Ok(Some(first));
-    }
-    if space == MemSpace::FrameParam
-        && let Some(first) = params_in_one(w, ty, addrs, exec, vals, store, touched)
-    {
-        return Ok(Some(first));
-    }
     let mut m = exec;
     while m != 0 {
         let l = m.trailing_zeros() as usize;
@@ -338,45 +346,34 @@ fn vector_access(
 /// and element. Returns `None`, having touched nothing, otherwise (the
 /// per-lane path then finds the faulting lane). Values, the lanes' order
 /// (lowest lane first, its elements in order: what overlapping stores
-/// leave) and what `touched` records are those of the per-lane path: with
+/// leave) and what the observer hears (the lanes' addresses, in
+/// [`transfer`]) are those of the per-lane path: with
 /// the access aligned to its power-of-two size every element is aligned to
 /// its own, and the one allocation holding the lowest to the highest byte is
 /// the one each element's search would find (allocations do not overlap).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn global_in_one(
-    ctx: &Ctx,
-    ty: Ty,
-    addrs: &Lanes,
-    exec: u32,
-    vals: &mut [Lanes],
-    store: bool,
-    touched: &mut Touched,
-) -> Option<Resolved> {
+fn global_in_one(ctx: &Ctx, ty: Ty, addrs: &Lanes, exec: u32, vals: &mut [Lanes], store: bool) -> Option<Resolved> {
     let size = ty.bytes();
     let (lo, hi, total) = aligned_span(size, vals.len(), addrs, exec)?;
     let span = (hi - lo).checked_add(total as u64)?;
     let (al, lo_off) = ctx.mem.find(lo, span)?;
     let first = exec.trailing_zeros() as usize;
-    touched.first = Some(MemSpace::Global);
-    touched.lanes |= exec;
-    let mut m = exec;
-    while m != 0 {
-        let l = m.trailing_zeros() as usize;
-        m &= m - 1;
-        let a = addrs[l];
-        touched.space[l] = Some(MemSpace::Global);
-        touched.addr[l] = a;
-        let off = lo_off + (a - lo);
-        for (k, v) in vals.iter_mut().enumerate() {
-            let ok = off + (k as u32 * size) as u64;
-            if store {
-                al.store(ok, size, v[l] & ty.mask());
-            } else {
-                v[l] = ty.extend(al.load(ok, size));
+    lanes_in_one(
+        ty,
+        addrs,
+        exec,
+        vals,
+        store,
+        |_, a| lo_off + (a - lo),
+        |_, off, size, v| match v {
+            Some(v) => {
+                al.store(off, size, v);
+                0
             }
-        }
-    }
+            None => al.load(off, size),
+        },
+    );
     Some(Resolved::Global(addrs[first]))
 }
 
@@ -463,8 +460,8 @@ fn lane_span(addrs: &Lanes, exec: u32) -> (u64, u64, u64) {
 /// and bounding each lane and element. Returns `None`, having touched
 /// nothing, otherwise (the per-lane path then finds the faulting lane, or
 /// resolves lanes of several spaces). Values, lane and element order and
-/// what `touched` records (the local offset, not the generic address) are
-/// those of the per-lane path: the local window is aligned far beyond any
+/// what the observer hears (the local offset, not the generic address: see
+/// [`transfer`]) are those of the per-lane path: the local window is aligned far beyond any
 /// access size, so a generic address and its local offset have the same
 /// alignment; the access aligned to its power-of-two size aligns each
 /// element to its own; and every element's offset lies below the highest
@@ -480,7 +477,6 @@ fn local_in_one(
     exec: u32,
     vals: &mut [Lanes],
     store: bool,
-    touched: &mut Touched,
 ) -> Option<Resolved> {
     let window = match space {
         MemSpace::Local => 0,
@@ -497,28 +493,21 @@ fn local_in_one(
         return None;
     }
     let first = exec.trailing_zeros() as usize;
-    touched.first = Some(MemSpace::Local);
-    touched.lanes |= exec;
-    let ext = Extend::of(ty);
-    let mut lanes = |size: u32| {
-        let mut m = exec;
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let off = addrs[l] - window;
-            touched.space[l] = Some(MemSpace::Local);
-            touched.addr[l] = off;
-            for (k, v) in vals.iter_mut().enumerate() {
-                let ok = off + (k as u32 * size) as u64;
-                if store {
-                    w.local_store(l, ok, size, v[l] & ext.mask);
-                } else {
-                    v[l] = ext.apply(w.local_load(l, ok, size));
-                }
+    lanes_in_one(
+        ty,
+        addrs,
+        exec,
+        vals,
+        store,
+        |_, a| a - window,
+        |l, off, size, v| match v {
+            Some(v) => {
+                w.local_store(l, off, size, v);
+                0
             }
-        }
-    };
-    by_size(size, &mut lanes);
+            None => w.local_load(l, off, size),
+        },
+    );
     Some(Resolved::Local(addrs[first] - window))
 }
 
@@ -529,19 +518,11 @@ fn local_in_one(
 /// (`Frame::param_size`), no lane can fault and the lanes' areas are
 /// loaded or stored without checks per lane and element. Returns `None`,
 /// having touched nothing, otherwise (the per-lane path then reports the
-/// faulting lane). Values, order and what `touched` records are the
+/// faulting lane). Values, order and what the observer hears are the
 /// per-lane path's, for the reasons given at [`local_in_one`].
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn params_in_one(
-    w: &mut Warp,
-    ty: Ty,
-    addrs: &Lanes,
-    exec: u32,
-    vals: &mut [Lanes],
-    store: bool,
-    touched: &mut Touched,
-) -> Option<Resolved> {
+fn params_in_one(w: &mut Warp, ty: Ty, addrs: &Lanes, exec: u32, vals: &mut [Lanes], store: bool) -> Option<Resolved> {
     let size = ty.bytes();
     let (_, hi, total) = aligned_span(size, vals.len(), addrs, exec)?;
     let f = w.frames.last_mut().expect("frame");
@@ -551,26 +532,105 @@ fn params_in_one(
         return None;
     }
     let first = exec.trailing_zeros() as usize;
-    touched.first = Some(MemSpace::FrameParam);
-    touched.lanes |= exec;
+    let params = &mut f.params;
+    lanes_in_one(
+        ty,
+        addrs,
+        exec,
+        vals,
+        store,
+        |l, a| l as u64 * ps + a,
+        |_, off, size, v| match v {
+            Some(v) => {
+                bytes_store(params, off, size, v).expect("within the lane's area");
+                0
+            }
+            None => bytes_load(params, off, size).expect("within the lane's area"),
+        },
+    );
+    Some(Resolved::FParam(addrs[first]))
+}
+
+/// The lane loop of the per-warp paths ([`global_in_one`], [`local_in_one`],
+/// [`params_in_one`]), once their checks have shown that no lane can fault:
+/// for every active lane, lowest first, `at(lane, address)` gives the
+/// offset of its first element; its `vals.len()` elements of `ty`,
+/// `ty.bytes()` apart, are stored (`mem(lane, offset, size, Some(value
+/// masked to the type))`) or loaded (`mem(lane, offset, size, None)`,
+/// extended to the type). The loop is compiled once per access size
+/// ([`by_size`]) and the type's extension resolved once ([`Extend`]).
+#[inline(always)]
+fn lanes_in_one(
+    ty: Ty,
+    addrs: &Lanes,
+    exec: u32,
+    vals: &mut [Lanes],
+    store: bool,
+    at: impl Fn(usize, u64) -> u64,
+    mut mem: impl FnMut(usize, u64, u32, Option<u64>) -> u64,
+) {
+    let ext = Extend::of(ty);
+    // one loop per direction and, for loads, per kind of extension, so that
+    // neither is decided per lane and element
+    by_size(ty.bytes(), |size| {
+        if store {
+            each_element(exec, addrs, vals, size, &at, |l, off, v| {
+                mem(l, off, size, Some(*v & ext.mask));
+            })
+        } else if ext.signed {
+            each_element(exec, addrs, vals, size, &at, |l, off, v| *v = ext.apply(mem(l, off, size, None)))
+        } else {
+            each_element(exec, addrs, vals, size, &at, |l, off, v| *v = mem(l, off, size, None) & ext.mask)
+        }
+    });
+}
+
+/// `f(lane, offset, value)` for every active lane, lowest first, and each of
+/// its elements in order (`size` bytes apart from `at(lane, address)`).
+#[inline(always)]
+fn each_element(
+    exec: u32,
+    addrs: &Lanes,
+    vals: &mut [Lanes],
+    size: u32,
+    at: &impl Fn(usize, u64) -> u64,
+    mut f: impl FnMut(usize, u64, &mut u64),
+) {
     let mut m = exec;
     while m != 0 {
         let l = m.trailing_zeros() as usize;
         m &= m - 1;
-        let off = addrs[l];
-        touched.space[l] = Some(MemSpace::FrameParam);
-        touched.addr[l] = off;
-        let base = l as u64 * ps + off;
+        let off = at(l, addrs[l]);
         for (k, v) in vals.iter_mut().enumerate() {
-            let ok = base + (k as u32 * size) as u64;
-            if store {
-                bytes_store(&mut f.params, ok, size, v[l] & ty.mask()).expect("within the lane's area");
-            } else {
-                v[l] = ty.extend(bytes_load(&f.params, ok, size).expect("within the lane's area"));
-            }
+            f(l, off + (k as u32 * size) as u64, &mut v[l]);
         }
     }
-    Some(Resolved::FParam(addrs[first]))
+}
+
+/// The per-warp paths: the whole warp's access at once when no lane can
+/// fault and every lane resolves to one space ([`global_in_one`],
+/// [`local_in_one`], [`params_in_one`]); `None`, having touched nothing,
+/// otherwise (the per-lane [`vector_access`] then runs). Returns the space
+/// the lanes resolved to with the first active lane's address in it, as
+/// the per-lane path's first lane would.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn in_one(
+    ctx: &Ctx,
+    w: &mut Warp,
+    space: MemSpace,
+    ty: Ty,
+    addrs: &Lanes,
+    exec: u32,
+    vals: &mut [Lanes],
+    store: bool,
+) -> Option<Resolved> {
+    match space {
+        MemSpace::Global => global_in_one(ctx, ty, addrs, exec, vals, store),
+        MemSpace::Local | MemSpace::Generic => local_in_one(w, space, ty, addrs, exec, vals, store),
+        MemSpace::FrameParam => params_in_one(w, ty, addrs, exec, vals, store),
+        _ => None,
+    }
 }
 
 /// Vector accesses must be aligned to their whole size.
@@ -652,14 +712,29 @@ pub(super) fn transfer(
     exec: u32,
     vals: &mut [Lanes],
 ) -> Result<(), Box<ExecFault>> {
+    let (elem, n) = (ty.bytes(), vals.len() as u32);
+    let op = if store { MemOp::Store } else { MemOp::Load };
+    if let Some(r) = in_one(ctx, w, space, ty, addrs, exec, vals, store) {
+        // one space for every active lane: one event, at the instruction's own
+        // addresses (less the window for a generic local access), with
+        // nothing recorded per lane
+        count_space(if store { &mut cta.counters.stores } else { &mut cta.counters.loads }, r);
+        let offsets;
+        let at = if space == MemSpace::Generic {
+            offsets = addrs.map(|a| a.wrapping_sub(LOCAL_WINDOW));
+            &offsets
+        } else {
+            addrs
+        };
+        emit_one(cta, w, (func, pc), op, nc, elem, n, r.space(), exec, at);
+        return Ok(());
+    }
     let mut touched = Touched::new();
     let first = vector_access(ctx, w, cta.shared, space, ty, addrs, exec, vals, store, &mut touched)?;
-    let (counts, op) =
-        if store { (&mut cta.counters.stores, MemOp::Store) } else { (&mut cta.counters.loads, MemOp::Load) };
     if let Some(r) = first {
-        count_space(counts, r);
+        count_space(if store { &mut cta.counters.stores } else { &mut cta.counters.loads }, r);
     }
-    emit(cta, w, func, pc, op, nc, ty.bytes(), vals.len() as u32, &touched);
+    emit(cta, w, func, pc, op, nc, elem, n, &touched);
     Ok(())
 }
 
@@ -895,6 +970,101 @@ mod tests {
         b[3] += 2;
         assert_eq!(aligned_span(2, 1, &b, 1 << 3), Some((0x1032, 0x1032, 2)), "a half-word at 2");
         assert_eq!(aligned_span(4, 1, &b, 1 << 3 | 1), None, "a word at 2");
+    }
+
+    /// A warp of one frame whose parameter area is `param_size` bytes a lane,
+    /// with `local_top` bytes of local memory a thread.
+    fn warp(local_top: u32, param_size: u32) -> crate::sim::warp::Warp {
+        use crate::sim::simt_stack::{SimtEntry, SimtStack};
+        use crate::sim::warp::{Frame, Warp, WarpState};
+        let frame = Frame {
+            func: 0,
+            regs: Vec::new(),
+            preds: vec![0, u32::MAX],
+            params: vec![0; param_size as usize * 32],
+            param_size,
+            local_base: 0,
+            stack_base: 0,
+            call_pc: 0,
+            returned: 0,
+        };
+        let mut w = Warp {
+            id: 0,
+            frames: vec![frame],
+            stack: SimtStack { entries: vec![SimtEntry { pc: 0, rpc: 0, mask: u32::MAX }] },
+            lanes: u32::MAX,
+            live: u32::MAX,
+            state: WarpState::Ready,
+            local: Vec::new(),
+            local_top,
+            frame_pool: Vec::new(),
+            bar_red: None,
+        };
+        w.ensure_local(local_top);
+        w
+    }
+
+    /// The per-warp local and parameter paths at the edge of what a thread
+    /// has: an access whose last byte is the last of `local_top` (or of the
+    /// lane's parameter area) takes the path (`Some`, with the first
+    /// lane's local offset) and loads what was stored; one element further
+    /// (the access ending one word past the edge) declines (`None`) and
+    /// stores nothing. Scalars and pairs, local and generic addresses.
+    #[test]
+    fn per_warp_local_and_parameter_paths_end_exactly_at_the_edge() {
+        use super::{Resolved, local_in_one, params_in_one};
+        use crate::ptx::ir::MemSpace;
+        use crate::ptx::types::Ty;
+        const TOP: u32 = 64;
+        for n in [1usize, 2] {
+            let size = 4 * n as u64;
+            for (space, window) in [(MemSpace::Local, 0), (MemSpace::Generic, LOCAL_WINDOW)] {
+                // lane l at offset 8 * (l % 4): lane 3's access the highest
+                for (last, fits) in [(TOP as u64 - size, true), (TOP as u64 - size + 4 * n as u64, false)] {
+                    let mut w = warp(TOP, 0);
+                    let mut addrs = [0u64; 32];
+                    for (l, a) in addrs.iter_mut().enumerate() {
+                        *a = window + if l % 4 == 3 { last } else { 8 * (l % 4) as u64 };
+                    }
+                    let exec = 0xF0F0_F0F0 | 0x8888_8888;
+                    let mut vals = [[0u64; 32]; 2];
+                    for (k, v) in vals.iter_mut().enumerate() {
+                        *v = std::array::from_fn(|l| (l * 10 + k) as u64);
+                    }
+                    let st = local_in_one(&mut w, space, Ty::U32, &addrs, exec, &mut vals[..n], true);
+                    assert_eq!(st.is_some(), fits, "{space:?} n {n} last {last}");
+                    if !fits {
+                        assert!(w.local.iter().all(|&x| x == 0), "nothing stored");
+                        continue;
+                    }
+                    assert_eq!(st, Some(Resolved::Local(addrs[exec.trailing_zeros() as usize] - window)));
+                    let mut back = [[0u64; 32]; 2];
+                    let ld = local_in_one(&mut w, space, Ty::U32, &addrs, 1 << 3, &mut back[..n], false);
+                    assert!(ld.is_some());
+                    // each lane's local memory is its own
+                    for k in 0..n {
+                        assert_eq!(back[k][3], vals[k][3], "element {k}");
+                    }
+                }
+            }
+            // the parameter area: 16 bytes a lane
+            for (last, fits) in [(16 - size, true), (16 - size + 4 * n as u64, false)] {
+                let mut w = warp(0, 16);
+                let mut addrs = [0u64; 32];
+                addrs[5] = last;
+                let mut vals = [[7u64; 32]; 2];
+                let st = params_in_one(&mut w, Ty::U32, &addrs, 1 << 5 | 1, &mut vals[..n], true);
+                assert_eq!(st.is_some(), fits, "param n {n} last {last}");
+                if fits {
+                    assert_eq!(st, Some(Resolved::FParam(0)));
+                    let p = &w.frames[0].params;
+                    assert_eq!(p[5 * 16 + last as usize], 7, "lane 5's own area");
+                    assert_eq!(p[16 + last as usize], 0, "not lane 1's");
+                } else {
+                    assert!(w.frames[0].params.iter().all(|&b| b == 0), "nothing stored");
+                }
+            }
+        }
     }
 
     /// A lane whose local access is misaligned or out of bounds makes the
