@@ -409,6 +409,11 @@ fn compact_form(i: &Inst, fz: Option<&Fused>, sfu: SfuModel, consts: &mut Consts
             let (d, a, b) = (Dest::of(*d)?, consts.opnd(*a)?, consts.opnd(*b)?);
             Exec::Lanes { f, d, a, b, c: if reads_c { consts.opnd(*c)? } else { a } }
         }
+        Kind::Cvt { dty, sty, mode, d, a } => {
+            let f = resolve_cvt(*dty, *sty, *mode)?;
+            let a = consts.opnd(*a)?;
+            Exec::Lanes { f, d: Dest::of(*d)?, a, b: a, c: a }
+        }
         Kind::Mov { d, a } => Exec::Mov { d: Dest::of(*d)?, a: consts.opnd(*a)? },
         Kind::Selp { d, a, b, p } => Exec::Selp { d: Dest::of(*d)?, a: consts.opnd(*a)?, b: consts.opnd(*b)?, p: *p },
         Kind::Setp { cmp, ty, p, q, a, b, comb: None, ftz } if !matches!(ty, Ty::F16x2 | Ty::BF16x2) => Exec::Setp {
@@ -650,6 +655,39 @@ pub fn resolve_arith(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Opt
     Some((f, false))
 }
 
+lanefn2!(zext32, |x, _y| x & 0xFFFF_FFFF);
+lanefn2!(sext32, |x, _y| x as u32 as i32 as i64 as u64);
+lanefn2!(f32_from_s32, |x, _y| (x as u32 as i32 as f32).to_bits() as u64);
+lanefn2!(f32_from_u32, |x, _y| (x as u32 as f32).to_bits() as u64);
+// `as` truncates toward zero and saturates, NaN to 0: `cvt`'s rules
+lanefn2!(s32_floor_f32, |x, _y| f32::from_bits(x as u32).floor() as i32 as i64 as u64);
+lanefn2!(s32_trunc_f32, |x, _y| f32::from_bits(x as u32) as i32 as i64 as u64);
+
+/// The 32-lane function of the frequent `cvt` forms (the kernels' index
+/// widening and narrowing, integer to float, float to integer rounding
+/// down or toward zero): `dty.extend(alu::cvt(dty, sty, mode, a))` per lane,
+/// the value the interpreted `cvt` writes. `None` for the rest
+/// (saturation, `.ftz`, other types and roundings: interpreted).
+pub fn resolve_cvt(dty: Ty, sty: Ty, mode: FloatMode) -> Option<LaneFn> {
+    use Ty as T;
+    if mode.sat || mode.ftz {
+        return None;
+    }
+    let int = mode.rnd.is_none();
+    let nearest = matches!(mode.rnd, None | Some(Rounding::Rn));
+    Some(match (dty, sty) {
+        (T::U64 | T::S64 | T::B64, T::U32 | T::B32) if int => zext32,
+        (T::U64 | T::S64 | T::B64, T::S32) if int => sext32,
+        (T::U32 | T::B32, T::U64 | T::S64 | T::B64 | T::U32 | T::S32 | T::B32) if int => zext32,
+        (T::S32, T::U64 | T::S64 | T::B64 | T::U32 | T::S32 | T::B32) if int => sext32,
+        (T::F32, T::S32) if nearest => f32_from_s32,
+        (T::F32, T::U32) if nearest => f32_from_u32,
+        (T::S32, T::F32) if mode.rnd == Some(Rounding::Rmi) => s32_floor_f32,
+        (T::S32, T::F32) if mode.rnd == Some(Rounding::Rzi) => s32_trunc_f32,
+        _ => return None,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -747,6 +785,83 @@ mod tests {
             }
         }
         assert!(resolved > 40, "only {resolved} forms resolved");
+    }
+
+    /// Every resolved `cvt` form computes what the interpreted `cvt` writes
+    /// (`dty.extend(alu::cvt(..))`), on integers at the 32-bit boundaries
+    /// with garbage above them and floats at the edges (NaN, infinities,
+    /// signed zeros, subnormals, halves, out of the integer range); the
+    /// index widening of the ray-tracing kernels is among the forms.
+    #[test]
+    fn resolved_conversions_agree_with_the_interpreted_cvt() {
+        let f = |x: f32| x.to_bits() as u64;
+        let vals = [
+            0,
+            1,
+            0x7FFF_FFFF,
+            0x8000_0000,
+            0xFFFF_FFFF,
+            0x1_0000_0000,
+            0xDEAD_BEEF_8000_0001,
+            u64::MAX,
+            16_777_217,
+            0x8000_0001,
+            f(1.5),
+            f(-1.5),
+            f(2.5),
+            f(-0.5),
+            f(0.0),
+            f(-0.0),
+            f(f32::NAN),
+            f(-f32::NAN),
+            f(f32::INFINITY),
+            f(f32::NEG_INFINITY),
+            f(1e-40),
+            f(-1e-40),
+            f(3.0e9),
+            f(-3.0e9),
+            f(2147483520.0),
+            f(-2147483648.0),
+        ];
+        let tys = [Ty::U32, Ty::S32, Ty::B32, Ty::U64, Ty::S64, Ty::B64, Ty::F32, Ty::F64, Ty::U16, Ty::S16];
+        let mut modes = vec![FloatMode::default(), FloatMode { sat: true, ..FloatMode::default() }];
+        for r in [
+            Rounding::Rn,
+            Rounding::Rz,
+            Rounding::Rm,
+            Rounding::Rp,
+            Rounding::Rni,
+            Rounding::Rzi,
+            Rounding::Rmi,
+            Rounding::Rpi,
+        ] {
+            modes.push(FloatMode { rnd: Some(r), ..FloatMode::default() });
+            modes.push(FloatMode { rnd: Some(r), ftz: true, ..FloatMode::default() });
+        }
+        let mut resolved = vec![];
+        for dty in tys {
+            for sty in tys {
+                for mode in &modes {
+                    let Some(func) = resolve_cvt(dty, sty, *mode) else { continue };
+                    resolved.push((dty, sty, mode.rnd));
+                    let a: Lanes = std::array::from_fn(|l| vals[l % vals.len()]);
+                    let b: Lanes = std::array::from_fn(|l| vals[(l + 7) % vals.len()]);
+                    for a in [a, b] {
+                        let mut out = [0; 32];
+                        func(&a, &a, &a, &mut out);
+                        for l in 0..32 {
+                            let want = dty.extend(alu::cvt(dty, sty, *mode, a[l]));
+                            assert_eq!(out[l], want, "cvt{:?}.{dty:?}.{sty:?} a={:#x}", mode.rnd, a[l]);
+                        }
+                    }
+                }
+            }
+        }
+        for form in
+            [(Ty::U64, Ty::U32, None), (Ty::F32, Ty::S32, Some(Rounding::Rn)), (Ty::S32, Ty::F32, Some(Rounding::Rmi))]
+        {
+            assert!(resolved.contains(&form), "{form:?} not resolved");
+        }
     }
 
     /// The lane functions of an `add`/`sub` contracted with a `mul` compute
