@@ -31,21 +31,30 @@ pub fn sectors_into(mask: u32, bytes: u32, addr: impl Fn(usize) -> u64, v: &mut 
     v.clear();
     let span = bytes.max(1) as u64 - 1;
     let mut sorted = true;
+    // the last sector pushed (none yet: no sector number reaches u64::MAX)
+    let mut top = u64::MAX;
     let mut m = mask;
     while m != 0 {
         let l = m.trailing_zeros() as usize;
         m &= m - 1;
         let a = addr(l);
         let (first, last) = (a / SECTOR, (a + span) / SECTOR);
-        for s in first..=last {
-            match v.last() {
-                Some(&p) if p == s => {}
-                Some(&p) => {
-                    sorted &= p < s;
-                    v.push(s);
-                }
-                None => v.push(s),
+        // first..=last (empty only if `a + span` wrapped), without
+        // `RangeInclusive`'s bookkeeping per step
+        if first > last {
+            continue;
+        }
+        let mut s = first;
+        loop {
+            if s != top {
+                sorted &= top == u64::MAX || top < s;
+                v.push(s);
+                top = s;
             }
+            if s >= last {
+                break;
+            }
+            s += 1;
         }
     }
     if !sorted {

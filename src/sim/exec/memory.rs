@@ -273,7 +273,8 @@ fn emit_one(
 /// for every active lane, lane by lane: loaded values go to `vals`, what
 /// every lane touched to `touched`. Returns the first lane's resolved space
 /// (for counting). The per-lane path: it finds the faulting lane and
-/// resolves lanes of several spaces ([`in_one`] takes the common warps).
+/// resolves lanes of several spaces ([`transfer`] takes the common warps
+/// through the per-warp paths first).
 #[allow(clippy::too_many_arguments)]
 fn vector_access(
     ctx: &Ctx,
@@ -358,23 +359,16 @@ fn global_in_one(ctx: &Ctx, ty: Ty, addrs: &Lanes, exec: u32, vals: &mut [Lanes]
     let (lo, hi, total) = aligned_span(size, vals.len(), addrs, exec)?;
     let span = (hi - lo).checked_add(total as u64)?;
     let (al, lo_off) = ctx.mem.find(lo, span)?;
-    let first = exec.trailing_zeros() as usize;
-    lanes_in_one(
-        ty,
-        addrs,
-        exec,
-        vals,
-        store,
-        |_, a| lo_off + (a - lo),
-        |_, off, size, v| match v {
-            Some(v) => {
-                al.store(off, size, v);
-                0
-            }
-            None => al.load(off, size),
-        },
-    );
-    Some(Resolved::Global(addrs[first]))
+    let at = |_, a| lo_off + (a - lo);
+    let mem = |_, off, size, v: Option<u64>| match v {
+        Some(v) => {
+            al.store(off, size, v);
+            0
+        }
+        None => al.load(off, size),
+    };
+    lanes_in_one(ty, addrs, exec, vals, store, at, mem);
+    Some(Resolved::Global(addrs[exec.trailing_zeros() as usize]))
 }
 
 /// [`Ty::extend`] and [`Ty::mask`] with the type's width and signedness
@@ -492,23 +486,16 @@ fn local_in_one(
     if hi - window + total as u64 > w.local_top as u64 {
         return None;
     }
-    let first = exec.trailing_zeros() as usize;
-    lanes_in_one(
-        ty,
-        addrs,
-        exec,
-        vals,
-        store,
-        |_, a| a - window,
-        |l, off, size, v| match v {
-            Some(v) => {
-                w.local_store(l, off, size, v);
-                0
-            }
-            None => w.local_load(l, off, size),
-        },
-    );
-    Some(Resolved::Local(addrs[first] - window))
+    let at = |_, a| a - window;
+    let mem = |l, off, size, v: Option<u64>| match v {
+        Some(v) => {
+            w.local_store(l, off, size, v);
+            0
+        }
+        None => w.local_load(l, off, size),
+    };
+    lanes_in_one(ty, addrs, exec, vals, store, at, mem);
+    Some(Resolved::Local(addrs[exec.trailing_zeros() as usize] - window))
 }
 
 /// The common access to the current frame's parameter area (a call's
@@ -531,24 +518,17 @@ fn params_in_one(w: &mut Warp, ty: Ty, addrs: &Lanes, exec: u32, vals: &mut [Lan
     if hi.checked_add(total as u64).is_none_or(|e| e > ps) {
         return None;
     }
-    let first = exec.trailing_zeros() as usize;
     let params = &mut f.params;
-    lanes_in_one(
-        ty,
-        addrs,
-        exec,
-        vals,
-        store,
-        |l, a| l as u64 * ps + a,
-        |_, off, size, v| match v {
-            Some(v) => {
-                bytes_store(params, off, size, v).expect("within the lane's area");
-                0
-            }
-            None => bytes_load(params, off, size).expect("within the lane's area"),
-        },
-    );
-    Some(Resolved::FParam(addrs[first]))
+    let at = |l, a| l as u64 * ps + a;
+    let mem = |_, off, size, v: Option<u64>| match v {
+        Some(v) => {
+            bytes_store(params, off, size, v).expect("within the lane's area");
+            0
+        }
+        None => bytes_load(params, off, size).expect("within the lane's area"),
+    };
+    lanes_in_one(ty, addrs, exec, vals, store, at, mem);
+    Some(Resolved::FParam(addrs[exec.trailing_zeros() as usize]))
 }
 
 /// The lane loop of the per-warp paths ([`global_in_one`], [`local_in_one`],
@@ -604,32 +584,6 @@ fn each_element(
         for (k, v) in vals.iter_mut().enumerate() {
             f(l, off + (k as u32 * size) as u64, &mut v[l]);
         }
-    }
-}
-
-/// The per-warp paths: the whole warp's access at once when no lane can
-/// fault and every lane resolves to one space ([`global_in_one`],
-/// [`local_in_one`], [`params_in_one`]); `None`, having touched nothing,
-/// otherwise (the per-lane [`vector_access`] then runs). Returns the space
-/// the lanes resolved to with the first active lane's address in it, as
-/// the per-lane path's first lane would.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn in_one(
-    ctx: &Ctx,
-    w: &mut Warp,
-    space: MemSpace,
-    ty: Ty,
-    addrs: &Lanes,
-    exec: u32,
-    vals: &mut [Lanes],
-    store: bool,
-) -> Option<Resolved> {
-    match space {
-        MemSpace::Global => global_in_one(ctx, ty, addrs, exec, vals, store),
-        MemSpace::Local | MemSpace::Generic => local_in_one(w, space, ty, addrs, exec, vals, store),
-        MemSpace::FrameParam => params_in_one(w, ty, addrs, exec, vals, store),
-        _ => None,
     }
 }
 
@@ -714,7 +668,16 @@ pub(super) fn transfer(
 ) -> Result<(), Box<ExecFault>> {
     let (elem, n) = (ty.bytes(), vals.len() as u32);
     let op = if store { MemOp::Store } else { MemOp::Load };
-    if let Some(r) = in_one(ctx, w, space, ty, addrs, exec, vals, store) {
+    // the per-warp paths: the whole warp's access at once when no lane can
+    // fault and every lane resolves to one space (`None`, having touched
+    // nothing, otherwise: the per-lane path then runs)
+    let in_one = match space {
+        MemSpace::Global => global_in_one(ctx, ty, addrs, exec, vals, store),
+        MemSpace::Local | MemSpace::Generic => local_in_one(w, space, ty, addrs, exec, vals, store),
+        MemSpace::FrameParam => params_in_one(w, ty, addrs, exec, vals, store),
+        _ => None,
+    };
+    if let Some(r) = in_one {
         // one space for every active lane: one event, at the instruction's own
         // addresses (less the window for a generic local access), with
         // nothing recorded per lane
