@@ -216,3 +216,97 @@ fn a_curved_mirror_focuses_a_parallel_beam_at_half_its_radius() {
         assert!(focus.length() < 0.06, "{focus}");
     }
 }
+
+/// A diffuse box (walls without vertex normals) with a concave mirror on its
+/// floor: a spherical cap of radius 3 tessellated into 56 triangles (the pole's 8 have zero area) whose
+/// vertex normals point to the sphere's centre (with `normals`), the point
+/// light above it.
+fn curved_mirror_scene(normals: bool) -> warplight::host::scene::Scene {
+    use warplight::host::scene::{Light, Material, MaterialKind, Scene, Triangle};
+    let mut tris = Vec::new();
+    let mut vn = Vec::new();
+    // the box [-2, 2]³: six faces of two triangles (material 0)
+    for axis in 0..3 {
+        for side in [-2.0f32, 2.0] {
+            let p = |a: f32, b: f32| {
+                let mut c = [0.0; 3];
+                c[axis] = side;
+                c[(axis + 1) % 3] = a;
+                c[(axis + 2) % 3] = b;
+                Vec3::from(c)
+            };
+            for t in [[p(-2.0, -2.0), p(2.0, -2.0), p(2.0, 2.0)], [p(-2.0, -2.0), p(2.0, 2.0), p(-2.0, 2.0)]] {
+                tris.push(Triangle { v: t, material: 0 });
+                vn.push([[0.0; 3]; 3]);
+            }
+        }
+    }
+    // the cap: centre (0, 1.5, 0), polar angle up to 0.5 in 4 rings, 8 sectors (material 1)
+    let (c, r) = (Vec3::new(0.0, 1.5, 0.0), 3.0f32);
+    let at = |ring: usize, sector: usize| {
+        let (th, ph) = (0.5 * ring as f32 / 4.0, std::f32::consts::TAU * sector as f32 / 8.0);
+        let p = c + r * Vec3::new(th.sin() * ph.cos(), -th.cos(), th.sin() * ph.sin());
+        (p, ((c - p) / r).to_array())
+    };
+    for ring in 0..4 {
+        for s in 0..8 {
+            let (a, b, d, e) = (at(ring, s), at(ring, s + 1), at(ring + 1, s), at(ring + 1, s + 1));
+            for t in [[a, d, e], [a, e, b]] {
+                tris.push(Triangle { v: t.map(|x| x.0), material: 1 });
+                vn.push(if normals { t.map(|x| x.1) } else { [[0.0; 3]; 3] });
+            }
+        }
+    }
+    let mirror = Material { name: "mirror".into(), kind: MaterialKind::Mirror, color: [0.9; 3], emission: [0.0; 3] };
+    let materials = vec![Material::diffuse("wall", [0.7, 0.6, 0.5]), mirror];
+    let vn = if normals { vn } else { Vec::new() };
+    let mut s = Scene::assemble_with_vertices("curved-mirror", Path::new("test"), tris, Vec::new(), vn, materials);
+    s.lights.push(Light::Point { position: [0.3, 1.0, 0.2], intensity: [1.0; 3] });
+    s
+}
+
+/// Eqs. 5.12–5.21 in the kernel: on a scene with a concave mirror whose
+/// triangles have vertex normals (the walls have none: all zero), the
+/// emulated tracer stores exactly the native reference's photons, and the
+/// interpolated normals change every photon that left the mirror: the same
+/// scene without vertex normals (flat facets) stores other bits for them.
+#[test]
+fn kernel_reflects_about_interpolated_normals_bit_for_bit() {
+    let scene = curved_mirror_scene(true);
+    // the pole's eight zero-area triangles are dropped with their normals
+    assert_eq!((scene.triangles.len(), scene.normals.len()), (68, 68));
+    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+    let e = Emission::of(&scene, 2048).unwrap();
+    let native = photons::reference(&scene, &tree, &e);
+    let mut dev = Device::new();
+    let module = photons::load(&mut dev).unwrap();
+    let k = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap();
+    for (i, (a, b)) in k.photons.iter().zip(&native).enumerate() {
+        for s in 0..2 {
+            assert_eq!(a[s].map(|p| p.bits()), b[s].map(|p| p.bits()), "photon {i} slot {s}");
+        }
+    }
+    // the photons whose first hit is the mirror (material 1) and that were stored later
+    let flat = photons::reference(&curved_mirror_scene(false), &tree, &e);
+    let caster = warplight::host::raycast::Caster::new(&scene, &tree);
+    let (mut mirrored, mut differ) = (0, 0);
+    for (i, (a, b)) in native.iter().zip(&flat).enumerate() {
+        let cp1 = rng(i as u32, 0) * 2.0 - 1.0;
+        let p = emit(e.position, cp1, azimuth(rng(i as u32, 1)));
+        let ray = warplight::host::camera::Ray { origin: v(p.z), dir: v(p.w) };
+        let mut st = Default::default();
+        let first = caster.intersect(&ray, caster.eps(), f32::INFINITY, false, &mut st).unwrap();
+        let on_mirror = scene.triangles[first.tri as usize].material == 1;
+        let bits = |x: &[Option<photons::Photon>; 2]| x.map(|p| p.map(|p| p.bits()));
+        if on_mirror && a[0].is_some() {
+            mirrored += 1;
+            differ += (bits(a) != bits(b)) as usize;
+        } else if !on_mirror {
+            // a path that met a wall first reaches its 2nd interaction as in the flat scene
+            assert_eq!(bits(a)[0], bits(b)[0], "photon {i}");
+        }
+    }
+    assert!(mirrored > 60, "{mirrored} photons stored after the mirror");
+    assert_eq!(differ, mirrored, "every photon reflected by the curved mirror changes");
+}

@@ -18,6 +18,8 @@ fn distributed_scenes_load_with_their_counts() {
         let s = load(name);
         assert_eq!((s.triangles.len(), s.dropped_degenerate), (tris, dropped), "{name}");
         assert!(!s.lights.is_empty(), "{name} has a light");
+        // of these OBJ files only Sponza's has vertex normals (`vn`), one set per kept triangle
+        assert_eq!(s.normals.len(), if name == "sponza" { tris } else { 0 }, "{name}");
     }
     // Sponza and the scaled Conference room have Table A.1's extent to 0.1 m.
     for name in ["sponza", "conference"] {
@@ -34,6 +36,31 @@ fn distributed_scenes_load_with_their_counts() {
         _ => None,
     });
     assert_eq!(area, Some(2));
+}
+
+/// An OBJ's vertex normals are read per triangle: a zero-area triangle drops
+/// its normals with it, and a negative scale turns them with the mirrored
+/// geometry; an OBJ with a face without normals gives none at all (tobj
+/// would make up the previous face's for it).
+#[test]
+fn vertex_normals_are_read_per_triangle() {
+    let dir = std::env::temp_dir().join(format!("warplight-normals-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nvt 0 0\nvn 0 0 1\nvn 0.5 0 1\nvn 0 0.5 1\n";
+    let obj = format!("{head}g a\nf 1//1 2//2 3//3\nf 1//1 2//2 4//1\ng b\nf 2/1/1 4/1/1 3/1/3\n");
+    std::fs::write(dir.join("n.obj"), obj).unwrap();
+    let toml = "obj = \"n.obj\"\nscale = -2.0\n[[light]]\nposition = [0.0, 0.0, 1.0]\n";
+    std::fs::write(dir.join("n.toml"), toml).unwrap();
+    let s = scene_file::load(&dir.join("n.toml")).unwrap_or_else(|e| panic!("{e}"));
+    // the collinear triangle (1, 2, 4) is dropped with its normals
+    assert_eq!((s.triangles.len(), s.dropped_degenerate), (2, 1));
+    let (a, c) = ([-0.0, -0.0, -1.0], [-0.0, -0.5, -1.0]);
+    assert_eq!(s.normals, vec![[a, [-0.5, -0.0, -1.0], c], [a, a, c]]);
+    // a face without normals: none at all
+    std::fs::write(dir.join("n.obj"), format!("{head}f 1//1 2//2 3//3\nf 2 4 3\n")).unwrap();
+    let s = scene_file::load(&dir.join("n.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert!(s.normals.is_empty());
+    assert_eq!(s.vertex_normals(0), [[0.0; 3]; 3]);
 }
 
 #[test]

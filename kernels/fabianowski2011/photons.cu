@@ -7,7 +7,9 @@
 // differentials are propagated (eqs. 3.7-3.9); interaction 2 and 3 on a diffuse
 // surface are stored; Russian roulette with the mean reflectivity rho keeps the
 // photon (flux scaled by rho_i / rho, differentials by rho^(-1/2), §5.1.4);
-// a mirror reflects it (eqs. 3.10-3.11, flat triangles: dn/dp = 0); a diffuse
+// a mirror reflects it (eqs. 3.10-3.11; where the scene has vertex normals
+// about the interpolated normal with dn/dp from eqs. 5.12-5.21, otherwise
+// flat: dn/dp = 0); a diffuse
 // surface absorbs and re-emits it with cosine sampling and the virtual offset
 // t_v (eqs. 5.25-5.29). Tracing ends at the 3rd interaction.
 //
@@ -35,6 +37,7 @@ struct Params {
   float lo[3], hi[3];
   float eps;
   int num_photons;
+  int has_normals;  // 0: no vertex normals (flat mirrors); 1: `nrm` holds them
 };
 
 struct V3 { float x, y, z; };
@@ -55,6 +58,7 @@ struct Scene {
   const float4 *tris;      // 3 float4 per triangle: [n'i n'j n'd k], [e'1], [e'2]
   const unsigned *tri_mat; // material per triangle
   const float4 *mats;      // [r g b kind], kind: 0 diffuse, 1 mirror, 2 emitter; then [emission, 0]
+  const float *nrm;        // 9 floats per triangle: n0, n'1 = n1 - n0, n'2 = n2 - n0 (L2247)
 };
 
 // The counter-based generator: a uniform float in [0, 1) with 24 random bits
@@ -89,8 +93,10 @@ static __device__ __forceinline__ void azimuth(float y, float *c, float *s) {
   else { *c = sr; *s = -cr; }
 }
 
-// Alg. 3.3: Wald's test; updates t_hit and returns true on a hit.
-static __device__ __forceinline__ bool wald(const Scene &s, unsigned t, V3 o, V3 d, float t_min, float *t_hit) {
+// Alg. 3.3: Wald's test; updates t_hit and the barycentric weights (u, v) of
+// vertices 1 and 2 and returns true on a hit.
+static __device__ __forceinline__ bool wald(const Scene &s, unsigned t, V3 o, V3 d, float t_min, float *t_hit,
+                                            float *u_hit, float *v_hit) {
   const float *w = (const float *)(s.tris + 3 * t);
   float n0 = __ldg(w), n1 = __ldg(w + 1), n2 = __ldg(w + 2);
   int k = __float_as_int(__ldg(w + 3));
@@ -104,11 +110,13 @@ static __device__ __forceinline__ bool wald(const Scene &s, unsigned t, V3 o, V3
   float v = __ldg(w + 4) * hx + __ldg(w + 5) * hy + __ldg(w + 6);
   if (u < 0.0f || v < 0.0f || u + v > 1.0f) return false;
   *t_hit = tt;
+  *u_hit = u;
+  *v_hit = v;
   return true;
 }
 
-// The nearest hit in (t_min, inf): the stack-based traversal of raytrace.cu.
-static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float *t_out) {
+// The nearest hit in (t_min, inf) and its barycentric weights: the stack-based traversal of raytrace.cu.
+static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float *t_out, float *u_out, float *v_out) {
   V3 inv = v3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
   const Params *p = s.p;
   float t0x = (p->lo[0] - o.x) * inv.x, t1x = (p->hi[0] - o.x) * inv.x;
@@ -151,7 +159,7 @@ static __device__ int trace(const Scene &s, V3 o, V3 d, float t_min, float *t_ou
     int found = -1;
     for (unsigned r = 0; r < n.x; r++) {
       unsigned t = __ldg(s.refs + (n.y >> 2) + r);
-      if (wald(s, t, o, d, lo, &t_hit)) found = (int)t;
+      if (wald(s, t, o, d, lo, &t_hit, u_out, v_out)) found = (int)t;
     }
     if (found >= 0) {
       *t_out = t_hit;
@@ -180,6 +188,53 @@ static __device__ V3 normal_of(const Scene &s, unsigned t, V3 d) {
   return v;
 }
 
+// Component c of the row of dlambda/dz (eq. 5.21) whose values at the axes
+// i = k + 1 and j = k + 2 (mod 3) are a and b: zero at axis k.
+static __device__ __forceinline__ V3 place(int k, float a, float b) {
+  return v3(k == 0 ? 0.0f : (k == 2 ? a : b), k == 1 ? 0.0f : (k == 0 ? a : b), k == 2 ? 0.0f : (k == 1 ? a : b));
+}
+
+static __device__ __forceinline__ bool finite3(V3 a) {
+  const float inf = __int_as_float(0x7f800000);
+  return fabsf(a.x) < inf && fabsf(a.y) < inf && fabsf(a.z) < inf;
+}
+
+// Mirror reflection at the barycentric weights (u, v) of triangle t about the
+// interpolated normal n(lambda) = normalize(n0 + u n'1 + v n'2) (L2247), with
+// dn/dp = (dn/dlambda)(dlambda/dz)(dz/dp) (eqs. 5.12, 5.13, 5.21) in eq. 3.11:
+// dw' = dw - 2[(w.n) dn/dp + (dw.n + w.dn/dp) n]. Returns false (nothing
+// changed) where ||n'(lambda)|| is 0 or a derivative is not finite: the
+// caller reflects about the flat normal. photons.rs's shading_normal and
+// reflect_curved perform the same operations in the same order.
+static __device__ bool reflect_curved(const Scene &s, unsigned t, float u, float v, V3 *w, V3 *dz1, V3 *dz2,
+                                      V3 *dw1, V3 *dw2) {
+  const float *q = s.nrm + 9 * t;
+  V3 n0 = v3(__ldg(q), __ldg(q + 1), __ldg(q + 2));
+  V3 d1 = v3(__ldg(q + 3), __ldg(q + 4), __ldg(q + 5));
+  V3 d2 = v3(__ldg(q + 6), __ldg(q + 7), __ldg(q + 8));
+  V3 raw = add3(n0, add3(scale3(d1, u), scale3(d2, v)));
+  float l = len3(raw);
+  if (!(l > 0.0f && l < __int_as_float(0x7f800000))) return false;
+  float il = 1.0f / l;
+  V3 n = scale3(raw, il);
+  V3 dnu = scale3(add3(d1, scale3(n, -dot3(d1, n))), il);
+  V3 dnv = scale3(add3(d2, scale3(n, -dot3(d2, n))), il);
+  const float *w4 = (const float *)(s.tris + 3 * t);
+  int k = __float_as_int(__ldg(w4 + 3));
+  V3 ru = place(k, __ldg(w4 + 8), __ldg(w4 + 9));  // du/dz from e'2
+  V3 rv = place(k, __ldg(w4 + 4), __ldg(w4 + 5));  // dv/dz from e'1
+  if (!(finite3(dnu) && finite3(dnv) && finite3(ru) && finite3(rv))) return false;
+  float wn = dot3(*w, n);
+  V3 dn1 = add3(scale3(dnu, dot3(ru, *dz1)), scale3(dnv, dot3(rv, *dz1)));
+  float c1 = dot3(*dw1, n) + dot3(*w, dn1);
+  *dw1 = add3(*dw1, scale3(add3(scale3(dn1, wn), scale3(n, c1)), -2.0f));
+  V3 dn2 = add3(scale3(dnu, dot3(ru, *dz2)), scale3(dnv, dot3(rv, *dz2)));
+  float c2 = dot3(*dw2, n) + dot3(*w, dn2);
+  *dw2 = add3(*dw2, scale3(add3(scale3(dn2, wn), scale3(n, c2)), -2.0f));
+  *w = add3(*w, scale3(n, -2.0f * wn));
+  return true;
+}
+
 static __device__ __forceinline__ void put(float *o, int at, V3 v) {
   o[at] = v.x;
   o[at + 1] = v.y;
@@ -188,8 +243,8 @@ static __device__ __forceinline__ void put(float *o, int at, V3 v) {
 
 extern "C" __global__ void trace_photons(const Params *p, const uint2 *nodes, const unsigned *refs,
                                          const float4 *tris, const unsigned *tri_mat, const float4 *mats,
-                                         float *out) {
-  Scene s = {p, nodes, refs, tris, tri_mat, mats};
+                                         const float *nrm, float *out) {
+  Scene s = {p, nodes, refs, tris, tri_mat, mats, nrm};
   for (unsigned i = WL_TID; i < (unsigned)p->num_photons; i += blockDim.x * gridDim.x) {
     // emission (eqs. 5.1, 5.9-5.10 with alpha = pi, R = I): cos p1 = y1 in [-1, 1)
     float cp1 = rng(i, 0) * 2.0f - 1.0f;
@@ -203,8 +258,8 @@ extern "C" __global__ void trace_photons(const Params *p, const uint2 *nodes, co
     V3 dw2 = v3(-sp2, cp2, 0.0f);
     V3 flux = v3(p->flux[0], p->flux[1], p->flux[2]);
     for (int k = 1; k <= 3; k++) {
-      float t;
-      int h = trace(s, z, w, p->eps, &t);
+      float t, hu = 0.0f, hv = 0.0f;
+      int h = trace(s, z, w, p->eps, &t, &hu, &hv);
       if (h < 0) break;
       V3 n = normal_of(s, (unsigned)h, w);
       // propagation (eqs. 3.7-3.9)
@@ -244,7 +299,9 @@ extern "C" __global__ void trace_photons(const Params *p, const uint2 *nodes, co
       dw1 = scale3(dw1, g);
       dw2 = scale3(dw2, g);
       if (!diffuse) {
-        // specular reflection (eqs. 3.10-3.11 with dn/dp = 0)
+        // specular reflection about the interpolated normal (eqs. 3.10-3.11, 5.12-5.21)
+        if (p->has_normals && reflect_curved(s, (unsigned)h, hu, hv, &w, &dz1, &dz2, &dw1, &dw2)) continue;
+        // a flat mirror (eqs. 3.10-3.11 with dn/dp = 0)
         float s2 = 2.0f * wn;
         w = v3(w.x - s2 * n.x, w.y - s2 * n.y, w.z - s2 * n.z);
         float s1 = 2.0f * dot3(dw1, n), s3 = 2.0f * dot3(dw2, n);

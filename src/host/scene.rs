@@ -166,6 +166,12 @@ pub struct Scene {
     pub surfaces: Vec<Surface>,
     /// Per triangle, the texture coordinates of its three vertices (empty: none).
     pub uvs: Vec<[[f32; 2]; 3]>,
+    /// Per triangle, the normals of its three vertices as the OBJ gives them
+    /// (`vn`, not normalised; empty: the scene has none; all zero: this
+    /// triangle has none). Only thesis 000's photon tracer reads them
+    /// (`repro::fabianowski2011::photons`, eqs. 5.12–5.21); every other
+    /// renderer shades with the geometric normal.
+    pub normals: Vec<[[f32; 3]; 3]>,
     /// Per material, the Beckmann roughness α of a mirror or glass (a scene
     /// file's `roughness`; a material past the end, or 0, is smooth). Thesis
     /// 003's path tracer makes a rough mirror a Cook-Torrance conductor and a
@@ -219,13 +225,29 @@ impl Scene {
         uvs: Vec<[[f32; 2]; 3]>,
         materials: Vec<Material>,
     ) -> Scene {
+        Scene::assemble_with_vertices(name, source, tris, uvs, Vec::new(), materials)
+    }
+
+    /// [`Scene::assemble_with_uvs`] with the vertex normals of each triangle
+    /// as well (`normals`: none, or one entry per triangle of `tris`), dropped
+    /// with their zero-area triangles like the texture coordinates.
+    pub fn assemble_with_vertices(
+        name: &str,
+        source: &Path,
+        tris: Vec<Triangle>,
+        uvs: Vec<[[f32; 2]; 3]>,
+        normals: Vec<[[f32; 3]; 3]>,
+        materials: Vec<Material>,
+    ) -> Scene {
         let n = tris.len();
         let mut triangles = Vec::with_capacity(n);
         let mut kept_uvs = Vec::with_capacity(uvs.len());
+        let mut kept_normals = Vec::with_capacity(normals.len());
         for (i, t) in tris.into_iter().enumerate() {
             if t.double_area() > 0.0 {
                 triangles.push(t);
                 kept_uvs.extend(uvs.get(i).copied());
+                kept_normals.extend(normals.get(i).copied());
             }
         }
         let dropped = n - triangles.len();
@@ -243,6 +265,7 @@ impl Scene {
             textures: Vec::new(),
             surfaces: Vec::new(),
             uvs: kept_uvs,
+            normals: kept_normals,
             roughness: Vec::new(),
             environment: None,
             exact_fresnel: Vec::new(),
@@ -274,6 +297,11 @@ impl Scene {
     /// Texture coordinates of triangle `t`'s vertices (zero when the scene has none).
     pub fn uv(&self, t: u32) -> [[f32; 2]; 3] {
         self.uvs.get(t as usize).copied().unwrap_or_default()
+    }
+
+    /// The vertex normals of triangle `t` (all zero when it has none).
+    pub fn vertex_normals(&self, t: u32) -> [[f32; 3]; 3] {
+        self.normals.get(t as usize).copied().unwrap_or_default()
     }
 
     /// The diffuse colour of material `m` at barycentric weights (`u`, `v`)

@@ -287,7 +287,11 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         }
         extra.surface(m as usize).reflect = w;
     }
-    let mut scene = Scene::assemble_with_uvs(&name, path, tris, std::mem::take(&mut extra.uvs), materials);
+    // a negative scale mirrors the geometry: its normals turn with it
+    let normals =
+        std::mem::take(&mut extra.normals).into_iter().map(|t| t.map(|n| n.map(|x| x * scale.signum()))).collect();
+    let uvs = std::mem::take(&mut extra.uvs);
+    let mut scene = Scene::assemble_with_vertices(&name, path, tris, uvs, normals, materials);
     scene.textures = extra.textures;
     scene.surfaces = extra.surfaces;
     scene.roughness = roughness;
@@ -405,6 +409,9 @@ struct ObjExtras {
     surfaces: Vec<Surface>,
     /// Per triangle, its vertices' texture coordinates (empty when the OBJ has none).
     uvs: Vec<[[f32; 2]; 3]>,
+    /// Per triangle, its vertices' normals (empty when the OBJ has none; all
+    /// zero for a triangle of a group without them).
+    normals: Vec<[[f32; 3]; 3]>,
 }
 
 impl ObjExtras {
@@ -524,6 +531,7 @@ fn load_obj(
     };
     let mut out = Vec::new();
     let mut uvs = Vec::new();
+    let mut normals = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
         let mtl_mat = mesh.material_id.and_then(|i| mtl.get(i));
@@ -546,8 +554,19 @@ fn load_obj(
             mesh.texcoords.get(i..i + 2).map_or([0.0; 2], |c| [c[0], c[1]])
         };
         let has_uv = mesh.texcoord_indices.len() == mesh.indices.len();
+        let vn = |i: u32| {
+            let i = 3 * i as usize;
+            mesh.normals.get(i..i + 3).map_or([0.0; 3], |c| [c[0], c[1], c[2]])
+        };
+        let has_vn = mesh.normal_indices.len() == mesh.indices.len();
         for (n, f) in mesh.indices.chunks_exact(3).enumerate() {
             out.push(Triangle { v: [p(f[0]), p(f[1]), p(f[2])], material: mi });
+            normals.push(if has_vn {
+                let c = &mesh.normal_indices[3 * n..3 * n + 3];
+                [vn(c[0]), vn(c[1]), vn(c[2])]
+            } else {
+                [[0.0; 3]; 3]
+            });
             uvs.push(if has_uv {
                 let c = &mesh.texcoord_indices[3 * n..3 * n + 3];
                 [uv(c[0]), uv(c[1]), uv(c[2])]
@@ -560,5 +579,20 @@ fn load_obj(
     if !extra.textures.is_empty() {
         extra.uvs = uvs;
     }
+    // vertex normals only where the OBJ gives them on every face: for a face
+    // without, tobj makes up the previous face's
+    if normals.iter().any(|n| *n != [[0.0; 3]; 3]) && every_face_has_normals(path) {
+        extra.normals = normals;
+    }
     Ok(out)
+}
+
+/// Whether every face (`f`) of the OBJ at `path` names a normal at each
+/// vertex (`v//vn` or `v/vt/vn`); false where the file cannot be read again.
+fn every_face_has_normals(path: &Path) -> bool {
+    let Ok(bytes) = std::fs::read(path) else { return false };
+    String::from_utf8_lossy(&bytes)
+        .lines()
+        .filter_map(|l| l.trim_start().strip_prefix("f "))
+        .all(|f| f.split_whitespace().all(|v| v.splitn(3, '/').nth(2).is_some_and(|n| !n.trim().is_empty())))
 }

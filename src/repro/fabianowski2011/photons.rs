@@ -5,7 +5,9 @@
 //! position, direction and four differentials, pre-scaled so that one global
 //! Δp = √(4π/n) applies (eqs. 5.9–5.11). Surface hits propagate the
 //! differentials (eqs. 3.7–3.9, [`propagate`]); mirrors reflect them (eqs.
-//! 3.10–3.11 with ∂n/∂p = 0 on flat triangles, [`reflect`]); diffuse surfaces
+//! 3.10–3.11: about the interpolated vertex normal with ∂n/∂p from eqs.
+//! 5.12–5.21 where the scene has vertex normals, [`reflect_curved`],
+//! otherwise flat with ∂n/∂p = 0, [`reflect`]); diffuse surfaces
 //! absorb and re-emit with cosine sampling and the virtual offset t_v (eqs.
 //! 5.22–5.29); Russian roulette scales survivors' differentials by ρ^(−1/2)
 //! (§5.1.4). The 2nd and 3rd surface interactions on diffuse surfaces are
@@ -20,7 +22,7 @@ use glam::Vec3;
 
 use crate::host::camera::Ray;
 use crate::host::kdtree::KdTree;
-use crate::host::kdtree::layout::layout;
+use crate::host::kdtree::layout::{layout, wald};
 use crate::host::raycast::{Caster, EPS_REL, TraceStats};
 use crate::host::scene::{Light, MaterialKind, Scene};
 use crate::sim::device::to_bytes;
@@ -237,44 +239,60 @@ impl ShadingTriangle {
     /// (i, j) = (k + 1, k + 2) mod 3, e1 = v1 − v0, e2 = v2 − v0,
     /// e'1 = (−e1j, e1i, det(e1ji, v0ji)) / det(e1ij, e2ij),
     /// e'2 = (e2j, −e2i, det(e2ij, v0ij)) / det(e1ij, e2ij),
-    /// (u, v) = (e'2xy · z_ij + e'2z, e'1xy · z_ij + e'1z).
+    /// (u, v) = (e'2xy · z_ij + e'2z, e'1xy · z_ij + e'1z); the kernels' Wald
+    /// form ([`wald`]) and [`shading_normal`].
     /// `None` where the derivative is undefined: a degenerate triangle, or
     /// vertex normals that cancel, ‖n'(λ)‖ = 0 (the extract's §2.8 item 9).
     pub fn normal_at(&self, z: [f32; 3]) -> Option<ShadingNormal> {
-        let [v0, v1, v2] = self.v;
-        let e1 = [v1[0] - v0[0], v1[1] - v0[1], v1[2] - v0[2]];
-        let e2 = [v2[0] - v0[0], v2[1] - v0[1], v2[2] - v0[2]];
-        let g = cross(e1, e2);
-        let k = (0..3).max_by(|&a, &b| g[a].abs().total_cmp(&g[b].abs())).unwrap_or(2);
-        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-        let det = e1[i] * e2[j] - e1[j] * e2[i];
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
-        let e1p = [-e1[j] / det, e1[i] / det, (e1[j] * v0[i] - e1[i] * v0[j]) / det];
-        let e2p = [e2[j] / det, -e2[i] / det, (e2[i] * v0[j] - e2[j] * v0[i]) / det];
+        let (k, _, e1p, e2p) = wald(&self.v.map(Vec3::from));
+        let (i, j) = ((k as usize + 1) % 3, (k as usize + 2) % 3);
         let u = e2p[0] * z[i] + e2p[1] * z[j] + e2p[2];
         let v = e1p[0] * z[i] + e1p[1] * z[j] + e1p[2];
-        let [n0, n1, n2] = self.n;
-        let (d1, d2) = (add(n1, scale(n0, -1.0)), add(n2, scale(n0, -1.0)));
-        let raw = add(n0, add(scale(d1, u), scale(d2, v)));
-        let l = len(raw);
-        if !(l > 0.0 && l.is_finite()) {
-            return None;
-        }
-        let n = scale(raw, 1.0 / l);
-        let col = |d: [f32; 3]| scale(add(d, scale(n, -dot(d, n))), 1.0 / l);
-        let row = |a: [f32; 2]| {
-            let mut r = [0.0; 3];
-            r[i] = a[0];
-            r[j] = a[1];
-            r
-        };
-        let dl_dz = [row([e2p[0], e2p[1]]), row([e1p[0], e1p[1]])];
-        let out = ShadingNormal { n, dn_dl: [col(d1), col(d2)], dl_dz };
-        let finite = |a: &[[f32; 3]; 2]| a.iter().flatten().all(|x| x.is_finite());
-        (finite(&out.dn_dl) && finite(&out.dl_dz)).then_some(out)
+        shading_normal(k, e1p, e2p, (u, v), normal_deltas(self.n))
     }
+}
+
+/// What the photon kernel stores per triangle for its interpolated normal
+/// (L2247): n0, n'1 = n1 − n0, n'2 = n2 − n0.
+pub fn normal_deltas(n: [[f32; 3]; 3]) -> [[f32; 3]; 3] {
+    let [n0, n1, n2] = n;
+    [n0, add(n1, scale(n0, -1.0)), add(n2, scale(n0, -1.0))]
+}
+
+/// The interpolated normal n(λ) = normalize(n0 + u n'1 + v n'2) at the
+/// barycentric weights `uv` = (u, v) of vertices 1 and 2 (eq. 5.20, as
+/// Wald's test computes them at the hit), with ∂n/∂λ (eq. 5.13) and ∂λ/∂z
+/// (eq. 5.21: the rows e'2 and e'1 of the Wald form placed at the axes
+/// i, j = k + 1, k + 2, zero at k), from `nd` = [`normal_deltas`]; the
+/// photon kernel's float operations in its order. `None` where ‖n'(λ)‖ is 0
+/// or not finite (vertex normals that cancel, or a triangle without any:
+/// all zero) or a derivative is not finite.
+pub fn shading_normal(
+    k: u32,
+    e1p: [f32; 3],
+    e2p: [f32; 3],
+    uv: (f32, f32),
+    nd: [[f32; 3]; 3],
+) -> Option<ShadingNormal> {
+    let [n0, d1, d2] = nd;
+    let raw = add(n0, add(scale(d1, uv.0), scale(d2, uv.1)));
+    let l = len(raw);
+    if !(l > 0.0 && l.is_finite()) {
+        return None;
+    }
+    let il = 1.0 / l;
+    let n = scale(raw, il);
+    let col = |d: [f32; 3]| scale(add(d, scale(n, -dot(d, n))), il);
+    let (i, j) = ((k as usize + 1) % 3, (k as usize + 2) % 3);
+    let row = |a: f32, b: f32| {
+        let mut r = [0.0; 3];
+        r[i] = a;
+        r[j] = b;
+        r
+    };
+    let out = ShadingNormal { n, dn_dl: [col(d1), col(d2)], dl_dz: [row(e2p[0], e2p[1]), row(e1p[0], e1p[1])] };
+    let finite = |a: &[[f32; 3]; 2]| a.iter().flatten().all(|x| x.is_finite());
+    (finite(&out.dn_dl) && finite(&out.dl_dz)).then_some(out)
 }
 
 /// Mirror reflection about a curved surface (eqs. 3.10–3.11 with the
@@ -398,10 +416,34 @@ pub fn trace_one(caster: &Caster, e: &Emission, i: u32) -> [Option<Photon>; 2] {
         if diffuse {
             reemit(&mut p, n, rng(i, 4 * k - 1), azimuth(rng(i, 4 * k)));
         } else {
-            reflect(&mut p, n);
+            reflect_curved(&mut p, mirror_normal(caster.scene, &h).as_ref(), n);
         }
     }
     out
+}
+
+/// The interpolated normal a mirror reflects about at hit `h` (eqs.
+/// 5.12–5.21), from the scene's vertex normals and the hit's barycentric
+/// weights; `None` (the flat mirror) where the scene or the triangle has no
+/// vertex normals, or they cancel there.
+fn mirror_normal(scene: &Scene, h: &crate::host::raycast::Hit) -> Option<ShadingNormal> {
+    if scene.normals.is_empty() {
+        return None;
+    }
+    let (k, _, e1p, e2p) = wald(&scene.triangles[h.tri as usize].v);
+    shading_normal(k, e1p, e2p, (h.u, h.v), normal_deltas(scene.vertex_normals(h.tri)))
+}
+
+/// The kernel's table of [`normal_deltas`], nine floats per triangle, and
+/// whether the scene has vertex normals (one zero float when it has none).
+pub fn normal_table(scene: &Scene) -> (Vec<f32>, bool) {
+    if scene.normals.is_empty() {
+        return (vec![0.0], false);
+    }
+    let table = (0..scene.triangles.len() as u32)
+        .flat_map(|t| normal_deltas(scene.vertex_normals(t)).into_iter().flatten())
+        .collect();
+    (table, true)
 }
 
 /// The native reference: every photon of `e` traced through `scene`'s `tree`.
@@ -480,6 +522,8 @@ pub fn trace_kernel_observed(
         eps,
     ]);
     params.extend_from_slice(&(e.n as i32).to_le_bytes());
+    let (normals, has_normals) = normal_table(scene);
+    params.extend_from_slice(&(has_normals as i32).to_le_bytes());
     let mats = crate::host::rt_kernels::material_table(scene);
     let tri_mat: Vec<u32> = scene.triangles.iter().map(|t| t.material).collect();
     let up = crate::host::rt_kernels::upload;
@@ -489,9 +533,10 @@ pub fn trace_kernel_observed(
     let tb = up(dev, &lay.triangles, "triangles")?;
     let tm = up(dev, &to_bytes(&tri_mat), "tri_mat")?;
     let mb = up(dev, &to_bytes(&mats), "materials")?;
+    let nb = up(dev, &to_bytes(&normals), "normals")?;
     let out = dev.alloc_zeroed::<f32>(2 * SLOT * e.n.max(1));
     let ctas = (e.n.div_ceil(THREADS as usize) as u32).clamp(1, MAX_CTAS);
-    let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, out].into_iter().map(Arg::Ptr).collect();
+    let args: Vec<Arg> = [pp, nodes, refs, tb, tm, mb, nb, out].into_iter().map(Arg::Ptr).collect();
     let observer = model.map(|m| m as &dyn crate::sim::ObserverFactory);
     let launch = dev.launch_observed(module, KERNEL, LaunchConfig::linear(ctas, THREADS), &args, observer)?;
     let raw = dev.read::<f32>(out, 2 * SLOT * e.n);
