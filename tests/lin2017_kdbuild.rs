@@ -1,0 +1,129 @@
+//! Thesis 003's GPU full-SAH kd-tree construction (§6.5, 003:L548-587):
+//! the kernels of `kernels/lin2017/kdbuild.cu` on the emulator build the
+//! same tree as their serial twin (`host::path::gpu_build::twin`), node for
+//! node and reference for reference, in both forms (one axis per node as
+//! the thesis describes it, and all three axes). Against the serial CPU
+//! construction (`host::path::build`, Wald and Havran's sweep over three
+//! axes, no clipping) the statistics are recorded as they are: the thesis'
+//! "same tree" claim (003:L578) holds only for the three-axis form
+//! (erratum 13; docs/reproduction-lin2017.md).
+
+use warplight::host::kdtree::{KdTree, TreeStats};
+use warplight::host::path::build;
+use warplight::host::path::gpu_build::{self, GpuParams};
+use warplight::host::scene_file;
+use warplight::sim::Fidelity;
+
+fn triangles(name: &str) -> Vec<[glam::Vec3; 3]> {
+    let s = scene_file::load(&scene_file::resolve(name)).unwrap_or_else(|e| panic!("scenes/{name}.toml: {e}"));
+    s.triangles.iter().map(|t| t.v).collect()
+}
+
+fn emulated(tris: &[[glam::Vec3; 3]], p: &GpuParams) -> gpu_build::GpuBuild {
+    let (mut dev, m) = gpu_build::device(Fidelity::Functional).expect("load PTX");
+    gpu_build::build(&mut dev, &m, tris, p).expect("build")
+}
+
+fn summary(t: &KdTree, p: &GpuParams) -> (TreeStats, f64) {
+    (t.stats(), gpu_build::sah_cost(t, p.k_t as f64, p.k_i as f64))
+}
+
+#[test]
+fn the_emulated_build_is_its_twin_node_for_node() {
+    for name in ["cornell-lambert", "suzanne"] {
+        let tris = triangles(name);
+        for all_axes in [false, true] {
+            let p = GpuParams { all_axes, ..GpuParams::thesis(tris.len()) };
+            let g = emulated(&tris, &p);
+            let t = gpu_build::twin(&tris, &p).expect("twin");
+            assert_eq!(g.tree.nodes, t.nodes, "{name} all_axes {all_axes}");
+            assert_eq!(g.tree.tri_refs, t.tri_refs, "{name} all_axes {all_axes}");
+            assert_eq!(g.tree.depth, t.depth, "{name} all_axes {all_axes}");
+            assert_eq!(g.levels.len() as u32, t.depth + 1);
+        }
+    }
+}
+
+/// (inner nodes, leaves, references, depth, SAH cost) of a tree.
+fn stats(t: &KdTree, p: &GpuParams) -> (u64, u64, u64, u32, f64) {
+    let (s, sah) = summary(t, p);
+    (s.inner_nodes, s.leaves, s.tri_refs, s.depth, (sah * 100.0).round() / 100.0)
+}
+
+#[test]
+fn the_serial_build_is_not_the_one_axis_tree_and_almost_the_three_axis_one() {
+    // recorded (docs/reproduction-lin2017.md, Table 2): the thesis' one-axis
+    // form builds smaller trees of higher SAH cost than the serial sweep over
+    // three axes; the three-axis form differs from it only where flat
+    // triangles lie in a plane (counted on one side here, on both there)
+    let cases = [
+        ("cornell-lambert", (18, 19, 119, 6, 457.47), (20, 21, 109, 8, 396.99), (19, 20, 107, 8, 396.29)),
+        ("suzanne", (1248, 1249, 4156, 18, 645.85), (1567, 1568, 4504, 19, 601.97), (1563, 1564, 4490, 19, 601.92)),
+    ];
+    for (name, one, three, serial) in cases {
+        let tris = triangles(name);
+        let p = GpuParams::thesis(tris.len());
+        let p3 = GpuParams { all_axes: true, ..p };
+        assert_eq!(stats(&gpu_build::twin(&tris, &p).expect("twin"), &p), one, "{name} one axis");
+        assert_eq!(stats(&gpu_build::twin(&tris, &p3).expect("twin"), &p), three, "{name} three axes");
+        assert_eq!(stats(&build::build(&tris, &p.serial()), &p), serial, "{name} serial");
+    }
+}
+
+/// The first node (depth first, lower child first) where two trees part:
+/// its depth, and the two nodes there.
+fn first_difference(a: &KdTree, b: &KdTree) -> Option<(u32, String, String)> {
+    use warplight::host::kdtree::Node;
+    let mut todo = vec![(0usize, 0usize, 0u32)];
+    while let Some((i, j, d)) = todo.pop() {
+        match (a.nodes[i], b.nodes[j]) {
+            (Node::Inner { axis, split, left, right }, Node::Inner { axis: x2, split: s2, left: l2, right: r2 })
+                if axis == x2 && split == s2 =>
+            {
+                todo.push((right as usize, r2 as usize, d + 1));
+                todo.push((left as usize, l2 as usize, d + 1));
+            }
+            (Node::Leaf { first, count }, Node::Leaf { first: f2, count: c2 })
+                if a.tri_refs[first as usize..(first + count) as usize]
+                    == b.tri_refs[f2 as usize..(f2 + c2) as usize] => {}
+            (x, y) => {
+                let refs = |t: &KdTree, n: Node| match n {
+                    Node::Leaf { first, count } => format!("{:?}", &t.tri_refs[first as usize..(first + count) as usize]),
+                    _ => String::new(),
+                };
+                return Some((d, format!("{x:?} {}", refs(a, x)), format!("{y:?} {}", refs(b, y))));
+            }
+        }
+    }
+    None
+}
+
+#[test]
+fn where_the_three_axis_form_parts_from_the_serial_build() {
+    for name in ["cornell-lambert", "suzanne"] {
+        let tris = triangles(name);
+        let p = GpuParams { all_axes: true, ..GpuParams::thesis(tris.len()) };
+        let t = gpu_build::twin(&tris, &p).expect("twin");
+        let serial = build::build(&tris, &p.serial());
+        let (depth, ours, theirs) = first_difference(&t, &serial).expect("the trees differ");
+        eprintln!("{name}: depth {depth}: {ours} / {theirs}");
+        // Cornell: a plane through the top of the short box (flat quads) is
+        // cheaper when they count on one side; Suzanne: triangles 254 and 255
+        // lie flat in z = 4.838267, where the three-axis form splits a node
+        // the serial build keeps as a leaf
+        let expected = if name == "suzanne" { (12, "Inner { axis: 2, split: 4.838267") } else { (3, "Inner { axis: 1, split: 0.6") };
+        assert_eq!(depth, expected.0, "{name}");
+        assert!(ours.starts_with(expected.1), "{name}: {ours}");
+    }
+}
+
+#[test]
+#[ignore = "minutes: the bunny's build on the emulator at fidelity memory"]
+fn bunny_timing() {
+    let tris = triangles("stanford-bunny");
+    let p = GpuParams::thesis(tris.len());
+    let t0 = std::time::Instant::now();
+    let (mut dev, m) = gpu_build::device(Fidelity::Memory).expect("load PTX");
+    let g = gpu_build::build(&mut dev, &m, &tris, &p).expect("build");
+    eprintln!("bunny: {:.1} s, {:?}, {:?}", t0.elapsed().as_secs_f64(), g.tree.stats(), g.total());
+}
