@@ -12,6 +12,10 @@ use warplight::host::kdtree::{KdTree, TreeStats};
 use warplight::host::path::build;
 use warplight::host::path::gpu_build::{self, GpuParams};
 use warplight::host::scene_file;
+use warplight::repro::baseline::Baseline;
+use warplight::repro::lin2017::table_2;
+use warplight::repro::registry::{Workspace, resolve};
+use warplight::repro::results::Results;
 use warplight::sim::Fidelity;
 
 fn triangles(name: &str) -> Vec<[glam::Vec3; 3]> {
@@ -88,7 +92,9 @@ fn first_difference(a: &KdTree, b: &KdTree) -> Option<(u32, String, String)> {
                     == b.tri_refs[f2 as usize..(f2 + c2) as usize] => {}
             (x, y) => {
                 let refs = |t: &KdTree, n: Node| match n {
-                    Node::Leaf { first, count } => format!("{:?}", &t.tri_refs[first as usize..(first + count) as usize]),
+                    Node::Leaf { first, count } => {
+                        format!("{:?}", &t.tri_refs[first as usize..(first + count) as usize])
+                    }
                     _ => String::new(),
                 };
                 return Some((d, format!("{x:?} {}", refs(a, x)), format!("{y:?} {}", refs(b, y))));
@@ -111,7 +117,11 @@ fn where_the_three_axis_form_parts_from_the_serial_build() {
         // cheaper when they count on one side; Suzanne: triangles 254 and 255
         // lie flat in z = 4.838267, where the three-axis form splits a node
         // the serial build keeps as a leaf
-        let expected = if name == "suzanne" { (12, "Inner { axis: 2, split: 4.838267") } else { (3, "Inner { axis: 1, split: 0.6") };
+        let expected = if name == "suzanne" {
+            (12, "Inner { axis: 2, split: 4.838267")
+        } else {
+            (3, "Inner { axis: 1, split: 0.6")
+        };
         assert_eq!(depth, expected.0, "{name}");
         assert!(ours.starts_with(expected.1), "{name}: {ours}");
     }
@@ -126,4 +136,58 @@ fn bunny_timing() {
     let (mut dev, m) = gpu_build::device(Fidelity::Memory).expect("load PTX");
     let g = gpu_build::build(&mut dev, &m, &tris, &p).expect("build");
     eprintln!("bunny: {:.1} s, {:?}, {:?}", t0.elapsed().as_secs_f64(), g.tree.stats(), g.total());
+}
+
+fn root() -> &'static std::path::Path {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The committed quick run's raw results (`warplight tables lin:1 lin:2 --out`).
+const QUICK: &str = "docs/results/lin-quick.json";
+/// Its verdicts (`--write-baseline`).
+const QUICK_BASELINE: &str = "docs/results/lin-quick.baseline.json";
+
+#[test]
+fn the_committed_run_renders_the_recorded_verdicts() {
+    // every compared cell and check of lin:1 and lin:2 gives the verdict the
+    // baseline records, either way (a verdict that moves fails until the
+    // baseline is re-recorded: warplight tables lin:1 lin:2 --protocol quick
+    // --out docs/results/lin-quick.json --write-baseline docs/results/lin-quick.baseline.json)
+    let r = Results::read(&root().join(QUICK)).expect("committed results");
+    let mut tables = Vec::new();
+    for e in resolve(&["lin:1".into(), "lin:2".into()]).expect("registered") {
+        tables.extend((e.table.render.expect("rendered"))(&e, &r));
+    }
+    let scenes: Vec<String> = r.scenes.iter().map(|s| s.name.clone()).collect();
+    let now = Baseline::record(&r.protocol.describe(), &scenes, &tables);
+    let base: Baseline =
+        serde_json::from_str(&std::fs::read_to_string(root().join(QUICK_BASELINE)).expect("baseline")).expect("json");
+    assert_eq!(now, base);
+    let lin2 = &base.tables["lin:2"];
+    assert_eq!(lin2.values().filter(|v| *v == "within").count(), 3, "{lin2:?}");
+    assert_eq!(base.tables["lin:1"].values().filter(|v| *v == "within").count(), 4);
+}
+
+#[test]
+fn a_fresh_build_counts_what_the_committed_run_recorded() {
+    // the GPU build is deterministic: launches, instructions, bytes and tree
+    // statistics of Cornell and Suzanne equal the committed quick run's
+    let r = Results::read(&root().join(QUICK)).expect("committed results");
+    for name in ["cornell-lambert", "suzanne"] {
+        let scene = scene_file::load(&scene_file::resolve(name)).expect("scene");
+        let mut ws = Workspace::new(&scene, 0..1, 32);
+        let fresh = table_2::measure(&mut ws, &mut |_| {}).expect("measure");
+        assert!(fresh.len() > 3, "{name}");
+        for s in fresh {
+            let old = r.samples.iter().find(|o| o.group == s.group && o.scene == s.scene && o.variant == s.variant);
+            let old = old.unwrap_or_else(|| panic!("{name} {}: not in {QUICK}", s.variant));
+            for (k, v) in &s.counters {
+                // the SAH costs pass through JSON's shortest decimal form
+                let was = old.counters.get(k).copied().unwrap_or(f64::NAN);
+                if k != "serial_seconds" {
+                    assert!((v - was).abs() <= 1e-12 * v.abs(), "{name} {} {k}: {v} vs {was}", s.variant);
+                }
+            }
+        }
+    }
 }

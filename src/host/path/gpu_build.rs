@@ -547,7 +547,11 @@ impl Launcher<'_> {
         let blocks = n.div_ceil(THREADS as usize).max(1);
         let s = sums.ensure::<u32>(self.dev, blocks + 1);
         let (n32, b32) = (n as u32, blocks as u32);
-        self.launch_grid("kd_scan_blocks", b32, &[Arg::Ptr(input), Arg::U32(mask), Arg::U32(n32), Arg::Ptr(out), Arg::Ptr(s)])?;
+        self.launch_grid(
+            "kd_scan_blocks",
+            b32,
+            &[Arg::Ptr(input), Arg::U32(mask), Arg::U32(n32), Arg::Ptr(out), Arg::Ptr(s)],
+        )?;
         self.launch_grid("kd_scan_sums", 1, &[Arg::Ptr(s), Arg::U32(b32)])?;
         self.launch("kd_scan_add", n + 1, &[Arg::Ptr(out), Arg::Ptr(s), Arg::U32(n32), Arg::U32(b32)])?;
         Ok(self.dev.try_read::<u32>(DevicePtr(out.0 + 4 * n as u64), 1)?[0])
@@ -605,8 +609,13 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
             keys.swap(0, 1);
             width *= 2;
         }
-        let (p_, f_, t_) = (pos.ensure::<f32>(l.dev, 3 * m), flags.ensure::<u32>(l.dev, 3 * m), tri.ensure::<u32>(l.dev, 3 * m));
-        l.launch("kd_unpack", 3 * m, &[Arg::Ptr(keys[0]), Arg::U32(3 * m as u32), Arg::Ptr(p_), Arg::Ptr(f_), Arg::Ptr(t_)])?;
+        let (p_, f_, t_) =
+            (pos.ensure::<f32>(l.dev, 3 * m), flags.ensure::<u32>(l.dev, 3 * m), tri.ensure::<u32>(l.dev, 3 * m));
+        l.launch(
+            "kd_unpack",
+            3 * m,
+            &[Arg::Ptr(keys[0]), Arg::U32(3 * m as u32), Arg::Ptr(p_), Arg::Ptr(f_), Arg::Ptr(t_)],
+        )?;
     }
     let sort = l.take(0, 0, n as u64);
     let ids: Vec<u32> = (0..n as u32).collect();
@@ -678,8 +687,11 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
             Arg::Ptr(nb),
         ];
         l.launch("kd_nodes", count, &args)?;
-        let (nl, no, lf) =
-            (next_list.ensure::<u32>(l.dev, next_t), next_owner.ensure::<u32>(l.dev, next_t), leaf.ensure::<u32>(l.dev, leaves_here));
+        let (nl, no, lf) = (
+            next_list.ensure::<u32>(l.dev, next_t),
+            next_owner.ensure::<u32>(l.dev, next_t),
+            leaf.ensure::<u32>(l.dev, leaves_here),
+        );
         let args = [
             Arg::Ptr(tri_list.ptr),
             Arg::Ptr(tri_owner.ptr),
