@@ -358,7 +358,7 @@ pub fn twin(tris: &[[Vec3; 3]], p: &GpuParams) -> Result<KdTree, GpuBuildError> 
                 continue;
             }
             let a = area(nd.lo, nd.hi);
-            if !(a > 0.0) {
+            if a.is_nan() || a <= 0.0 {
                 continue;
             }
             let off = 2 * nd.tri_off as usize;

@@ -29,9 +29,13 @@ pub const CLIPPING: &str = "lin/clipping";
 /// The longest image side the group emulates (the protocol's resolution, capped).
 pub const MAX_SIDE: u32 = 32;
 
+/// A row of Tables 1 and 2 as printed: our scene (`None`: not in
+/// `scenes/`) and the five printed cells.
+pub type PrintedRow = (Option<&'static str>, &'static str, &'static str, &'static str, &'static str, &'static str);
+
 /// Table 1 as printed, column by column: our scene (`None`: not in
 /// `scenes/`), model, face count, FPS w/o clipping, FPS w clipping, speedup.
-pub const PRINTED: [(Option<&str>, &str, &str, &str, &str, &str); 4] = [
+pub const PRINTED: [PrintedRow; 4] = [
     (Some("suzanne"), "Suzzane", "500", "39.73", "42.63", "7.3%"),
     (Some("stanford-bunny"), "Stanford Bunny", "69,451", "33.11", "36.12", "9.1%"),
     (None, "Armadillo", "345,944", "27.30", "28.25", "3.5%"),

@@ -13,6 +13,7 @@
 
 use std::collections::BTreeMap;
 
+use super::table_1::PrintedRow;
 use crate::host::kdtree::KdTree;
 use crate::host::path::build;
 use crate::host::path::gpu_build::{self, GpuParams, LevelCost};
@@ -27,7 +28,7 @@ pub const BUILDS: &str = "lin/gpu-build";
 
 /// Table 2 as printed: our scene (`None`: not in `scenes/`), model, face
 /// count, CPU (s), GPU (s), speedup.
-pub const PRINTED: [(Option<&str>, &str, &str, &str, &str, &str); 5] = [
+pub const PRINTED: [PrintedRow; 5] = [
     (Some("cornell-lambert"), "Cornell", "32", "0.001", "0.046", "0.02x"),
     (Some("suzanne"), "Suzanne", "968", "0.016", "0.095", "0.17x"),
     (Some("stanford-bunny"), "Bunny", "69,451", "1.442", "0.655", "2.20x"),
