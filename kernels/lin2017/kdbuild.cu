@@ -144,26 +144,13 @@ extern "C" __global__ void kd_scan_blocks(const unsigned *in, unsigned mask, uns
                                           unsigned *sums) {
   __shared__ unsigned buf[KD_THREADS];
   unsigned j = WL_TID;
-  unsigned v = j < n ? ((in[j] & mask) != 0u ? 1u : 0u) : 0u;
-  unsigned total;
-  unsigned ex = cta_scan<KD_THREADS>(buf, v, &total);
-  if (j < n) out[j] = ex;
-  if (threadIdx.x == 0) sums[blockIdx.x] = total;
+  cta_scan_block<KD_THREADS>(buf, j < n && (in[j] & mask) != 0u ? 1u : 0u, j, n, out, sums);
 }
 
 // One CTA: the exclusive scan of the CTA totals; the grand total in sums[blocks].
 extern "C" __global__ void kd_scan_sums(unsigned *sums, unsigned blocks) {
   __shared__ unsigned buf[KD_THREADS];
-  unsigned carry = 0;
-  for (unsigned base = 0; base < blocks; base += KD_THREADS) {
-    unsigned k = base + threadIdx.x;
-    unsigned v = k < blocks ? sums[k] : 0u;
-    unsigned total;
-    unsigned ex = cta_scan<KD_THREADS>(buf, v, &total);
-    if (k < blocks) sums[k] = carry + ex;
-    carry += total;
-  }
-  if (threadIdx.x == 0) sums[blocks] = carry;
+  cta_scan_sums<KD_THREADS>(buf, sums, blocks);
 }
 
 // out[j] += its CTA's offset; out[n] = the grand total.

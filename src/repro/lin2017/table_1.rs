@@ -33,6 +33,14 @@ pub const MAX_SIDE: u32 = 32;
 /// `scenes/`) and the five printed cells.
 pub type PrintedRow = (Option<&'static str>, &'static str, &'static str, &'static str, &'static str, &'static str);
 
+/// A row's label: the model as printed and our scene, or that we have none.
+pub fn row_label(model: &str, scene: Option<&str>) -> String {
+    match scene {
+        Some(s) => format!("{model} ({s})"),
+        None => format!("{model} (not in scenes/)"),
+    }
+}
+
 /// Table 1 as printed, column by column: our scene (`None`: not in
 /// `scenes/`), model, face count, FPS w/o clipping, FPS w clipping, speedup.
 pub const PRINTED: [PrintedRow; 4] = [
@@ -157,11 +165,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
                 cells.push(Cell { ours: x, ..Cell::default() });
             }
         }
-        let label = match scene {
-            Some(s) => format!("{model_name} ({s})"),
-            None => format!("{model_name} (not in scenes/)"),
-        };
-        rows.push(Row { label, kind: RowKind::Scene, cells });
+        rows.push(Row { label: row_label(model_name, scene), kind: RowKind::Scene, cells });
     }
     let mut table =
         Table { address: e.address(), heading: e.heading(), columns, rows, checks: Vec::new(), notes: Vec::new() };

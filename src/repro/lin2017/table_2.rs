@@ -13,7 +13,7 @@
 
 use std::collections::BTreeMap;
 
-use super::table_1::PrintedRow;
+use super::table_1::{PrintedRow, row_label};
 use crate::host::kdtree::KdTree;
 use crate::host::path::build;
 use crate::host::path::gpu_build::{self, GpuParams, LevelCost};
@@ -183,11 +183,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
             [ours("levels"), ours("launches"), mega("warp_instructions", 1e6), mega("bytes", 1e6)]
                 .map(|x| Cell { ours: x, ..Cell::default() }),
         );
-        let label = match scene {
-            Some(s) => format!("{model} ({s})"),
-            None => format!("{model} (not in scenes/)"),
-        };
-        rows.push(Row { label, kind: RowKind::Scene, cells });
+        rows.push(Row { label: row_label(model, scene), kind: RowKind::Scene, cells });
     }
     let mut table =
         Table { address: e.address(), heading: e.heading(), columns, rows, checks: Vec::new(), notes: Vec::new() };
