@@ -2,7 +2,8 @@
 //! the kernels of `kernels/lin2017/kdbuild.cu` on the emulator build the
 //! same tree as their serial twin (`host::path::gpu_build::twin`), node for
 //! node and reference for reference, in both forms (one axis per node as
-//! the thesis describes it, and all three axes). Against the serial CPU
+//! the thesis describes it, and all three axes), from clang's PTX and from
+//! nvcc's. Against the serial CPU
 //! construction (`host::path::build`, Wald and Havran's sweep over three
 //! axes, no clipping) the statistics are recorded as they are: the thesis'
 //! "same tree" claim (003:L578) holds only for the three-axis form
@@ -190,4 +191,17 @@ fn a_fresh_build_counts_what_the_committed_run_recorded() {
             }
         }
     }
+}
+
+#[test]
+fn nvccs_ptx_builds_the_same_tree() {
+    // the second dialect (kernels/lin2017/kdbuild.nvcc.ptx) on the emulator
+    let tris = triangles("suzanne");
+    let p = GpuParams::thesis(tris.len());
+    let (mut dev, _) = gpu_build::device(Fidelity::Functional).expect("load PTX");
+    let text = std::fs::read_to_string(root().join("kernels/lin2017/kdbuild.nvcc.ptx")).expect("nvcc PTX");
+    let m = dev.load_ptx(&text, "kernels/lin2017/kdbuild.nvcc.ptx").expect("load nvcc PTX");
+    let g = gpu_build::build(&mut dev, &m, &tris, &p).expect("build");
+    let t = gpu_build::twin(&tris, &p).expect("twin");
+    assert_eq!((g.tree.nodes, g.tree.tri_refs), (t.nodes, t.tri_refs));
 }

@@ -35,8 +35,16 @@
 #include "../prelude.h"
 #include "cta_scan.h"
 
+// The SAH costs round every product and sum (no fused multiply-add), so
+// that both dialects build the serial twin's tree: clang by the pragma, nvcc
+// (which contracts by default) by the _rn intrinsics.
 #if defined(__clang__) && !defined(__NVCC__)
 #pragma clang fp contract(off)
+#define MUL(a, b) ((a) * (b))
+#define ADD(a, b) ((a) + (b))
+#else
+#define MUL(a, b) __fmul_rn(a, b)
+#define ADD(a, b) __fadd_rn(a, b)
 #endif
 
 #define KD_THREADS 256
@@ -82,7 +90,7 @@ static __device__ __forceinline__ float unord(unsigned u) {
 // Surface area as host::kdtree::Aabb::area.
 static __device__ __forceinline__ float area(const float *lo, const float *hi) {
   float x = fmaxf(hi[0] - lo[0], 0.0f), y = fmaxf(hi[1] - lo[1], 0.0f), z = fmaxf(hi[2] - lo[2], 0.0f);
-  return 2.0f * (x * y + y * z + z * x);
+  return MUL(2.0f, ADD(ADD(MUL(x, y), MUL(y, z)), MUL(z, x)));
 }
 
 // ---- the root's events -------------------------------------------------------
@@ -189,7 +197,7 @@ extern "C" __global__ void kd_sah(const KdNode *nodes, u64 *best, const float *p
   float r_lo[3] = {nd->lo[0], nd->lo[1], nd->lo[2]};
   l_hi[d] = p;
   r_lo[d] = p;
-  float cost = k_t + k_i * (area(nd->lo, l_hi) / a * (float)n_l + area(r_lo, nd->hi) / a * (float)n_r);
+  float cost = ADD(k_t, MUL(k_i, ADD(MUL(area(nd->lo, l_hi) / a, (float)n_l), MUL(area(r_lo, nd->hi) / a, (float)n_r))));
   u64 key = ((u64)__float_as_uint(cost) << 32) | ((u64)d << 30) | rel;
   atomic_min_u64(best + o, key);
 }
@@ -206,7 +214,7 @@ extern "C" __global__ void kd_decide(KdNode *nodes, const u64 *best, unsigned co
   bool split = false;
   if (b != NO_SPLIT && nd->depth < max_depth && nd->n > 0u) {
     float cost = __uint_as_float((unsigned)(b >> 32));
-    split = cost < k_i * (float)nd->n || nd->n > max_leaf;
+    split = cost < MUL(k_i, (float)nd->n) || nd->n > max_leaf;
   }
   if (split) {
     unsigned d = (unsigned)(b >> 30) & 3u, rel = (unsigned)b & 0x3fffffffu;
