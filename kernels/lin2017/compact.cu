@@ -28,25 +28,12 @@ extern "C" __global__ void compact_flag(const float4 *states, unsigned n, unsign
 extern "C" __global__ void compact_scan(const unsigned *flags, unsigned n, unsigned *offsets, unsigned *sums) {
   __shared__ unsigned buf[COMPACT_THREADS];
   unsigned j = WL_TID;
-  unsigned v = j < n ? flags[j] : 0u;
-  unsigned total;
-  unsigned ex = cta_scan<COMPACT_THREADS>(buf, v, &total);
-  if (j < n) offsets[j] = ex;
-  if (threadIdx.x == 0) sums[blockIdx.x] = total;
+  cta_scan_block<COMPACT_THREADS>(buf, j < n ? flags[j] : 0u, j, n, offsets, sums);
 }
 
 extern "C" __global__ void compact_scan_sums(unsigned *sums, unsigned blocks) {
   __shared__ unsigned buf[COMPACT_THREADS];
-  unsigned carry = 0;
-  for (unsigned base = 0; base < blocks; base += COMPACT_THREADS) {
-    unsigned k = base + threadIdx.x;
-    unsigned v = k < blocks ? sums[k] : 0u;
-    unsigned total;
-    unsigned ex = cta_scan<COMPACT_THREADS>(buf, v, &total);
-    if (k < blocks) sums[k] = carry + ex;
-    carry += total;
-  }
-  if (threadIdx.x == 0) sums[blocks] = carry;
+  cta_scan_sums<COMPACT_THREADS>(buf, sums, blocks);
 }
 
 extern "C" __global__ void compact_scatter(const float4 *in, const unsigned *flags, const unsigned *offsets,

@@ -13,6 +13,7 @@ pub mod build;
 pub mod bvh;
 pub mod counts;
 pub mod environment;
+pub mod gpu_build;
 pub mod kernel;
 pub mod layout;
 pub mod native;
