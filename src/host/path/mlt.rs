@@ -6,8 +6,8 @@
 //!
 //! One Markov chain per pixel (003:L328). A chain's state is the random
 //! numbers of its current path, 10 floats a path segment (003:L328: "about
-//! 10 samples need to be generated for each path segment"), k = max bounces
-//! + 1 segments: 40 k bytes a chain, 40 k W H in all ([`state_bytes`]), plus
+//! 10 samples need to be generated for each path segment"), k segments
+//! (k = max bounces plus one): 40 k bytes a chain, 40 k W H in all ([`state_bytes`]), plus
 //! its current radiance and pixel (16 bytes). The path is traced by the base
 //! integrator [`super::MLT_BASE`] (bdpt, as the thesis' Fig. 9), which draws
 //! dimension d from slot [`slot`]`(d)` of the state after the iteration's
