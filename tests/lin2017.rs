@@ -59,6 +59,41 @@ fn bdpt_traces_the_same_bits_emulated_and_native() {
     same_frames(load("cornell-glossy"), &[Integrator::Bdpt]);
 }
 
+/// Metropolis light transport (`mlt_init`, `mlt_frame`): the chains' start,
+/// b, every splat (64-bit fixed-point atomics) and each frame's image are the
+/// same bits emulated and native, on the Lambertian box and on the glossy one,
+/// at the default 16 bounces and at 3 (a shorter state, k = 4).
+#[test]
+fn mlt_traces_the_same_bits_emulated_and_native() {
+    use warplight::host::path::mlt;
+    same_frames(cornell(), &[Integrator::Mlt]);
+    for (name, max_bounces) in [("cornell-lambert", 3), ("cornell-glossy", 16)] {
+        let (scene, ps) = load(name);
+        let (w, h) = (12, 10);
+        let cam = camera(&scene, w, h);
+        let p = FrameParams {
+            width: w,
+            height: h,
+            integrator: Integrator::Mlt,
+            max_bounces,
+            seed: 4,
+            traversal: Traversal::ShortStack,
+        };
+        let native = mlt::render_native(&ps, &cam, p, 2, true, |_| {});
+        let mut cfg = kernel::sim_config(&p);
+        cfg.fidelity = Fidelity::Functional;
+        let mut dev = Device::with_config(cfg);
+        let module = kernel::load(&mut dev).expect("load PTX");
+        let emu = mlt::render_emulated(&mut dev, &module, &ps, &cam, p, 2, true, |_| {}).expect("launch");
+        assert!(native.b > 0.0, "{name}: b = {}", native.b);
+        assert_eq!(native.b.to_bits(), emu.b.to_bits(), "{name}: b");
+        assert_eq!(native.fixed, emu.fixed, "{name}: the fixed-point image");
+        assert_eq!(native.image.frame_images, emu.image.frame_images, "{name}: the frames");
+        assert!(native.fixed.iter().filter(|&&v| v > 0).count() > native.fixed.len() / 2, "{name}: splats missing");
+        assert_eq!(emu.state_bytes, 40 * (max_bounces as u64 + 1) * (w * h) as u64, "{name}: 40 k W H");
+    }
+}
+
 /// bdpt at most 1 bounce is direct light only, whose techniques are the eye
 /// path hitting the light (weight 1/2 after a Lambertian bounce) and the
 /// connection to the light point y0 (1/2); the same pixels at 0 bounces see
@@ -157,8 +192,12 @@ fn render_takes_each_traversal_and_names_a_wrong_one() {
     let (ok, stdout, stderr) =
         render_path(&["--spp", "4", "--integrator", "bdpt", "-o", out.to_str().expect("utf-8 path")]);
     assert!(ok && stdout.contains("path tracer bdpt") && out.exists(), "--integrator bdpt: {stdout} {stderr}");
-    let (ok, _, stderr) = render_path(&["--integrator", "mlt"]);
-    assert!(!ok && stderr.contains("unknown integrator `mlt`") && stderr.contains("bdpt"), "{stderr}");
+    let out = dir.join("mlt.exr");
+    let (ok, stdout, stderr) =
+        render_path(&["--spp", "4", "--integrator", "mlt", "-o", out.to_str().expect("utf-8 path")]);
+    assert!(ok && stdout.contains("path tracer mlt") && out.exists(), "--integrator mlt: {stdout} {stderr}");
+    let (ok, _, stderr) = render_path(&["--integrator", "metropolis"]);
+    assert!(!ok && stderr.contains("unknown integrator `metropolis`") && stderr.contains("mlt"), "{stderr}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -33,7 +33,10 @@
 // 003:L249), mis (both, balance or power heuristic, §4.6). Rough glass is
 // sampled only (emission after it counts in full). Russian roulette on the
 // per-bounce mask (003:L267-271): continue with q = max RGB of the bounce's
-// f cos / p, then divide by q.
+// f cos / p, then divide by q. bdpt (bdpt_frame) and Metropolis light
+// transport over it (mlt_init, mlt_frame) are below. Every integrator draws
+// its random numbers through rng(K key, d): K is a path's key or an MLT
+// iteration's sampler (Mlt), whose numbers are its chain's mutated samples.
 //
 // Random numbers are counter based: dimension d of path i in frame f is a
 // hash of (i, f, seed, d), so the native path tracer (src/host/path/) draws
@@ -71,6 +74,7 @@
 // random dimensions: 2 for the camera ray, then 8 per bounce
 #define DIMS_CAMERA 2u
 #define DIMS_PER_BOUNCE 8u
+#define DIMS_LIGHT 0x10000u   // bdpt's light subpath: 5 at y0, then 8 per bounce
 #define INV_PI 0.318309886183790672f
 
 // Scene, camera and frame, laid out by src/host/path/kernel.rs.
@@ -80,6 +84,7 @@ struct Params {
   float eps, tan_half, aspect, light_area;
   int width, height, num_paths, frame, integrator, max_bounces, num_lights, seed, traversal;
   int env_w, env_h;   // the environment map's texels across and down (0: none)
+  float mlt_b;        // mlt_frame: the bootstrap's mean luminance b (003:L330)
 };
 
 struct V3 { float x, y, z; };
@@ -169,6 +174,72 @@ static __device__ __forceinline__ float exp_neg(float x) {
   float r = x - n * 0.693145751953125f - n * 1.42860682030941723e-6f;
   float poly = 1.0f + r * (1.0f + r * 0.5f * (1.0f + r / 3.0f * (1.0f + r * 0.25f * (1.0f + r * 0.2f * (1.0f + r / 6.0f * (1.0f + r / 7.0f))))));
   return poly * __int_as_float(((int)n + 127) << 23);
+}
+
+// ---- Metropolis light transport's samples (§4.8; the kernels: mlt_init, mlt_frame) ----
+//
+// Primary sample space (Kelemen et al. 2002; "store and mutate only the random
+// numbers", 003:L316): a chain keeps the path's random numbers as floats in
+// global memory, 10 a path segment (003:L328), k = max bounces + 1 segments.
+// The integrators draw dimension d through rng(K key, d); with the sampler Mlt
+// the value is the chain's slot mlt_slot(d) after the iteration's mutation.
+#define MLT_SLOTS_PER_SEGMENT 10u
+#define MLT_DIM_LARGE 0x30000u    // the iteration's large-or-small choice
+#define MLT_DIM_ACCEPT 0x30001u   // the acceptance test (mlt_init: the start's choice)
+#define MLT_P_LARGE 0.25f         // 003:L318's example: 1 large per 3 small on average
+#define MLT_S2 (1.0f / 64.0f)     // Kelemen's small step: s1 = 1/1024, s2 = 1/64 (not stated)
+#define MLT_LN_S2_S1 2.77258872223978124f   // ln(s2 / s1) = ln 16
+
+// The slot of dimension d for max bounces m: segment s holds in slots 0-6 the
+// eye bounce's dimensions 2 + 8 s + j (j = 0-6: the light point, the
+// direction, roulette, the Fresnel switch) and in slots 7-9 bdpt's light
+// vertex s's (direction and roulette, j = 3-5); y0's point takes segment 0's
+// 7-9 and its direction segment 1's 7-8 (vertex 1 draws none); the camera's 2
+// take segment m's 0-1 (bounce m draws none). Dimensions no integrator draws
+// may share a slot.
+static __device__ __forceinline__ unsigned mlt_slot(unsigned d, unsigned m) {
+  if (d < DIMS_CAMERA) return MLT_SLOTS_PER_SEGMENT * m + d;
+  if (d < DIMS_LIGHT) {
+    unsigned e = d - DIMS_CAMERA;
+    return MLT_SLOTS_PER_SEGMENT * (e >> 3) + (e & 7u);
+  }
+  unsigned e = d - DIMS_LIGHT, c = e >> 3, j = e & 7u;
+  if (c == 0u) return j < 3u ? 7u + j : 14u + j;
+  return MLT_SLOTS_PER_SEGMENT * c + 4u + j;
+}
+
+// An MLT iteration's sampler: the chain's current samples u (slots floats), the
+// iteration's key (the mutation's random numbers) and whether it is a large step.
+struct Mlt {
+  const float *u;
+  unsigned key, slots, max_bounces;
+  bool large;
+};
+
+// Slot `slot` of the proposal: a large step draws it afresh; a small step moves
+// the current value by s2 e^(-ln(s2 / s1) v) (Kelemen's exponential
+// perturbation, "sampled by an exponential distribution", 003:L318), up or down
+// with equal probability, wrapped into [0, 1).
+static __device__ __forceinline__ float mlt_value(const Mlt &m, unsigned slot) {
+  float r = rng(m.key, slot);
+  if (m.large) return r;
+  float x = m.u[slot];
+  float r2 = r * 2.0f;
+  bool up = r2 < 1.0f;
+  float v = up ? r2 : r2 - 1.0f;
+  float dv = MLT_S2 * exp_neg(-MLT_LN_S2_S1 * v);
+  x = up ? x + dv : x - dv;
+  if (x >= 1.0f) x = x - 1.0f;
+  if (x < 0.0f) x = x + 1.0f;
+  if (!(x < 1.0f)) x = __int_as_float(0x3f7fffff);   // a tiny negative x + 1 rounds to 1
+  return x;
+}
+
+// Dimension d drawn through an MLT sampler (a dimension beyond the slots,
+// which no integrator draws, is fresh).
+static __device__ __forceinline__ float rng(const Mlt &m, unsigned d) {
+  unsigned slot = mlt_slot(d, m.max_bounces);
+  return slot < m.slots ? mlt_value(m, slot) : rng(m.key, d);
 }
 
 // Beckmann's distribution (§5.1, 003:L344) of a microfacet normal whose cosine
@@ -481,12 +552,13 @@ struct Path {
   float bsdf_pdf;         // solid-angle pdf of the last diffuse bounce (mis)
 };
 
-// Path i's camera ray: tent-jittered in subpixel (sub & 1, sub >> 1) of the 2 x 2 grid.
-static __device__ __forceinline__ Path camera_path(const Params *p, int i, unsigned key) {
+// Path i's camera ray: tent-jittered in subpixel (sub & 1, sub >> 1) of the 2 x 2
+// grid by the tent filter's uniforms r0 (across) and r1 (down).
+static __device__ __forceinline__ Path camera_ray(const Params *p, int i, float r0, float r1) {
   int pixel = i >> 2, sub = i & 3;
   int x = pixel % p->width, y = pixel / p->width;
-  float px = (float)x + ((float)(sub & 1) + 0.5f + tent(rng(key, 0))) * 0.5f;
-  float py = (float)y + ((float)(sub >> 1) + 0.5f + tent(rng(key, 1))) * 0.5f;
+  float px = (float)x + ((float)(sub & 1) + 0.5f + tent(r0)) * 0.5f;
+  float py = (float)y + ((float)(sub >> 1) + 0.5f + tent(r1)) * 0.5f;
   float cx = (px / (float)p->width * 2.0f - 1.0f) * p->tan_half * p->aspect;
   float cy = (1.0f - py / (float)p->height * 2.0f) * p->tan_half;
   V3 fwd = v3(p->cam_fwd[0], p->cam_fwd[1], p->cam_fwd[2]);
@@ -503,10 +575,16 @@ static __device__ __forceinline__ Path camera_path(const Params *p, int i, unsig
   return P;
 }
 
+// Path i's camera ray with the tent filter's uniforms from dimensions 0 and 1.
+static __device__ __forceinline__ Path camera_path(const Params *p, int i, unsigned key) {
+  return camera_ray(p, i, rng(key, 0), rng(key, 1));
+}
+
 // The next direction at a hit (d in, the sampled direction out) and the
 // bounce's mask f cos / p in wgt; false when the path ends there.
+template <class K>
 static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 td, int kind, V3 ns, V3 color,
-                                               float cos_d, float cos_o, unsigned key, unsigned dim, V3 &d, V3 &wgt) {
+                                               float cos_d, float cos_o, K key, unsigned dim, V3 &d, V3 &wgt) {
   wgt = color;
   if (kind == KIND_DIFFUSE) {
     float lz;
@@ -591,9 +669,28 @@ static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 t
   return true;
 }
 
+// A point on the area lights, as next-event estimation and bdpt's light subpath
+// both choose it: the light triangle by the cumulative areas from dimension
+// dim, the point uniform on it from dim + 1 and dim + 2 (the light pdf is open,
+// 003:L240); *tri the triangle. Needs a light.
+template <class K>
+static __device__ __forceinline__ V3 light_point(const Scene &s, K key, unsigned dim, int *tri) {
+  const Params *p = s.p;
+  float yl = rng(key, dim);
+  int l = 0;
+  while (l + 1 < p->num_lights && !(yl < s.lights[3 * l].w)) l++;
+  float4 la = s.lights[3 * l], lb = s.lights[3 * l + 1], lc = s.lights[3 * l + 2];
+  float su = sqrtf(rng(key, dim + 1));
+  float yv = rng(key, dim + 2);
+  float bu = su * (1.0f - yv), bv = su * yv;
+  *tri = __float_as_int(lb.w);
+  return add3(add3(v3(la.x, la.y, la.z), scale3(v3(lb.x, lb.y, lb.z), bu)), scale3(v3(lc.x, lc.y, lc.z), bv));
+}
+
 // Russian roulette on the bounce's mask wgt = f cos / p (003:L267-271): continue
 // with q = its max RGB, then divide by q; false when the path ends.
-static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, unsigned key, unsigned dim) {
+template <class K>
+static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, K key, unsigned dim) {
   float q = fmaxf(fmaxf(wgt.x, wgt.y), wgt.z);
   if (q < 1.0f) {
     if (!(rng(key, dim + 5) < q)) return false;
@@ -608,7 +705,8 @@ static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, unsigned key, 
 // emission and the light sample, pick the next direction, Russian roulette.
 // False when the path ends (missed, hit an emitter, the longest path, or
 // terminated); P then holds its final radiance.
-static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned key) {
+template <class K>
+static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key) {
   const Params *p = s.p;
   int integrator = p->integrator;
   int bounce = P.bounce;
@@ -649,19 +747,12 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, unsigned ke
   bool sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
   if (sampled_light && integrator != INTEGRATOR_PT && p->num_lights > 0 && bounce < p->max_bounces) {
     // next event estimation: a light triangle by area, a point on it uniformly
-    float yl = rng(key, dim);
-    int l = 0;
-    while (l + 1 < p->num_lights && !(yl < s.lights[3 * l].w)) l++;
-    float4 la = s.lights[3 * l], lb = s.lights[3 * l + 1], lc = s.lights[3 * l + 2];
-    float su = sqrtf(rng(key, dim + 1));
-    float yv = rng(key, dim + 2);
-    float bu = su * (1.0f - yv), bv = su * yv;
-    V3 q = add3(add3(v3(la.x, la.y, la.z), scale3(v3(lb.x, lb.y, lb.z), bu)), scale3(v3(lc.x, lc.y, lc.z), bv));
+    int ltri;
+    V3 q = light_point(s, key, dim, &ltri);
     V3 wl = sub3(q, hitp);
     float dist2 = dot3(wl, wl);
     float dist = sqrtf(dist2);
     wl = scale3(wl, 1.0f / dist);
-    int ltri = __float_as_int(lb.w);
     float4 ld = s.tri_data[ltri];
     float cos_s = dot3(ns, wl);
     float cos_l = -dot3(v3(ld.x, ld.y, ld.z), wl);
@@ -751,7 +842,6 @@ extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, 
 // for m the Lambertian vertices in a row from the light's end. No light
 // vertex is connected to the camera (t = 1: splats, not counted in c).
 #define LIGHT_VERTICES 16
-#define DIMS_LIGHT 0x10000u   // the light subpath's dimensions: 5 at y0, then 8 per bounce
 
 static __device__ __forceinline__ int imin(int a, int b) { return a < b ? a : b; }
 
@@ -762,17 +852,12 @@ struct LightVertex {
 };
 
 // Traces the light subpath of `key` into lv (at most nl vertices); returns its vertex count.
-static __device__ int light_subpath(const Scene &s, unsigned key, int nl, LightVertex *lv) {
+template <class K>
+static __device__ int light_subpath(const Scene &s, K key, int nl, LightVertex *lv) {
   const Params *p = s.p;
-  float yl = rng(key, DIMS_LIGHT);
-  int l = 0;
-  while (l + 1 < p->num_lights && !(yl < s.lights[3 * l].w)) l++;
-  float4 la = s.lights[3 * l], lb = s.lights[3 * l + 1], lc = s.lights[3 * l + 2];
-  float su = sqrtf(rng(key, DIMS_LIGHT + 1));
-  float yv = rng(key, DIMS_LIGHT + 2);
-  float bu = su * (1.0f - yv), bv = su * yv;
-  V3 o = add3(add3(v3(la.x, la.y, la.z), scale3(v3(lb.x, lb.y, lb.z), bu)), scale3(v3(lc.x, lc.y, lc.z), bv));
-  float4 ld = s.tri_data[__float_as_int(lb.w)];
+  int ltri;
+  V3 o = light_point(s, key, DIMS_LIGHT, &ltri);
+  float4 ld = s.tri_data[ltri];
   float4 le = s.mats[3 * __float_as_int(ld.w) + 1];
   V3 alpha = scale3(v3(le.x, le.y, le.z), p->light_area);
   lv[0].p = o;
@@ -812,7 +897,8 @@ static __device__ int light_subpath(const Scene &s, unsigned key, int nl, LightV
 // One eye vertex of bdpt: trace, count emission with its uniform weight, connect
 // a Lambertian vertex to the light subpath, scatter. run: the Lambertian eye
 // vertices in a row ending at the previous one. False when the path ends.
-static __device__ __forceinline__ bool bdpt_step(const Scene &s, Path &P, unsigned key, const LightVertex *lv, int nl,
+template <class K>
+static __device__ __forceinline__ bool bdpt_step(const Scene &s, Path &P, K key, const LightVertex *lv, int nl,
                                                  int nl_max, int &run) {
   const Params *p = s.p;
   int bounce = P.bounce;
@@ -949,4 +1035,149 @@ extern "C" __global__ void path_level(const Params *params, const uint4 *nodes, 
     finish(accum, last, i, P.L);
     st[3].w = __uint_as_float(0u);
   }
+}
+
+// ---- Metropolis light transport (§4.8, 003:L310-336): mlt_init, mlt_frame ----
+//
+// Primary-sample-space MLT over the path tracer named by p->integrator (pt,
+// nee, mis or bdpt; the thesis runs it over bdpt, 003:L332): one Markov chain
+// per pixel ("the number of threads is set to be equal to the number of screen
+// pixels", 003:L328), its state the path's random numbers (mlt_slot(), 40 k
+// bytes a chain) and its current radiance and pixel (a float4). A proposal's
+// camera ray takes its subpixel and tent jitter from samples 0 and 1 over the
+// whole image, so any chain splats anywhere. The scalar contribution is the
+// luminance Y (003:L322); acceptance min(1, Y' / Y) (the mutations are
+// symmetric, 003:L316); splats by expected values (the current sample weighted
+// 1 - a, the proposal a), each b F / Y (003:L330) with b the bootstrap's mean
+// luminance, added by 64-bit integer atomics in 32.32 fixed point: integer
+// addition is associative, so the image does not depend on the order of the
+// atomics and the native mirror (rayon) gets the same bits.
+#define MLT_BOOTSTRAP 16            // large-step samples per chain at start-up (not stated)
+#define MLT_BOOTSTRAP_FRAME 0xffffffffu
+#define MLT_STEPS 4                 // iterations per chain per frame (a frame's 4 samples a pixel)
+#define MLT_FIXED 4294967296.0f     // 2^32: the splats' fixed point
+
+typedef unsigned long long ull;
+static __device__ __forceinline__ void add_u64(ull *a, ull v) {
+#if defined(__NVCC__)
+  atomicAdd(a, v);
+#else
+  __nvvm_atom_add_gen_ll((long long *)a, (long long)v);
+#endif
+}
+
+// Y of an RGB radiance (003:L322).
+static __device__ __forceinline__ float luminance(V3 c) {
+  return 0.212671f * c.x + 0.715160f * c.y + 0.072169f * c.z;
+}
+
+// Adds the colour c times w to pixel `pixel` of the fixed-point image.
+static __device__ __forceinline__ void splat(ull *image, int pixel, V3 c, float w) {
+  ull *a = image + 3 * pixel;
+  add_u64(a, (ull)(c.x * w * MLT_FIXED));
+  add_u64(a + 1, (ull)(c.y * w * MLT_FIXED));
+  add_u64(a + 2, (ull)(c.z * w * MLT_FIXED));
+}
+
+// The radiance the integrator p->integrator finds along camera path P with sampler key.
+template <class K>
+static __device__ __forceinline__ V3 radiance(const Scene &s, Path P, K key) {
+  const Params *p = s.p;
+  if (p->integrator == INTEGRATOR_BDPT) {
+    LightVertex lv[LIGHT_VERTICES];
+    int nl_max = p->num_lights > 0 ? imin(p->max_bounces, LIGHT_VERTICES) : 0;
+    int nl = nl_max > 0 ? light_subpath(s, key, nl_max, lv) : 0;
+    int run = 0;
+    while (bdpt_step(s, P, key, lv, nl, nl_max, run)) {
+    }
+  } else {
+    while (step(s, P, key)) {
+    }
+  }
+  return P.L;
+}
+
+// A proposal's camera path: its subpixel of the 2W x 2H grid and its tent
+// jitter from samples 0 and 1; *i the path index (4 pixel + subpixel).
+static __device__ __forceinline__ Path mlt_camera(const Params *p, const Mlt &m, int *i) {
+  float x = rng(m, 0) * (float)(2 * p->width), y = rng(m, 1) * (float)(2 * p->height);
+  int sx = (int)x, sy = (int)y;
+  if (sx > 2 * p->width - 1) sx = 2 * p->width - 1;
+  if (sy > 2 * p->height - 1) sy = 2 * p->height - 1;
+  *i = 4 * ((sy >> 1) * p->width + (sx >> 1)) + 2 * (sy & 1) + (sx & 1);
+  return camera_ray(p, *i, x - (float)sx, y - (float)sy);
+}
+
+// Start-up: each chain draws MLT_BOOTSTRAP large-step samples, stores the sum of
+// their luminances in ysum (the host's b = the mean over all chains, 003:L330)
+// and starts at one of them chosen in proportion to its luminance (a weighted
+// reservoir of one).
+extern "C" __global__ void mlt_init(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                    const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                    const float4 *lights, const float4 *boxes, const float4 *env, float *state,
+                                    float4 *chains, float *ysum) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  const Params *p = params;
+  int c = (int)WL_TID;
+  if (c >= p->width * p->height) return;
+  unsigned slots = MLT_SLOTS_PER_SEGMENT * (unsigned)(p->max_bounces + 1);
+  float *u = state + (ull)slots * (ull)c;
+  float sum = 0.0f;
+  V3 pick = v3(0.0f, 0.0f, 0.0f);
+  int pick_i = 0;
+  unsigned pick_key = 0u;
+  for (int j = 0; j < MLT_BOOTSTRAP; j++) {
+    unsigned key = path_key((unsigned)(MLT_BOOTSTRAP * c + j), MLT_BOOTSTRAP_FRAME, (unsigned)p->seed);
+    Mlt m = {u, key, slots, (unsigned)p->max_bounces, true};
+    int i;
+    Path P = mlt_camera(p, m, &i);
+    V3 L = radiance(s, P, m);
+    float y = luminance(L);
+    sum = sum + y;
+    if (j == 0 || rng(key, MLT_DIM_ACCEPT) * sum < y) {
+      pick = L;
+      pick_i = i;
+      pick_key = key;
+    }
+  }
+  for (unsigned k = 0; k < slots; k++) u[k] = rng(pick_key, k);
+  chains[c] = make_float4(pick.x, pick.y, pick.z, __int_as_float(pick_i >> 2));
+  ysum[c] = sum;
+}
+
+// One frame: each chain takes MLT_STEPS iterations (a large step with
+// probability MLT_P_LARGE), splatting both the current sample and the proposal.
+extern "C" __global__ void mlt_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                     const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                     const float4 *lights, const float4 *boxes, const float4 *env, float *state,
+                                     float4 *chains, ull *image) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  const Params *p = params;
+  int c = (int)WL_TID;
+  if (c >= p->width * p->height) return;
+  unsigned slots = MLT_SLOTS_PER_SEGMENT * (unsigned)(p->max_bounces + 1);
+  float *u = state + (ull)slots * (ull)c;
+  float4 cur = chains[c];
+  V3 fc = v3(cur.x, cur.y, cur.z);
+  int pc = __float_as_int(cur.w);
+  float yc = luminance(fc);
+  float b = p->mlt_b;
+  for (int t = 0; t < MLT_STEPS; t++) {
+    unsigned key = path_key((unsigned)(MLT_STEPS * c + t), (unsigned)p->frame, (unsigned)p->seed);
+    Mlt m = {u, key, slots, (unsigned)p->max_bounces, rng(key, MLT_DIM_LARGE) < MLT_P_LARGE};
+    int i;
+    Path P = mlt_camera(p, m, &i);
+    V3 L = radiance(s, P, m);
+    float y = luminance(L);
+    float a = yc > 0.0f ? fminf(1.0f, y / yc) : 1.0f;
+    if (yc > 0.0f) splat(image, pc, fc, (1.0f - a) * b / yc);
+    if (y > 0.0f) splat(image, i >> 2, L, a * b / y);
+    if (rng(key, MLT_DIM_ACCEPT) < a) {
+      for (unsigned k = 0; k < slots; k++) u[k] = mlt_value(m, k);
+      fc = L;
+      pc = i >> 2;
+      yc = y;
+    }
+  }
+  chains[c] = make_float4(fc.x, fc.y, fc.z, __int_as_float(pc));
 }

@@ -71,8 +71,11 @@ pub struct RenderArgs {
     /// its JSON, and OUT-summary.json (the reference's own error, when each display settles).
     #[arg(long, default_value = "raycast")]
     pub method: String,
-    /// Path tracer: pt, nee, mis (balance heuristic), mis-power, or bdpt (bidirectional:
-    /// light and eye subpaths, every Lambertian pair connected, the thesis' uniform weights).
+    /// Path tracer: pt, nee, mis (balance heuristic), mis-power, bdpt (bidirectional:
+    /// light and eye subpaths, every Lambertian pair connected, the thesis' uniform weights),
+    /// or mlt (Metropolis light transport in primary sample space over bdpt: one chain a
+    /// pixel, 16 bootstrap samples a pixel for b, large steps with probability 0.25,
+    /// --spp mutations a pixel; consistent, with start-up bias in early frames).
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
@@ -443,7 +446,10 @@ fn run_path(
 ) -> Result<(), Box<dyn std::error::Error>> {
     use crate::host::path::{FrameParams, Integrator, Traversal};
     let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
-        format!("unknown integrator `{}`; expected pt, nee, mis (balance heuristic), mis-power or bdpt", a.integrator)
+        format!(
+            "unknown integrator `{}`; expected pt, nee, mis (balance heuristic), mis-power, bdpt or mlt",
+            a.integrator
+        )
     })?;
     let traversal = Traversal::parse(&a.traversal)
         .ok_or_else(|| format!("unknown traversal `{}`; expected stack, stack12, restart or backtrack", a.traversal))?;

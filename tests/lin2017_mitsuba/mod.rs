@@ -50,6 +50,8 @@ pub fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
 }
 
 /// A native render of `frames` frames against `reference`.
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
 pub fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32, reference: &Estimate) -> Outcome {
     let r = render_native(ps, cam, p, frames, true, |_| {});
     let ours = from_frames(&r.frame_images, BLOCK).expect("two frames or more");

@@ -19,9 +19,13 @@ pub const KERNEL: &str = "path_frame";
 /// The bidirectional path tracer's entry point.
 pub const BDPT_KERNEL: &str = "bdpt_frame";
 
-/// The entry point that renders `integrator`.
+/// The entry point that renders `integrator` (mlt: its frame kernel, after `mlt_init`).
 pub fn entry(integrator: super::Integrator) -> &'static str {
-    if integrator == super::Integrator::Bdpt { BDPT_KERNEL } else { KERNEL }
+    match integrator {
+        super::Integrator::Bdpt => BDPT_KERNEL,
+        super::Integrator::Mlt => super::mlt::FRAME_KERNEL,
+        _ => KERNEL,
+    }
 }
 /// Threads per CTA.
 pub const THREADS: u32 = 256;
@@ -35,16 +39,27 @@ pub fn load(dev: &mut Device) -> Result<Module, SimError> {
 }
 
 /// The simulator settings for frames of `params`: the default, with a
-/// watchdog that grows with the number of paths.
+/// watchdog that grows with the number of paths (under mlt, with the
+/// start-up's samples: [`super::mlt::BOOTSTRAP`] a pixel).
 pub fn sim_config(params: &FrameParams) -> SimConfig {
     let mut c = SimConfig::default();
-    let budget = (params.paths() as u64).saturating_mul(WARP_INSTRUCTIONS_PER_PATH);
+    let mut paths = params.paths() as u64;
+    if params.integrator == super::Integrator::Mlt {
+        paths = paths.max(params.width as u64 * params.height as u64 * super::mlt::BOOTSTRAP as u64);
+    }
+    let budget = paths.saturating_mul(WARP_INSTRUCTIONS_PER_PATH);
     c.schedule.max_warp_instructions = c.schedule.max_warp_instructions.max(budget);
     c
 }
 
 /// The kernel's parameter block for `frame`.
 pub fn params_bytes(scene: &PathScene, camera: &Camera, params: &FrameParams, frame: u32) -> Vec<u8> {
+    params_bytes_mlt(scene, camera, params, frame, 0.0)
+}
+
+/// The parameter block for `frame` of `mlt_frame`, whose `mlt_b` is `b`
+/// (the other kernels read no `mlt_b`).
+pub fn params_bytes_mlt(scene: &PathScene, camera: &Camera, params: &FrameParams, frame: u32, b: f32) -> Vec<u8> {
     let c = frame_of(camera, eps_for(scene.lo, scene.hi));
     let mut floats = Vec::with_capacity(22);
     for v in [c.pos, c.fwd, c.right, c.up, scene.lo, scene.hi] {
@@ -67,6 +82,7 @@ pub fn params_bytes(scene: &PathScene, camera: &Camera, params: &FrameParams, fr
     ] {
         bytes.extend_from_slice(&v.to_le_bytes());
     }
+    bytes.extend_from_slice(&b.to_le_bytes());
     bytes
 }
 
@@ -141,6 +157,10 @@ pub fn render(
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Result<KernelRender, SimError> {
+    if params.integrator == super::Integrator::Mlt {
+        return super::mlt::render_emulated(dev, module, scene, camera, params, frames, keep_frames, progress)
+            .map(KernelRender::from);
+    }
     let bufs = upload_scene(dev, scene, camera, &params)?;
     let pp = bufs.params;
     let n = params.paths() * 3;

@@ -16,6 +16,7 @@ pub mod environment;
 pub mod gpu_build;
 pub mod kernel;
 pub mod layout;
+pub mod mlt;
 pub mod native;
 pub mod rng;
 pub mod stats;
@@ -40,13 +41,21 @@ pub enum Integrator {
     /// over the combinations that can make a path (`bdpt_frame`; the
     /// megakernel only, not the wavefront form). Not in [`Integrator::ALL`].
     Bdpt,
+    /// Metropolis light transport in primary sample space (§4.8) over
+    /// [`MLT_BASE`]: one chain a pixel, splats anywhere ([`mlt`]; `mlt_init`
+    /// and `mlt_frame`). Consistent, not unbiased per pixel. Not in [`Integrator::ALL`].
+    Mlt,
 }
+
+/// The integrator whose paths MLT mutates: bdpt, as the thesis' Fig. 9
+/// (003:L332: "bi-directional path tracing ... is used").
+pub const MLT_BASE: Integrator = Integrator::Bdpt;
 
 impl Integrator {
     /// The unidirectional integrators (those the wavefront form also runs; bdpt is not one).
     pub const ALL: [Integrator; 4] = [Integrator::Pt, Integrator::Nee, Integrator::MisBalance, Integrator::MisPower];
 
-    /// The kernel's code.
+    /// The kernel's code (mlt: its base's, which `mlt_frame` traces).
     pub fn code(self) -> i32 {
         match self {
             Integrator::Pt => 0,
@@ -54,6 +63,7 @@ impl Integrator {
             Integrator::MisBalance => 2,
             Integrator::MisPower => 3,
             Integrator::Bdpt => 4,
+            Integrator::Mlt => MLT_BASE.code(),
         }
     }
 
@@ -65,6 +75,7 @@ impl Integrator {
             Integrator::MisBalance => "mis",
             Integrator::MisPower => "mis-power",
             Integrator::Bdpt => "bdpt",
+            Integrator::Mlt => "mlt",
         }
     }
 
@@ -73,6 +84,7 @@ impl Integrator {
         match s {
             "mis-balance" => Some(Integrator::MisBalance),
             "bdpt" => Some(Integrator::Bdpt),
+            "mlt" => Some(Integrator::Mlt),
             _ => Integrator::ALL.into_iter().find(|i| i.name() == s),
         }
     }
@@ -248,7 +260,8 @@ impl Progressive {
     }
 }
 
-/// Renders `frames` frames natively; `keep_frames` keeps each frame's image.
+/// Renders `frames` frames natively; `keep_frames` keeps each frame's image
+/// (mlt: [`mlt::render_native`]'s image).
 pub fn render_native(
     scene: &layout::PathScene,
     camera: &Camera,
@@ -257,6 +270,9 @@ pub fn render_native(
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Progressive {
+    if params.integrator == Integrator::Mlt {
+        return mlt::render_native(scene, camera, params, frames, keep_frames, progress).image;
+    }
     let eps = eps_for(scene.lo, scene.hi);
     let tracer = native::Tracer { scene, frame: frame_of(camera, eps), params };
     let mut out = Progressive::new(params.width, params.height);

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use super::counts::Counts;
 use super::layout::{KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, LEAF_AXIS, PathScene};
-use super::rng::{azimuth, path_key, rng, tent};
+use super::rng::{Sample, azimuth, path_key, tent};
 use super::{FrameParams, Integrator, Traversal};
 
 /// Random dimensions of the camera ray.
@@ -290,20 +290,26 @@ impl Tracer<'_> {
         found.map(|t| (t, hi))
     }
 
+    /// The integrator that traces the paths: mlt's base, or the frame's own.
+    fn base(&self) -> Integrator {
+        if self.params.integrator == Integrator::Mlt { super::MLT_BASE } else { self.params.integrator }
+    }
+
     fn mis_weight(&self, a: f32, b: f32) -> f32 {
-        let (a, b) = if self.params.integrator == Integrator::MisPower { (a * a, b * b) } else { (a, b) };
+        let (a, b) = if self.base() == Integrator::MisPower { (a * a, b * b) } else { (a, b) };
         a / (a + b)
     }
 
     /// Path `i`'s camera ray (origin, direction): tent-jittered in its
-    /// subpixel of the 2 x 2 grid, the kernel's `camera_path`.
-    fn camera_ray(&self, i: u32, key: u32) -> (V3, V3) {
+    /// subpixel of the 2 x 2 grid by the tent filter's uniforms `r0` (across)
+    /// and `r1` (down), the kernel's `camera_ray`.
+    fn camera_ray(&self, i: u32, r0: f32, r1: f32) -> (V3, V3) {
         let cam = &self.frame;
         let (w, h) = (self.params.width, self.params.height);
         let (pixel, sub) = (i >> 2, i & 3);
         let (x, y) = (pixel % w, pixel / w);
-        let px = x as f32 + ((sub & 1) as f32 + 0.5 + tent(rng(key, 0))) * 0.5;
-        let py = y as f32 + ((sub >> 1) as f32 + 0.5 + tent(rng(key, 1))) * 0.5;
+        let px = x as f32 + ((sub & 1) as f32 + 0.5 + tent(r0)) * 0.5;
+        let py = y as f32 + ((sub >> 1) as f32 + 0.5 + tent(r1)) * 0.5;
         let cx = (px / w as f32 * 2.0 - 1.0) * cam.tan_half * cam.aspect;
         let cy = (1.0 - py / h as f32 * 2.0) * cam.tan_half;
         let (fwd, right, up) = (xyz(&cam.fwd, 0), xyz(&cam.right, 0), xyz(&cam.up, 0));
@@ -315,22 +321,22 @@ impl Tracer<'_> {
     /// by the cumulative areas in `lights[i][3]` from dimension `dim`, the
     /// point uniform on its triangle from `dim + 1` and `dim + 2`. Needs a
     /// light.
-    fn light_point(&self, key: u32, dim: u32) -> (&[f32; 12], V3) {
+    fn light_point<S: Sample>(&self, key: S, dim: u32) -> (&[f32; 12], V3) {
         let lights = &self.scene.lights;
-        let yl = rng(key, dim);
+        let yl = key.at(dim);
         let mut li = 0usize;
         while li + 1 < lights.len() && !(yl < lights[li][3]) {
             li += 1;
         }
         let lg = &lights[li];
-        let su = rng(key, dim + 1).sqrt();
-        let yv = rng(key, dim + 2);
+        let su = key.at(dim + 1).sqrt();
+        let yv = key.at(dim + 2);
         let (bu, bv) = (su * (1.0 - yv), su * yv);
         (lg, xyz(lg, 0).add(xyz(lg, 4).scale(bu)).add(xyz(lg, 8).scale(bv)))
     }
 
     /// The light subpath of `key` (at most `nl` vertices): the kernel's `light_subpath`.
-    fn light_subpath(&self, key: u32, nl: usize, c: &mut Counts) -> Vec<LightVertex> {
+    fn light_subpath<S: Sample>(&self, key: S, nl: usize, c: &mut Counts) -> Vec<LightVertex> {
         let s = self.scene;
         let eps = self.frame.eps;
         let (lg, mut o) = self.light_point(key, DIMS_LIGHT);
@@ -341,7 +347,7 @@ impl Tracer<'_> {
         let mut lv = Vec::with_capacity(nl);
         lv.push(LightVertex { p: o, n: n0, alpha, color: v3(0.0, 0.0, 0.0) });
         // the emitted direction, cosine-weighted: Le cos / (cos / pi) = pi Le
-        let (mut d, _) = cosine_dir(n0, rng(key, DIMS_LIGHT + 3), rng(key, DIMS_LIGHT + 4));
+        let (mut d, _) = cosine_dir(n0, key.at(DIMS_LIGHT + 3), key.at(DIMS_LIGHT + 4));
         alpha = alpha.scale(std::f32::consts::PI);
         while lv.len() < nl {
             let Some((tri, t)) = self.trace(o, d, eps, f32::INFINITY, false, c) else {
@@ -361,7 +367,7 @@ impl Tracer<'_> {
                 break;
             }
             let dim = DIMS_LIGHT + DIMS_PER_BOUNCE * lv.len() as u32;
-            (d, _) = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4));
+            (d, _) = cosine_dir(ns, key.at(dim + 3), key.at(dim + 4));
             if !roulette(&mut alpha, color, key, dim) {
                 break;
             }
@@ -372,14 +378,13 @@ impl Tracer<'_> {
 
     /// Radiance of bdpt's path `i` (its light and eye subpaths and their
     /// connections under the uniform weights): the kernel's `bdpt_frame`.
-    fn bdpt(&self, i: u32, key: u32, counts: &mut Counts) -> [f32; 3] {
+    fn bdpt<S: Sample>(&self, (mut o, mut d): (V3, V3), key: S, counts: &mut Counts) -> [f32; 3] {
         let s = self.scene;
         let cam = &self.frame;
         let p = &self.params;
         let nl_max = if s.lights.is_empty() { 0 } else { p.max_bounces.min(LIGHT_VERTICES as u32) as i32 };
         let lv = if nl_max > 0 { self.light_subpath(key, nl_max as usize, counts) } else { Vec::new() };
         let nl = lv.len() as i32;
-        let (mut o, mut d) = self.camera_ray(i, key);
         let (mut l, mut beta) = (v3(0.0, 0.0, 0.0), v3(1.0, 1.0, 1.0));
         let (mut bsdf_pdf, mut count_emission) = (0.0f32, true);
         let mut run = 0i32;
@@ -463,15 +468,33 @@ impl Tracer<'_> {
 
     /// Radiance of path `i` in frame `frame`, adding its traversal events to `c`.
     pub fn path_counted(&self, i: u32, frame: u32, counts: &mut Counts) -> [f32; 3] {
+        let key = path_key(i, frame, self.params.seed);
+        self.radiance(self.camera_ray(i, key.at(0), key.at(1)), key, counts)
+    }
+
+    /// An MLT proposal (or bootstrap sample) drawn through `m`: its path
+    /// index (4 x pixel + subpixel) and radiance, the kernel's `mlt_camera`
+    /// and `radiance`. The subpixel of the 2W x 2H grid and the tent jitter
+    /// come from samples 0 and 1.
+    pub fn mlt_sample(&self, m: super::mlt::Sampler<'_>, counts: &mut Counts) -> (u32, [f32; 3]) {
+        let (w, h) = (self.params.width as i32, self.params.height as i32);
+        let (x, y) = (m.at(0) * (2 * w) as f32, m.at(1) * (2 * h) as f32);
+        let (sx, sy) = ((x as i32).min(2 * w - 1), (y as i32).min(2 * h - 1));
+        let i = (4 * ((sy >> 1) * w + (sx >> 1)) + 2 * (sy & 1) + (sx & 1)) as u32;
+        (i, self.radiance(self.camera_ray(i, x - sx as f32, y - sy as f32), m, counts))
+    }
+
+    /// The radiance the frame's integrator (mlt's base under mlt) finds along
+    /// the camera ray (origin, direction), drawing its random numbers from
+    /// `key`: the kernel's `radiance`.
+    fn radiance<S: Sample>(&self, (mut o, mut d): (V3, V3), key: S, counts: &mut Counts) -> [f32; 3] {
         let s = self.scene;
         let cam = &self.frame;
         let p = &self.params;
-        let key = path_key(i, frame, p.seed);
-        let integrator = p.integrator;
+        let integrator = self.base();
         if integrator == Integrator::Bdpt {
-            return self.bdpt(i, key, counts);
+            return self.bdpt((o, d), key, counts);
         }
-        let (mut o, mut d) = self.camera_ray(i, key);
         let mut l = v3(0.0, 0.0, 0.0);
         let mut beta = v3(1.0, 1.0, 1.0);
         let mut count_emission = true;
@@ -576,7 +599,7 @@ impl Tracer<'_> {
     /// The next direction at a hit (`d` in, the sampled direction out) and the
     /// bounce's mask f cos / p: the kernel's `scatter`; `None` when the path ends.
     #[allow(clippy::too_many_arguments)]
-    fn scatter(
+    fn scatter<S: Sample>(
         &self,
         mat: &[f32; 12],
         kind: u32,
@@ -584,7 +607,7 @@ impl Tracer<'_> {
         color: V3,
         cos_d: f32,
         cos_o: f32,
-        key: u32,
+        key: S,
         dim: u32,
         d: &mut V3,
         bsdf_pdf: &mut f32,
@@ -593,16 +616,16 @@ impl Tracer<'_> {
         let mut wgt = color;
         if kind == KIND_DIFFUSE {
             let lz;
-            (*d, lz) = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4));
+            (*d, lz) = cosine_dir(ns, key.at(dim + 3), key.at(dim + 4));
             *bsdf_pdf = lz * INV_PI;
             *count_emission = false;
         } else if kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS {
             let alpha = mat[8];
             let a2 = alpha * alpha;
-            let tan2 = a2 * -ln(1.0 - rng(key, dim + 3));
+            let tan2 = a2 * -ln(1.0 - key.at(dim + 3));
             let cm = 1.0 / (1.0 + tan2).sqrt();
             let sm = tan2.sqrt() * cm;
-            let (cs, sn) = azimuth(rng(key, dim + 4));
+            let (cs, sn) = azimuth(key.at(dim + 4));
             let (b1, b2) = basis(ns);
             let mh = b1.scale(sm * cs).add(b2.scale(sm * sn)).add(ns.scale(cm));
             let co = -d.dot(mh);
@@ -629,7 +652,7 @@ impl Tracer<'_> {
                     } else {
                         schlick(r0 * r0, if into { co } else { cos_t })
                     };
-                    if !(rng(key, dim + 6) < fr) {
+                    if !(key.at(dim + 6) < fr) {
                         next = d.scale(eta).add(mh.scale(eta * co - cos_t));
                         scale = eta * eta;
                         refracted = true;
@@ -665,7 +688,7 @@ impl Tracer<'_> {
                         let c2 = cc * cc;
                         r0 + (1.0 - r0) * (c2 * c2 * cc)
                     };
-                    if !(rng(key, dim + 6) < fr) {
+                    if !(key.at(dim + 6) < fr) {
                         next = tdir;
                     }
                 }
@@ -678,7 +701,7 @@ impl Tracer<'_> {
 
     /// [`Self::scatter`] then [`roulette`]: false when the path ends at this hit.
     #[allow(clippy::too_many_arguments)]
-    fn bounce_on(
+    fn bounce_on<S: Sample>(
         &self,
         mat: &[f32; 12],
         kind: u32,
@@ -686,7 +709,7 @@ impl Tracer<'_> {
         color: V3,
         cos_d: f32,
         cos_o: f32,
-        key: u32,
+        key: S,
         dim: u32,
         d: &mut V3,
         beta: &mut V3,
@@ -725,10 +748,10 @@ impl Tracer<'_> {
 
 /// Russian roulette on the bounce's mask `wgt` = f cos / p: the kernel's
 /// `roulette` (continue with q = its max RGB, then divide by q).
-fn roulette(beta: &mut V3, wgt: V3, key: u32, dim: u32) -> bool {
+fn roulette<S: Sample>(beta: &mut V3, wgt: V3, key: S, dim: u32) -> bool {
     let q = fmax(fmax(wgt.x, wgt.y), wgt.z);
     if q < 1.0 {
-        if !(rng(key, dim + 5) < q) {
+        if !(key.at(dim + 5) < q) {
             return false;
         }
         *beta = v3(beta.x * (wgt.x / q), beta.y * (wgt.y / q), beta.z * (wgt.z / q));

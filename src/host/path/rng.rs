@@ -25,6 +25,20 @@ pub fn rng(key: u32, d: u32) -> f32 {
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
+/// Where an integrator draws its random numbers: dimension `d`'s uniform.
+/// A path's key ([`path_key`]) draws them by [`rng`]; an MLT iteration's
+/// [`super::mlt::Sampler`] from its chain's primary samples.
+pub trait Sample: Copy {
+    /// Dimension `d`.
+    fn at(self, d: u32) -> f32;
+}
+
+impl Sample for u32 {
+    fn at(self, d: u32) -> f32 {
+        rng(self, d)
+    }
+}
+
 /// smallpt's tent warp of a uniform `y` in [0, 1) to [-1, 1).
 pub fn tent(y: f32) -> f32 {
     let r = 2.0 * y;

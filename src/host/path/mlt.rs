@@ -1,0 +1,393 @@
+//! Metropolis light transport in primary sample space (§4.8, 003:L310-336;
+//! Kelemen et al. 2002): `mlt_init` and `mlt_frame` of
+//! `kernels/lin2017/path.cu` on the emulator ([`render_emulated`]) and their
+//! native mirror ([`render_native`]), which performs the same float
+//! operations in the same order with the same counter-based random numbers.
+//!
+//! One Markov chain per pixel (003:L328). A chain's state is the random
+//! numbers of its current path, 10 floats a path segment (003:L328: "about
+//! 10 samples need to be generated for each path segment"), k segments
+//! (k = max bounces plus one): 40 k bytes a chain, 40 k W H in all ([`state_bytes`]), plus
+//! its current radiance and pixel (16 bytes). The path is traced by the base
+//! integrator [`super::MLT_BASE`] (bdpt, as the thesis' Fig. 9), which draws
+//! dimension d from slot [`slot`]`(d)` of the state after the iteration's
+//! mutation: a large step (probability 0.25, 003:L318) draws every slot
+//! afresh, a small step moves each by Kelemen's exponential perturbation
+//! (s1 = 1/1024, s2 = 1/64; the thesis states none). Acceptance min(1, Y'/Y)
+//! of the luminance Y (003:L322); both samples are splatted with their
+//! expected weights, b F / Y each, b the bootstrap's mean luminance
+//! (003:L330, [`BOOTSTRAP`] large steps a chain). The splats are 64-bit
+//! integer atomics in 32.32 fixed point, so the image does not depend on
+//! their order.
+
+use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+
+use rayon::prelude::*;
+
+use super::counts::Counts;
+use super::kernel::{self, KernelRender};
+use super::layout::PathScene;
+use super::native::{Tracer, exp_neg};
+use super::rng::{Sample, path_key, rng};
+use super::{FrameParams, Progressive, eps_for, frame_of};
+use crate::host::camera::Camera;
+use crate::sim::{Arg, Counters, Device, DevicePtr, LaunchConfig, Module, SimError};
+
+/// State floats a path segment (003:L328).
+pub const SLOTS_PER_SEGMENT: u32 = 10;
+/// The random dimension of an iteration's large-or-small choice.
+pub const DIM_LARGE: u32 = 0x30000;
+/// The random dimension of the acceptance test (at start-up: the start's choice).
+pub const DIM_ACCEPT: u32 = 0x30001;
+/// The probability of a large step (003:L318's example).
+pub const P_LARGE: f32 = 0.25;
+/// Kelemen's largest small step s2 (the smallest is s1 = 1/1024).
+pub const S2: f32 = 1.0 / 64.0;
+/// ln(s2 / s1) = ln 16, as the kernel's literal.
+#[allow(clippy::excessive_precision)]
+const LN_S2_S1: f32 = 2.772_588_722_239_781_24;
+/// Large-step samples a chain draws at start-up (the thesis states no count).
+pub const BOOTSTRAP: u32 = 16;
+/// The frame number of the start-up's random keys (no frame reaches it).
+pub const BOOTSTRAP_FRAME: u32 = u32::MAX;
+/// Iterations a chain takes a frame (a frame's 4 samples a pixel).
+pub const STEPS: u32 = 4;
+/// The splats' fixed point: 2^32 a unit.
+pub const FIXED: f32 = 4_294_967_296.0;
+
+/// State floats a chain for paths of at most `max_bounces` bounces: 10 (k = max bounces + 1).
+pub fn slots(max_bounces: u32) -> usize {
+    (SLOTS_PER_SEGMENT * (max_bounces + 1)) as usize
+}
+
+/// The bytes of random numbers the chains of a `width` x `height` image keep: 40 k W H.
+pub fn state_bytes(width: u32, height: u32, max_bounces: u32) -> u64 {
+    4 * slots(max_bounces) as u64 * width as u64 * height as u64
+}
+
+/// The state slot of the integrators' random dimension `d` for paths of at
+/// most `m` bounces: the kernel's `mlt_slot`. Segment s holds in slots 0-6
+/// the eye bounce s's dimensions 2 + 8 s + j (j = 0-6: the light point, the
+/// direction, roulette, the Fresnel switch) and in slots 7-9 bdpt's light
+/// vertex s's (direction and roulette); y0's point takes segment 0's slots
+/// 7-9 and its direction segment 1's 7-8 (vertex 1 draws none); the camera's
+/// two take segment m's 0-1 (bounce m draws none).
+pub fn slot(d: u32, m: u32) -> u32 {
+    use super::native::{DIMS_CAMERA, DIMS_LIGHT};
+    if d < DIMS_CAMERA {
+        return SLOTS_PER_SEGMENT * m + d;
+    }
+    if d < DIMS_LIGHT {
+        let e = d - DIMS_CAMERA;
+        return SLOTS_PER_SEGMENT * (e >> 3) + (e & 7);
+    }
+    let e = d - DIMS_LIGHT;
+    let (c, j) = (e >> 3, e & 7);
+    if c == 0 {
+        return if j < 3 { 7 + j } else { 14 + j };
+    }
+    SLOTS_PER_SEGMENT * c + 4 + j
+}
+
+/// An MLT iteration's random numbers: the chain's current samples `u`, the
+/// iteration's key (its mutation's random numbers) and whether it is a large
+/// step (the kernel's `Mlt`).
+#[derive(Debug, Clone, Copy)]
+pub struct Sampler<'a> {
+    /// The chain's current primary samples ([`slots`] floats).
+    pub u: &'a [f32],
+    /// The iteration's counter-based key.
+    pub key: u32,
+    /// The longest path in bounces (k − 1).
+    pub max_bounces: u32,
+    /// A large step: every sample afresh.
+    pub large: bool,
+}
+
+impl Sampler<'_> {
+    /// Slot `slot` of the proposal, the kernel's `mlt_value`: a large step's
+    /// fresh uniform, or the current value moved by s2 e^(−ln(s2/s1) v), up
+    /// or down with equal probability, wrapped into [0, 1).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // !(x < 1), NaN included: the kernel's test
+    pub fn value(&self, slot: u32) -> f32 {
+        let r = rng(self.key, slot);
+        if self.large {
+            return r;
+        }
+        let mut x = self.u[slot as usize];
+        let r2 = r * 2.0;
+        let up = r2 < 1.0;
+        let v = if up { r2 } else { r2 - 1.0 };
+        let dv = S2 * exp_neg(-LN_S2_S1 * v);
+        x = if up { x + dv } else { x - dv };
+        if x >= 1.0 {
+            x -= 1.0;
+        }
+        if x < 0.0 {
+            x += 1.0;
+        }
+        // a tiny negative x + 1 rounds to 1
+        if !(x < 1.0) {
+            x = f32::from_bits(0x3f7f_ffff);
+        }
+        x
+    }
+}
+
+impl Sample for Sampler<'_> {
+    fn at(self, d: u32) -> f32 {
+        let k = slot(d, self.max_bounces);
+        if (k as usize) < self.u.len() { self.value(k) } else { rng(self.key, d) }
+    }
+}
+
+/// Y of an RGB radiance (003:L322): the kernel's `luminance`.
+pub fn luminance(c: [f32; 3]) -> f32 {
+    0.212_671 * c[0] + 0.715_160 * c[1] + 0.072_169 * c[2]
+}
+
+/// A chain's current sample: its radiance and pixel (the kernel's float4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Current {
+    /// Radiance.
+    pub f: [f32; 3],
+    /// Pixel index.
+    pub pixel: u32,
+}
+
+/// An MLT render: the image and what the chains kept.
+#[derive(Debug, Clone)]
+pub struct MltRender {
+    /// The image as the other integrators' (per path sums, frames and, if kept, each frame's own image).
+    pub image: Progressive,
+    /// Per pixel and channel, the splats' sum in 32.32 fixed point.
+    pub fixed: Vec<u64>,
+    /// The bootstrap's mean luminance b.
+    pub b: f32,
+    /// The bytes of the chains' random numbers: emulated, the size of the
+    /// device allocation `mlt state`; natively, the host vector's.
+    pub state_bytes: u64,
+    /// The emulator's counters summed over the launches (native: none).
+    pub totals: Option<Counters>,
+}
+
+/// b from the chains' sums of bootstrap luminances, summed in chain order (f64).
+pub fn b_of(ysum: &[f32]) -> f32 {
+    let s: f64 = ysum.iter().map(|&y| y as f64).sum();
+    (s / (BOOTSTRAP as f64 * ysum.len().max(1) as f64)) as f32
+}
+
+/// The image of the fixed-point sums after `frames` frames, as per-path sums
+/// (each of a pixel's 4 path slots a quarter of the pixel's sum), so that
+/// [`Progressive::image`] divides by the frames.
+fn progressive_of(p: &FrameParams, fixed: &[u64], frames: u32) -> Progressive {
+    let mut out = Progressive::new(p.width, p.height);
+    out.frames = frames;
+    for (px, sums) in fixed.chunks(3).enumerate() {
+        for k in 0..4 {
+            for (c, &v) in sums.iter().enumerate() {
+                out.accum[3 * (4 * px + k) + c] = (v as f64 / FIXED as f64 / STEPS as f64) as f32;
+            }
+        }
+    }
+    out
+}
+
+/// One frame's own image: the splats it added (`now` − `before`), divided by its iterations a pixel.
+fn frame_image(p: &FrameParams, before: &[u64], now: &[u64]) -> crate::host::image::FrameBuffer {
+    let mut fb = crate::host::image::FrameBuffer::new(p.width, p.height);
+    for (i, px) in fb.pixels.iter_mut().enumerate() {
+        for (c, v) in px.iter_mut().enumerate() {
+            *v = ((now[3 * i + c] - before[3 * i + c]) as f64 / FIXED as f64 / STEPS as f64) as f32;
+        }
+    }
+    fb
+}
+
+/// Adds `c` × `w` to `pixel` of the fixed-point image: the kernel's `splat`.
+fn splat(image: &[AtomicU64], pixel: u32, c: [f32; 3], w: f32) {
+    for (k, v) in c.iter().enumerate() {
+        image[3 * pixel as usize + k].fetch_add((v * w * FIXED) as u64, Relaxed);
+    }
+}
+
+/// Renders `frames` frames of MLT natively (`params.integrator` is mlt).
+pub fn render_native(
+    scene: &PathScene,
+    camera: &Camera,
+    params: FrameParams,
+    frames: u32,
+    keep_frames: bool,
+    mut progress: impl FnMut(u32),
+) -> MltRender {
+    let tracer = Tracer { scene, frame: frame_of(camera, eps_for(scene.lo, scene.hi)), params };
+    let (m, n) = (slots(params.max_bounces), (params.width * params.height) as usize);
+    let mut u = vec![0.0f32; m * n];
+    let mut cur = vec![Current { f: [0.0; 3], pixel: 0 }; n];
+    let mut ysum = vec![0.0f32; n];
+    let mut counts = u
+        .par_chunks_mut(m)
+        .zip(cur.par_iter_mut())
+        .zip(ysum.par_iter_mut())
+        .enumerate()
+        .map(|(c, ((u, cur), ysum))| {
+            let mut counts = Counts::default();
+            (*cur, *ysum) = init_chain(&tracer, c as u32, u, &mut counts);
+            counts
+        })
+        .reduce(Counts::default, add);
+    let b = b_of(&ysum);
+    let image: Vec<AtomicU64> = (0..3 * n).map(|_| AtomicU64::new(0)).collect();
+    let mut out_frames = Vec::new();
+    let mut before = vec![0u64; 3 * n];
+    for f in 0..frames {
+        let c = u
+            .par_chunks_mut(m)
+            .zip(cur.par_iter_mut())
+            .enumerate()
+            .map(|(c, (u, cur))| {
+                let mut counts = Counts::default();
+                frame_chain(&tracer, c as u32, f, b, u, cur, &image, &mut counts);
+                counts
+            })
+            .reduce(Counts::default, add);
+        counts.add(&c);
+        if keep_frames {
+            let now: Vec<u64> = image.iter().map(|a| a.load(Relaxed)).collect();
+            out_frames.push(frame_image(&params, &before, &now));
+            before = now;
+        }
+        progress(f + 1);
+    }
+    let fixed: Vec<u64> = image.iter().map(|a| a.load(Relaxed)).collect();
+    let mut image = progressive_of(&params, &fixed, frames);
+    image.frame_images = out_frames;
+    image.counts = counts;
+    MltRender { image, fixed, b, state_bytes: (4 * u.len()) as u64, totals: None }
+}
+
+fn add(mut a: Counts, b: Counts) -> Counts {
+    a.add(&b);
+    a
+}
+
+/// Chain `c`'s start-up (the kernel's `mlt_init`): its bootstrap samples'
+/// summed luminance and the start, one of them chosen in proportion to its
+/// luminance; fills `u` with the start's samples.
+fn init_chain(tracer: &Tracer, c: u32, u: &mut [f32], counts: &mut Counts) -> (Current, f32) {
+    let p = &tracer.params;
+    let (mut sum, mut pick, mut pick_i, mut pick_key) = (0.0f32, [0.0f32; 3], 0u32, 0u32);
+    for j in 0..BOOTSTRAP {
+        let key = path_key(BOOTSTRAP * c + j, BOOTSTRAP_FRAME, p.seed);
+        let m = Sampler { u, key, max_bounces: p.max_bounces, large: true };
+        let (i, l) = tracer.mlt_sample(m, counts);
+        let y = luminance(l);
+        sum += y;
+        if j == 0 || rng(key, DIM_ACCEPT) * sum < y {
+            (pick, pick_i, pick_key) = (l, i, key);
+        }
+    }
+    for (k, v) in u.iter_mut().enumerate() {
+        *v = rng(pick_key, k as u32);
+    }
+    (Current { f: pick, pixel: pick_i >> 2 }, sum)
+}
+
+/// Chain `c`'s iterations in frame `f` (the kernel's `mlt_frame`).
+#[allow(clippy::too_many_arguments)]
+fn frame_chain(
+    tracer: &Tracer,
+    c: u32,
+    f: u32,
+    b: f32,
+    u: &mut [f32],
+    cur: &mut Current,
+    image: &[AtomicU64],
+    counts: &mut Counts,
+) {
+    let p = &tracer.params;
+    let mut yc = luminance(cur.f);
+    let mut next = vec![0.0f32; u.len()];
+    for t in 0..STEPS {
+        let key = path_key(STEPS * c + t, f, p.seed);
+        let m = Sampler { u, key, max_bounces: p.max_bounces, large: rng(key, DIM_LARGE) < P_LARGE };
+        let (i, l) = tracer.mlt_sample(m, counts);
+        let y = luminance(l);
+        let a = if yc > 0.0 { 1.0f32.min(y / yc) } else { 1.0 };
+        if yc > 0.0 {
+            splat(image, cur.pixel, cur.f, (1.0 - a) * b / yc);
+        }
+        if y > 0.0 {
+            splat(image, i >> 2, l, a * b / y);
+        }
+        if rng(key, DIM_ACCEPT) < a {
+            for (k, v) in next.iter_mut().enumerate() {
+                *v = m.value(k as u32);
+            }
+            u.copy_from_slice(&next);
+            *cur = Current { f: l, pixel: i >> 2 };
+            yc = y;
+        }
+    }
+}
+
+/// The name of the device allocation that holds the chains' random numbers.
+pub const STATE_BUFFER: &str = "mlt state";
+
+/// Renders `frames` frames of MLT on the emulator (`mlt_init` once, then
+/// `mlt_frame` a frame; `module` loaded by [`kernel::load`]).
+#[allow(clippy::too_many_arguments)]
+pub fn render_emulated(
+    dev: &mut Device,
+    module: &Module,
+    scene: &PathScene,
+    camera: &Camera,
+    params: FrameParams,
+    frames: u32,
+    keep_frames: bool,
+    mut progress: impl FnMut(u32),
+) -> Result<MltRender, SimError> {
+    let bufs = kernel::upload_scene(dev, scene, camera, &params)?;
+    let n = (params.width * params.height) as usize;
+    let state = dev.alloc_bytes(state_bytes(params.width, params.height, params.max_bounces), STATE_BUFFER);
+    let chains = dev.alloc_bytes(16 * n as u64, "mlt chains");
+    let ysum = dev.alloc_bytes(4 * n as u64, "mlt bootstrap sums");
+    let image = dev.alloc_bytes(24 * n as u64, "mlt image");
+    let args = |last: DevicePtr| -> Vec<Arg> {
+        bufs.scene_args().into_iter().chain([state, chains, last]).map(Arg::Ptr).collect()
+    };
+    let cfg = LaunchConfig::linear(n.div_ceil(kernel::THREADS as usize) as u32, kernel::THREADS);
+    let mut totals = Counters::default();
+    let st = dev.launch(module, INIT_KERNEL, cfg, &args(ysum))?;
+    totals.merge(&st.totals);
+    let b = b_of(&dev.read::<f32>(ysum, n));
+    let mut out_frames = Vec::new();
+    let mut before = vec![0u64; 3 * n];
+    for f in 0..frames {
+        dev.write(bufs.params, &kernel::params_bytes_mlt(scene, camera, &params, f, b))?;
+        let st = dev.launch(module, FRAME_KERNEL, cfg, &args(image))?;
+        totals.merge(&st.totals);
+        if keep_frames {
+            let now = dev.read::<u64>(image, 3 * n);
+            out_frames.push(frame_image(&params, &before, &now));
+            before = now;
+        }
+        progress(f + 1);
+    }
+    let fixed = dev.read::<u64>(image, 3 * n);
+    let mut img = progressive_of(&params, &fixed, frames);
+    img.frame_images = out_frames;
+    let state_bytes = dev.memory().allocations().iter().find(|a| a.name == STATE_BUFFER).map_or(0, |a| a.len);
+    Ok(MltRender { image: img, fixed, b, state_bytes, totals: Some(totals) })
+}
+
+/// The start-up kernel.
+pub const INIT_KERNEL: &str = "mlt_init";
+/// The frame kernel.
+pub const FRAME_KERNEL: &str = "mlt_frame";
+
+impl From<MltRender> for KernelRender {
+    fn from(r: MltRender) -> KernelRender {
+        KernelRender { image: r.image, totals: r.totals.unwrap_or_default(), counts: None }
+    }
+}
