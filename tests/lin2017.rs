@@ -97,7 +97,9 @@ fn mlt_traces_the_same_bits_emulated_and_native() {
 /// bdpt at most 1 bounce is direct light only, whose techniques are the eye
 /// path hitting the light (weight 1/2 after a Lambertian bounce) and the
 /// connection to the light point y0 (1/2); the same pixels at 0 bounces see
-/// only the light itself, weight 1, as every other integrator.
+/// only the light itself, weight 1, as every other integrator. The means
+/// show unbiasedness only (any split has nee's mean); the 1/2 + 1/2 split
+/// is checked by the variance in `tests/bdpt_weights.rs`.
 #[test]
 fn bdpt_weights_a_direct_path_by_its_two_techniques() {
     let (scene, ps) = cornell();

@@ -115,10 +115,13 @@ fn a_rougher_mirror_fails() {
 fn bdpt_agrees_with_mitsuba() {
     let (reference, size) = reference();
     let (_, ps, cam) = cornell(size);
-    let o = native_outcome(&ps, &cam, params(size, Integrator::Bdpt, 300), 96, &reference);
+    // 384 frames and a 1 % bound on the mean: at 96 frames the whole image's
+    // mean varies by about ±1 % between seeds, and a light subpath whose
+    // roulette forgets to divide by q (about -2 %) passed (review 6, finding 4)
+    let o = native_outcome(&ps, &cam, params(size, Integrator::Bdpt, 300), 384, &reference);
     eprintln!("bdpt lambert: {o:?}");
     assert!(o.passed(), "bdpt disagrees with Mitsuba: {o:?}");
-    assert!(o.mean_rel_diff.abs() < 0.02, "bdpt: mean off by {:.3}", o.mean_rel_diff);
+    assert!(o.mean_rel_diff.abs() < 0.01, "bdpt: mean off by {:.3}", o.mean_rel_diff);
     // The emulated kernel: its 4 frames equal the native ones bit for bit, so
     // the native pass above covers it. Its own t-test at 4 or 16 frames is not
     // asserted: uniform weights leave short connections (G ~ 1 / d^2) their

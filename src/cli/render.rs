@@ -81,8 +81,9 @@ pub struct RenderArgs {
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
     #[arg(long, default_value_t = 16)]
     pub spp: u32,
-    /// Path tracer: the longest path in bounces.
-    #[arg(long, default_value_t = crate::host::path::DEFAULT_MAX_BOUNCES)]
+    /// Path tracer: the longest path in bounces (at most 8190).
+    #[arg(long, default_value_t = crate::host::path::DEFAULT_MAX_BOUNCES,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(crate::host::path::MAX_BOUNCES)))]
     pub bounces: u32,
     /// Path tracer: seed of the random numbers.
     #[arg(long, default_value_t = 0)]

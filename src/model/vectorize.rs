@@ -15,8 +15,10 @@
 //!   the run. Stores must follow one another (non-memory instructions between
 //!   are allowed). Greedy from the lowest offset: 16 bytes where the start is
 //!   16-byte aligned, else 8 where 8-byte aligned.
-//! - **Alignment** comes from a trailing-zero analysis of the registers
-//!   (flow-insensitive, every definition of a register considered): shared
+//! - **Alignment** comes from a trailing-zero analysis of the registers (a
+//!   register read where one unguarded definition reaches it in
+//!   straight-line code — no branch target in between — has that
+//!   definition's; otherwise the fewest of all its definitions): shared
 //!   variables' offsets, immediates, `shl` by a constant, `mul`/`mad` (zeros
 //!   add up), `add`/`sub`/`or` (the fewer), `and` (the more), `neg`, moves
 //!   and conversions keep them; anything loaded or special is unaligned. A
@@ -26,13 +28,21 @@
 //!   is two `LDS`, in 32 bits, or as `arr + (-64 tid)`, one `LDS.64`). A
 //!   register stepped round a loop (`add`/`sub %r, %r, k`) is as aligned as
 //!   its first value and its step (`kernels/validation/loop_stepped.cu`). A
-//!   shared variable is as aligned as its offset in ptxas's layout of the
-//!   kernel: the variables the function names, in declaration order, each at
-//!   its `.align` (not warplight's layout of the whole module). The evidence
-//!   (`docs/validation.md`, "Vectorisation: the alignment rule"):
+//!   shared variable's symbol — as a `mov`/`cvta` source or as an address
+//!   base, `[var+8]` — stands for its offset in ptxas's layout of the kernel
+//!   ([`Program::kernel_shared_layout`]: the variables the kernel and its
+//!   callees name, its own function-scope ones first, then module-scope,
+//!   then its callees' function-scope ones, each at its `.align`), not in
+//!   warplight's layout of the whole module; a number written in the PTX
+//!   is itself ([`crate::ptx::ir::Function::shared_symbols`] tells them
+//!   apart). The evidence (`docs/validation.md`, "Vectorisation: the
+//!   alignment rule"): the rule was read off
 //!   `tests/fixtures/validation/vectorize_probes.sass` (ptxas 13.5),
 //!   `loop_stepped.*.sass` and the suite (ptxas 13.0, needleman_wunsch's
-//!   `sub.s64` base: no `LDS.64`).
+//!   `sub.s64` base: no `LDS.64`); `vectorize_heldout.sass` (its layout
+//!   order refuted in two of eleven kernels, then corrected) and
+//!   `vectorize_heldout2.sass` (five of five) were predicted before they
+//!   were made.
 //! - **Repeated loads.** A shared load of the same base register (same
 //!   definition), offset and width as an earlier load of the same run is
 //!   dropped (ptxas reuses the register): not counted.
@@ -65,7 +75,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::ptx::Program;
-use crate::ptx::ir::{Address, ArithOp, AtomOp, Dst, Function, Kind, MemSpace, PredSrc, RegId, Src};
+use crate::ptx::ir::{Address, ArithOp, AtomOp, Dst, Function, Inst, Kind, MemSpace, PredSrc, RegId, Src};
 
 /// How the counter model counts one instruction's accesses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -113,7 +123,8 @@ impl Plan {
 
     /// Plans every function of `prog`.
     pub fn new(prog: &Program) -> Plan {
-        Plan { actions: prog.functions.iter().map(|f| plan_function(f, &shared_var_alignment(prog, f))).collect() }
+        let places = shared_places(prog);
+        Plan { actions: prog.functions.iter().zip(&places).map(|(f, p)| plan_function(f, p)).collect() }
     }
 }
 
@@ -188,34 +199,138 @@ fn tz_imm(v: u64) -> u32 {
     v.trailing_zeros()
 }
 
-/// The shared variables `f` names, with the alignment ptxas knows their
-/// addresses by: (warplight's offset, trailing zeros of the offset in
-/// ptxas's layout). ptxas lays out only the variables a kernel uses, in
-/// declaration order, each at its `.align`, from a base aligned far beyond
-/// 16 bytes, and knows the offsets (ptxas 13.5: an unused 4-byte array
-/// declared first takes no room; a `.align 4` array of 1,024 bytes after
-/// one of 1,156 sits at 0x484 and is not read as `LDS.64`; a `.align 4`
-/// array of 1,156 bytes first is;
-/// `tests/fixtures/validation/vectorize_probes.sass`). Warplight's own
-/// layout holds every variable of the module, so its offsets can be
-/// aligned otherwise.
-fn shared_var_alignment(prog: &Program, f: &Function) -> Vec<(u64, u32)> {
-    let mut off: u64 = 0;
-    let mut out = Vec::new();
-    for v in prog.shared_vars.iter().filter(|v| v.size > 0 && f.shared_refs.contains(&v.offset)) {
-        let align = u64::from(v.align.max(1));
-        off = off.div_ceil(align).saturating_mul(align);
-        out.push((u64::from(v.offset), tz_imm(off)));
-        off = off.saturating_add(u64::from(v.size));
-    }
-    out
+/// Where a shared variable lies, as ptxas knows it when it compiles one
+/// function: in the layout of every kernel that reaches the function
+/// ([`Program::kernel_shared_layout`]) its offset agrees with `offset` in
+/// the low `bits` bits (64: it is `offset` in all of them). ptxas compiles a
+/// callee once per calling kernel (`$kernel$callee` in the SASS), in that
+/// kernel's layout; warplight plans each function once, so a callee of
+/// kernels whose layouts disagree is taken as aligned only as far as they
+/// agree.
+#[derive(Debug, Clone, Copy)]
+struct Place {
+    /// The variable's offset in warplight's (module-wide) layout: the value
+    /// of its symbol in the IR.
+    warplight: u64,
+    /// Its offset in ptxas's layout (the low `bits` bits known).
+    offset: u64,
+    /// How many low bits of `offset` hold in every layout.
+    bits: u32,
 }
 
-/// Known trailing zeros of every data register of `f` (see the module
-/// comment); `vars`: [`shared_var_alignment`].
-fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
+impl Place {
+    /// Trailing zeros known of the variable's address.
+    fn tz(&self) -> u32 {
+        tz_imm(self.offset).min(self.bits)
+    }
+}
+
+/// Per function of `prog`, the shared variables of the kernels that reach it
+/// (a function no kernel calls: as if it were one).
+fn shared_places(prog: &Program) -> Vec<Vec<Place>> {
+    let n = prog.functions.len();
+    let taken = prog.address_taken();
+    let mut places: Vec<Vec<Place>> = vec![Vec::new(); n];
+    let mut reached = vec![false; n];
+    let mut add = |f: usize, layout: &[crate::ptx::ir::SharedPlace]| {
+        for p in layout {
+            let warplight = u64::from(prog.shared_vars[p.var].offset);
+            let offset = u64::from(p.offset);
+            match places[f].iter_mut().find(|x| x.warplight == warplight) {
+                Some(x) => x.bits = x.bits.min(tz_imm(x.offset ^ offset)),
+                None => places[f].push(Place { warplight, offset, bits: 64 }),
+            }
+        }
+    };
+    for k in (0..n as u32).filter(|&k| prog.functions[k as usize].is_entry) {
+        let layout = prog.kernel_shared_layout(k);
+        for f in prog.reachable(k, &taken) {
+            reached[f as usize] = true;
+            add(f as usize, &layout);
+        }
+    }
+    for f in (0..n).filter(|&f| !reached[f]) {
+        add(f, &prog.kernel_shared_layout(f as u32));
+    }
+    places
+}
+
+/// The place of the shared variable whose symbol instruction `pc` of `f`
+/// names with value `v` (`None` for a number written in the PTX).
+fn symbol_place(f: &Function, places: &[Place], pc: usize, v: u64) -> Option<Place> {
+    if f.shared_symbols.binary_search(&(pc as u32)).is_err() {
+        return None;
+    }
+    places.iter().find(|p| p.warplight == v).copied()
+}
+
+/// Known trailing zeros of the values of `f`'s data registers (see the
+/// module comment): of each definition, and of each register over all of
+/// them.
+struct Zeros {
+    /// Per instruction: of the value it writes (64 where it writes none).
+    at_def: Vec<u32>,
+    /// Per register: the fewest over all its definitions.
+    reg: Vec<u32>,
+}
+
+impl Zeros {
+    /// Trailing zeros of register `r` read where `reaching` stands: those of
+    /// the one definition that reaches it in straight-line code, else the
+    /// fewest of all its definitions (a loop's register: its first value and
+    /// its steps).
+    fn of(&self, r: RegId, reaching: &Reaching) -> u32 {
+        match reaching.last.get(r as usize).copied().flatten() {
+            Some(d) => self.at_def.get(d).copied().unwrap_or(0),
+            None => self.reg.get(r as usize).copied().unwrap_or(0),
+        }
+    }
+}
+
+/// The definition of each register that reaches an instruction in
+/// straight-line code: its last unguarded one, and none past a branch
+/// target (where other paths join).
+struct Reaching {
+    last: Vec<Option<usize>>,
+}
+
+impl Reaching {
+    fn new(f: &Function) -> Reaching {
+        Reaching { last: vec![None; f.reg_masks.len()] }
+    }
+
+    /// Steps onto instruction `pc` (before its operands are read).
+    fn enter(&mut self, pc: usize, target: &[bool]) {
+        if target.get(pc).copied().unwrap_or(false) {
+            self.last.fill(None);
+        }
+    }
+
+    /// Records the registers instruction `pc` writes (after its operands were read).
+    fn leave(&mut self, pc: usize, inst: &Inst) {
+        for r in inst.kind.writes() {
+            if let Some(x) = self.last.get_mut(r as usize) {
+                *x = inst.guard.is_none().then_some(pc);
+            }
+        }
+    }
+}
+
+/// Which instructions of `f` a branch may jump to.
+fn branch_targets(f: &Function) -> Vec<bool> {
+    let mut target = vec![false; f.insts.len() + 1];
+    for (_, t) in &f.labels {
+        if let Some(x) = target.get_mut(*t as usize) {
+            *x = true;
+        }
+    }
+    target
+}
+
+/// [`Zeros`] of `f`; `places`: [`shared_places`] of `f`.
+fn trailing_zeros(f: &Function, places: &[Place], target: &[bool]) -> Zeros {
     let n = f.reg_masks.len();
-    let mut tz = vec![64u32; n];
+    let mut z = Zeros { at_def: vec![64u32; f.insts.len()], reg: vec![64u32; n] };
     let width = |r: RegId| f.reg_masks.get(r as usize).map_or(64, |m| m.count_ones());
     // registers every definition of which moves an immediate into them
     let mut constant = vec![true; n];
@@ -234,23 +349,25 @@ fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
     };
     loop {
         let mut changed = false;
-        for inst in &f.insts {
-            let of = |s: &Src, tz: &[u32]| match s {
-                Src::Reg(r) => tz.get(*r as usize).copied().unwrap_or(0),
+        let mut reaching = Reaching::new(f);
+        for (pc, inst) in f.insts.iter().enumerate() {
+            reaching.enter(pc, target);
+            let of = |s: &Src, z: &Zeros| match s {
+                Src::Reg(r) => z.of(*r, &reaching),
                 Src::Imm(v) => tz_imm(*v),
                 _ => 0,
             };
-            // a shared variable's address (an immediate in warplight's
-            // layout) as aligned as ptxas knows it
-            let var = |s: &Src, tz: &[u32]| match s {
-                Src::Imm(v) => vars.iter().find(|x| x.0 == *v).map_or(tz_imm(*v), |x| x.1),
-                _ => of(s, tz),
+            // a shared variable's symbol (an immediate in warplight's
+            // layout) as aligned as ptxas knows it; a number as itself
+            let var = |s: &Src, z: &Zeros| match s {
+                Src::Imm(v) => symbol_place(f, places, pc, *v).map_or(tz_imm(*v), |p| p.tz()),
+                _ => of(s, z),
             };
             let (regs, value): (Vec<RegId>, u32) = match &inst.kind {
-                Kind::Mov { d, a } => (vec![d.reg], var(a, &tz)),
-                Kind::Cvt { d, a, dty, sty, .. } if !dty.is_float() && !sty.is_float() => (vec![d.reg], of(a, &tz)),
-                Kind::Cvta { d, a, .. } => (vec![d.reg], var(a, &tz)),
-                Kind::Selp { d, a, b, .. } => (vec![d.reg], of(a, &tz).min(of(b, &tz))),
+                Kind::Mov { d, a } => (vec![d.reg], var(a, &z)),
+                Kind::Cvt { d, a, dty, sty, .. } if !dty.is_float() && !sty.is_float() => (vec![d.reg], of(a, &z)),
+                Kind::Cvta { d, a, .. } => (vec![d.reg], var(a, &z)),
+                Kind::Selp { d, a, b, .. } => (vec![d.reg], of(a, &z).min(of(b, &z))),
                 // ptxas 13.5 keeps no alignment through a 64-bit `sub` of a
                 // non-constant or a 64-bit `neg` (32-bit ones keep it)
                 Kind::Arith { op: ArithOp::Sub, d, b, ty, .. } if ty.bytes() == 8 && !is_constant(b) => {
@@ -258,7 +375,7 @@ fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
                 }
                 Kind::Arith { op: ArithOp::Neg, d, ty, .. } if ty.bytes() == 8 && !ty.is_float() => (vec![d.reg], 0),
                 Kind::Arith { op, d, a, b, c, ty, .. } if !ty.is_float() => {
-                    let (a, b, c) = (of(a, &tz), of(b, &tz), of(c, &tz));
+                    let (a, b, c) = (of(a, &z), of(b, &z), of(c, &z));
                     let v = match op {
                         ArithOp::Add | ArithOp::Sub | ArithOp::Or | ArithOp::Xor => a.min(b),
                         ArithOp::And => a.max(b),
@@ -282,23 +399,30 @@ fn trailing_zeros(f: &Function, vars: &[(u64, u32)]) -> Vec<u32> {
                     continue;
                 }
                 let v = value.min(width(r));
-                if v < tz[r as usize] {
-                    tz[r as usize] = v;
+                if v < z.at_def[pc] {
+                    z.at_def[pc] = v;
+                    changed = true;
+                }
+                if v < z.reg[r as usize] {
+                    z.reg[r as usize] = v;
                     changed = true;
                 }
             }
+            reaching.leave(pc, inst);
         }
         if !changed {
-            return tz;
+            return z;
         }
     }
 }
 
 /// The base of an address as the pass compares them: a register at one of its
-/// definitions, or an absolute shared offset.
+/// definitions, a shared variable's symbol (by its warplight offset), or an
+/// absolute shared address written as a number.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Base {
     Reg(RegId, u32),
+    Sym(u64),
     Abs,
 }
 
@@ -307,7 +431,9 @@ enum Base {
 struct Pending {
     pc: usize,
     base: Base,
-    /// Byte offset from the base (absolute offset for [`Base::Abs`]).
+    /// Byte offset from the base (for [`Base::Sym`], from the start of
+    /// ptxas's layout, the low bits its `tz` says; for [`Base::Abs`], the
+    /// absolute address).
     off: i64,
     /// Bytes of the access (4 or 8).
     bytes: u32,
@@ -388,10 +514,11 @@ fn settle(run: &mut Vec<Pending>, loads: bool, actions: &mut [Action]) {
     }
 }
 
-/// Plans one function.
-fn plan_function(f: &Function, vars: &[(u64, u32)]) -> Vec<Action> {
+/// Plans one function; `places`: [`shared_places`] of `f`.
+fn plan_function(f: &Function, places: &[Place]) -> Vec<Action> {
     let mut actions = vec![Action::Count; f.insts.len()];
-    let tz = trailing_zeros(f, vars);
+    let target = branch_targets(f);
+    let zeros = trailing_zeros(f, places, &target);
     // registers some instruction reads (for atomics without a used result)
     let mut read = vec![false; f.reg_masks.len()];
     for inst in &f.insts {
@@ -432,18 +559,14 @@ fn plan_function(f: &Function, vars: &[(u64, u32)]) -> Vec<Action> {
             };
         }
     }
-    let mut target = vec![false; f.insts.len() + 1];
-    for (_, t) in &f.labels {
-        if let Some(x) = target.get_mut(*t as usize) {
-            *x = true;
-        }
-    }
     // each register's definition count so far, and the predicate writes so far
     let mut version = vec![0u32; f.reg_masks.len()];
     let mut pred_epoch = 0u32;
     let mut loads: Vec<Pending> = Vec::new();
     let mut stores: Vec<Pending> = Vec::new();
+    let mut reaching = Reaching::new(f);
     for (pc, inst) in f.insts.iter().enumerate() {
+        reaching.enter(pc, &target);
         if target[pc] {
             settle(&mut loads, true, &mut actions);
             settle(&mut stores, false, &mut actions);
@@ -473,9 +596,13 @@ fn plan_function(f: &Function, vars: &[(u64, u32)]) -> Vec<Action> {
                         Src::Reg(r) => (
                             Base::Reg(r, version.get(r as usize).copied().unwrap_or(0)),
                             addr.offset,
-                            tz.get(r as usize).copied().unwrap_or(0),
+                            zeros.of(r, &reaching),
                         ),
-                        Src::Imm(v) => (Base::Abs, addr.offset.wrapping_add(v as i64), 64),
+                        Src::Imm(v) => match symbol_place(f, places, pc, v) {
+                            // in ptxas's layout: aligned as far as the layouts agree
+                            Some(p) => (Base::Sym(v), addr.offset.wrapping_add(p.offset as i64), p.bits),
+                            None => (Base::Abs, addr.offset.wrapping_add(v as i64), 64),
+                        },
                         _ => return None,
                     };
                     (bytes == 4 || bytes == 8).then_some((load, base, off, bytes, tzb))
@@ -514,6 +641,7 @@ fn plan_function(f: &Function, vars: &[(u64, u32)]) -> Vec<Action> {
                 *v += 1;
             }
         }
+        reaching.leave(pc, inst);
     }
     settle(&mut loads, true, &mut actions);
     settle(&mut stores, false, &mut actions);

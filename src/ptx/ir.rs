@@ -751,6 +751,11 @@ pub struct Function {
     pub declared_reg_words: u32,
     /// Offsets of the shared variables the function names itself (callees not included).
     pub shared_refs: Vec<u32>,
+    /// The instructions (ascending) whose moved value (`mov`, `cvta`) or
+    /// address base is a shared variable's name: their [`Src::Imm`] is that
+    /// variable's offset in warplight's layout, not a number written in the
+    /// PTX (which the IR does not tell apart).
+    pub shared_symbols: Vec<u32>,
     /// Why the function cannot run, when it (or a function it calls) holds an
     /// instruction warplight does not execute: the module still loads, and only
     /// a launch of this kernel fails, with this error (file, line, instruction).
@@ -782,6 +787,19 @@ pub struct SharedVar {
     pub size: u32,
     /// Alignment in bytes (`.align`, else the element size).
     pub align: u32,
+    /// The function whose body declares it (index into
+    /// [`Program::functions`]); `None` at module scope.
+    pub scope: Option<u32>,
+}
+
+/// A shared variable in ptxas's layout of one kernel
+/// ([`Program::kernel_shared_layout`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SharedPlace {
+    /// The variable (index into [`Program::shared_vars`]).
+    pub var: usize,
+    /// Its offset in the kernel's layout (warplight's own is [`SharedVar::offset`]).
+    pub offset: u32,
 }
 
 /// A complete validated module.
@@ -830,28 +848,62 @@ impl Program {
         exact.or_else(plain).map(|i| i as u32)
     }
 
-    /// Static shared memory `kernel` itself needs in bytes: the shared variables
-    /// it or a function it calls (transitively) names, each at its own alignment,
-    /// as ptxas lays out only what a kernel uses. The emulator still gives every
-    /// CTA the whole module layout ([`Program::static_shared_size`]); this is the
-    /// figure for occupancy.
+    /// Static shared memory `kernel` itself needs in bytes: the end of its
+    /// layout ([`Program::kernel_shared_layout`]). The emulator still gives
+    /// every CTA the whole module layout ([`Program::static_shared_size`]);
+    /// this is the figure for occupancy.
     pub fn kernel_shared_size(&self, kernel: u32) -> u32 {
+        let layout = self.kernel_shared_layout(kernel);
+        layout.iter().map(|p| p.offset.saturating_add(self.shared_vars[p.var].size)).max().unwrap_or(0)
+    }
+
+    /// ptxas's layout of `kernel`'s static shared memory: only the variables
+    /// it or a function it calls (transitively) names, each at its own
+    /// alignment from 0, in this order: the kernel's own function-scope
+    /// variables, then the module-scope ones, then its callees'
+    /// function-scope ones, each group in declaration order. ptxas 13.5
+    /// (`-arch=sm_90`) knows these offsets when it vectorises
+    /// (`src/model/vectorize.rs`; `tests/fixtures/validation/vectorize_*.sass`,
+    /// `docs/validation.md`, "Vectorisation: the alignment rule").
+    pub fn kernel_shared_layout(&self, kernel: u32) -> Vec<SharedPlace> {
         let taken = self.address_taken();
-        let mut seen = vec![false; self.functions.len()];
-        let mut todo = vec![kernel as usize];
         let mut offsets = std::collections::BTreeSet::new();
-        while let Some(f) = todo.pop() {
-            if f >= seen.len() || std::mem::replace(&mut seen[f], true) {
+        for f in self.reachable(kernel, &taken) {
+            offsets.extend(self.functions[f as usize].shared_refs.iter().copied());
+        }
+        let group = |v: &SharedVar| match v.scope {
+            Some(f) if f == kernel => 0,
+            None => 1,
+            Some(_) => 2,
+        };
+        let mut used: Vec<usize> = (0..self.shared_vars.len())
+            .filter(|&i| self.shared_vars[i].size > 0 && offsets.contains(&self.shared_vars[i].offset))
+            .collect();
+        // stable: declaration order within each group
+        used.sort_by_key(|&i| group(&self.shared_vars[i]));
+        let mut end = 0u32;
+        used.into_iter()
+            .map(|var| {
+                let v = &self.shared_vars[var];
+                let offset = end.div_ceil(v.align.max(1)).saturating_mul(v.align.max(1));
+                end = offset.saturating_add(v.size);
+                SharedPlace { var, offset }
+            })
+            .collect()
+    }
+
+    /// `f` and every function it calls, transitively (ascending);
+    /// `address_taken`: [`Program::address_taken`].
+    pub fn reachable(&self, f: u32, address_taken: &[u32]) -> Vec<u32> {
+        let mut seen = vec![false; self.functions.len()];
+        let mut todo = vec![f as usize];
+        while let Some(g) = todo.pop() {
+            if g >= seen.len() || std::mem::replace(&mut seen[g], true) {
                 continue;
             }
-            offsets.extend(self.functions[f].shared_refs.iter().copied());
-            todo.extend(self.callees(f as u32, &taken).into_iter().map(|c| c as usize));
+            todo.extend(self.callees(g as u32, address_taken).into_iter().map(|c| c as usize));
         }
-        let mut size = 0u32;
-        for v in self.shared_vars.iter().filter(|v| v.size > 0 && offsets.contains(&v.offset)) {
-            size = size.div_ceil(v.align) * v.align + v.size;
-        }
-        size
+        (0..seen.len() as u32).filter(|&g| seen[g as usize]).collect()
     }
 
     /// The functions whose address the module takes (`mov.u64 %rd, f;`, or a

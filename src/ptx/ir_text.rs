@@ -41,8 +41,9 @@ pub fn program(p: &Program) -> String {
         let _ = writeln!(s, "const bank {} B: {}", p.const_bank.len(), hex(&p.const_bank));
     }
     for v in &p.shared_vars {
-        let SharedVar { name, offset, size, align } = v;
-        let _ = writeln!(s, "shared {name} @{offset}: {size} B align {align}");
+        let SharedVar { name, offset, size, align, scope } = v;
+        let scope = scope.map(|f| format!(" (in function {f})")).unwrap_or_default();
+        let _ = writeln!(s, "shared {name} @{offset}: {size} B align {align}{scope}");
     }
     let _ = writeln!(s, "static shared {} B", p.static_shared_size);
     for f in &p.functions {
@@ -84,6 +85,7 @@ pub fn function(f: &Function) -> String {
         labels,
         declared_reg_words,
         shared_refs,
+        shared_symbols,
         unsupported: _,
     } = f;
     let mut s = String::new();
@@ -103,6 +105,9 @@ pub fn function(f: &Function) -> String {
          {local_align}, {} regs ({declared_reg_words} words), {num_preds} preds, shared refs {shared_refs:?}",
         reg_masks.len()
     );
+    if !shared_symbols.is_empty() {
+        let _ = writeln!(s, "  shared symbols at {shared_symbols:?}");
+    }
     debug_assert_eq!(reg_names.len(), reg_masks.len());
     debug_assert_eq!(pred_names.len(), *num_preds as usize);
     let names = Names { regs: reg_names, preds: pred_names };

@@ -73,7 +73,7 @@ pub fn params_bytes_mlt(scene: &PathScene, camera: &Camera, params: &FrameParams
         params.paths() as i32,
         frame as i32,
         params.integrator.code(),
-        params.max_bounces as i32,
+        params.max_bounces_i32(),
         scene.lights.len() as i32,
         params.seed as i32,
         params.traversal.code(),

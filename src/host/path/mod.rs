@@ -157,6 +157,22 @@ pub const SAMPLES_PER_FRAME: u32 = 4;
 /// Default longest path, in bounces (not stated by the thesis; `docs/fixtures.md`).
 pub const DEFAULT_MAX_BOUNCES: u32 = 16;
 
+/// The longest path [`FrameParams::check`] allows, in bounces: the eye
+/// subpath's random dimensions (`2 + 8 bounce + 0..6`) stay below bdpt's
+/// light subpath's (from `0x10000`, `kernels/lin2017/path.cu`) up to bounce
+/// 8190, so the two never share random numbers.
+pub const MAX_BOUNCES: u32 = 8190;
+
+/// Settings of a frame the path tracer refuses.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum FrameParamsError {
+    /// A longest path beyond [`MAX_BOUNCES`].
+    #[error(
+        "a longest path of {0} bounces: at most {MAX_BOUNCES} (beyond, the eye and light subpaths would share random numbers)"
+    )]
+    TooManyBounces(u32),
+}
+
 /// The settings of a frame as the kernel reads them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrameParams {
@@ -178,6 +194,20 @@ impl FrameParams {
     /// Paths per frame: 4 per pixel.
     pub fn paths(&self) -> usize {
         self.width as usize * self.height as usize * SAMPLES_PER_FRAME as usize
+    }
+
+    /// Refuses settings the tracer does not take: more than [`MAX_BOUNCES`] bounces.
+    pub fn check(&self) -> Result<(), FrameParamsError> {
+        if self.max_bounces > MAX_BOUNCES {
+            return Err(FrameParamsError::TooManyBounces(self.max_bounces));
+        }
+        Ok(())
+    }
+
+    /// The longest path as the kernel's `int` holds it (saturated, never
+    /// negative), which the native tracer uses too.
+    pub fn max_bounces_i32(&self) -> i32 {
+        i32::try_from(self.max_bounces).unwrap_or(i32::MAX)
     }
 }
 

@@ -416,7 +416,7 @@ impl Tracer<'_> {
             let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
             if kind == KIND_DIFFUSE {
                 // light vertex k makes a path of k + bounce + 1 bounces
-                let last = (p.max_bounces as i32 - bounce as i32 - 1).min(nl - 1);
+                let last = (p.max_bounces_i32() - bounce as i32 - 1).min(nl - 1);
                 for k in 0..=last {
                     let y = &lv[k as usize];
                     let mut w = y.p.sub(hitp);

@@ -131,6 +131,7 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
             offset: off as u32,
             size: size as u32,
             align: align as u32,
+            scope: None,
         });
         Ok(off as u32)
     };
@@ -198,7 +199,7 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
     prog.static_shared_size = shared_off as u32;
     let dyn_base = align_up(shared_off, 16) as u32;
     for name in &extern_shared {
-        prog.shared_vars.push(SharedVar { name: name.clone(), offset: dyn_base, size: 0, align: 16 });
+        prog.shared_vars.push(SharedVar { name: name.clone(), offset: dyn_base, size: 0, align: 16, scope: None });
     }
     let fix_extern = |off: u32| if off == u32::MAX { dyn_base } else { off };
     for s in module_syms.values_mut() {
@@ -260,6 +261,12 @@ pub fn lower(m: &ast::Module, source_name: &str, src: &str) -> LResult<Program> 
                 return invalid(v.pos, format!("function address `{name}` past the end of `{}`", v.name));
             };
             slot.copy_from_slice(&bytes);
+        }
+    }
+    // function-scope variables belong to the function (its definition) that declares them
+    for (a, map) in fn_shared.iter().enumerate() {
+        for v in prog.shared_vars.iter_mut().filter(|v| v.size > 0 && map.values().any(|&o| o == v.offset)) {
+            v.scope = Some(fn_index[a] as u32);
         }
     }
     let sigs: Vec<Signature> = defs.iter().map(|f| signature(f)).collect::<LResult<_>>()?;
@@ -363,6 +370,7 @@ impl<'a> FnLower<'a> {
             labels: Vec::new(),
             declared_reg_words: 0,
             shared_refs: Vec::new(),
+            shared_symbols: Vec::new(),
             unsupported: None,
         };
         FnLower {
@@ -587,6 +595,21 @@ impl<'a> FnLower<'a> {
             (Family::Warp, _) => self.lower_shfl(i, &d)?,
             (Family::Texture, _) => self.lower_texture(i, &d)?,
         };
+        // a shared variable's name as the moved value or the address base
+        let names_shared = |o: &ast::Operand| match o {
+            ast::Operand::Name(n) | ast::Operand::Addr(Some(n), _) => matches!(self.lookup(n), Some(Sym::Shared(_))),
+            _ => false,
+        };
+        let symbol = match &kind {
+            Kind::Mov { .. } | Kind::Cvta { .. } => i.operands.get(1).is_some_and(names_shared),
+            Kind::Ld { .. } | Kind::St { .. } | Kind::Atom { .. } => {
+                i.operands.iter().any(|o| matches!(o, ast::Operand::Addr(..)) && names_shared(o))
+            }
+            _ => false,
+        };
+        if symbol {
+            self.out.shared_symbols.push(self.out.insts.len() as u32);
+        }
         let class = d.op.class();
         self.emit(kind, guard, pos, d.full, class);
         Ok(())

@@ -58,6 +58,7 @@ pub fn render(
     frames: u32,
     emulated: Option<&dyn Fn(&mut crate::sim::SimConfig)>,
 ) -> Result<PathRender, Box<dyn std::error::Error>> {
+    params.check()?;
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     // the stackless traversals cannot return to a split plane they crossed:
     // they need thesis 003's SAH tree, which keeps a triangle lying in a split
