@@ -337,7 +337,7 @@ mod tests {
         assert!(matches!(resolve(&["nobody:1".into()]), Err(AddressError::Thesis(..))));
         assert!(matches!(resolve(&["fabianowski:9.9".into()]), Err(AddressError::Table(..))));
         // a table that exists but is not reproduced: a clear error, not "unknown"
-        let e = resolve(&["lin:1".into()]).unwrap_err();
+        let e = resolve(&["lin:3".into()]).unwrap_err();
         assert!(matches!(e, AddressError::NotReproduced(..)), "{e}");
         let all = resolve(&["all".into()]).unwrap();
         assert!(all.len() >= 10);
