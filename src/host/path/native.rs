@@ -113,25 +113,37 @@ pub struct Tracer<'a> {
     pub params: FrameParams,
 }
 
+/// §6.4's affine test of ray (o, d) against the affine rows `m`
+/// ([`super::layout::affine_rows`]): the hit distance in [t_min, t_max], if
+/// any. The same float operations in the same order as `affine()` in
+/// `kernels/lin2017/path.cu` (and `tri_affine` in `intersect.cu`).
+pub fn affine_test(m: &[f32; 12], o: [f32; 3], d: [f32; 3], t_min: f32, t_max: f32) -> Option<f32> {
+    let oz = m[8] * o[0] + m[9] * o[1] + m[10] * o[2] + m[11];
+    let dz = m[8] * d[0] + m[9] * d[1] + m[10] * d[2];
+    let tt = -oz / dz;
+    if !(tt >= t_min && tt <= t_max) {
+        return None;
+    }
+    let u = m[0] * o[0] + m[1] * o[1] + m[2] * o[2] + m[3] + tt * (m[0] * d[0] + m[1] * d[1] + m[2] * d[2]);
+    if u < 0.0 {
+        return None;
+    }
+    let v = m[4] * o[0] + m[5] * o[1] + m[6] * o[2] + m[7] + tt * (m[4] * d[0] + m[5] * d[1] + m[6] * d[2]);
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some(tt)
+}
+
 impl Tracer<'_> {
     fn affine(&self, t: u32, o: V3, d: V3, t_min: f32, t_hit: &mut f32) -> bool {
-        let m = &self.scene.tris[t as usize];
-        let oz = m[8] * o.x + m[9] * o.y + m[10] * o.z + m[11];
-        let dz = m[8] * d.x + m[9] * d.y + m[10] * d.z;
-        let tt = -oz / dz;
-        if !(tt >= t_min && tt <= *t_hit) {
-            return false;
+        match affine_test(&self.scene.tris[t as usize], [o.x, o.y, o.z], [d.x, d.y, d.z], t_min, *t_hit) {
+            Some(tt) => {
+                *t_hit = tt;
+                true
+            }
+            None => false,
         }
-        let u = m[0] * o.x + m[1] * o.y + m[2] * o.z + m[3] + tt * (m[0] * d.x + m[1] * d.y + m[2] * d.z);
-        if u < 0.0 {
-            return false;
-        }
-        let v = m[4] * o.x + m[5] * o.y + m[6] * o.z + m[7] + tt * (m[4] * d.x + m[5] * d.y + m[6] * d.z);
-        if v < 0.0 || u + v > 1.0 {
-            return false;
-        }
-        *t_hit = tt;
-        true
     }
 
     /// kd-restart and kd-backtrack: the kernel's `trace_stackless`.
