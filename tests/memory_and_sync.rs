@@ -379,3 +379,38 @@ fn each_kernel_counts_only_the_shared_memory_it_names() {
         assert_eq!(o.shared_per_cta, 64, "{d:?}");
     }
 }
+
+/// `mov` of a variable's address plus an offset (PTX's address expression
+/// `g+8`): the value is the variable's address plus 8 in the global, shared
+/// and local spaces, and a store through it writes the variable's third word.
+/// A register plus an offset, or a negative offset, is a load error naming
+/// the expression and the line.
+#[test]
+fn a_symbol_plus_an_offset_is_its_address_plus_the_offset() {
+    let head = ".version 7.8\n.target sm_90\n.address_size 64\n.global .align 4 .u32 g[4];\n\
+        .visible .entry k(.param .u64 out)\n{\n.reg .b32 %r<12>;\n.reg .b64 %rd<8>;\n\
+        .shared .align 4 .u32 s[4];\n.local .align 4 .u32 l[4];\n";
+    let body = "ld.param.u64 %rd1, [out];\ncvta.to.global.u64 %rd1, %rd1;\n\
+        mov.u64 %rd2, g+8;\nst.global.u64 [%rd1], %rd2;\nst.global.u32 [%rd2], 77;\n\
+        mov.u32 %r1, s;\nmov.u32 %r2, s+8;\nsub.s32 %r3, %r2, %r1;\nst.global.u32 [%rd1+8], %r3;\n\
+        st.shared.u32 [%r2], 55;\nld.shared.u32 %r4, [s+8];\nst.global.u32 [%rd1+12], %r4;\n\
+        mov.u64 %rd3, l;\nmov.u64 %rd4, l+12;\nsub.s64 %rd5, %rd4, %rd3;\nst.global.u64 [%rd1+16], %rd5;\n\
+        st.local.u32 [%rd4], 33;\nld.local.u32 %r5, [l+12];\nst.global.u32 [%rd1+24], %r5;\nret;\n}\n";
+    let mut dev = warplight::sim::Device::new();
+    let m = dev.load_ptx(&format!("{head}{body}"), "offset.ptx").unwrap_or_else(|e| panic!("{e}"));
+    let out = dev.alloc_zeroed::<u32>(7);
+    dev.launch(&m, "k", LaunchConfig::linear(1, 1), &[Arg::Ptr(out)]).unwrap();
+    let got = dev.read::<u32>(out, 7);
+    let g = m.global("g").expect("g is a module variable");
+    assert_eq!(got[0] as u64 | (got[1] as u64) << 32, g.0 + 8, "g+8 is g's address plus 8");
+    assert_eq!(dev.read::<u32>(g, 4), [0, 0, 77, 0], "the store through g+8 wrote g[2]");
+    assert_eq!(got[2..7], [8, 55, 12, 0, 33], "shared s+8 and local l+12");
+    for (line, want) in [
+        ("mov.u32 %r1, %r2+8;", "`%r2+8`: only a variable's address takes an offset"),
+        ("mov.u64 %rd2, g-4;", "`g-4`: an offset before the variable's start"),
+        ("mov.u32 %r1, nothing+4;", "`nothing+4`: undeclared name"),
+    ] {
+        let err = dev.load_ptx(&format!("{head}{line}\nret;\n}}\n"), "bad.ptx").unwrap_err().to_string();
+        assert!(err.contains(want) && err.contains("bad.ptx:11"), "{line}: {err}");
+    }
+}

@@ -57,11 +57,22 @@ fn each_frame_retraces_from_the_moved_light_and_every_stage_is_timed() {
             assert!(k > 0);
         }
         // every stage ran and has a positive modelled time
-        for c in [&fr.trace, &fr.lbvh, &fr.render[0], &fr.render[1]] {
+        for c in [&fr.trace, &fr.render[0], &fr.render[1]] {
             assert!(c.warp_instructions > 0.0 && c.dram_bytes > 0.0, "{c:?}");
             let ms = table_6_6::predicted_ms(c).unwrap();
             assert!(ms > 0.0 && ms.is_finite(), "{ms}");
         }
+        // the LBVH by grid: the radix sorts' scans on one CTA, the sorts' other launches on
+        // ceil(kernels / 256) CTAs (at most 30), each shape with its own positive time
+        let grids: Vec<u32> = fr.lbvh.iter().map(|(s, _)| s.ctas).collect();
+        let tiles = fr.kernels.div_ceil(256).min(30) as u32;
+        assert!(grids.contains(&1) && grids.contains(&tiles), "{grids:?}, {tiles} tiles");
+        for (shape, c) in &fr.lbvh {
+            assert!(c.warp_instructions > 0.0, "{shape:?}: {c:?}");
+            let ms = table_6_6::predicted_ms_at(c, *shape).unwrap();
+            assert!(ms > 0.0 && ms.is_finite(), "{shape:?}: {ms}");
+        }
+        assert!(table_6_6::grid_ms(&fr.lbvh).unwrap() > 0.0);
         lights.push(fr.light);
     }
     // the light moved between the frames (3 cm along each axis by default)

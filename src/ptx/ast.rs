@@ -156,6 +156,9 @@ pub enum Operand {
     Not(String),
     /// `[base+offset]`: base name (or none for an absolute address) and byte offset.
     Addr(Option<String>, i64),
+    /// `sym+8` (or `sym-8`): a variable's address plus a byte offset, PTX's
+    /// address expression as a value (`mov.u32 %r1, sym+8`).
+    Offset(String, i64),
     /// `{a, b, ...}`
     Vector(Vec<Operand>),
     /// `(a, b, ...)` in `call`.

@@ -766,6 +766,31 @@ impl<'a> Parser<'a> {
                     let q = self.expect_ident()?;
                     return Ok(Operand::Pair(n, q));
                 }
+                // `sym+8`, `sym-8`: an address expression (the lowering checks that `sym` is a variable)
+                if let Some(Tok::Punct(sign @ ('+' | '-'))) = self.peek() {
+                    let mut neg = *sign == '-';
+                    self.i += 1;
+                    if !neg && self.eat_punct('-') {
+                        neg = true;
+                    }
+                    let sign = if neg { '-' } else { '+' };
+                    let at = self.pos();
+                    let Some(Tok::Int(v)) = self.peek() else {
+                        return syntax(
+                            at,
+                            format!(
+                                "expected an integer byte offset after `{n}{sign}` (an address expression is a \
+                                 variable plus or minus an integer, `{n}+8`), found {}",
+                                self.describe()
+                            ),
+                        );
+                    };
+                    self.i += 1;
+                    let Ok(v) = i64::try_from(*v) else {
+                        return syntax(at, format!("offset {v} of `{n}{sign}{v}` out of range"));
+                    };
+                    return Ok(Operand::Offset(n, if neg { -v } else { v }));
+                }
                 Ok(Operand::Name(n))
             }
             _ => match self.literal()? {
@@ -803,6 +828,38 @@ mod tests {
         let Stmt::Inst(ld) = &body[3] else { panic!() };
         assert_eq!(ld.full_opcode(), "ld.global.nc.v2.f32");
         assert_eq!(ld.operands[1], Operand::Addr(Some("%rd1".into()), -8));
+    }
+
+    #[test]
+    fn a_symbol_plus_an_offset_is_an_address_expression() {
+        let m = parse_str(
+            ".global .u32 g[4];\n.entry k()\n{\n.reg .b32 %r<3>;\n.reg .b64 %rd<2>;\n\
+             mov.u32 %r1, g+8;\nmov.u64 %rd1, g - 4;\nmov.u32 %r2, g+0x10;\nmov.u32 %r2, g+-2;\nret;\n}\n",
+        );
+        let ops: Vec<Operand> = m.functions[0]
+            .body
+            .as_ref()
+            .unwrap()
+            .iter()
+            .filter_map(|s| match s {
+                Stmt::Inst(i) if i.opcode == "mov" => Some(i.operands[1].clone()),
+                _ => None,
+            })
+            .collect();
+        let want = [8, -4, 16, -2].map(|o| Operand::Offset("g".into(), o));
+        assert_eq!(ops, want);
+        // bad forms: no integer after the sign, a register offset, a second term
+        for (body, what) in [
+            ("mov.u32 %r1, g+;", "after `g+`"),
+            ("mov.u32 %r1, g+%r2;", "found `%r2`"),
+            ("mov.u32 %r1, g-h;", "found `h`"),
+            ("mov.u32 %r1, g+8+4;", "expected `,` or `;`, found `+`"),
+        ] {
+            let src = format!(".entry k()\n{{\n{body}\nret;\n}}\n");
+            let (pos, kind) = parse(&lex(&src).unwrap()).unwrap_err();
+            assert_eq!(pos.line, 3, "{body}: {kind}");
+            assert!(matches!(&kind, PtxErrorKind::Syntax(m) if m.contains(what)), "{body}: {kind}");
+        }
     }
 
     #[test]

@@ -597,7 +597,9 @@ impl<'a> FnLower<'a> {
         };
         // a shared variable's name as the moved value or the address base
         let names_shared = |o: &ast::Operand| match o {
-            ast::Operand::Name(n) | ast::Operand::Addr(Some(n), _) => matches!(self.lookup(n), Some(Sym::Shared(_))),
+            ast::Operand::Name(n) | ast::Operand::Offset(n, _) | ast::Operand::Addr(Some(n), _) => {
+                matches!(self.lookup(n), Some(Sym::Shared(_)))
+            }
             _ => false,
         };
         let symbol = match &kind {

@@ -129,8 +129,39 @@ impl FnLower<'_> {
                     None => invalid(pos, format!("undeclared name `{n}`")),
                 },
             },
+            Operand::Offset(n, off) => self.offset_address(n, *off, pos),
             Operand::Not(_) => invalid(pos, "`!` applies to predicates only"),
             _ => invalid(pos, "expected a register or literal"),
+        }
+    }
+
+    /// The value of the address expression `n+off`: variable `n`'s address
+    /// plus `off` bytes (kernel and frame parameters, shared, constant and
+    /// local variables by their offset in their space, globals by their
+    /// address). Registers, predicates, functions and negative or
+    /// overflowing offsets are errors that name the expression.
+    fn offset_address(&self, n: &str, off: i64, pos: Pos) -> LResult<Src> {
+        let text = if off < 0 { format!("{n}{off}") } else { format!("{n}+{off}") };
+        let Ok(off) = u32::try_from(off) else {
+            return invalid(pos, format!("`{text}`: an offset before the variable's start is not supported"));
+        };
+        let plus = |base: u32| match base.checked_add(off) {
+            Some(a) => Ok(a),
+            None => invalid(pos, format!("`{text}`: the address overflows 32 bits of the variable's space")),
+        };
+        match self.lookup(n) {
+            Some(Sym::Shared(o)) | Some(Sym::Const(o)) | Some(Sym::KernelParam(o)) | Some(Sym::FrameParam(o, _)) => {
+                Ok(Src::Imm(plus(o)? as u64))
+            }
+            Some(Sym::Local(o)) => Ok(Src::LocalAddr(plus(o)?)),
+            Some(Sym::Global(g)) => Ok(Src::GlobalAddr(g, off)),
+            Some(Sym::Reg(_)) | Some(Sym::Pred(_)) => invalid(
+                pos,
+                format!("`{text}`: only a variable's address takes an offset; `{n}` is a register (use `add`)"),
+            ),
+            Some(Sym::Func(_)) => invalid(pos, format!("`{text}`: `{n}` is a function, not a variable")),
+            None if n.starts_with('%') => invalid(pos, format!("`{text}`: undeclared register `{n}`")),
+            None => invalid(pos, format!("`{text}`: undeclared name `{n}`")),
         }
     }
 

@@ -289,16 +289,81 @@ pub fn build_kernel_observed(
     n_auto: u32,
     model: Option<&crate::model::Model>,
 ) -> Result<(Lbvh, Vec<LaunchStats>), PhotonError> {
-    let observer = model.map(|m| m as &dyn crate::sim::ObserverFactory);
+    let mut l = Launcher { shared: model, own: None, launches: Vec::new() };
+    let lbvh = build_launches(dev, module, kernels, n_auto, &mut l)?;
+    Ok((lbvh, l.launches.into_iter().map(|o| o.stats).collect()))
+}
+
+/// One launch of the build: its grid, its counters and, from
+/// [`build_kernel_per_launch`], the memory traffic its own model counted.
+#[derive(Debug, Clone)]
+pub struct ObservedLaunch {
+    /// The launch's grid and CTA shape.
+    pub config: LaunchConfig,
+    /// Its counters.
+    pub stats: LaunchStats,
+    /// What a memory model of its own counted (`None` unless asked for).
+    pub memory: Option<crate::model::ModelStats>,
+}
+
+/// As [`build_kernel`], each launch observed by a memory model of `profile`
+/// of its own and returned with its grid, so that a timing model can take
+/// every launch at its real grid (the radix sort's one-CTA scan as one CTA).
+pub fn build_kernel_per_launch(
+    dev: &mut Device,
+    module: &Module,
+    kernels: &[Kernel],
+    n_auto: u32,
+    profile: crate::model::Profile,
+) -> Result<(Lbvh, Vec<ObservedLaunch>), PhotonError> {
+    let mut l = Launcher { shared: None, own: Some(profile), launches: Vec::new() };
+    let lbvh = build_launches(dev, module, kernels, n_auto, &mut l)?;
+    Ok((lbvh, l.launches))
+}
+
+/// Runs the build's launches: observed by one shared model, or each by a
+/// model of its own (`own`), recorded in order.
+struct Launcher<'m> {
+    shared: Option<&'m crate::model::Model>,
+    own: Option<crate::model::Profile>,
+    launches: Vec<ObservedLaunch>,
+}
+
+impl Launcher<'_> {
+    fn run(
+        &mut self,
+        dev: &mut Device,
+        module: &Module,
+        kernel: &str,
+        config: LaunchConfig,
+        args: &[Arg],
+    ) -> Result<(), SimError> {
+        let own = self.own.map(|p| crate::model::Model::new(p, &module.prog));
+        let observer = match &own {
+            Some(m) => Some(m as &dyn crate::sim::ObserverFactory),
+            None => self.shared.map(|m| m as &dyn crate::sim::ObserverFactory),
+        };
+        let stats = dev.launch_observed(module, kernel, config, args, observer)?;
+        self.launches.push(ObservedLaunch { config, stats, memory: own.map(|m| m.finish()) });
+        Ok(())
+    }
+}
+
+fn build_launches(
+    dev: &mut Device,
+    module: &Module,
+    kernels: &[Kernel],
+    n_auto: u32,
+    launcher: &mut Launcher,
+) -> Result<Lbvh, PhotonError> {
     let n = kernels.len();
     if n > (LEAF_REF - 1) as usize {
         return Err(PhotonError::TooMany(n));
     }
     if n == 0 {
-        return Ok((build(kernels, n_auto), Vec::new()));
+        return Ok(build(kernels, n_auto));
     }
     let up = crate::host::rt_kernels::upload;
-    let mut launches = Vec::new();
     let q = Quantiser::of(kernels);
     let mut p = to_bytes(&[q.lo[0], q.lo[1], q.lo[2], q.scale[0], q.scale[1], q.scale[2]]);
     p.extend_from_slice(&(n as i32).to_le_bytes());
@@ -307,29 +372,29 @@ pub fn build_kernel_observed(
     let cb = up(dev, &to_bytes(&centres), "centres")?;
     let codes_out = dev.alloc_zeroed::<u32>(n);
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(codes_out)];
-    launches.push(dev.launch_observed(module, CODES, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
+    launcher.run(dev, module, CODES, LaunchConfig::linear(ctas(n), THREADS), &args)?;
     // the references radix-sorted by code, their AABBs gathered in that order
-    let (codes_dev, order_dev) = radix_sort(dev, module, codes_out, n, CODE_BITS, observer, &mut launches)?;
+    let (codes_dev, order_dev) = radix_sort(dev, module, codes_out, n, CODE_BITS, launcher)?;
     let kernel_boxes: Vec<f32> =
         kernels.iter().flat_map(|k| [k.lo[0], k.lo[1], k.lo[2], k.hi[0], k.hi[1], k.hi[2]]).collect();
     let kb = up(dev, &to_bytes(&kernel_boxes), "kernel boxes")?;
     let bb = dev.alloc_zeroed::<f32>(6 * n);
     let pp = up(dev, &params(n, n_auto, 0, 0), "params")?;
     let args = [Arg::Ptr(pp), Arg::Ptr(order_dev), Arg::Ptr(kb), Arg::Ptr(bb)];
-    launches.push(dev.launch_observed(module, GATHER, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
+    launcher.run(dev, module, GATHER, LaunchConfig::linear(ctas(n), THREADS), &args)?;
     let cb = codes_dev;
     let size = dev.alloc_zeroed::<u32>(n);
     let bx = dev.alloc_zeroed::<f32>(6 * n);
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(bb), Arg::Ptr(size), Arg::Ptr(bx)];
-    launches.push(dev.launch_observed(module, RUNS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
+    launcher.run(dev, module, RUNS, LaunchConfig::linear(ctas(n), THREADS), &args)?;
     let lv = dev.alloc_zeroed::<u32>(n);
     let args = [Arg::Ptr(pp), Arg::Ptr(cb), Arg::Ptr(lv)];
-    launches.push(dev.launch_observed(module, LEVELS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
+    launcher.run(dev, module, LEVELS, LaunchConfig::linear(ctas(n), THREADS), &args)?;
     // the merge points radix-sorted by level, deepest first, ascending positions within a level
     let keys = dev.alloc_zeroed::<u32>(n);
     let args = [Arg::Ptr(pp), Arg::Ptr(lv), Arg::Ptr(keys)];
-    launches.push(dev.launch_observed(module, LEVEL_KEYS, LaunchConfig::linear(ctas(n), THREADS), &args, observer)?);
-    let (keys, points) = radix_sort(dev, module, keys, n - 1, LEVEL_KEY_BITS, observer, &mut launches)?;
+    launcher.run(dev, module, LEVEL_KEYS, LaunchConfig::linear(ctas(n), THREADS), &args)?;
+    let (keys, points) = radix_sort(dev, module, keys, n - 1, LEVEL_KEY_BITS, launcher)?;
     // the launches per level: the sorted keys' runs (a point's place is its node id)
     let keys = dev.read::<u32>(keys, n - 1);
     let total = keys.iter().take_while(|&&k| k < CODE_BITS).count();
@@ -340,7 +405,7 @@ pub fn build_kernel_observed(
         let len = keys[first..total].iter().take_while(|&&k| k == keys[first]).count();
         let pp = up(dev, &params(n, n_auto, len, first as u32), "params")?;
         let args = [Arg::Ptr(pp), Arg::Ptr(points), Arg::Ptr(size), Arg::Ptr(bx), Arg::Ptr(node_of), Arg::Ptr(nodes)];
-        launches.push(dev.launch_observed(module, MERGE, LaunchConfig::linear(ctas(len), THREADS), &args, observer)?);
+        launcher.run(dev, module, MERGE, LaunchConfig::linear(ctas(len), THREADS), &args)?;
         first += len;
     }
     let order = dev.read::<u32>(order_dev, n);
@@ -350,12 +415,12 @@ pub fn build_kernel_observed(
     let root = dev.read::<u32>(node_of, 1)[0];
     let b = dev.read::<f32>(bx, 6);
     let root_box = std::array::from_fn(|k| b[k]);
-    Ok((Lbvh { order, codes, n_auto, nodes, root, root_box }, launches))
+    Ok(Lbvh { order, codes, n_auto, nodes, root, root_box })
 }
 
 /// Radix-sorts the `n` keys at `keys` (their low `bits` bits) on the
 /// emulator, stably, with the indices 0..n as values: three launches a pass
-/// of [`RADIX_BITS`] bits (counts, scan, scatter), appended to `launches`.
+/// of [`RADIX_BITS`] bits (counts, scan on one CTA, scatter), run by `launcher`.
 /// Returns the device buffers of the sorted keys and of their values.
 fn radix_sort(
     dev: &mut Device,
@@ -363,8 +428,7 @@ fn radix_sort(
     keys: DevicePtr,
     n: usize,
     bits: u32,
-    observer: Option<&dyn crate::sim::ObserverFactory>,
-    launches: &mut Vec<LaunchStats>,
+    launcher: &mut Launcher,
 ) -> Result<(DevicePtr, DevicePtr), PhotonError> {
     if n > i32::MAX as usize {
         return Err(PhotonError::TooMany(n));
@@ -379,17 +443,11 @@ fn radix_sort(
         let pp = crate::host::rt_kernels::upload(dev, &to_bytes(&p), "sort params")?;
         let cfg = LaunchConfig::linear(grid, SORT_THREADS as u32);
         let args = [Arg::Ptr(pp), Arg::Ptr(k_in), Arg::Ptr(counts)];
-        launches.push(dev.launch_observed(module, RADIX_COUNT, cfg, &args, observer)?);
+        launcher.run(dev, module, RADIX_COUNT, cfg, &args)?;
         let args = [Arg::Ptr(pp), Arg::Ptr(counts)];
-        launches.push(dev.launch_observed(
-            module,
-            RADIX_SCAN,
-            LaunchConfig::linear(1, SORT_THREADS as u32),
-            &args,
-            observer,
-        )?);
+        launcher.run(dev, module, RADIX_SCAN, LaunchConfig::linear(1, SORT_THREADS as u32), &args)?;
         let args = [Arg::Ptr(pp), Arg::Ptr(counts), Arg::Ptr(k_in), Arg::Ptr(v_in), Arg::Ptr(k_out), Arg::Ptr(v_out)];
-        launches.push(dev.launch_observed(module, RADIX_SCATTER, cfg, &args, observer)?);
+        launcher.run(dev, module, RADIX_SCATTER, cfg, &args)?;
         std::mem::swap(&mut k_in, &mut k_out);
         std::mem::swap(&mut v_in, &mut v_out);
     }
@@ -417,8 +475,9 @@ pub struct Sorted {
 pub fn sort_kernel(dev: &mut Device, module: &Module, keys: &[u32], bits: u32) -> Result<Sorted, PhotonError> {
     let n = keys.len();
     let kb = crate::host::rt_kernels::upload(dev, &to_bytes(keys), "keys")?;
-    let mut launches = Vec::new();
-    let (k, v) = radix_sort(dev, module, kb, n, bits, None, &mut launches)?;
+    let mut l = Launcher { shared: None, own: None, launches: Vec::new() };
+    let (k, v) = radix_sort(dev, module, kb, n, bits, &mut l)?;
+    let launches = l.launches.into_iter().map(|o| o.stats).collect();
     Ok(Sorted { keys: dev.read::<u32>(k, n), order: dev.read::<u32>(v, n), launches })
 }
 

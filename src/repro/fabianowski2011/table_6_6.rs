@@ -126,8 +126,9 @@ pub struct Frame {
     pub radiance: Vec<Vec<[f32; 3]>>,
     /// Photon tracing and kernel construction.
     pub trace: KernelCounts,
-    /// The LBVH build's launches.
-    pub lbvh: KernelCounts,
+    /// The LBVH build's launches by grid: per launch shape (its real grid and
+    /// CTA size), the summed counters of the launches of that shape.
+    pub lbvh: Vec<(LaunchShape, KernelCounts)>,
     /// Per shape: the camera rays' stack kernel and the gather.
     pub render: Vec<KernelCounts>,
 }
@@ -198,9 +199,8 @@ pub fn frame(
     let kernels = &constructed.kernels;
     // the LBVH with n_auto, recomputed every frame (L2663)
     let n_auto = lbvh::n_auto(kernels, scene);
-    let model = Model::new(Profile::Gt200, &k.lbvh.prog);
-    let (built, ll) = lbvh::build_kernel_observed(dev, &k.lbvh, kernels, n_auto, Some(&model))?;
-    let build = stage_counts(&k.lbvh.prog, &ll, &model.finish());
+    let (built, ll) = lbvh::build_kernel_per_launch(dev, &k.lbvh, kernels, n_auto, Profile::Gt200)?;
+    let build = by_grid(&k.lbvh.prog, &ll);
     // rendering: the camera rays, then the gathers
     let mut config = rt_kernels::sim_config(cam);
     Profile::Gt200.configure(&mut config, None);
@@ -263,7 +263,9 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
                 ("light_x".to_string(), fr.light[0] as f64),
             ];
             record(&mut c, "trace", &fr.trace);
-            record(&mut c, "lbvh", &fr.lbvh);
+            for (shape, counts) in &fr.lbvh {
+                record(&mut c, &grid_stage("lbvh", shape), counts);
+            }
             record(&mut c, "render", &fr.render[i]);
             out.push(Sample {
                 group: PIPELINE.into(),
@@ -275,6 +277,53 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
         }
     }
     Ok(out)
+}
+
+/// The launches `launches` of `prog` grouped by their shape (grid, CTA size,
+/// shared memory; chapter 4's 54 registers): per shape the summed timing
+/// counters, each launch with the memory traffic its own model counted.
+pub fn by_grid(prog: &Program, launches: &[lbvh::ObservedLaunch]) -> Vec<(LaunchShape, KernelCounts)> {
+    let mut out: Vec<(LaunchShape, KernelCounts)> = Vec::new();
+    for l in launches {
+        let c = &l.config;
+        let shape = LaunchShape {
+            ctas: c.grid.iter().product(),
+            threads_per_cta: c.block.iter().product(),
+            registers_per_thread: super::timing::REGISTERS,
+            shared_per_cta: super::timing::shape(prog, &l.stats.kernel).shared_per_cta + c.dynamic_shared,
+        };
+        // a launch without a model of its own (not from `build_kernel_per_launch`): no memory traffic
+        let none = || Model::new(Profile::Gt200, prog).finish();
+        let counts = match &l.memory {
+            Some(m) => super::timing::counts_of(prog, &l.stats, m),
+            None => super::timing::counts_of(prog, &l.stats, &none()),
+        };
+        match out.iter_mut().find(|(s, _)| *s == shape) {
+            Some((_, k)) => k.add(&counts),
+            None => out.push((shape, counts)),
+        }
+    }
+    out
+}
+
+/// The results' name of `stage`'s launches of `shape`: `lbvh@1x256+4096`
+/// (CTAs x threads + shared bytes); its counters are this + `.` + the
+/// names of [`KernelCounts::counters`].
+pub fn grid_stage(stage: &str, shape: &LaunchShape) -> String {
+    format!("{stage}@{}x{}+{}", shape.ctas, shape.threads_per_cta, shape.shared_per_cta)
+}
+
+/// The launch shape a [`grid_stage`] name of `stage` gives, `None` for other names.
+fn parse_grid_stage(stage: &str, name: &str) -> Option<LaunchShape> {
+    let rest = name.strip_prefix(stage)?.strip_prefix('@')?;
+    let (ctas, rest) = rest.split_once('x')?;
+    let (threads, shared) = rest.split_once('+')?;
+    Some(LaunchShape {
+        ctas: ctas.parse().ok()?,
+        threads_per_cta: threads.parse().ok()?,
+        registers_per_thread: super::timing::REGISTERS,
+        shared_per_cta: shared.parse().ok()?,
+    })
 }
 
 /// The persistent launch the timing model assumes for every stage: 30 CTAs of
@@ -291,21 +340,56 @@ fn shape() -> LaunchShape {
 
 /// Predicted milliseconds of `stage` of `variant` on `scene`, a mean frame;
 /// the rendering counts scaled from the run's resolution to 512 × 512.
+/// A stage recorded by grid ([`grid_stage`]: the LBVH) is the sum over its
+/// launch shapes, each predicted at its own grid ([`grid_ms`]); one recorded
+/// as a whole (every stage before the LBVH was recorded by grid) is one
+/// persistent launch ([`predicted_ms`]).
 fn stage_ms(r: &Results, scene: &str, variant: &str, stage: &str) -> Option<f64> {
-    let frames = r.samples.iter().filter(|s| s.group == PIPELINE && s.scene == scene && s.variant == variant).count();
-    let c = KernelCounts::from_counters(|n| r.sum(PIPELINE, scene, variant, &format!("{stage}.{n}")))?;
+    let samples = || r.samples.iter().filter(|s| s.group == PIPELINE && s.scene == scene && s.variant == variant);
+    let frames = samples().count();
     let mut k = 1.0 / frames.max(1) as f64;
     if stage == "render" {
         let res = r.protocol.resolution.max(1) as f64;
         k *= (super::timing::THESIS_RESOLUTION as f64 / res).powi(2);
     }
-    predicted_ms(&c.scaled(k))
+    let mut shapes: Vec<LaunchShape> = Vec::new();
+    for name in samples().flat_map(|s| s.counters.keys()) {
+        let Some(shape) = name.split_once('.').and_then(|(g, _)| parse_grid_stage(stage, g)) else { continue };
+        if !shapes.contains(&shape) {
+            shapes.push(shape);
+        }
+    }
+    if shapes.is_empty() {
+        let c = KernelCounts::from_counters(|n| r.sum(PIPELINE, scene, variant, &format!("{stage}.{n}")))?;
+        return predicted_ms(&c.scaled(k));
+    }
+    let groups = shapes
+        .into_iter()
+        .map(|shape| {
+            let g = grid_stage(stage, &shape);
+            let c = KernelCounts::from_counters(|n| r.sum(PIPELINE, scene, variant, &format!("{g}.{n}")))?;
+            Some((shape, c.scaled(k)))
+        })
+        .collect::<Option<Vec<_>>>()?;
+    grid_ms(&groups)
+}
+
+/// The GTX 280 timing model's milliseconds for launches grouped by shape:
+/// each group predicted at its own grid (a one-CTA launch on one SM, a
+/// 30-CTA launch on 30), summed.
+pub fn grid_ms(groups: &[(LaunchShape, KernelCounts)]) -> Option<f64> {
+    groups.iter().map(|(shape, c)| predicted_ms_at(c, *shape)).sum()
+}
+
+/// The GTX 280 timing model's milliseconds for `counts` run as `shape`.
+pub fn predicted_ms_at(counts: &KernelCounts, shape: LaunchShape) -> Option<f64> {
+    predict(&GTX_280, &Launch { counts: *counts, shape }).ok().map(|p| p.seconds * 1e3)
 }
 
 /// The GTX 280 timing model's milliseconds for `counts` run as one
 /// persistent launch (30 CTAs x 256 threads, 54 registers).
 pub fn predicted_ms(counts: &KernelCounts) -> Option<f64> {
-    predict(&GTX_280, &Launch { counts: *counts, shape: shape() }).ok().map(|p| p.seconds * 1e3)
+    predicted_ms_at(counts, shape())
 }
 
 /// The table.
@@ -387,8 +471,11 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         super::timing::FPS_TOLERANCE.describe()
     ));
     t.notes.push(format!(
-        "Modelled: {}. Each stage's launches are summed and predicted as one persistent launch (30 CTAs x 256 \
-         threads, 54 registers; the thesis gives no register count for these kernels); Trace from the first 2^14 \
+        "Modelled: {}. The Trace and Render stages' launches are summed and predicted as one persistent launch (30 \
+         CTAs x 256 threads, 54 registers; the thesis gives no register count for these kernels); the LBVH's \
+         launches at their real grids (the radix sorts' scan on one CTA, a level's merge on as many CTAs as its \
+         merge points fill, at most 30), summed by grid shape, each shape predicted on its own (a results file \
+         recorded before the LBVH was recorded by grid: one persistent launch); Trace from the first 2^14 \
          photons of each frame on the emulator, scaled to the table's emissions, LBVH at the full kernel count, Render scaled from the run's resolution to 512 x 512. FPS = 1000 / (Trace + LBVH + \
          Render), as every printed row obeys within 0.3 ms (extract §3.14). Not modelled: the OpenGL visualisation the \
          thesis' Render includes.",
@@ -402,4 +489,39 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
             .into(),
     );
     vec![t]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An issue-bound launch (warp instructions only, no waits): the model's
+    /// time is W × 4 cycles / (SMs the grid occupies) at 1.296 GHz (8 warps a
+    /// CTA of 256 threads cover the 24-cycle register latency: 4 cycles a warp
+    /// instruction). 1.296e6 warp instructions take 4 ms on one CTA (one SM)
+    /// and 0.1333 ms on 30 CTAs (30 SMs, one CTA each); 6 CTAs 0.6667 ms.
+    #[test]
+    fn each_grid_is_modelled_at_its_own_size() {
+        let w = KernelCounts { warp_instructions: 1.296e6, ..KernelCounts::default() };
+        let at = |ctas: u32| LaunchShape { ctas, threads_per_cta: 256, registers_per_thread: 54, shared_per_cta: 1024 };
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9 * b;
+        let one = predicted_ms_at(&w, at(1)).unwrap();
+        let thirty = predicted_ms_at(&w, at(30)).unwrap();
+        assert!(close(one, 4.0), "{one}");
+        assert!(close(thirty, 4.0 / 30.0), "{thirty}");
+        assert!(close(predicted_ms_at(&w, at(6)).unwrap(), 4.0 / 6.0));
+        // the stage: a 1-CTA scan and a 30-CTA pass, each at its grid, summed
+        let stage = grid_ms(&[(at(1), w), (at(30), w)]).unwrap();
+        assert!(close(stage, 4.0 + 4.0 / 30.0), "{stage}");
+        // the old reading: both as one persistent 30-CTA launch, 30 / 2 times less
+        let mut both = w;
+        both.add(&w);
+        assert!(close(predicted_ms(&both).unwrap(), 8.0 / 30.0));
+        // the results' names round-trip
+        let name = grid_stage("lbvh", &at(1));
+        assert_eq!(name, "lbvh@1x256+1024");
+        assert_eq!(parse_grid_stage("lbvh", &name), Some(at(1)));
+        assert_eq!(parse_grid_stage("render", &name), None);
+        assert_eq!(parse_grid_stage("lbvh", "lbvh"), None);
+    }
 }
