@@ -192,8 +192,8 @@ pub fn bootstrap_key(n: u32, seed: u32) -> u32 {
 /// uniform `rng(path_key(c, START_FRAME, seed), DIM_ACCEPT)` over the
 /// samples' cumulative sum (f64, in sample order). The start is then
 /// distributed as the chains' stationary distribution (up to the pool's
-/// finite size), so no chain needs a run-in. If every sample is black, chain
-/// c starts at its own first sample.
+/// finite size), so no chain needs a run-in. If the sum is not a positive
+/// finite number (every sample black), chain c starts at its own first sample.
 pub fn starts(boot: &[f32], chains: u32, seed: u32) -> Vec<u32> {
     let mut total = 0.0f64;
     let cdf: Vec<f64> = boot
@@ -204,9 +204,10 @@ pub fn starts(boot: &[f32], chains: u32, seed: u32) -> Vec<u32> {
         })
         .collect();
     let last = boot.len().saturating_sub(1) as u32;
+    let usable = total.is_finite() && total > 0.0;
     (0..chains)
         .map(|c| {
-            if !(total > 0.0) {
+            if !usable {
                 return (BOOTSTRAP * c).min(last);
             }
             let r = rng(path_key(c, START_FRAME, seed), DIM_ACCEPT) as f64 * total;
