@@ -59,7 +59,7 @@ fn bdpt_traces_the_same_bits_emulated_and_native() {
     same_frames(load("cornell-glossy"), &[Integrator::Bdpt]);
 }
 
-/// Metropolis light transport (`mlt_init`, `mlt_frame`): the chains' start,
+/// Metropolis light transport (`mlt_init`, `mlt_start`, `mlt_frame`): the chains' start,
 /// b, every splat (64-bit fixed-point atomics) and each frame's image are the
 /// same bits emulated and native, on the Lambertian box and on the glossy one,
 /// at the default 16 bounces and at 3 (a shorter state, k = 4).

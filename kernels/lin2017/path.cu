@@ -34,7 +34,7 @@
 // sampled only (emission after it counts in full). Russian roulette on the
 // per-bounce mask (003:L267-271): continue with q = max RGB of the bounce's
 // f cos / p, then divide by q. bdpt (bdpt_frame) and Metropolis light
-// transport over it (mlt_init, mlt_frame) are below. Every integrator draws
+// transport over it (mlt_init, mlt_start, mlt_frame) are below. Every integrator draws
 // its random numbers through rng(K key, d): K is a path's key or an MLT
 // iteration's sampler (Mlt), whose numbers are its chain's mutated samples.
 //
@@ -176,7 +176,7 @@ static __device__ __forceinline__ float exp_neg(float x) {
   return poly * __int_as_float(((int)n + 127) << 23);
 }
 
-// ---- Metropolis light transport's samples (§4.8; the kernels: mlt_init, mlt_frame) ----
+// ---- Metropolis light transport's samples (§4.8; the kernels: mlt_init, mlt_start, mlt_frame) ----
 //
 // Primary sample space (Kelemen et al. 2002; "store and mutate only the random
 // numbers", 003:L316): a chain keeps the path's random numbers as floats in
@@ -185,7 +185,7 @@ static __device__ __forceinline__ float exp_neg(float x) {
 // the value is the chain's slot mlt_slot(d) after the iteration's mutation.
 #define MLT_SLOTS_PER_SEGMENT 10u
 #define MLT_DIM_LARGE 0x30000u    // the iteration's large-or-small choice
-#define MLT_DIM_ACCEPT 0x30001u   // the acceptance test (mlt_init: the start's choice)
+#define MLT_DIM_ACCEPT 0x30001u   // the acceptance test (the host's start pick: its choice)
 #define MLT_P_LARGE 0.25f         // 003:L318's example: 1 large per 3 small on average
 #define MLT_S2 (1.0f / 64.0f)     // Kelemen's small step: s1 = 1/1024, s2 = 1/64 (not stated)
 #define MLT_LN_S2_S1 2.77258872223978124f   // ln(s2 / s1) = ln 16
@@ -1037,7 +1037,7 @@ extern "C" __global__ void path_level(const Params *params, const uint4 *nodes, 
   }
 }
 
-// ---- Metropolis light transport (§4.8, 003:L310-336): mlt_init, mlt_frame ----
+// ---- Metropolis light transport (§4.8, 003:L310-336): mlt_init, mlt_start, mlt_frame ----
 //
 // Primary-sample-space MLT over the path tracer named by p->integrator (pt,
 // nee, mis or bdpt; the thesis runs it over bdpt, 003:L332): one Markov chain
@@ -1051,7 +1051,13 @@ extern "C" __global__ void path_level(const Params *params, const uint4 *nodes, 
 // 1 - a, the proposal a), each b F / Y (003:L330) with b the bootstrap's mean
 // luminance, added by 64-bit integer atomics in 32.32 fixed point: integer
 // addition is associative, so the image does not depend on the order of the
-// atomics and the native mirror (rayon) gets the same bits.
+// atomics and the native mirror (rayon) gets the same bits. Each chain starts
+// at a bootstrap sample picked from all chains' in proportion to Y (the host's
+// pick, mlt_start): the start is then distributed as the chains' stationary
+// distribution. A pick among a chain's own 16 samples was not: most chains
+// missed the light (1.2 % of primary sample space at 32 x 32, half of Y) and
+// took hundreds of iterations to find it (the start-up bias that was issue 15's
+// MLT bug).
 #define MLT_BOOTSTRAP 16            // large-step samples per chain at start-up (not stated)
 #define MLT_BOOTSTRAP_FRAME 0xffffffffu
 #define MLT_STEPS 4                 // iterations per chain per frame (a frame's 4 samples a pixel)
@@ -1108,41 +1114,67 @@ static __device__ __forceinline__ Path mlt_camera(const Params *p, const Mlt &m,
   return camera_ray(p, *i, x - (float)sx, y - (float)sy);
 }
 
-// Start-up: each chain draws MLT_BOOTSTRAP large-step samples, stores the sum of
-// their luminances in ysum (the host's b = the mean over all chains, 003:L330)
-// and starts at one of them chosen in proportion to its luminance (a weighted
-// reservoir of one).
+// The state floats of a chain: k = max bounces + 1 segments of MLT_SLOTS_PER_SEGMENT.
+static __device__ __forceinline__ unsigned mlt_slots(const Params *p) {
+  return MLT_SLOTS_PER_SEGMENT * (unsigned)(p->max_bounces + 1);
+}
+
+// The sample of sampler m (iteration `key` over chain samples u, a large step or
+// a small one): its radiance F, *i its path index (the pixel is *i >> 2).
+static __device__ __forceinline__ V3 mlt_sample(const Scene &s, const float *u, unsigned key, bool large, int *i) {
+  const Params *p = s.p;
+  Mlt m = {u, key, mlt_slots(p), (unsigned)p->max_bounces, large};
+  Path P = mlt_camera(p, m, i);
+  return radiance(s, P, m);
+}
+
+// The chain of this thread: its index *c and its samples *u (mlt_slots floats
+// of state); false for a thread past the image's chains.
+static __device__ __forceinline__ bool mlt_chain(const Params *p, float *state, int *c, float **u) {
+  *c = (int)WL_TID;
+  if (*c >= p->width * p->height) return false;
+  *u = state + (ull)mlt_slots(p) * (ull)*c;
+  return true;
+}
+
+// The key of bootstrap sample j (0 .. MLT_BOOTSTRAP W H - 1; chain c draws c MLT_BOOTSTRAP ...).
+static __device__ __forceinline__ unsigned mlt_bootstrap_key(const Params *p, unsigned j) {
+  return path_key(j, MLT_BOOTSTRAP_FRAME, (unsigned)p->seed);
+}
+
+// Start-up, 1: each chain draws MLT_BOOTSTRAP large-step samples and stores
+// their luminances in boot (the host sums them to b, 003:L330, and picks each
+// chain's start from all of them in proportion to Y: mlt_start).
 extern "C" __global__ void mlt_init(const Params *params, const uint4 *nodes, const unsigned *refs,
                                     const float4 *tris, const float4 *tri_data, const float4 *mats,
-                                    const float4 *lights, const float4 *boxes, const float4 *env, float *state,
-                                    float4 *chains, float *ysum) {
+                                    const float4 *lights, const float4 *boxes, const float4 *env, float *boot) {
   Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
   const Params *p = params;
   int c = (int)WL_TID;
   if (c >= p->width * p->height) return;
-  unsigned slots = MLT_SLOTS_PER_SEGMENT * (unsigned)(p->max_bounces + 1);
-  float *u = state + (ull)slots * (ull)c;
-  float sum = 0.0f;
-  V3 pick = v3(0.0f, 0.0f, 0.0f);
-  int pick_i = 0;
-  unsigned pick_key = 0u;
   for (int j = 0; j < MLT_BOOTSTRAP; j++) {
-    unsigned key = path_key((unsigned)(MLT_BOOTSTRAP * c + j), MLT_BOOTSTRAP_FRAME, (unsigned)p->seed);
-    Mlt m = {u, key, slots, (unsigned)p->max_bounces, true};
+    unsigned n = (unsigned)(MLT_BOOTSTRAP * c + j);
     int i;
-    Path P = mlt_camera(p, m, &i);
-    V3 L = radiance(s, P, m);
-    float y = luminance(L);
-    sum = sum + y;
-    if (j == 0 || rng(key, MLT_DIM_ACCEPT) * sum < y) {
-      pick = L;
-      pick_i = i;
-      pick_key = key;
-    }
+    boot[n] = luminance(mlt_sample(s, nullptr, mlt_bootstrap_key(p, n), true, &i));
   }
-  for (unsigned k = 0; k < slots; k++) u[k] = rng(pick_key, k);
-  chains[c] = make_float4(pick.x, pick.y, pick.z, __int_as_float(pick_i >> 2));
-  ysum[c] = sum;
+}
+
+// Start-up, 2: chain c starts at bootstrap sample start[c] (the host's pick):
+// the sample is traced again (a large step is a function of its key) and its
+// random numbers become the chain's state.
+extern "C" __global__ void mlt_start(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                     const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                     const float4 *lights, const float4 *boxes, const float4 *env, float *state,
+                                     float4 *chains, const unsigned *start) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  int c;
+  float *u;
+  if (!mlt_chain(params, state, &c, &u)) return;
+  unsigned key = mlt_bootstrap_key(params, start[c]);
+  int i;
+  V3 L = mlt_sample(s, u, key, true, &i);
+  for (unsigned k = 0; k < mlt_slots(params); k++) u[k] = rng(key, k);
+  chains[c] = make_float4(L.x, L.y, L.z, __int_as_float(i >> 2));
 }
 
 // One frame: each chain takes MLT_STEPS iterations (a large step with
@@ -1153,10 +1185,10 @@ extern "C" __global__ void mlt_frame(const Params *params, const uint4 *nodes, c
                                      float4 *chains, ull *image) {
   Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
   const Params *p = params;
-  int c = (int)WL_TID;
-  if (c >= p->width * p->height) return;
-  unsigned slots = MLT_SLOTS_PER_SEGMENT * (unsigned)(p->max_bounces + 1);
-  float *u = state + (ull)slots * (ull)c;
+  int c;
+  float *u;
+  if (!mlt_chain(p, state, &c, &u)) return;
+  unsigned slots = mlt_slots(p);
   float4 cur = chains[c];
   V3 fc = v3(cur.x, cur.y, cur.z);
   int pc = __float_as_int(cur.w);
@@ -1164,15 +1196,15 @@ extern "C" __global__ void mlt_frame(const Params *params, const uint4 *nodes, c
   float b = p->mlt_b;
   for (int t = 0; t < MLT_STEPS; t++) {
     unsigned key = path_key((unsigned)(MLT_STEPS * c + t), (unsigned)p->frame, (unsigned)p->seed);
-    Mlt m = {u, key, slots, (unsigned)p->max_bounces, rng(key, MLT_DIM_LARGE) < MLT_P_LARGE};
+    bool large = rng(key, MLT_DIM_LARGE) < MLT_P_LARGE;
     int i;
-    Path P = mlt_camera(p, m, &i);
-    V3 L = radiance(s, P, m);
+    V3 L = mlt_sample(s, u, key, large, &i);
     float y = luminance(L);
     float a = yc > 0.0f ? fminf(1.0f, y / yc) : 1.0f;
     if (yc > 0.0f) splat(image, pc, fc, (1.0f - a) * b / yc);
     if (y > 0.0f) splat(image, i >> 2, L, a * b / y);
     if (rng(key, MLT_DIM_ACCEPT) < a) {
+      Mlt m = {u, key, slots, (unsigned)p->max_bounces, large};
       for (unsigned k = 0; k < slots; k++) u[k] = mlt_value(m, k);
       fc = L;
       pc = i >> 2;

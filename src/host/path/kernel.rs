@@ -19,7 +19,7 @@ pub const KERNEL: &str = "path_frame";
 /// The bidirectional path tracer's entry point.
 pub const BDPT_KERNEL: &str = "bdpt_frame";
 
-/// The entry point that renders `integrator` (mlt: its frame kernel, after `mlt_init`).
+/// The entry point that renders `integrator` (mlt: its frame kernel, after `mlt_init` and `mlt_start`).
 pub fn entry(integrator: super::Integrator) -> &'static str {
     match integrator {
         super::Integrator::Bdpt => BDPT_KERNEL,

@@ -16,9 +16,11 @@
 //! (s1 = 1/1024, s2 = 1/64; the thesis states none). Acceptance min(1, Y'/Y)
 //! of the luminance Y (003:L322); both samples are splatted with their
 //! expected weights, b F / Y each, b the bootstrap's mean luminance
-//! (003:L330, [`BOOTSTRAP`] large steps a chain). The splats are 64-bit
-//! integer atomics in 32.32 fixed point, so the image does not depend on
-//! their order.
+//! (003:L330, [`BOOTSTRAP`] large steps a chain). Each chain starts at a
+//! bootstrap sample picked from all chains' in proportion to Y ([`starts`]),
+//! so the chains start in their stationary distribution. The splats are
+//! 64-bit integer atomics in 32.32 fixed point, so the image does not depend
+//! on their order.
 
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
@@ -37,7 +39,7 @@ use crate::sim::{Arg, Counters, Device, DevicePtr, LaunchConfig, Module, SimErro
 pub const SLOTS_PER_SEGMENT: u32 = 10;
 /// The random dimension of an iteration's large-or-small choice.
 pub const DIM_LARGE: u32 = 0x30000;
-/// The random dimension of the acceptance test (at start-up: the start's choice).
+/// The random dimension of the acceptance test (at start-up: the start's pick, [`starts`]).
 pub const DIM_ACCEPT: u32 = 0x30001;
 /// The probability of a large step (003:L318's example).
 pub const P_LARGE: f32 = 0.25;
@@ -48,8 +50,10 @@ pub const S2: f32 = 1.0 / 64.0;
 const LN_S2_S1: f32 = 2.772_588_722_239_781_24;
 /// Large-step samples a chain draws at start-up (the thesis states no count).
 pub const BOOTSTRAP: u32 = 16;
-/// The frame number of the start-up's random keys (no frame reaches it).
+/// The frame number of the bootstrap samples' random keys (no frame reaches it).
 pub const BOOTSTRAP_FRAME: u32 = u32::MAX;
+/// The frame number of the start picks' random keys (no frame reaches it).
+pub const START_FRAME: u32 = u32::MAX - 1;
 /// Iterations a chain takes a frame (a frame's 4 samples a pixel).
 pub const STEPS: u32 = 4;
 /// The splats' fixed point: 2^32 a unit.
@@ -171,10 +175,45 @@ pub struct MltRender {
     pub totals: Option<Counters>,
 }
 
-/// b from the chains' sums of bootstrap luminances, summed in chain order (f64).
-pub fn b_of(ysum: &[f32]) -> f32 {
-    let s: f64 = ysum.iter().map(|&y| y as f64).sum();
-    (s / (BOOTSTRAP as f64 * ysum.len().max(1) as f64)) as f32
+/// b, the mean luminance of the bootstrap samples `boot` (summed in order, f64).
+pub fn b_of(boot: &[f32]) -> f32 {
+    let s: f64 = boot.iter().map(|&y| y as f64).sum();
+    (s / boot.len().max(1) as f64) as f32
+}
+
+/// The key of bootstrap sample `n` (chain c draws samples `BOOTSTRAP` c ..
+/// `BOOTSTRAP` (c + 1) − 1): the kernel's `mlt_bootstrap_key`.
+pub fn bootstrap_key(n: u32, seed: u32) -> u32 {
+    path_key(n, BOOTSTRAP_FRAME, seed)
+}
+
+/// Each of `chains` chains' start: a bootstrap sample picked from all of
+/// them (`boot`, their luminances) in proportion to Y, chain c by the
+/// uniform `rng(path_key(c, START_FRAME, seed), DIM_ACCEPT)` over the
+/// samples' cumulative sum (f64, in sample order). The start is then
+/// distributed as the chains' stationary distribution (up to the pool's
+/// finite size), so no chain needs a run-in. If the sum is not a positive
+/// finite number (every sample black), chain c starts at its own first sample.
+pub fn starts(boot: &[f32], chains: u32, seed: u32) -> Vec<u32> {
+    let mut total = 0.0f64;
+    let cdf: Vec<f64> = boot
+        .iter()
+        .map(|&y| {
+            total += y as f64;
+            total
+        })
+        .collect();
+    let last = boot.len().saturating_sub(1) as u32;
+    let usable = total.is_finite() && total > 0.0;
+    (0..chains)
+        .map(|c| {
+            if !usable {
+                return (BOOTSTRAP * c).min(last);
+            }
+            let r = rng(path_key(c, START_FRAME, seed), DIM_ACCEPT) as f64 * total;
+            (cdf.partition_point(|&v| v <= r) as u32).min(last)
+        })
+        .collect()
 }
 
 /// The image of the fixed-point sums after `frames` frames, as per-path sums
@@ -211,6 +250,33 @@ fn splat(image: &[AtomicU64], pixel: u32, c: [f32; 3], w: f32) {
     }
 }
 
+/// What the chains sample: sampler `m`'s path index (4 pixel + subpixel;
+/// the pixel is the index >> 2) and radiance. The renderer's is the path
+/// tracer ([`Tracer::mlt_sample`]); a test may give the chains any function
+/// of the samples.
+pub trait Target: Sync {
+    /// The sample of `m`.
+    fn sample(&self, m: Sampler<'_>, counts: &mut Counts) -> (u32, [f32; 3]);
+}
+
+impl Target for Tracer<'_> {
+    fn sample(&self, m: Sampler<'_>, counts: &mut Counts) -> (u32, [f32; 3]) {
+        self.mlt_sample(m, counts)
+    }
+}
+
+/// Where the chains start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Start {
+    /// A bootstrap sample picked from all chains' in proportion to Y
+    /// ([`starts`]): the kernel's, the chains' stationary distribution.
+    Pool,
+    /// One of the chain's own [`BOOTSTRAP`] samples in proportion to Y
+    /// ([`own_starts`]): the start before issue 15's fix (native only),
+    /// biased where a bright region is a small part of sample space.
+    Own,
+}
+
 /// Renders `frames` frames of MLT natively (`params.integrator` is mlt).
 pub fn render_native(
     scene: &PathScene,
@@ -218,25 +284,52 @@ pub fn render_native(
     params: FrameParams,
     frames: u32,
     keep_frames: bool,
-    mut progress: impl FnMut(u32),
+    progress: impl FnMut(u32),
 ) -> MltRender {
     let tracer = Tracer { scene, frame: frame_of(camera, eps_for(scene.lo, scene.hi)), params };
+    render_target(&tracer, params, Start::Pool, frames, keep_frames, progress)
+}
+
+/// Renders `frames` frames of MLT natively over `target` with chains that
+/// start at `start` (`params` gives the image size, the state's length by
+/// its bounces, and the seed).
+pub fn render_target(
+    target: &impl Target,
+    params: FrameParams,
+    start: Start,
+    frames: u32,
+    keep_frames: bool,
+    mut progress: impl FnMut(u32),
+) -> MltRender {
     let (m, n) = (slots(params.max_bounces), (params.width * params.height) as usize);
-    let mut u = vec![0.0f32; m * n];
-    let mut cur = vec![Current { f: [0.0; 3], pixel: 0 }; n];
-    let mut ysum = vec![0.0f32; n];
-    let mut counts = u
-        .par_chunks_mut(m)
-        .zip(cur.par_iter_mut())
-        .zip(ysum.par_iter_mut())
+    let mut boot = vec![0.0f32; BOOTSTRAP as usize * n];
+    let mut counts = boot
+        .par_chunks_mut(BOOTSTRAP as usize)
         .enumerate()
-        .map(|(c, ((u, cur), ysum))| {
+        .map(|(c, boot)| {
             let mut counts = Counts::default();
-            (*cur, *ysum) = init_chain(&tracer, c as u32, u, &mut counts);
+            boot_chain(target, &params, c as u32, boot, &mut counts);
             counts
         })
         .reduce(Counts::default, add);
-    let b = b_of(&ysum);
+    let b = b_of(&boot);
+    let start = match start {
+        Start::Pool => starts(&boot, n as u32, params.seed),
+        Start::Own => own_starts(&boot, params.seed),
+    };
+    let mut u = vec![0.0f32; m * n];
+    let mut cur = vec![Current { f: [0.0; 3], pixel: 0 }; n];
+    let c = u
+        .par_chunks_mut(m)
+        .zip(cur.par_iter_mut())
+        .zip(start.par_iter())
+        .map(|((u, cur), &start)| {
+            let mut counts = Counts::default();
+            *cur = start_chain(target, &params, start, u, &mut counts);
+            counts
+        })
+        .reduce(Counts::default, add);
+    counts.add(&c);
     let image: Vec<AtomicU64> = (0..3 * n).map(|_| AtomicU64::new(0)).collect();
     let mut out_frames = Vec::new();
     let mut before = vec![0u64; 3 * n];
@@ -247,7 +340,7 @@ pub fn render_native(
             .enumerate()
             .map(|(c, (u, cur))| {
                 let mut counts = Counts::default();
-                frame_chain(&tracer, c as u32, f, b, u, cur, &image, &mut counts);
+                frame_chain(target, &params, c as u32, f, b, u, cur, &image, &mut counts);
                 counts
             })
             .reduce(Counts::default, add);
@@ -271,32 +364,54 @@ fn add(mut a: Counts, b: Counts) -> Counts {
     a
 }
 
-/// Chain `c`'s start-up (the kernel's `mlt_init`): its bootstrap samples'
-/// summed luminance and the start, one of them chosen in proportion to its
-/// luminance; fills `u` with the start's samples.
-fn init_chain(tracer: &Tracer, c: u32, u: &mut [f32], counts: &mut Counts) -> (Current, f32) {
-    let p = &tracer.params;
-    let (mut sum, mut pick, mut pick_i, mut pick_key) = (0.0f32, [0.0f32; 3], 0u32, 0u32);
-    for j in 0..BOOTSTRAP {
-        let key = path_key(BOOTSTRAP * c + j, BOOTSTRAP_FRAME, p.seed);
-        let m = Sampler { u, key, max_bounces: p.max_bounces, large: true };
-        let (i, l) = tracer.mlt_sample(m, counts);
-        let y = luminance(l);
-        sum += y;
-        if j == 0 || rng(key, DIM_ACCEPT) * sum < y {
-            (pick, pick_i, pick_key) = (l, i, key);
-        }
+/// Each chain's start among its own [`BOOTSTRAP`] samples (`boot`, their
+/// luminances, chain by chain) in proportion to Y, by a weighted reservoir of
+/// one with the uniforms `rng(bootstrap_key(n, seed), DIM_ACCEPT)`: the start
+/// before issue 15's fix ([`Start::Own`]).
+pub fn own_starts(boot: &[f32], seed: u32) -> Vec<u32> {
+    let k = BOOTSTRAP as usize;
+    (0..boot.len() / k)
+        .map(|c| {
+            let (mut sum, mut pick) = (0.0f32, (k * c) as u32);
+            for (j, &y) in boot[k * c..k * (c + 1)].iter().enumerate() {
+                let n = (k * c + j) as u32;
+                sum += y;
+                if j == 0 || rng(bootstrap_key(n, seed), DIM_ACCEPT) * sum < y {
+                    pick = n;
+                }
+            }
+            pick
+        })
+        .collect()
+}
+
+/// Chain `c`'s bootstrap samples' luminances into `boot` (the kernel's `mlt_init`).
+fn boot_chain(target: &impl Target, p: &FrameParams, c: u32, boot: &mut [f32], counts: &mut Counts) {
+    // a large step reads no current sample; the sampler's length is the state's
+    let u = vec![0.0f32; slots(p.max_bounces)];
+    for (j, y) in boot.iter_mut().enumerate() {
+        let key = bootstrap_key(BOOTSTRAP * c + j as u32, p.seed);
+        let m = Sampler { u: &u, key, max_bounces: p.max_bounces, large: true };
+        *y = luminance(target.sample(m, counts).1);
     }
+}
+
+/// A chain's start at bootstrap sample `start` (the kernel's `mlt_start`):
+/// the sample traced again, its random numbers into `u`.
+fn start_chain(target: &impl Target, p: &FrameParams, start: u32, u: &mut [f32], counts: &mut Counts) -> Current {
+    let key = bootstrap_key(start, p.seed);
+    let (i, l) = target.sample(Sampler { u, key, max_bounces: p.max_bounces, large: true }, counts);
     for (k, v) in u.iter_mut().enumerate() {
-        *v = rng(pick_key, k as u32);
+        *v = rng(key, k as u32);
     }
-    (Current { f: pick, pixel: pick_i >> 2 }, sum)
+    Current { f: l, pixel: i >> 2 }
 }
 
 /// Chain `c`'s iterations in frame `f` (the kernel's `mlt_frame`).
 #[allow(clippy::too_many_arguments)]
 fn frame_chain(
-    tracer: &Tracer,
+    target: &impl Target,
+    p: &FrameParams,
     c: u32,
     f: u32,
     b: f32,
@@ -305,13 +420,12 @@ fn frame_chain(
     image: &[AtomicU64],
     counts: &mut Counts,
 ) {
-    let p = &tracer.params;
     let mut yc = luminance(cur.f);
     let mut next = vec![0.0f32; u.len()];
     for t in 0..STEPS {
         let key = path_key(STEPS * c + t, f, p.seed);
         let m = Sampler { u, key, max_bounces: p.max_bounces, large: rng(key, DIM_LARGE) < P_LARGE };
-        let (i, l) = tracer.mlt_sample(m, counts);
+        let (i, l) = target.sample(m, counts);
         let y = luminance(l);
         let a = if yc > 0.0 { 1.0f32.min(y / yc) } else { 1.0 };
         if yc > 0.0 {
@@ -334,8 +448,9 @@ fn frame_chain(
 /// The name of the device allocation that holds the chains' random numbers.
 pub const STATE_BUFFER: &str = "mlt state";
 
-/// Renders `frames` frames of MLT on the emulator (`mlt_init` once, then
-/// `mlt_frame` a frame; `module` loaded by [`kernel::load`]).
+/// Renders `frames` frames of MLT on the emulator (`mlt_init` and
+/// `mlt_start` once, then `mlt_frame` a frame; `module` loaded by
+/// [`kernel::load`]).
 #[allow(clippy::too_many_arguments)]
 pub fn render_emulated(
     dev: &mut Device,
@@ -351,21 +466,26 @@ pub fn render_emulated(
     let n = (params.width * params.height) as usize;
     let state = dev.alloc_bytes(state_bytes(params.width, params.height, params.max_bounces), STATE_BUFFER);
     let chains = dev.alloc_bytes(16 * n as u64, "mlt chains");
-    let ysum = dev.alloc_bytes(4 * n as u64, "mlt bootstrap sums");
+    let boot = dev.alloc_bytes(4 * BOOTSTRAP as u64 * n as u64, "mlt bootstrap");
+    let start = dev.alloc_bytes(4 * n as u64, "mlt starts");
     let image = dev.alloc_bytes(24 * n as u64, "mlt image");
-    let args = |last: DevicePtr| -> Vec<Arg> {
-        bufs.scene_args().into_iter().chain([state, chains, last]).map(Arg::Ptr).collect()
+    let args = |bufs_after: &[DevicePtr]| -> Vec<Arg> {
+        bufs.scene_args().into_iter().chain(bufs_after.iter().copied()).map(Arg::Ptr).collect()
     };
     let cfg = LaunchConfig::linear(n.div_ceil(kernel::THREADS as usize) as u32, kernel::THREADS);
     let mut totals = Counters::default();
-    let st = dev.launch(module, INIT_KERNEL, cfg, &args(ysum))?;
+    let st = dev.launch(module, INIT_KERNEL, cfg, &args(&[boot]))?;
     totals.merge(&st.totals);
-    let b = b_of(&dev.read::<f32>(ysum, n));
+    let ys = dev.read::<f32>(boot, BOOTSTRAP as usize * n);
+    let b = b_of(&ys);
+    dev.write(start, &starts(&ys, n as u32, params.seed))?;
+    let st = dev.launch(module, START_KERNEL, cfg, &args(&[state, chains, start]))?;
+    totals.merge(&st.totals);
     let mut out_frames = Vec::new();
     let mut before = vec![0u64; 3 * n];
     for f in 0..frames {
         dev.write(bufs.params, &kernel::params_bytes_mlt(scene, camera, &params, f, b))?;
-        let st = dev.launch(module, FRAME_KERNEL, cfg, &args(image))?;
+        let st = dev.launch(module, FRAME_KERNEL, cfg, &args(&[state, chains, image]))?;
         totals.merge(&st.totals);
         if keep_frames {
             let now = dev.read::<u64>(image, 3 * n);
@@ -381,8 +501,10 @@ pub fn render_emulated(
     Ok(MltRender { image: img, fixed, b, state_bytes, totals: Some(totals) })
 }
 
-/// The start-up kernel.
+/// The start-up's bootstrap kernel.
 pub const INIT_KERNEL: &str = "mlt_init";
+/// The start-up's kernel that sets each chain at its start.
+pub const START_KERNEL: &str = "mlt_start";
 /// The frame kernel.
 pub const FRAME_KERNEL: &str = "mlt_frame";
 

@@ -42,8 +42,8 @@ pub enum Integrator {
     /// megakernel only, not the wavefront form). Not in [`Integrator::ALL`].
     Bdpt,
     /// Metropolis light transport in primary sample space (§4.8) over
-    /// [`MLT_BASE`]: one chain a pixel, splats anywhere ([`mlt`]; `mlt_init`
-    /// and `mlt_frame`). Consistent, not unbiased per pixel. Not in [`Integrator::ALL`].
+    /// [`MLT_BASE`]: one chain a pixel, splats anywhere ([`mlt`]; `mlt_init`,
+    /// `mlt_start` and `mlt_frame`). Consistent, not unbiased per pixel. Not in [`Integrator::ALL`].
     Mlt,
 }
 
