@@ -230,7 +230,8 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         "Ours: the GPU build of §6.5 on the emulator (kernels/lin2017/kdbuild.cu, launched level by level from \
          src/host/path/gpu_build.rs), one axis per node (the longest, 003:L560, L576); the serial CPU build is thesis \
          003's (src/host/path/build.rs) without clipping. Fixtures not stated by the thesis: K_T = {}, K_I = {}, \
-         depth at most 8 + 1.3 log2 n, a node of more than 63 triangles is split (6-bit count), flat triangles in the \
+         depth at most 8 + 1.3 log2 n, a node of more than 63 triangles is split (6-bit count) when it has a candidate \
+         plane inside its box and is shallower than the depth limit, flat triangles in the \
          plane counted on one side by the event order (003:L562) and assigned to both (003:L566). The GPU 3-axis \
          columns are the serial twin of the same kernels with all three axes (the emulated kernels give the same tree \
          node for node: tests/lin2017_kdbuild.rs).",
