@@ -200,7 +200,8 @@ fn the_committed_run_renders_the_recorded_verdicts() {
     // the tolerance cannot pass no speedup at all, nor the model's
     use warplight::repro::compare::Verdict;
     use warplight::repro::lin2017::table_1::SPEEDUP_TOLERANCE;
-    for (ours, thesis, v) in [(0.0, 7.3, Verdict::Outside), (12.6, 7.3, Verdict::Outside), (7.34, 7.3, Verdict::Within)] {
+    for (ours, thesis, v) in [(0.0, 7.3, Verdict::Outside), (12.6, 7.3, Verdict::Outside), (7.34, 7.3, Verdict::Within)]
+    {
         assert_eq!(SPEEDUP_TOLERANCE.verdict(ours, thesis), v, "{ours} vs {thesis}");
     }
 }

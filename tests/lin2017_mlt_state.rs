@@ -48,9 +48,8 @@ fn the_kernels_touch_40_k_w_h_bytes_of_state() {
         let chains = dev.alloc_bytes(16 * n, "mlt chains");
         let ysum = dev.alloc_bytes(4 * n, "mlt bootstrap sums");
         let image = dev.alloc_bytes(24 * n, "mlt image");
-        let args = |last| -> Vec<Arg> {
-            bufs.scene_args().into_iter().chain([state, chains, last]).map(Arg::Ptr).collect()
-        };
+        let args =
+            |last| -> Vec<Arg> { bufs.scene_args().into_iter().chain([state, chains, last]).map(Arg::Ptr).collect() };
         let cfg = LaunchConfig::linear(1, kernel::THREADS);
         let log = AccessLog::new();
         dev.launch_observed(&module, mlt::INIT_KERNEL, cfg, &args(ysum), Some(&log)).expect("mlt_init");
@@ -96,10 +95,7 @@ fn mlt_refuses_bounds_it_cannot_keep() {
     }
     // within the bounce bound, the state past its bound: 40 x 8191 x 1920 x 1080 = 679 GB
     let e = mlt::check(&params(1920, 1080, MAX_BOUNCES)).unwrap_err();
-    assert!(
-        matches!(e, MltError::StateTooLarge { bytes: Some(679_394_304_000), .. }),
-        "{e:?}"
-    );
+    assert!(matches!(e, MltError::StateTooLarge { bytes: Some(679_394_304_000), .. }), "{e:?}");
     assert!(e.to_string().contains("679394304000") && e.to_string().contains("8190 bounces"), "{e}");
     // one byte past the bound is refused, the bound itself taken
     let at = |w: u32| mlt::check(&FrameParams { width: w, ..params(1, 1, 0) });

@@ -593,7 +593,8 @@ fn load_obj(
 /// allows tabs).
 fn every_face_has_normals(path: &Path) -> bool {
     let Ok(bytes) = std::fs::read(path) else { return false };
-    String::from_utf8_lossy(&bytes).lines().map(str::split_whitespace).all(|mut w| {
-        w.next() != Some("f") || w.all(|v| v.splitn(3, '/').nth(2).is_some_and(|n| !n.trim().is_empty()))
-    })
+    String::from_utf8_lossy(&bytes)
+        .lines()
+        .map(str::split_whitespace)
+        .all(|mut w| w.next() != Some("f") || w.all(|v| v.splitn(3, '/').nth(2).is_some_and(|n| !n.trim().is_empty())))
 }
