@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use glam::Vec3;
-use warplight::host::kdtree::{BuildParams, Heuristic, build};
+use warplight::host::kdtree::{BuildParams, Heuristic, KdTree, build};
 use warplight::host::scene_file;
 use warplight::repro::fabianowski2011::photons::{
     self, Differentials, Emission, PhotonError, azimuth, emit, propagate, reemit, reflect, rng,
@@ -16,20 +16,30 @@ fn v(a: [f32; 3]) -> Vec3 {
     Vec3::from(a)
 }
 
+/// Per photon, the two stored interactions.
+type Stored = Vec<[Option<photons::Photon>; 2]>;
+
+/// `scene`'s SIROH tree, the emission of `n` photons, and the photons the
+/// native reference and the emulated kernel store.
+fn trace_both(scene: &warplight::host::scene::Scene, n: usize) -> (KdTree, Emission, Stored, Stored) {
+    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+    let e = Emission::of(scene, n).unwrap();
+    let native = photons::reference(scene, &tree, &e);
+    let mut dev = Device::new();
+    let module = photons::load(&mut dev).unwrap();
+    let k = photons::trace_kernel(&mut dev, &module, scene, &tree, &e).unwrap();
+    (tree, e, native, k.photons)
+}
+
 #[test]
 fn kernel_stores_the_reference_photons_bit_for_bit() {
     let scene = scene_file::load(Path::new("scenes/cornell-box.toml")).unwrap();
-    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
-    let e = Emission::of(&scene, 384).unwrap();
-    let native = photons::reference(&scene, &tree, &e);
-    let mut dev = Device::new();
-    let module = photons::load(&mut dev).unwrap();
-    let k = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap();
-    assert_eq!(k.photons.len(), native.len());
+    let (_, _, native, kernel) = trace_both(&scene, 384);
+    assert_eq!(kernel.len(), native.len());
     // the same float operations in the same order (no contraction on either side,
     // correctly rounded sqrt and division): every stored bit agrees
-    for (i, (a, b)) in k.photons.iter().zip(&native).enumerate() {
+    for (i, (a, b)) in kernel.iter().zip(&native).enumerate() {
         for s in 0..2 {
             assert_eq!(a[s].map(|p| p.bits()), b[s].map(|p| p.bits()), "photon {i} slot {s}");
         }
@@ -278,14 +288,8 @@ fn kernel_reflects_about_interpolated_normals_bit_for_bit() {
     let scene = curved_mirror_scene(true, 0);
     // the pole's eight zero-area triangles are dropped with their normals
     assert_eq!((scene.triangles.len(), scene.normals.len()), (68, 68));
-    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
-    let e = Emission::of(&scene, 2048).unwrap();
-    let native = photons::reference(&scene, &tree, &e);
-    let mut dev = Device::new();
-    let module = photons::load(&mut dev).unwrap();
-    let k = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap();
-    for (i, (a, b)) in k.photons.iter().zip(&native).enumerate() {
+    let (tree, e, native, kernel) = trace_both(&scene, 2048);
+    for (i, (a, b)) in kernel.iter().zip(&native).enumerate() {
         for s in 0..2 {
             assert_eq!(a[s].map(|p| p.bits()), b[s].map(|p| p.bits()), "photon {i} slot {s}");
         }
@@ -331,15 +335,9 @@ fn kernel_reflects_bit_for_bit_on_every_projection_axis() {
             per_axis[(0..3).fold(0, |m, a| if g[a] > g[m] { a } else { m })] += 1;
         }
         assert_eq!(per_axis[k], 56, "turn {turn}: mirror triangles per axis {per_axis:?}");
-        let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-        let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
-        let e = Emission::of(&scene, 2048).unwrap();
-        let native = photons::reference(&scene, &tree, &e);
-        let mut dev = Device::new();
-        let module = photons::load(&mut dev).unwrap();
-        let kp = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap();
+        let (tree, e, native, kernel) = trace_both(&scene, 2048);
         let bits = |x: &[Option<photons::Photon>; 2]| x.map(|p| p.map(|p| p.bits()));
-        let differ = kp.photons.iter().zip(&native).filter(|(a, b)| bits(a) != bits(b)).count();
+        let differ = kernel.iter().zip(&native).filter(|(a, b)| bits(a) != bits(b)).count();
         assert_eq!(differ, 0, "turn {turn} (k = {k}): photons differing emulated vs native");
         // the mirror's interpolated normals take part: the flat-faceted cap stores other photons
         let flat = photons::reference(&curved_mirror_scene(false, turn), &tree, &e);
