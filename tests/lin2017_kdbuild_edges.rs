@@ -80,10 +80,10 @@ fn a_level_the_kernels_cannot_index_is_refused() {
     // 12 t < 2^32 (kd_event_flags / kd_event_scatter index 6 x 2 t entries in
     // u32) and 2 t < 2^30 (a node's event in the best key's 30 bits)
     assert_eq!(MAX_LEVEL_REFS, 357_913_941);
-    assert!(
-        12 * MAX_LEVEL_REFS as u64 <= u64::from(u32::MAX) && 12 * (MAX_LEVEL_REFS as u64 + 1) > u64::from(u32::MAX)
-    );
-    assert!(2 * MAX_LEVEL_REFS < 1 << 30);
+    const {
+        assert!(12 * MAX_LEVEL_REFS as u64 <= u32::MAX as u64 && 12 * (MAX_LEVEL_REFS as u64 + 1) > u32::MAX as u64);
+        assert!(2 * MAX_LEVEL_REFS < 1 << 30);
+    };
     assert!(gpu_build::check_level(19, MAX_LEVEL_REFS).is_ok());
     let e = gpu_build::check_level(19, MAX_LEVEL_REFS + 1).unwrap_err();
     assert!(matches!(e, GpuBuildError::TooManyRefs { depth: 19, refs } if refs == MAX_LEVEL_REFS + 1), "{e:?}");
