@@ -21,7 +21,7 @@ use warplight::host::path::{FrameParams, Integrator, Progressive, Traversal, ren
 const SIZE: u32 = 32;
 const FRAMES: u32 = 256;
 
-/// The frames' images of `integrator` at `max_bounces` (16 x 16 pixels).
+/// The frames' images of `integrator` at `max_bounces` (`SIZE` x `SIZE` = 32 x 32 pixels).
 fn frames(integrator: Integrator, max_bounces: u32, seed: u32) -> Progressive {
     let (_, ps, cam) = scene_of("cornell-lambert", SIZE);
     let p = FrameParams { width: SIZE, height: SIZE, integrator, max_bounces, seed, traversal: Traversal::ShortStack };

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use glam::Vec3;
-use warplight::host::kdtree::{BuildParams, Heuristic, build};
+use warplight::host::kdtree::{BuildParams, Heuristic, KdTree, build};
 use warplight::host::scene_file;
 use warplight::repro::fabianowski2011::photons::{
     self, Differentials, Emission, PhotonError, azimuth, emit, propagate, reemit, reflect, rng,
@@ -16,20 +16,30 @@ fn v(a: [f32; 3]) -> Vec3 {
     Vec3::from(a)
 }
 
+/// Per photon, the two stored interactions.
+type Stored = Vec<[Option<photons::Photon>; 2]>;
+
+/// `scene`'s SIROH tree, the emission of `n` photons, and the photons the
+/// native reference and the emulated kernel store.
+fn trace_both(scene: &warplight::host::scene::Scene, n: usize) -> (KdTree, Emission, Stored, Stored) {
+    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
+    let e = Emission::of(scene, n).unwrap();
+    let native = photons::reference(scene, &tree, &e);
+    let mut dev = Device::new();
+    let module = photons::load(&mut dev).unwrap();
+    let k = photons::trace_kernel(&mut dev, &module, scene, &tree, &e).unwrap();
+    (tree, e, native, k.photons)
+}
+
 #[test]
 fn kernel_stores_the_reference_photons_bit_for_bit() {
     let scene = scene_file::load(Path::new("scenes/cornell-box.toml")).unwrap();
-    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
-    let e = Emission::of(&scene, 384).unwrap();
-    let native = photons::reference(&scene, &tree, &e);
-    let mut dev = Device::new();
-    let module = photons::load(&mut dev).unwrap();
-    let k = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap();
-    assert_eq!(k.photons.len(), native.len());
+    let (_, _, native, kernel) = trace_both(&scene, 384);
+    assert_eq!(kernel.len(), native.len());
     // the same float operations in the same order (no contraction on either side,
     // correctly rounded sqrt and division): every stored bit agrees
-    for (i, (a, b)) in k.photons.iter().zip(&native).enumerate() {
+    for (i, (a, b)) in kernel.iter().zip(&native).enumerate() {
         for s in 0..2 {
             assert_eq!(a[s].map(|p| p.bits()), b[s].map(|p| p.bits()), "photon {i} slot {s}");
         }
@@ -220,9 +230,12 @@ fn a_curved_mirror_focuses_a_parallel_beam_at_half_its_radius() {
 /// A diffuse box (walls without vertex normals) with a concave mirror on its
 /// floor: a spherical cap of radius 3 tessellated into 56 triangles (the pole's 8 have zero area) whose
 /// vertex normals point to the sphere's centre (with `normals`), the point
-/// light above it.
-fn curved_mirror_scene(normals: bool) -> warplight::host::scene::Scene {
+/// light above it. `turn` moves coordinate c to axis (c + turn) mod 3, so
+/// that the cap's triangles project on Wald's axis k = 1 (turn 0), 2 (turn 1)
+/// or 0 (turn 2).
+fn curved_mirror_scene(normals: bool, turn: usize) -> warplight::host::scene::Scene {
     use warplight::host::scene::{Light, Material, MaterialKind, Scene, Triangle};
+    let rot = |a: Vec3| Vec3::from(std::array::from_fn(|c| a.to_array()[(c + 3 - turn) % 3]));
     let mut tris = Vec::new();
     let mut vn = Vec::new();
     // the box [-2, 2]³: six faces of two triangles (material 0)
@@ -246,7 +259,7 @@ fn curved_mirror_scene(normals: bool) -> warplight::host::scene::Scene {
     let at = |ring: usize, sector: usize| {
         let (th, ph) = (0.5 * ring as f32 / 4.0, std::f32::consts::TAU * sector as f32 / 8.0);
         let p = c + r * Vec3::new(th.sin() * ph.cos(), -th.cos(), th.sin() * ph.sin());
-        (p, ((c - p) / r).to_array())
+        (rot(p), rot((c - p) / r).to_array())
     };
     for ring in 0..4 {
         for s in 0..8 {
@@ -261,7 +274,7 @@ fn curved_mirror_scene(normals: bool) -> warplight::host::scene::Scene {
     let materials = vec![Material::diffuse("wall", [0.7, 0.6, 0.5]), mirror];
     let vn = if normals { vn } else { Vec::new() };
     let mut s = Scene::assemble_with_vertices("curved-mirror", Path::new("test"), tris, Vec::new(), vn, materials);
-    s.lights.push(Light::Point { position: [0.3, 1.0, 0.2], intensity: [1.0; 3] });
+    s.lights.push(Light::Point { position: rot(Vec3::new(0.3, 1.0, 0.2)).to_array(), intensity: [1.0; 3] });
     s
 }
 
@@ -272,23 +285,17 @@ fn curved_mirror_scene(normals: bool) -> warplight::host::scene::Scene {
 /// scene without vertex normals (flat facets) stores other bits for them.
 #[test]
 fn kernel_reflects_about_interpolated_normals_bit_for_bit() {
-    let scene = curved_mirror_scene(true);
+    let scene = curved_mirror_scene(true, 0);
     // the pole's eight zero-area triangles are dropped with their normals
     assert_eq!((scene.triangles.len(), scene.normals.len()), (68, 68));
-    let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
-    let e = Emission::of(&scene, 2048).unwrap();
-    let native = photons::reference(&scene, &tree, &e);
-    let mut dev = Device::new();
-    let module = photons::load(&mut dev).unwrap();
-    let k = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap();
-    for (i, (a, b)) in k.photons.iter().zip(&native).enumerate() {
+    let (tree, e, native, kernel) = trace_both(&scene, 2048);
+    for (i, (a, b)) in kernel.iter().zip(&native).enumerate() {
         for s in 0..2 {
             assert_eq!(a[s].map(|p| p.bits()), b[s].map(|p| p.bits()), "photon {i} slot {s}");
         }
     }
     // the photons whose first hit is the mirror (material 1) and that were stored later
-    let flat = photons::reference(&curved_mirror_scene(false), &tree, &e);
+    let flat = photons::reference(&curved_mirror_scene(false, 0), &tree, &e);
     let caster = warplight::host::raycast::Caster::new(&scene, &tree);
     let (mut mirrored, mut differ) = (0, 0);
     for (i, (a, b)) in native.iter().zip(&flat).enumerate() {
@@ -309,4 +316,32 @@ fn kernel_reflects_about_interpolated_normals_bit_for_bit() {
     }
     assert!(mirrored > 60, "{mirrored} photons stored after the mirror");
     assert_eq!(differ, mirrored, "every photon reflected by the curved mirror changes");
+}
+
+/// Eq. 5.21's rows for every projection axis k in the kernel (review 7,
+/// finding 1): the cap above projects on k = 1 only; turned so that it
+/// projects on k = 2 and k = 0, the emulated tracer still stores exactly the
+/// native reference's photons. (A kernel whose `place` swaps the entries of
+/// k = 0 and k = 2 passes the test above and differs here in about 250 of
+/// 2048 photons per turn.)
+#[test]
+fn kernel_reflects_bit_for_bit_on_every_projection_axis() {
+    for (turn, k) in [(1usize, 2usize), (2, 0)] {
+        let scene = curved_mirror_scene(true, turn);
+        // Wald's k: the axis of the geometric normal's largest component
+        let mut per_axis = [0; 3];
+        for t in scene.triangles.iter().filter(|t| t.material == 1) {
+            let g = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]).abs().to_array();
+            per_axis[(0..3).fold(0, |m, a| if g[a] > g[m] { a } else { m })] += 1;
+        }
+        assert_eq!(per_axis[k], 56, "turn {turn}: mirror triangles per axis {per_axis:?}");
+        let (tree, e, native, kernel) = trace_both(&scene, 2048);
+        let bits = |x: &[Option<photons::Photon>; 2]| x.map(|p| p.map(|p| p.bits()));
+        let differ = kernel.iter().zip(&native).filter(|(a, b)| bits(a) != bits(b)).count();
+        assert_eq!(differ, 0, "turn {turn} (k = {k}): photons differing emulated vs native");
+        // the mirror's interpolated normals take part: the flat-faceted cap stores other photons
+        let flat = photons::reference(&curved_mirror_scene(false, turn), &tree, &e);
+        let changed = native.iter().zip(&flat).filter(|(a, b)| bits(a) != bits(b)).count();
+        assert!(changed > 60, "turn {turn}: {changed} photons changed by the vertex normals");
+    }
 }

@@ -56,11 +56,15 @@ fn vertex_normals_are_read_per_triangle() {
     assert_eq!((s.triangles.len(), s.dropped_degenerate), (2, 1));
     let (a, c) = ([-0.0, -0.0, -1.0], [-0.0, -0.5, -1.0]);
     assert_eq!(s.normals, vec![[a, [-0.5, -0.0, -1.0], c], [a, a, c]]);
-    // a face without normals: none at all
-    std::fs::write(dir.join("n.obj"), format!("{head}f 1//1 2//2 3//3\nf 2 4 3\n")).unwrap();
-    let s = scene_file::load(&dir.join("n.toml")).unwrap_or_else(|e| panic!("{e}"));
-    assert!(s.normals.is_empty());
-    assert_eq!(s.vertex_normals(0), [[0.0; 3]; 3]);
+    // a face without normals: none at all, whatever whitespace follows `f`
+    // (review 7, finding 4: a tab escaped the check and tobj's made-up normals were kept)
+    for faces in ["f 1//1 2//2 3//3\nf 2 4 3\n", "f 1//1 2//2 3//3\nf\t2 4 3\n", "f\t2 4 3\nf 1//1 2//2 3//3\n"] {
+        std::fs::write(dir.join("n.obj"), format!("{head}{faces}")).unwrap();
+        let s = scene_file::load(&dir.join("n.toml")).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(s.triangles.len(), 2, "{faces:?}");
+        assert!(s.normals.is_empty(), "{faces:?}: {:?}", s.normals);
+        assert_eq!(s.vertex_normals(0), [[0.0; 3]; 3]);
+    }
 }
 
 #[test]

@@ -589,10 +589,12 @@ fn load_obj(
 
 /// Whether every face (`f`) of the OBJ at `path` names a normal at each
 /// vertex (`v//vn` or `v/vt/vn`); false where the file cannot be read again.
+/// A face line is `f` and its vertices, separated by any whitespace (OBJ
+/// allows tabs).
 fn every_face_has_normals(path: &Path) -> bool {
     let Ok(bytes) = std::fs::read(path) else { return false };
     String::from_utf8_lossy(&bytes)
         .lines()
-        .filter_map(|l| l.trim_start().strip_prefix("f "))
-        .all(|f| f.split_whitespace().all(|v| v.splitn(3, '/').nth(2).is_some_and(|n| !n.trim().is_empty())))
+        .map(str::split_whitespace)
+        .all(|mut w| w.next() != Some("f") || w.all(|v| v.splitn(3, '/').nth(2).is_some_and(|n| !n.trim().is_empty())))
 }

@@ -54,6 +54,13 @@ const EV_END: u32 = 1;
 const EV_FLAT: u32 = 2;
 /// Triangles the event keys can address (30 bits).
 pub const MAX_TRIANGLES: usize = 1 << 30;
+/// The most triangle references a level may hold: the kernels index a
+/// level's 6 x 2 t event-side entries (`kd_event_flags`, `kd_event_scatter`:
+/// `6u * ev`, ev = 2 t) in 32 bits, so 12 t < 2^32; the best key keeps a
+/// node's event (fewer than 2 t) in 30 bits, which this bound implies
+/// (2 t < 2^30). A level holds more references than the build has triangles
+/// (the bunny's level 19: 220,750 for 69,451).
+pub const MAX_LEVEL_REFS: usize = (u32::MAX / 12) as usize;
 
 /// Construction parameters (none stated by the thesis).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -102,6 +109,28 @@ pub enum GpuBuildError {
     /// More triangles than the event keys address.
     #[error("{0} triangles: the GPU build's event keys address at most 2^30")]
     TooMany(usize),
+    /// A level holds more references than the kernels index in 32 bits.
+    #[error(
+        "level {depth} of the GPU build holds {refs} triangle references: the kernels index 12 entries a reference in 32 bits, so at most {MAX_LEVEL_REFS}"
+    )]
+    TooManyRefs {
+        /// The level (the root is 0).
+        depth: u32,
+        /// Its triangle references.
+        refs: usize,
+    },
+    /// A count passed to a kernel does not fit its 32-bit parameter.
+    #[error("a count of {0} does not fit the kernels' 32-bit parameters")]
+    Count(usize),
+}
+
+/// Refuses a level of `refs` triangle references that the kernels cannot
+/// index ([`MAX_LEVEL_REFS`]): the emulated build and its twin check each level.
+pub fn check_level(depth: u32, refs: usize) -> Result<(), GpuBuildError> {
+    if refs > MAX_LEVEL_REFS {
+        return Err(GpuBuildError::TooManyRefs { depth, refs });
+    }
+    Ok(())
 }
 
 /// What one level (or the root's sort) cost on the emulator.
@@ -343,6 +372,7 @@ pub fn twin(tris: &[[Vec3; 3]], p: &GpuParams) -> Result<KdTree, GpuBuildError> 
     let (mut records, mut leaf_tris) = (Vec::new(), Vec::new());
     let mut depth = 0;
     loop {
+        check_level(depth, t)?;
         let e = 2 * t;
         let ends = scan(ev.flags.iter().map(|f| f & EV_END != 0));
         let mut best = vec![NO_SPLIT; nodes.len()];
@@ -633,24 +663,26 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
     let (mut ev_bits, mut ev_addr) = (Buf::new(), Buf::new());
     let (mut records, mut leaf_tris, mut levels) = (Vec::new(), Vec::new(), Vec::new());
     let (mut t, mut count, mut depth) = (n, 1usize, 0u32);
-    let (t_, all) = (|x: usize| Arg::U32(x as u32), Arg::U32(p.all_axes as u32));
+    let t_ = |x: usize| u32::try_from(x).map(Arg::U32).map_err(|_| GpuBuildError::Count(x));
+    let all = Arg::U32(p.all_axes as u32);
     loop {
+        check_level(depth, t)?;
         let e = 2 * t;
         let end_scan = ends.ensure::<u32>(l.dev, 3 * e + 1);
         l.scan(flags.ptr, EV_END, 3 * e, end_scan, &mut sums)?;
         let ev_args = [Arg::Ptr(pos.ptr), Arg::Ptr(flags.ptr), Arg::Ptr(tri.ptr)];
         let mut args = vec![Arg::Ptr(nodes.ptr), Arg::Ptr(best.ptr)];
         args.extend(ev_args.iter().cloned());
-        args.extend([Arg::Ptr(end_scan), Arg::Ptr(tri_owner.ptr), t_(e), all.clone(), Arg::U32(p.max_depth)]);
+        args.extend([Arg::Ptr(end_scan), Arg::Ptr(tri_owner.ptr), t_(e)?, all.clone(), Arg::U32(p.max_depth)]);
         args.extend([Arg::F32(p.k_t), Arg::F32(p.k_i)]);
         l.launch("kd_sah", 3 * e, &args)?;
         let flags_split = is_split.ensure::<u32>(l.dev, count);
         let args = [
             Arg::Ptr(nodes.ptr),
             Arg::Ptr(best.ptr),
-            t_(count),
+            t_(count)?,
             Arg::Ptr(pos.ptr),
-            t_(e),
+            t_(e)?,
             Arg::U32(p.max_depth),
             Arg::U32(p.max_leaf),
             Arg::F32(p.k_i),
@@ -660,10 +692,10 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
         let ranks = rank.ensure::<u32>(l.dev, count + 1);
         let splits = l.scan(flags_split, 1, count, ranks, &mut sums)? as usize;
         let b = bits.ensure::<u32>(l.dev, 3 * t);
-        l.launch("kd_clear", 3 * t, &[Arg::Ptr(b), t_(3 * t)])?;
+        l.launch("kd_clear", 3 * t, &[Arg::Ptr(b), t_(3 * t)?])?;
         let mut args = vec![Arg::Ptr(nodes.ptr)];
         args.extend(ev_args.iter().cloned());
-        args.extend([Arg::Ptr(tri_owner.ptr), t_(e), t_(t), Arg::Ptr(b)]);
+        args.extend([Arg::Ptr(tri_owner.ptr), t_(e)?, t_(t)?, Arg::Ptr(b)]);
         l.launch("kd_assign", 3 * e, &args)?;
         let a = addr.ensure::<u32>(l.dev, 3 * t + 1);
         let total = l.scan(b, 1, 3 * t, a, &mut sums)? as usize;
@@ -675,13 +707,13 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
         let nb = next_best.ensure::<u64>(l.dev, 2 * splits);
         let args = [
             Arg::Ptr(nodes.ptr),
-            t_(count),
+            t_(count)?,
             Arg::Ptr(ranks),
-            t_(splits),
+            t_(splits)?,
             Arg::Ptr(a),
-            t_(t),
-            t_(leaf_tris.len()),
-            t_(level_base),
+            t_(t)?,
+            t_(leaf_tris.len())?,
+            t_(level_base)?,
             Arg::Ptr(r),
             Arg::Ptr(nn),
             Arg::Ptr(nb),
@@ -697,9 +729,9 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
             Arg::Ptr(tri_owner.ptr),
             Arg::Ptr(b),
             Arg::Ptr(a),
-            t_(t),
+            t_(t)?,
             Arg::Ptr(ranks),
-            t_(splits),
+            t_(splits)?,
             Arg::Ptr(nl),
             Arg::Ptr(no),
             Arg::Ptr(lf),
@@ -709,7 +741,7 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
         leaf_tris.extend(l.dev.try_read::<u32>(lf, leaves_here)?);
         if splits > 0 {
             let eb = ev_bits.ensure::<u32>(l.dev, 6 * e);
-            l.launch("kd_event_flags", 6 * e, &[Arg::Ptr(tri.ptr), t_(e), t_(t), Arg::Ptr(b), Arg::Ptr(eb)])?;
+            l.launch("kd_event_flags", 6 * e, &[Arg::Ptr(tri.ptr), t_(e)?, t_(t)?, Arg::Ptr(b), Arg::Ptr(eb)])?;
             let ea = ev_addr.ensure::<u32>(l.dev, 6 * e + 1);
             l.scan(eb, 1, 6 * e, ea, &mut sums)?;
             let next_e = 2 * next_t;
@@ -719,7 +751,7 @@ pub fn build(dev: &mut Device, module: &Module, tris: &[[Vec3; 3]], p: &GpuParam
                 ntri.ensure::<u32>(l.dev, 3 * next_e),
             );
             let mut args = ev_args.to_vec();
-            args.splice(3..3, [t_(e), t_(t), Arg::Ptr(eb), Arg::Ptr(ea), Arg::Ptr(a)]);
+            args.splice(3..3, [t_(e)?, t_(t)?, Arg::Ptr(eb), Arg::Ptr(ea), Arg::Ptr(a)]);
             args.extend([Arg::Ptr(np), Arg::Ptr(nf), Arg::Ptr(nt)]);
             l.launch("kd_event_scatter", 6 * e, &args)?;
         }

@@ -159,7 +159,11 @@ pub fn render(
 ) -> Result<KernelRender, SimError> {
     if params.integrator == super::Integrator::Mlt {
         return super::mlt::render_emulated(dev, module, scene, camera, params, frames, keep_frames, progress)
-            .map(KernelRender::from);
+            .map(KernelRender::from)
+            .map_err(|e| match e {
+                super::mlt::MltError::Sim(e) => e,
+                refused => SimError::BadLaunch(refused.to_string()),
+            });
     }
     let bufs = upload_scene(dev, scene, camera, &params)?;
     let pp = bufs.params;

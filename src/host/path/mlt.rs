@@ -31,9 +31,57 @@ use super::kernel::{self, KernelRender};
 use super::layout::PathScene;
 use super::native::{Tracer, exp_neg};
 use super::rng::{Sample, path_key, rng};
-use super::{FrameParams, Progressive, eps_for, frame_of};
+use super::{FrameParams, FrameParamsError, Progressive, eps_for, frame_of};
 use crate::host::camera::Camera;
 use crate::sim::{Arg, Counters, Device, DevicePtr, LaunchConfig, Module, SimError};
+
+/// Why an MLT render was refused or failed.
+#[derive(Debug, thiserror::Error)]
+pub enum MltError {
+    /// Settings no integrator takes (more than [`super::MAX_BOUNCES`] bounces).
+    #[error(transparent)]
+    Params(#[from] FrameParamsError),
+    /// The chains' state (40 k W H bytes) overflows 64 bits or exceeds [`MAX_STATE_BYTES`].
+    #[error(
+        "mlt at {width} x {height} pixels and {max_bounces} bounces keeps {} bytes of chain state (40 k W H, k = bounces + 1): at most {MAX_STATE_BYTES}",
+        bytes.map_or("more than 2^64".to_string(), |b| b.to_string())
+    )]
+    StateTooLarge {
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+        /// Longest path in bounces.
+        max_bounces: u32,
+        /// The state's bytes (`None`: past 2^64).
+        bytes: Option<u64>,
+    },
+    /// The emulator faulted.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+/// The most bytes of chain state a render may keep: one allocation's bound
+/// ([`crate::limits::MAX_ALLOCATION_BYTES`], 8 GiB; 1920 x 1080 at the
+/// thesis' k = 30 keeps 2.3 GiB).
+pub const MAX_STATE_BYTES: u64 = crate::limits::MAX_ALLOCATION_BYTES;
+
+/// The chains' state in bytes for `params` ([`state_bytes`]), or why MLT
+/// refuses them: more than [`super::MAX_BOUNCES`] bounces (the kernels'
+/// `int` bound would overflow at `max_bounces + 1`), or a state past
+/// [`MAX_STATE_BYTES`]. Both render functions call it first.
+pub fn check(params: &FrameParams) -> Result<u64, MltError> {
+    params.check()?;
+    let (w, h, m) = (params.width, params.height, params.max_bounces);
+    let bytes = (4 * u64::from(SLOTS_PER_SEGMENT))
+        .checked_mul(u64::from(m) + 1)
+        .and_then(|b| b.checked_mul(u64::from(w)))
+        .and_then(|b| b.checked_mul(u64::from(h)));
+    match bytes {
+        Some(b) if b <= MAX_STATE_BYTES => Ok(b),
+        _ => Err(MltError::StateTooLarge { width: w, height: h, max_bounces: m, bytes }),
+    }
+}
 
 /// State floats a path segment (003:L328).
 pub const SLOTS_PER_SEGMENT: u32 = 10;
@@ -61,12 +109,13 @@ pub const FIXED: f32 = 4_294_967_296.0;
 
 /// State floats a chain for paths of at most `max_bounces` bounces: 10 (k = max bounces + 1).
 pub fn slots(max_bounces: u32) -> usize {
-    (SLOTS_PER_SEGMENT * (max_bounces + 1)) as usize
+    SLOTS_PER_SEGMENT as usize * (max_bounces as usize + 1)
 }
 
 /// The bytes of random numbers the chains of a `width` x `height` image keep: 40 k W H.
+/// (saturating; [`check`] refuses what does not fit).
 pub fn state_bytes(width: u32, height: u32, max_bounces: u32) -> u64 {
-    4 * slots(max_bounces) as u64 * width as u64 * height as u64
+    (4 * slots(max_bounces) as u64).saturating_mul(width as u64 * height as u64)
 }
 
 /// The state slot of the integrators' random dimension `d` for paths of at
@@ -168,8 +217,10 @@ pub struct MltRender {
     pub fixed: Vec<u64>,
     /// The bootstrap's mean luminance b.
     pub b: f32,
-    /// The bytes of the chains' random numbers: emulated, the size of the
-    /// device allocation `mlt state`; natively, the host vector's.
+    /// The bytes allocated for the chains' random numbers: emulated, the
+    /// size of the device allocation `mlt state`; natively, the host
+    /// vector's. Both are the host's formula ([`state_bytes`]);
+    /// `tests/lin2017_mlt_state.rs` measures what the kernels touch.
     pub state_bytes: u64,
     /// The emulator's counters summed over the launches (native: none).
     pub totals: Option<Counters>,
@@ -277,7 +328,8 @@ pub enum Start {
     Own,
 }
 
-/// Renders `frames` frames of MLT natively (`params.integrator` is mlt).
+/// Renders `frames` frames of MLT natively (`params.integrator` is mlt);
+/// settings [`check`] refuses are an error.
 pub fn render_native(
     scene: &PathScene,
     camera: &Camera,
@@ -285,14 +337,14 @@ pub fn render_native(
     frames: u32,
     keep_frames: bool,
     progress: impl FnMut(u32),
-) -> MltRender {
+) -> Result<MltRender, MltError> {
     let tracer = Tracer { scene, frame: frame_of(camera, eps_for(scene.lo, scene.hi)), params };
     render_target(&tracer, params, Start::Pool, frames, keep_frames, progress)
 }
 
 /// Renders `frames` frames of MLT natively over `target` with chains that
 /// start at `start` (`params` gives the image size, the state's length by
-/// its bounces, and the seed).
+/// its bounces, and the seed); settings [`check`] refuses are an error.
 pub fn render_target(
     target: &impl Target,
     params: FrameParams,
@@ -300,7 +352,8 @@ pub fn render_target(
     frames: u32,
     keep_frames: bool,
     mut progress: impl FnMut(u32),
-) -> MltRender {
+) -> Result<MltRender, MltError> {
+    check(&params)?;
     let (m, n) = (slots(params.max_bounces), (params.width * params.height) as usize);
     let mut boot = vec![0.0f32; BOOTSTRAP as usize * n];
     let mut counts = boot
@@ -356,7 +409,7 @@ pub fn render_target(
     let mut image = progressive_of(&params, &fixed, frames);
     image.frame_images = out_frames;
     image.counts = counts;
-    MltRender { image, fixed, b, state_bytes: (4 * u.len()) as u64, totals: None }
+    Ok(MltRender { image, fixed, b, state_bytes: (4 * u.len()) as u64, totals: None })
 }
 
 fn add(mut a: Counts, b: Counts) -> Counts {
@@ -450,7 +503,8 @@ pub const STATE_BUFFER: &str = "mlt state";
 
 /// Renders `frames` frames of MLT on the emulator (`mlt_init` and
 /// `mlt_start` once, then `mlt_frame` a frame; `module` loaded by
-/// [`kernel::load`]).
+/// [`kernel::load`]); settings [`check`] refuses are an error before
+/// anything reaches the kernels' parameters.
 #[allow(clippy::too_many_arguments)]
 pub fn render_emulated(
     dev: &mut Device,
@@ -461,10 +515,11 @@ pub fn render_emulated(
     frames: u32,
     keep_frames: bool,
     mut progress: impl FnMut(u32),
-) -> Result<MltRender, SimError> {
+) -> Result<MltRender, MltError> {
+    let state_len = check(&params)?;
     let bufs = kernel::upload_scene(dev, scene, camera, &params)?;
     let n = (params.width * params.height) as usize;
-    let state = dev.alloc_bytes(state_bytes(params.width, params.height, params.max_bounces), STATE_BUFFER);
+    let state = dev.alloc_bytes(state_len, STATE_BUFFER);
     let chains = dev.alloc_bytes(16 * n as u64, "mlt chains");
     let boot = dev.alloc_bytes(4 * BOOTSTRAP as u64 * n as u64, "mlt bootstrap");
     let start = dev.alloc_bytes(4 * n as u64, "mlt starts");

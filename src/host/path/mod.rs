@@ -292,6 +292,12 @@ impl Progressive {
 
 /// Renders `frames` frames natively; `keep_frames` keeps each frame's image
 /// (mlt: [`mlt::render_native`]'s image).
+///
+/// # Panics
+/// For mlt with settings [`mlt::check`] refuses (more than [`MAX_BOUNCES`]
+/// bounces, or more chain state than [`mlt::MAX_STATE_BYTES`]); call
+/// [`mlt::render_native`] for the typed error. The other integrators take
+/// any bound (a longest path past the kernel's `int` saturates).
 pub fn render_native(
     scene: &layout::PathScene,
     camera: &Camera,
@@ -301,7 +307,10 @@ pub fn render_native(
     mut progress: impl FnMut(u32),
 ) -> Progressive {
     if params.integrator == Integrator::Mlt {
-        return mlt::render_native(scene, camera, params, frames, keep_frames, progress).image;
+        return match mlt::render_native(scene, camera, params, frames, keep_frames, progress) {
+            Ok(r) => r.image,
+            Err(e) => panic!("render_native: {e}"),
+        };
     }
     let eps = eps_for(scene.lo, scene.hi);
     let tracer = native::Tracer { scene, frame: frame_of(camera, eps), params };

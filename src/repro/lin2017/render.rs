@@ -59,6 +59,10 @@ pub fn render(
     emulated: Option<&dyn Fn(&mut crate::sim::SimConfig)>,
 ) -> Result<PathRender, Box<dyn std::error::Error>> {
     params.check()?;
+    if params.integrator == crate::host::path::Integrator::Mlt {
+        // the chains' state (40 k W H bytes) within its bound, before anything is built
+        crate::host::path::mlt::check(&params)?;
+    }
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     // the stackless traversals cannot return to a split plane they crossed:
     // they need thesis 003's SAH tree, which keeps a triangle lying in a split

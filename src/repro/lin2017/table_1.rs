@@ -50,6 +50,15 @@ pub const PRINTED: [PrintedRow; 4] = [
     (None, "Happy Buddha", "1,087,716", "25.33", "26.56", "4.9%"),
 ];
 
+/// The speedup's tolerance: half a unit of its printed precision. The thesis
+/// prints the speedups to 0.1 % ("7.3%") and the frame rates they come from
+/// to 0.01 FPS (42.63 / 39.73 - 1 = 7.30 %: the rates' rounding moves it by
+/// at most 0.03 points), and states no spread between runs; so a speedup is
+/// the printed one within ±0.05 percentage points. (A factor tolerance of
+/// ±10 % on 1 + speedup, used before, accepted anything from about -3 % to
+/// +18 % here: no speedup at all was "within".)
+pub const SPEEDUP_TOLERANCE: Tolerance = Tolerance::Points(0.05);
+
 /// Our scenes of the table, in its order.
 pub const SCENES: [&str; 2] = ["suzanne", "stanford-bunny"];
 
@@ -122,7 +131,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         Column::ours_only("triangles", Unit::Count),
         Column::not_reproducible("FPS w/o clipping", Unit::Number(2), fps),
         Column::not_reproducible("FPS w clipping", Unit::Number(2), fps),
-        Column::modelled("Speedup", Unit::Change, model, Some(Tolerance::RATIO), None),
+        Column::modelled("Speedup", Unit::Change, model, Some(SPEEDUP_TOLERANCE), None),
     ];
     for what in ["tests/ray", "node visits/ray", "references"] {
         for clip in [false, true] {
@@ -151,7 +160,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
                 ours,
                 thesis: Some(speedup.into()),
                 thesis_value: Some(thesis_speedup),
-                verdict: ours.map(|o| Tolerance::RATIO.verdict(o, thesis_speedup)),
+                verdict: ours.map(|o| SPEEDUP_TOLERANCE.verdict(o, thesis_speedup)),
             },
         ];
         for what in ["tests", "visits", "refs"] {
@@ -200,9 +209,9 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     ));
     table.notes.push(format!(
         "Counted per ray traced (camera and bounce rays): triangle tests and node visits (inner-node steps plus \
-         leaves) at the kernel's `@count` lines. Modelled column: {model}; tolerance {}. The model does not see \
-         memory latency.",
-        Tolerance::RATIO.describe()
+         leaves) at the kernel's `@count` lines. Modelled column: {model}; tolerance {} (half a unit of the printed \
+         speedups' precision, 0.1 %; the thesis states no spread). The model does not see memory latency.",
+        SPEEDUP_TOLERANCE.describe()
     ));
     vec![table]
 }

@@ -134,7 +134,10 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     let hardware = "seconds on the thesis' i7-4770 (CPU) and GTX 1070 (GPU); the emulator keeps no GPU time and \
                     this host is another CPU";
     let mut columns = vec![
-        Column::measured("Face Count", Unit::Count, Tolerance::COUNT),
+        Column::measured("Face Count", Unit::Count, Tolerance::COUNT).uncompared(
+            "the input meshes' sizes, not a result: Suzanne's and the bunny's are the printed counts because the \
+             meshes were chosen to match",
+        ),
         Column::not_reproducible("CPU(s)", Unit::Number(3), hardware),
         Column::not_reproducible("GPU(s)", Unit::Number(3), hardware),
         Column::not_reproducible("Speedup", Unit::Number(2), "the ratio of the two"),
@@ -169,7 +172,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
             ours: ours("faces"),
             thesis: Some(faces.to_string()),
             thesis_value: Some(face_value),
-            verdict: ours("faces").map(|f| Tolerance::COUNT.verdict(f, face_value)),
+            verdict: None,
         }];
         cells.extend([printed(cpu), printed(gpu), printed(speedup)]);
         cells.push(Cell { ours: ours("serial_seconds"), ..Cell::default() });
@@ -218,8 +221,9 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         let (holds, evidence) = same("axes3", "serial", &[s]);
         table.checks.push(Check {
             claim: format!(
-                "{s}: with all three axes per node (Wald and Havran's sweep; not what §6.5 describes) the same \
-                 kernels build the serial tree: GPU 3-axis / serial"
+                "{s}: with all three axes per node (Wald and Havran's sweep; not what §6.5 describes) the kernels' \
+                 serial twin (equal to the emulated kernels node for node on Cornell and Suzanne) builds a tree of the \
+                 serial tree's statistics: GPU 3-axis / serial"
             ),
             evidence,
             holds,
@@ -230,10 +234,12 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         "Ours: the GPU build of §6.5 on the emulator (kernels/lin2017/kdbuild.cu, launched level by level from \
          src/host/path/gpu_build.rs), one axis per node (the longest, 003:L560, L576); the serial CPU build is thesis \
          003's (src/host/path/build.rs) without clipping. Fixtures not stated by the thesis: K_T = {}, K_I = {}, \
-         depth at most 8 + 1.3 log2 n, a node of more than 63 triangles is split (6-bit count), flat triangles in the \
+         depth at most 8 + 1.3 log2 n, a node of more than 63 triangles is split (6-bit count) when it has a candidate \
+         plane inside its box and is shallower than the depth limit, flat triangles in the \
          plane counted on one side by the event order (003:L562) and assigned to both (003:L566). The GPU 3-axis \
-         columns are the serial twin of the same kernels with all three axes (the emulated kernels give the same tree \
-         node for node: tests/lin2017_kdbuild.rs).",
+         columns are the serial twin of the same kernels with all three axes (the emulated kernels give the twin's tree \
+         node for node on Cornell and Suzanne, tests/lin2017_kdbuild.rs; the bunny's three-axis twin is the serial \
+         tree node for node, the one-axis emulated bunny has the one-axis twin's statistics and SAH cost).",
         p.k_t, p.k_i
     ));
     table.notes.push(
