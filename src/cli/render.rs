@@ -486,7 +486,11 @@ fn run_path(
     if let Some((w, t)) = r.instructions {
         println!(
             "  emulated {}: {w} warp instructions, {t} thread instructions",
-            crate::host::path::kernel::entry(integrator)
+            if scene.medium.is_some() {
+                crate::host::path::kernel::VOLUME_KERNEL
+            } else {
+                crate::host::path::kernel::entry(integrator)
+            }
         );
     }
     println!("  wrote {}", a.output.display());
