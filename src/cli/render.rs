@@ -76,6 +76,10 @@ pub struct RenderArgs {
     /// or mlt (Metropolis light transport in primary sample space over bdpt: one chain a
     /// pixel, 16 bootstrap samples a pixel for b, large steps with probability 0.25,
     /// --spp mutations a pixel; consistent, with start-up bias in early frames).
+    /// A scene with a `[medium]` (participating media, §5.2: smog-room, fog-box) is
+    /// marched by pt, nee and mis (kernel volume_frame: steps of the scene's `step`
+    /// with one random offset a ray, Beer's law, single scattering from direct
+    /// light with a shadow ray at each sample); bdpt and mlt refuse it.
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).

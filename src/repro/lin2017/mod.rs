@@ -14,6 +14,7 @@
 pub mod fig_16;
 pub mod fig_17;
 pub mod fig_3;
+pub mod media;
 pub mod render;
 pub mod table_1;
 pub mod table_2;
