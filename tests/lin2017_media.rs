@@ -13,18 +13,15 @@ mod lin2017_mitsuba;
 
 use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, reference_of, scene_of};
 use warplight::host::camera::Camera;
-use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
 
+/// Scene `name` of `scenes/`, laid out.
 fn load(name: &str) -> (Scene, PathScene) {
-    let scene = scene_file::load(&scene_file::resolve(name)).expect("a scene of scenes/");
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(&scene, &tree).expect("layout");
+    let (scene, ps, _) = scene_of(name, 12);
     (scene, ps)
 }
 

@@ -232,9 +232,7 @@ fn medium(cx: &Cx, m: &toml::Table, text: &str) -> Result<Medium, SceneError> {
         if !["sigma_a", "sigma_s", "g", "emission", "height_scale", "box", "step", "jitter"].contains(&k.as_str()) {
             return bad(
                 k,
-                format!(
-                    "unknown key `{k}`; expected sigma_a, sigma_s, g, emission, height_scale, box, step or jitter"
-                ),
+                format!("unknown key `{k}`; expected sigma_a, sigma_s, g, emission, height_scale, box, step or jitter"),
             );
         }
     }
@@ -245,7 +243,8 @@ fn medium(cx: &Cx, m: &toml::Table, text: &str) -> Result<Medium, SceneError> {
             (Some(v), _) => cx.num(v, &at(key)),
         }
     };
-    let (sigma_a, sigma_s, g, step) = (num("sigma_a", None)?, num("sigma_s", None)?, num("g", Some(0.0))?, num("step", None)?);
+    let (sigma_a, sigma_s, g, step) =
+        (num("sigma_a", None)?, num("sigma_s", None)?, num("g", Some(0.0))?, num("step", None)?);
     for (k, v) in [("sigma_a", sigma_a), ("sigma_s", sigma_s)] {
         if v < 0.0 {
             return bad(k, format!("{v} is negative; expected a coefficient >= 0 (per unit length)"));
@@ -266,7 +265,7 @@ fn medium(cx: &Cx, m: &toml::Table, text: &str) -> Result<Medium, SceneError> {
     }
     let height_scale = m.get("height_scale").map(|v| cx.num(v, &at("height_scale"))).transpose()?;
     if let Some(h) = height_scale
-        && !(h > 0.0)
+        && h <= 0.0
     {
         return bad("height_scale", format!("{h}: expected a scale height > 0"));
     }
@@ -275,14 +274,15 @@ fn medium(cx: &Cx, m: &toml::Table, text: &str) -> Result<Medium, SceneError> {
         Some(toml::Value::Table(b)) => {
             let lo = cx.vec3(b, "lo", &at("box"), None)?;
             let hi = cx.vec3(b, "hi", &at("box"), None)?;
-            if (0..3).any(|k| !(lo[k] < hi[k])) {
+            if (0..3).any(|k| lo[k] >= hi[k]) {
                 return bad("box", format!("lo {lo:?} must lie below hi {hi:?} on every axis"));
             }
             Some((lo, hi))
         }
         Some(_) => return bad("box", "expected { lo = [x, y, z], hi = [x, y, z] }".into()),
     };
-    if !(step > 0.0) {
+    if step <= 0.0 {
+        // finite: num() refuses NaN
         return bad("step", format!("{step}: expected a march step > 0"));
     }
     if let Some((lo, hi)) = region {
@@ -297,7 +297,9 @@ fn medium(cx: &Cx, m: &toml::Table, text: &str) -> Result<Medium, SceneError> {
     let jitter = match m.get("jitter").map(|v| v.as_str()) {
         None | Some(Some("stratified")) => Jitter::Stratified,
         Some(Some("random")) => Jitter::PerStep,
-        Some(_) => return bad("jitter", "expected \"stratified\" (one offset a ray) or \"random\" (one a step)".into()),
+        Some(_) => {
+            return bad("jitter", "expected \"stratified\" (one offset a ray) or \"random\" (one a step)".into());
+        }
     };
     Ok(Medium { sigma_a, sigma_s, g, emission, height_scale, region, step, jitter })
 }

@@ -572,7 +572,7 @@ impl Tracer<'_> {
                         }
                         let mut g = fs / light_pdf * wgt;
                         if let Some(m) = &s.medium {
-                            g = g * medium_transmittance(m, hitp, wl, dist);
+                            g *= medium_transmittance(m, hitp, wl, dist);
                         }
                         l = l.add(beta.mul(fc).mul(le).scale(g));
                     }
@@ -651,7 +651,7 @@ impl Tracer<'_> {
                     if cos_l > 0.0 && self.trace(x, wl, eps, dist - eps, true, counts).is_none() {
                         let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
                         let mut w = m[9] * rho * hg(m[7], wl.dot(d)) * cos_l * s.light_area / dist2;
-                        w = w * medium_transmittance(m, x, wl, dist);
+                        w *= medium_transmittance(m, x, wl, dist);
                         src = src.add(le.scale(w));
                     }
                 }
