@@ -701,18 +701,152 @@ static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, K key, unsigne
   return true;
 }
 
+// ---- Participating media (§5.2, 003:L359-386): the march of volume_frame ----
+//
+// One medium, in an axis-aligned box (the whole scene's box when the scene
+// file gives none): absorption sigma_a and scattering sigma_s (grey, per unit
+// length at unit density), the Henyey-Greenstein phase function with g
+// (003:L365), emission L_ve (RGB, per unit length at unit density) and a
+// density 1 or, with an exponential height falloff of scale height H,
+// e^(-(y - lo.y) / H) ("exponentially attenuated density in vertical
+// direction", 003:L385). The segment of each ray inside the box is marched
+// with steps of dt (003:L367): sample k at t = t_enter + (k + u) dt while
+// t < t_end, with u one offset for the whole ray (Pauly's stratified pattern)
+// or, for the comparison of 003:L367, one offset per step ("randomly pick a
+// point in each segment"). Each sample adds dt T(t) (rho L_ve + sigma_s rho
+// p L_light T_shadow G / pdf): single scattering from direct light only, one
+// light sample and shadow ray per march sample (003:L379). The transmittance
+// T is Beer's law, evaluated analytically (003:L369-371): sigma_t times the
+// density's integral, (1 - e^(-x)) / x in closed form for the exponential
+// density. T of the whole segment multiplies the mask (003:L377). Light
+// samples at surfaces are attenuated by T along the shadow ray. The medium's
+// random numbers: dimension MEDIUM_DIMS + MEDIUM_DIMS_PER_BOUNCE bounce + j,
+// j = 0 the ray's offset, 4 k + 1 step k's own offset, 4 k + 2..4 its light point.
+#define MEDIUM_DIMS 0x100000u
+#define MEDIUM_DIMS_PER_BOUNCE 0x1000u
+#define MEDIUM_MAX_STEPS 1023   // per ray segment (the host refuses a step that needs more)
+
+// The path tracer's kernels have no medium: every hook below compiles to nothing.
+struct NoMedium {};
+// The medium as src/host/path/layout.rs lays it out: [lo, dt], [hi, g],
+// [sigma_a, sigma_s, 1 / H (0: uniform density), 1: an offset per step (0: per ray)], [L_ve, 0].
+struct Medium {
+  float4 lo, hi, c, e;
+};
+
+template <class K>
+static __device__ __forceinline__ void march(const Scene &, Path &, K, const NoMedium &, V3, V3, float) {}
+static __device__ __forceinline__ float attenuate(const NoMedium &, float g, V3, V3, float) { return g; }
+
+// The part [*ta, *tb] of the ray o + t d, t in [0, t_end], inside the medium's box.
+static __device__ __forceinline__ void medium_span(const Medium &m, V3 o, V3 d, float t_end, float *ta, float *tb) {
+  float ix = 1.0f / d.x, iy = 1.0f / d.y, iz = 1.0f / d.z;
+  float t0x = (m.lo.x - o.x) * ix, t1x = (m.hi.x - o.x) * ix;
+  float t0y = (m.lo.y - o.y) * iy, t1y = (m.hi.y - o.y) * iy;
+  float t0z = (m.lo.z - o.z) * iz, t1z = (m.hi.z - o.z) * iz;
+  *ta = fmaxf(fmaxf(fmaxf(fminf(t0x, t1x), fminf(t0y, t1y)), fminf(t0z, t1z)), 0.0f);
+  *tb = fminf(fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z)), t_end);
+}
+
+// The density at height y: 1, or e^(-(y - lo.y) / H).
+static __device__ __forceinline__ float medium_density(const Medium &m, float y) {
+  return m.c.z > 0.0f ? exp_neg(-fmaxf(y - m.lo.y, 0.0f) * m.c.z) : 1.0f;
+}
+
+// The density's integral along o + t d over [ta, tb] (inside the box): tb - ta,
+// or for the exponential density rho_max len (1 - e^(-x)) / x with x = |d.y| len / H
+// and rho_max the density at the lower end (a series below x = 1e-3).
+static __device__ __forceinline__ float medium_depth(const Medium &m, V3 o, V3 d, float ta, float tb) {
+  if (!(ta < tb)) return 0.0f;
+  float len = tb - ta;
+  if (!(m.c.z > 0.0f)) return len;
+  float ya = o.y + ta * d.y, yb = o.y + tb * d.y;
+  float rho = medium_density(m, fminf(ya, yb));
+  float x = fabsf(d.y) * m.c.z * len;
+  float f = x < 1e-3f ? 1.0f - x * (0.5f - x * (1.0f / 6.0f)) : (1.0f - exp_neg(-x)) / x;
+  return rho * len * f;
+}
+
+// Beer's law along a shadow ray from x in unit direction w to distance dist.
+static __device__ __forceinline__ float medium_transmittance(const Medium &m, V3 x, V3 w, float dist) {
+  float ta, tb;
+  medium_span(m, x, w, dist, &ta, &tb);
+  return exp_neg(-(m.c.x + m.c.y) * medium_depth(m, x, w, ta, tb));
+}
+
+// Henyey-Greenstein (003:L365) for the cosine c between the light's and the
+// viewer's direction of travel: (1 - g^2) / (4 pi (1 + g^2 - 2 g c)^(3/2)).
+static __device__ __forceinline__ float hg(float g, float c) {
+  float den = 1.0f + g * g - 2.0f * g * c;
+  return (1.0f - g * g) * (0.25f * INV_PI) / (den * sqrtf(den));
+}
+
+// A surface's light sample g, attenuated along its shadow ray.
+static __device__ __forceinline__ float attenuate(const Medium &m, float g, V3 x, V3 w, float dist) {
+  return g * medium_transmittance(m, x, w, dist);
+}
+
+// The march of the segment o + t d, t in [0, t_end], of a path after P.bounce
+// bounces: the in-scattered and emitted light (if P.bounce < max bounces) into
+// P.L, the segment's transmittance into the mask.
+template <class K>
+static __device__ __forceinline__ void march(const Scene &s, Path &P, K key, const Medium &m, V3 o, V3 d,
+                                             float t_end) {
+  const Params *p = s.p;
+  float ta, tb;
+  medium_span(m, o, d, t_end, &ta, &tb);
+  if (!(ta < tb)) return;
+  float sigma_t = m.c.x + m.c.y, dt = m.lo.w;
+  if (P.bounce < p->max_bounces) {
+    unsigned dim = MEDIUM_DIMS + MEDIUM_DIMS_PER_BOUNCE * (unsigned)P.bounce;
+    float u = rng(key, dim);
+    V3 sum = v3(0.0f, 0.0f, 0.0f);
+    for (int k = 0; k < MEDIUM_MAX_STEPS; k++) {
+      unsigned dk = dim + 4u * (unsigned)k + 1u;
+      float uk = m.c.w > 0.0f ? rng(key, dk) : u;
+      float t = ta + ((float)k + uk) * dt;
+      if (!(t < tb)) break;
+      V3 x = add3(o, scale3(d, t));
+      float rho = medium_density(m, x.y);
+      V3 src = scale3(v3(m.e.x, m.e.y, m.e.z), rho);
+      if (p->num_lights > 0) {
+        int ltri;
+        V3 q = light_point(s, key, dk + 1u, &ltri);
+        V3 wl = sub3(q, x);
+        float dist2 = dot3(wl, wl);
+        float dist = sqrtf(dist2);
+        wl = scale3(wl, 1.0f / dist);
+        float4 ld = s.tri_data[ltri];
+        float cos_l = -dot3(v3(ld.x, ld.y, ld.z), wl);
+        float ts;
+        if (cos_l > 0.0f && trace(s, x, wl, p->eps, dist - p->eps, true, &ts) < 0) {
+          float4 le = s.mats[3 * __float_as_int(ld.w) + 1];
+          float w = m.c.y * rho * hg(m.hi.w, dot3(wl, d)) * cos_l * p->light_area / dist2;
+          w = w * medium_transmittance(m, x, wl, dist);
+          src = add3(src, scale3(v3(le.x, le.y, le.z), w));
+        }
+      }
+      sum = add3(sum, scale3(src, exp_neg(-sigma_t * medium_depth(m, o, d, ta, t))));
+    }
+    P.L = add3(P.L, mul3(P.beta, scale3(sum, dt)));
+  }
+  P.beta = scale3(P.beta, exp_neg(-sigma_t * medium_depth(m, o, d, ta, tb)));
+}
+
 // One level of the inner loop (003:L119) for one path: trace its ray, gather
 // emission and the light sample, pick the next direction, Russian roulette.
 // False when the path ends (missed, hit an emitter, the longest path, or
 // terminated); P then holds its final radiance.
-template <class K>
-static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key) {
+// M: NoMedium, or the Medium of volume_frame (march(), attenuate()).
+template <class K, class M = NoMedium>
+static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, const M &med = M()) {
   const Params *p = s.p;
   int integrator = p->integrator;
   int bounce = P.bounce;
   V3 o = P.o, d = P.d;
   float t;
   int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
+  march(s, P, key, med, o, d, tri < 0 ? __int_as_float(0x7f800000) : t);
   if (tri < 0) {
     // the environment: not light-sampled, so its radiance counts in full after any bounce
     if (p->env_w > 0) P.L = add3(P.L, mul3(P.beta, env(s, d)));
@@ -777,7 +911,7 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key) {
         float light_pdf = dist2 / (cos_l * p->light_area);
         float w = 1.0f;
         if (integrator != INTEGRATOR_NEE) w = mis_weight(integrator, light_pdf, bsdf_pdf);
-        float g = fs / light_pdf * w;
+        float g = attenuate(med, fs / light_pdf * w, hitp, wl, dist);
         P.L = add3(P.L, scale3(mul3(mul3(P.beta, fc), v3(le.x, le.y, le.z)), g));
       }
     }
@@ -806,20 +940,37 @@ static __device__ __forceinline__ void finish(float *accum, float *last, int i, 
   l[2] = L.z;
 }
 
+// One thread's path of a megakernel frame, run to the end with medium m (or none).
+template <class M>
+static __device__ __forceinline__ void frame_path(const Scene &s, float *accum, float *last, const M &m) {
+  const Params *p = s.p;
+  int i = (int)WL_TID;
+  if (i >= p->num_paths) return;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  Path P = camera_path(p, i, key);
+  while (step(s, P, key, m)) {
+  }
+  finish(accum, last, i, P.L);
+}
+
 // The megakernel: one launch per frame, each thread runs its path to the end.
 extern "C" __global__ void path_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
                                       const float4 *tris, const float4 *tri_data, const float4 *mats,
                                       const float4 *lights, const float4 *boxes, const float4 *env, float *accum,
                                       float *last) {
   Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
-  const Params *p = params;
-  int i = (int)WL_TID;
-  if (i >= p->num_paths) return;
-  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
-  Path P = camera_path(p, i, key);
-  while (step(s, P, key)) {
-  }
-  finish(accum, last, i, P.L);
+  frame_path(s, accum, last, NoMedium());
+}
+
+// The megakernel with a participating medium (§5.2): path_frame's paths, each
+// ray segment marched through the medium (march()); medium[0..3] as Medium.
+extern "C" __global__ void volume_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                        const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                        const float4 *lights, const float4 *boxes, const float4 *env,
+                                        const float4 *medium, float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  Medium m = {medium[0], medium[1], medium[2], medium[3]};
+  frame_path(s, accum, last, m);
 }
 
 // ---- Bidirectional path tracing (§4.7, 003:L295-308): bdpt_frame ----

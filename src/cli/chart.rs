@@ -56,6 +56,46 @@ The JSON:
    \"series\": [{\"name\": \"method A\", \"points\": [[0.5, 0.1], [1.0, 0.05]]}]}
 log_x, log_y (logarithmic axes) and connect (join each series' points in order) are optional.")]
     Scatter(ScatterArgs),
+    /// Thesis 003's volume march (§5.2): variance against step count, Pauly's
+    /// stratified offset (one a ray) against a random point in each step.
+    ///
+    /// Renders the medium scene natively (nee) with each pattern at each step
+    /// count (steps across the medium box's diagonal) and plots a pixel's
+    /// variance over frames, averaged over the pixels, log-log (003:L367:
+    /// the stratified pattern "can be shown to have a lower variance").
+    #[command(after_help = "\
+Example:
+  warplight chart media --scene smog-room --size 16 --frames 64 -o march.svg")]
+    Media(MediaArgs),
+}
+
+/// Options of `warplight chart media`.
+#[derive(Debug, clap::Args)]
+pub struct MediaArgs {
+    /// A scene with a `[medium]` (scenes/ name or path).
+    #[arg(long, default_value = "smog-room")]
+    pub scene: String,
+    /// Image width and height in pixels.
+    #[arg(long, default_value_t = 16)]
+    pub size: u32,
+    /// Frames (4 paths a pixel each) per measurement.
+    #[arg(long, default_value_t = 64)]
+    pub frames: u32,
+    /// The longest path in bounces (1: the camera ray's march and direct light only).
+    #[arg(long, default_value_t = 1)]
+    pub bounces: u32,
+    /// Step counts across the medium box's diagonal, comma-separated.
+    #[arg(long, default_value = "2,4,8,16,32,64", value_delimiter = ',')]
+    pub steps: Vec<u32>,
+    /// Seed of the random numbers.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    /// Output .svg or .png.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Size in pixels, WIDTHxHEIGHT (default 960x540).
+    #[arg(long)]
+    pub chart_size: Option<String>,
 }
 
 /// Which columns of a table to chart.
@@ -139,7 +179,43 @@ pub fn run(a: ChartArgs) -> Result<(), Box<dyn std::error::Error>> {
         ChartCommand::Table(t) => table(t),
         ChartCommand::Flight(f) => flight(f),
         ChartCommand::Scatter(s) => scatter(s),
+        ChartCommand::Media(m) => media(m),
     }
+}
+
+fn media(a: MediaArgs) -> Result<(), Box<dyn std::error::Error>> {
+    use crate::host::scene::Jitter;
+    let size = parse_size(a.chart_size.as_deref())?;
+    Format::of(&a.output)?;
+    if a.steps.is_empty() || a.steps.contains(&0) || a.size == 0 {
+        return Err("--steps: expected positive step counts; --size: positive".into());
+    }
+    let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
+    let v = crate::repro::lin2017::media::march_variance(&scene, a.size, a.frames, a.bounces, &a.steps, a.seed)?;
+    let series =
+        [(Jitter::Stratified, "stratified: one offset a ray (Pauly)"), (Jitter::PerStep, "random point in each step")]
+            .into_iter()
+            .map(|(j, name)| Series {
+                name: name.into(),
+                points: v.iter().filter(|m| m.jitter == j).map(|m| (m.steps as f64, m.variance)).collect(),
+            })
+            .collect();
+    for m in &v {
+        println!("{:?} steps {}: variance {:.6e}, mean {:.6}", m.jitter, m.steps, m.variance, m.mean);
+    }
+    let chart = Scatter {
+        title: format!(
+            "{}: variance vs march steps ({}x{}, {} frames, nee, {} bounce(s); measured)",
+            scene.name, a.size, a.size, a.frames, a.bounces
+        ),
+        x_label: "steps across the medium's box".into(),
+        y_label: "pixel variance over frames".into(),
+        log_x: true,
+        log_y: true,
+        connect: true,
+        series,
+    };
+    write(&Chart::Scatter(chart), &a.output, size)
 }
 
 fn parse_size(s: Option<&str>) -> Result<Option<(u32, u32)>, String> {

@@ -76,6 +76,10 @@ pub struct RenderArgs {
     /// or mlt (Metropolis light transport in primary sample space over bdpt: one chain a
     /// pixel, 16 bootstrap samples a pixel for b, large steps with probability 0.25,
     /// --spp mutations a pixel; consistent, with start-up bias in early frames).
+    /// A scene with a `[medium]` (participating media, §5.2: smog-room, fog-box) is
+    /// marched by pt, nee and mis (kernel volume_frame: steps of the scene's `step`
+    /// with one random offset a ray, Beer's law, single scattering from direct
+    /// light with a shadow ray at each sample); bdpt and mlt refuse it.
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
@@ -486,7 +490,11 @@ fn run_path(
     if let Some((w, t)) = r.instructions {
         println!(
             "  emulated {}: {w} warp instructions, {t} thread instructions",
-            crate::host::path::kernel::entry(integrator)
+            if scene.medium.is_some() {
+                crate::host::path::kernel::VOLUME_KERNEL
+            } else {
+                crate::host::path::kernel::entry(integrator)
+            }
         );
     }
     println!("  wrote {}", a.output.display());

@@ -186,6 +186,42 @@ pub struct Scene {
     /// approximation (a material past the end: Schlick's). Only thesis 003's
     /// path tracer reads it.
     pub exact_fresnel: Vec<bool>,
+    /// A participating medium (a scene file's `[medium]`; §5.2 of thesis
+    /// 003). Only thesis 003's path tracer reads it.
+    pub medium: Option<Medium>,
+}
+
+/// How the march places its samples in the steps of a ray (thesis 003, 003:L367).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum Jitter {
+    /// Pauly's stratified pattern: one random offset for every step of a ray.
+    Stratified,
+    /// A random point in each step ("normal Monte Carlo sampling").
+    PerStep,
+}
+
+/// A participating medium (thesis 003 §5.2): grey absorption and scattering
+/// coefficients at unit density, the Henyey-Greenstein asymmetry `g`, RGB
+/// emission per unit length at unit density, an optional exponential height
+/// falloff, the region it fills and the march's step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Medium {
+    /// Absorption coefficient σ_a (per unit length).
+    pub sigma_a: f32,
+    /// Scattering coefficient σ_s.
+    pub sigma_s: f32,
+    /// Henyey-Greenstein asymmetry, in (−1, 1).
+    pub g: f32,
+    /// Emission L_ve per unit length (RGB).
+    pub emission: [f32; 3],
+    /// Scale height H of the density e^(−(y − lo.y)/H); `None`: uniform density.
+    pub height_scale: Option<f32>,
+    /// The box it fills (lo, hi); `None`: the scene's bounds.
+    pub region: Option<([f32; 3], [f32; 3])>,
+    /// The march's step Δt.
+    pub step: f32,
+    /// Where the samples sit in each step.
+    pub jitter: Jitter,
 }
 
 impl Scene {
@@ -269,6 +305,7 @@ impl Scene {
             roughness: Vec::new(),
             environment: None,
             exact_fresnel: Vec::new(),
+            medium: None,
         }
     }
 

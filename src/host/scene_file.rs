@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::camera::{Camera, Flight};
 use super::procedural;
-use super::scene::{Light, Material, MaterialKind, Scene, Surface, Texture, ThesisScene, Triangle};
+use super::scene::{Jitter, Light, Material, MaterialKind, Medium, Scene, Surface, Texture, ThesisScene, Triangle};
 
 /// A scene file that could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -200,6 +200,110 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32, bool),
     Ok((m, roughness, exact))
 }
 
+/// The line of `key` in the `[medium]` table of `text` (1-based; the table's header line if
+/// the key is not written there), for the medium's errors.
+fn medium_line(text: &str, key: &str) -> usize {
+    let mut header = 0;
+    for (i, l) in text.lines().enumerate() {
+        let l = l.trim();
+        if l.starts_with('[') {
+            if header > 0 {
+                break;
+            }
+            if l == "[medium]" {
+                header = i + 1;
+            }
+        } else if header > 0 && l.split('=').next().map(str::trim) == Some(key) {
+            return i + 1;
+        }
+    }
+    header
+}
+
+/// The most march steps across the medium's box (its diagonal over the step): the
+/// kernel's `MEDIUM_MAX_STEPS` per ray segment.
+pub const MAX_MEDIUM_STEPS: f32 = 1023.0;
+
+/// A participating medium (`[medium]`, thesis 003 §5.2; `docs/scenes.md`).
+fn medium(cx: &Cx, m: &toml::Table, text: &str) -> Result<Medium, SceneError> {
+    let at = |key: &str| format!("medium.{key} (line {})", medium_line(text, key));
+    let bad = |key: &str, msg: String| -> Result<Medium, SceneError> { cx.err(&at(key), msg) };
+    for k in m.keys() {
+        if !["sigma_a", "sigma_s", "g", "emission", "height_scale", "box", "step", "jitter"].contains(&k.as_str()) {
+            return bad(
+                k,
+                format!("unknown key `{k}`; expected sigma_a, sigma_s, g, emission, height_scale, box, step or jitter"),
+            );
+        }
+    }
+    let num = |key: &str, default: Option<f32>| -> Result<f32, SceneError> {
+        match (m.get(key), default) {
+            (None, Some(d)) => Ok(d),
+            (None, None) => cx.err(&at(key), "missing; expected a number"),
+            (Some(v), _) => cx.num(v, &at(key)),
+        }
+    };
+    let (sigma_a, sigma_s, g, step) =
+        (num("sigma_a", None)?, num("sigma_s", None)?, num("g", Some(0.0))?, num("step", None)?);
+    for (k, v) in [("sigma_a", sigma_a), ("sigma_s", sigma_s)] {
+        if v < 0.0 {
+            return bad(k, format!("{v} is negative; expected a coefficient >= 0 (per unit length)"));
+        }
+    }
+    if !(g > -1.0 && g < 1.0) {
+        return bad("g", format!("{g}: the Henyey-Greenstein asymmetry must lie strictly between -1 and 1"));
+    }
+    let emission = match m.get("emission") {
+        None => [0.0; 3],
+        Some(toml::Value::Array(a)) if a.len() == 3 => {
+            [cx.num(&a[0], &at("emission"))?, cx.num(&a[1], &at("emission"))?, cx.num(&a[2], &at("emission"))?]
+        }
+        Some(_) => return bad("emission", "expected [r, g, b]".into()),
+    };
+    if emission.iter().any(|&e| e < 0.0) {
+        return bad("emission", "expected emission >= 0".into());
+    }
+    let height_scale = m.get("height_scale").map(|v| cx.num(v, &at("height_scale"))).transpose()?;
+    if let Some(h) = height_scale
+        && h <= 0.0
+    {
+        return bad("height_scale", format!("{h}: expected a scale height > 0"));
+    }
+    let region = match m.get("box") {
+        None => None,
+        Some(toml::Value::Table(b)) => {
+            let lo = cx.vec3(b, "lo", &at("box"), None)?;
+            let hi = cx.vec3(b, "hi", &at("box"), None)?;
+            if (0..3).any(|k| lo[k] >= hi[k]) {
+                return bad("box", format!("lo {lo:?} must lie below hi {hi:?} on every axis"));
+            }
+            Some((lo, hi))
+        }
+        Some(_) => return bad("box", "expected { lo = [x, y, z], hi = [x, y, z] }".into()),
+    };
+    if step <= 0.0 {
+        // finite: num() refuses NaN
+        return bad("step", format!("{step}: expected a march step > 0"));
+    }
+    if let Some((lo, hi)) = region {
+        let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f32>().sqrt();
+        if diag / step > MAX_MEDIUM_STEPS {
+            return bad(
+                "step",
+                format!("{step}: the box's diagonal {diag} needs more than {MAX_MEDIUM_STEPS} steps a ray"),
+            );
+        }
+    }
+    let jitter = match m.get("jitter").map(|v| v.as_str()) {
+        None | Some(Some("stratified")) => Jitter::Stratified,
+        Some(Some("random")) => Jitter::PerStep,
+        Some(_) => {
+            return bad("jitter", "expected \"stratified\" (one offset a ray) or \"random\" (one a step)".into());
+        }
+    };
+    Ok(Medium { sigma_a, sigma_s, g, emission, height_scale, region, step, jitter })
+}
+
 /// Loads a scene description.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let file = path.display().to_string();
@@ -304,6 +408,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         }
         scene.environment = Some(file);
     }
+    scene.medium = cx.table(&t, "medium")?.map(|m| medium(&cx, m, &text)).transpose()?;
     scene.variant = t.get("variant").and_then(|v| v.as_str()).unwrap_or("").to_string();
     if let Some(th) = cx.table(&t, "thesis")? {
         let triangles = match th.get("triangles").and_then(|v| v.as_integer()) {

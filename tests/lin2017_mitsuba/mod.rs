@@ -45,6 +45,8 @@ pub fn scene_of(name: &str, size: u32) -> (Scene, PathScene, Camera) {
 }
 
 /// Frames of `size` x `size` pixels, 16 bounces, the short stack.
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
 pub fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
     FrameParams { width: size, height: size, integrator, max_bounces: 16, seed, traversal: Traversal::ShortStack }
 }

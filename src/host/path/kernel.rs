@@ -27,6 +27,15 @@ pub fn entry(integrator: super::Integrator) -> &'static str {
         _ => KERNEL,
     }
 }
+/// The entry point with a participating medium (pt, nee, mis; §5.2).
+pub const VOLUME_KERNEL: &str = "volume_frame";
+
+/// The entry point that renders `integrator` on `scene`: [`VOLUME_KERNEL`]
+/// when it has a medium, else [`entry`].
+pub fn entry_for(scene: &PathScene, integrator: super::Integrator) -> &'static str {
+    if scene.medium.is_some() { VOLUME_KERNEL } else { entry(integrator) }
+}
+
 /// Threads per CTA.
 pub const THREADS: u32 = 256;
 /// Warp instructions per path the watchdog allows one launch (a path of the
@@ -170,7 +179,9 @@ pub fn render(
     let n = params.paths() * 3;
     let accum = dev.alloc_zeroed::<f32>(n);
     let last = dev.alloc_zeroed::<f32>(n);
-    let args: Vec<Arg> = bufs.scene_args().into_iter().chain([accum, last]).map(Arg::Ptr).collect();
+    // volume_frame takes the medium between the scene and the buffers
+    let medium = scene.medium.map(|m| upload(dev, &to_bytes(&m), "medium")).transpose()?;
+    let args: Vec<Arg> = bufs.scene_args().into_iter().chain(medium).chain([accum, last]).map(Arg::Ptr).collect();
     let ctas = params.paths().div_ceil(THREADS as usize) as u32;
     let mut out = Progressive::new(params.width, params.height);
     let mut totals = Counters::default();
@@ -179,7 +190,7 @@ pub fn render(
     let mut events = Counts::default();
     for f in 0..frames {
         dev.write(pp, &params_bytes(scene, camera, &params, f))?;
-        let st = dev.launch(module, entry(params.integrator), LaunchConfig::linear(ctas, THREADS), &args)?;
+        let st = dev.launch(module, entry_for(scene, params.integrator), LaunchConfig::linear(ctas, THREADS), &args)?;
         totals.merge(&st.totals);
         if counted {
             events.add(&Counts::from_tags(&counts::tagged(&module.prog, &st.profile, &tags)));

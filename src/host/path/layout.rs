@@ -39,6 +39,22 @@ pub enum LayoutError {
         "scene `{0}` has no emitting triangle and no environment: the path tracer needs an area light (an emitter material) or an `environment` map"
     )]
     NoLight(String),
+    /// The medium's march needs more steps a ray than the kernel takes.
+    #[error(
+        "the medium's step {step} needs {steps:.0} steps across the scene's box; at most {} (raise `medium.step`)",
+        crate::host::scene_file::MAX_MEDIUM_STEPS
+    )]
+    MediumSteps {
+        /// The step.
+        step: f32,
+        /// The box's diagonal over the step.
+        steps: f32,
+    },
+    /// An integrator that does not march the medium.
+    #[error(
+        "scene `{0}` has a participating medium, which only pt, nee, mis and mis-power march (volume_frame); not {1}"
+    )]
+    MediumIntegrator(String, &'static str),
     /// The environment map could not be read or is not one.
     #[error("environment map {path}: {msg}")]
     Environment {
@@ -103,6 +119,10 @@ pub struct PathScene {
     pub light_area: f32,
     /// The environment map seen by rays that miss every triangle (§5.4), if any.
     pub env: Option<Environment>,
+    /// The participating medium (§5.2), as `volume_frame` reads it: [lo, Δt],
+    /// [hi, g], [σ_a, σ_s, 1/H (0: uniform density), 1 for an offset per
+    /// step (0: one a ray)], [L_ve, 0]; `None`: no medium (`path_frame`).
+    pub medium: Option<[f32; 16]>,
     /// Scene bounds (the root's box).
     pub lo: [f32; 3],
     /// Scene bounds.
@@ -220,7 +240,28 @@ impl PathScene {
                 [v[0].x, v[0].y, v[0].z, cdf, e1.x, e1.y, e1.z, f32::from_bits(i as u32), e2.x, e2.y, e2.z, 0.0]
             })
             .collect();
+        let medium = match scene.medium {
+            None => None,
+            Some(m) => {
+                let (lo, hi) = m.region.unwrap_or((tree.bounds.lo.into(), tree.bounds.hi.into()));
+                let diag = (0..3).map(|k| (hi[k] - lo[k]).max(0.0).powi(2)).sum::<f32>().sqrt();
+                if diag / m.step > crate::host::scene_file::MAX_MEDIUM_STEPS {
+                    return Err(LayoutError::MediumSteps { step: m.step, steps: diag / m.step });
+                }
+                let per_step = if m.jitter == crate::host::scene::Jitter::PerStep { 1.0 } else { 0.0 };
+                let [er, eg, eb] = m.emission;
+                #[rustfmt::skip]
+                let v = [
+                    lo[0], lo[1], lo[2], m.step,
+                    hi[0], hi[1], hi[2], m.g,
+                    m.sigma_a, m.sigma_s, m.height_scale.map_or(0.0, |h| 1.0 / h), per_step,
+                    er, eg, eb, 0.0,
+                ];
+                Some(v)
+            }
+        };
         Ok(PathScene {
+            medium,
             nodes,
             up,
             refs,
@@ -233,6 +274,16 @@ impl PathScene {
             lo: tree.bounds.lo.into(),
             hi: tree.bounds.hi.into(),
         })
+    }
+}
+
+impl PathScene {
+    /// Refuses an integrator that ignores the scene's medium (bdpt, mlt).
+    pub fn check_integrator(&self, name: &str, integrator: super::Integrator) -> Result<(), LayoutError> {
+        if self.medium.is_some() && matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt) {
+            return Err(LayoutError::MediumIntegrator(name.to_string(), integrator.name()));
+        }
+        Ok(())
     }
 }
 

@@ -513,7 +513,12 @@ impl Tracer<'_> {
         let mut bsdf_pdf = 0.0f32;
         let mut bounce = 0u32;
         while bounce <= p.max_bounces {
-            let Some((tri, t)) = self.trace(o, d, cam.eps, f32::INFINITY, false, counts) else {
+            let hit = self.trace(o, d, cam.eps, f32::INFINITY, false, counts);
+            if let Some(m) = &s.medium {
+                let t_end = hit.map_or(f32::INFINITY, |h| h.1);
+                self.march(m, key, bounce, (o, d), t_end, (&mut l, &mut beta), counts);
+            }
+            let Some((tri, t)) = hit else {
                 // the environment: not light-sampled, its radiance counts in full after any bounce
                 if let Some(env) = &s.env {
                     let e = env.radiance([d.x, d.y, d.z]);
@@ -577,7 +582,10 @@ impl Tracer<'_> {
                         if integrator != Integrator::Nee {
                             wgt = self.mis_weight(light_pdf, bsdf_pdf_l);
                         }
-                        let g = fs / light_pdf * wgt;
+                        let mut g = fs / light_pdf * wgt;
+                        if let Some(m) = &s.medium {
+                            g *= medium_transmittance(m, hitp, wl, dist);
+                        }
                         l = l.add(beta.mul(fc).mul(le).scale(g));
                     }
                 }
@@ -606,6 +614,64 @@ impl Tracer<'_> {
             bounce += 1;
         }
         [l.x, l.y, l.z]
+    }
+
+    /// The kernel's `march`: the segment `o + t d`, t in [0, `t_end`], of a path
+    /// after `bounce` bounces through the medium `m` (`PathScene::medium`):
+    /// in-scattered and emitted light into `l` (if `bounce` < max bounces),
+    /// the segment's transmittance into the mask `beta`.
+    #[allow(clippy::too_many_arguments)]
+    fn march<S: Sample>(
+        &self,
+        m: &[f32; 16],
+        key: S,
+        bounce: u32,
+        (o, d): (V3, V3),
+        t_end: f32,
+        (l, beta): (&mut V3, &mut V3),
+        counts: &mut Counts,
+    ) {
+        let s = self.scene;
+        let eps = self.frame.eps;
+        let (ta, tb) = medium_span(m, o, d, t_end);
+        if !(ta < tb) {
+            return;
+        }
+        let (sigma_t, dt) = (m[8] + m[9], m[3]);
+        if bounce < self.params.max_bounces {
+            let dim = MEDIUM_DIMS + MEDIUM_DIMS_PER_BOUNCE * bounce;
+            let u = key.at(dim);
+            let mut sum = v3(0.0, 0.0, 0.0);
+            for k in 0..MEDIUM_MAX_STEPS {
+                let dk = dim + 4 * k + 1;
+                let uk = if m[11] > 0.0 { key.at(dk) } else { u };
+                let t = ta + (k as f32 + uk) * dt;
+                if !(t < tb) {
+                    break;
+                }
+                let x = o.add(d.scale(t));
+                let rho = medium_density(m, x.y);
+                let mut src = xyz(m, 12).scale(rho);
+                if !s.lights.is_empty() {
+                    let (lg, q) = self.light_point(key, dk + 1);
+                    let mut wl = q.sub(x);
+                    let dist2 = wl.dot(wl);
+                    let dist = dist2.sqrt();
+                    wl = wl.scale(1.0 / dist);
+                    let ld = s.tri_data[lg[7].to_bits() as usize];
+                    let cos_l = -v3(ld[0], ld[1], ld[2]).dot(wl);
+                    if cos_l > 0.0 && self.trace(x, wl, eps, dist - eps, true, counts).is_none() {
+                        let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
+                        let mut w = m[9] * rho * hg(m[7], wl.dot(d)) * cos_l * s.light_area / dist2;
+                        w *= medium_transmittance(m, x, wl, dist);
+                        src = src.add(le.scale(w));
+                    }
+                }
+                sum = sum.add(src.scale(exp_neg(-sigma_t * medium_depth(m, o, d, ta, t))));
+            }
+            *l = l.add(beta.mul(sum.scale(dt)));
+        }
+        *beta = beta.scale(exp_neg(-sigma_t * medium_depth(m, o, d, ta, tb)));
     }
 
     /// The next direction at a hit (`d` in, the sampled direction out) and the
@@ -758,6 +824,60 @@ impl Tracer<'_> {
     }
 }
 
+/// The medium's first random dimension (the kernel's `MEDIUM_DIMS`): a
+/// segment after b bounces draws from `MEDIUM_DIMS + MEDIUM_DIMS_PER_BOUNCE b`.
+pub const MEDIUM_DIMS: u32 = 0x10_0000;
+/// The medium's random dimensions per bounce.
+pub const MEDIUM_DIMS_PER_BOUNCE: u32 = 0x1000;
+/// The most march steps per ray segment (the kernel's `MEDIUM_MAX_STEPS`).
+pub const MEDIUM_MAX_STEPS: u32 = 1023;
+
+/// The part (ta, tb) of the ray `o + t d`, t in [0, `t_end`], inside the
+/// medium's box: the kernel's `medium_span`.
+fn medium_span(m: &[f32; 16], o: V3, d: V3, t_end: f32) -> (f32, f32) {
+    let (ix, iy, iz) = (1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+    let (t0x, t1x) = ((m[0] - o.x) * ix, (m[4] - o.x) * ix);
+    let (t0y, t1y) = ((m[1] - o.y) * iy, (m[5] - o.y) * iy);
+    let (t0z, t1z) = ((m[2] - o.z) * iz, (m[6] - o.z) * iz);
+    let ta = fmax(fmax(fmax(fmin(t0x, t1x), fmin(t0y, t1y)), fmin(t0z, t1z)), 0.0);
+    let tb = fmin(fmin(fmin(fmax(t0x, t1x), fmax(t0y, t1y)), fmax(t0z, t1z)), t_end);
+    (ta, tb)
+}
+
+/// The density at height `y`: the kernel's `medium_density`.
+pub fn medium_density(m: &[f32; 16], y: f32) -> f32 {
+    if m[10] > 0.0 { exp_neg(-fmax(y - m[1], 0.0) * m[10]) } else { 1.0 }
+}
+
+/// The density's integral along `o + t d` over [ta, tb]: the kernel's `medium_depth`.
+fn medium_depth(m: &[f32; 16], o: V3, d: V3, ta: f32, tb: f32) -> f32 {
+    if !(ta < tb) {
+        return 0.0;
+    }
+    let len = tb - ta;
+    if !(m[10] > 0.0) {
+        return len;
+    }
+    let (ya, yb) = (o.y + ta * d.y, o.y + tb * d.y);
+    let rho = medium_density(m, fmin(ya, yb));
+    let x = d.y.abs() * m[10] * len;
+    let f = if x < 1e-3 { 1.0 - x * (0.5 - x * (1.0 / 6.0)) } else { (1.0 - exp_neg(-x)) / x };
+    rho * len * f
+}
+
+/// Beer's law along a shadow ray: the kernel's `medium_transmittance`.
+fn medium_transmittance(m: &[f32; 16], x: V3, w: V3, dist: f32) -> f32 {
+    let (ta, tb) = medium_span(m, x, w, dist);
+    exp_neg(-(m[8] + m[9]) * medium_depth(m, x, w, ta, tb))
+}
+
+/// Henyey-Greenstein for the cosine `c` between the light's and the viewer's
+/// direction of travel: the kernel's `hg`.
+pub fn hg(g: f32, c: f32) -> f32 {
+    let den = 1.0 + g * g - 2.0 * g * c;
+    (1.0 - g * g) * (0.25 * INV_PI) / (den * den.sqrt())
+}
+
 /// Russian roulette on the bounce's mask `wgt` = f cos / p: the kernel's
 /// `roulette` (continue with q = its max RGB, then divide by q).
 fn roulette<S: Sample>(beta: &mut V3, wgt: V3, key: S, dim: u32) -> bool {
@@ -904,6 +1024,65 @@ mod tests {
         }
         assert_eq!(exp_neg(0.0), 1.0);
         assert_eq!(exp_neg(-100.0), 0.0);
+    }
+
+    /// Henyey-Greenstein is a distribution over the sphere (∫ p dω = 1)
+    /// whose mean cosine is g, and 1 / 4π for g = 0 (midpoint rule in θ).
+    #[test]
+    fn henyey_greenstein_integrates_to_one_with_mean_cosine_g() {
+        for g in [-0.5f32, 0.0, 0.3, 0.7] {
+            let n = 40_000;
+            let h = std::f64::consts::PI / n as f64;
+            let (mut total, mut mean) = (0.0f64, 0.0f64);
+            for i in 0..n {
+                let th = (i as f64 + 0.5) * h;
+                let w = hg(g, th.cos() as f32) as f64 * th.sin() * 2.0 * std::f64::consts::PI * h;
+                total += w;
+                mean += w * th.cos();
+            }
+            assert!((total - 1.0).abs() < 2e-3, "g {g}: {total}");
+            assert!((mean - g as f64).abs() < 2e-3, "g {g}: mean cosine {mean}");
+        }
+        assert!((hg(0.0, 0.3) - 0.25 / std::f32::consts::PI).abs() < 1e-7);
+    }
+
+    /// The optical depth per unit σ_t: the segment's length inside the box
+    /// for a uniform density; for e^(−(y − lo.y)/H) the closed form equals
+    /// a fine midpoint sum along the ray, steep, shallow (the series branch)
+    /// and horizontal; Beer's law on the shadow ray is e^(−σ_t depth).
+    #[test]
+    fn the_optical_depth_is_the_densitys_integral() {
+        let mut m = [0.0f32; 16];
+        m[..3].copy_from_slice(&[-1.0, 0.0, -1.0]);
+        m[4..7].copy_from_slice(&[1.0, 2.0, 1.0]);
+        m[8] = 0.5;
+        m[9] = 1.0;
+        let o = v3(-3.0, 0.5, 0.0);
+        let d = v3(1.0, 0.0, 0.0);
+        assert_eq!(medium_span(&m, o, d, f32::INFINITY), (2.0, 4.0));
+        assert_eq!(medium_span(&m, o, d, 3.0), (2.0, 3.0));
+        assert_eq!(medium_depth(&m, o, d, 2.0, 4.0), 2.0);
+        let t = medium_transmittance(&m, o, d, 10.0);
+        assert!((t as f64 - (-1.5f64 * 2.0).exp()).abs() < 1e-6, "{t}");
+        m[10] = 1.0 / 0.5; // H = 0.5
+        for (dir, ta, tb) in [
+            (v3(0.6, 0.8, 0.0), 0.1f32, 2.0f32),
+            (v3(0.6, -0.8, 0.0), 0.0, 0.5),
+            (v3(1.0, 1e-4, 0.0), 0.0, 2.0),
+            (v3(1.0, 0.0, 0.0), 0.0, 2.0),
+        ] {
+            let o = v3(-1.0, 0.5, 0.0);
+            let n = 100_000;
+            let h = (tb - ta) as f64 / n as f64;
+            let want: f64 = (0..n)
+                .map(|i| {
+                    let y = o.y as f64 + (ta as f64 + (i as f64 + 0.5) * h) * dir.y as f64;
+                    (-(y - m[1] as f64).max(0.0) * 2.0).exp() * h
+                })
+                .sum();
+            let got = medium_depth(&m, o, dir, ta, tb) as f64;
+            assert!((got - want).abs() < 1e-5 * want.max(1.0), "{dir:?}: {got} vs {want}");
+        }
     }
 
     /// Beckmann's D is normalised: ∫ D(m) cos θ_m dω_m = 1 (midpoint rule in θ).

@@ -15,6 +15,7 @@
 pub mod fig_16;
 pub mod fig_17;
 pub mod fig_3;
+pub mod media;
 pub mod render;
 pub mod sec_6_4;
 pub mod table_1;

@@ -72,6 +72,7 @@ pub fn render(
         _ => path_build::build(&tris, &path_build::Params::fig3(Construction::Sah, tris.len())),
     };
     let ps = PathScene::new(scene, &tree)?;
+    ps.check_integrator(&scene.name, params.integrator)?;
     let what = format!(
         "{} {} {}x{}",
         if emulated.is_some() { "emulating" } else { "tracing" },
