@@ -24,6 +24,7 @@ use std::cmp::Ordering;
 
 use crate::ptx::ir::{ArithOp, AtomOp, CarryOp, Cmp, FloatMode, Rounding};
 use crate::ptx::types::Ty;
+use crate::sim::decode::Word;
 use crate::sim::half;
 
 /// The canonical f32 NaN of NVIDIA GPUs.
@@ -692,19 +693,20 @@ impl Float for f64 {
 }
 
 /// Evaluates a comparison in all 32 lanes: bit `l` of the result is lane `l`'s
-/// outcome, exactly as [`compare`] gives it. The type and the comparison are
+/// outcome, exactly as [`compare`] gives it (on narrow rows, `W = u32`, of
+/// the lanes zero-extended). The type and the comparison are
 /// dispatched once per warp instead of once per lane (`setp` is the most
 /// frequent instruction of the ray-tracing kernels).
-pub fn compare_lanes(cmp: Cmp, ty: Ty, ftz: bool, a: &[u64; 32], b: &[u64; 32]) -> u32 {
+pub fn compare_lanes<W: Word>(cmp: Cmp, ty: Ty, ftz: bool, a: &[W; 32], b: &[W; 32]) -> u32 {
     #[inline(always)]
-    fn each(a: &[u64; 32], b: &[u64; 32], f: impl Fn(u64, u64) -> bool) -> u32 {
+    fn each<W: Word>(a: &[W; 32], b: &[W; 32], f: impl Fn(u64, u64) -> bool) -> u32 {
         let mut t = 0u32;
         for l in 0..32 {
-            t |= (f(a[l], b[l]) as u32) << l;
+            t |= (f(a[l].wide(), b[l].wide()) as u32) << l;
         }
         t
     }
-    let generic = |a: &[u64; 32], b: &[u64; 32]| each(a, b, |x, y| compare(cmp, ty, ftz, x, y));
+    let generic = |a: &[W; 32], b: &[W; 32]| each(a, b, |x, y| compare(cmp, ty, ftz, x, y));
     #[inline(always)]
     fn unordered<F: Float>(x: F, y: F, f: impl Fn(F, F) -> bool) -> bool {
         x.is_nan() || y.is_nan() || f(x, y)
@@ -910,6 +912,29 @@ pub fn atom(op: AtomOp, ty: Ty, old: u64, b: u64, c: u64) -> u64 {
     r & mask
 }
 
+/// Every comparison, for tests.
+#[cfg(test)]
+pub(crate) const ALL_CMPS: [Cmp; 18] = [
+    Cmp::Eq,
+    Cmp::Ne,
+    Cmp::Lt,
+    Cmp::Le,
+    Cmp::Gt,
+    Cmp::Ge,
+    Cmp::Lo,
+    Cmp::Ls,
+    Cmp::Hi,
+    Cmp::Hs,
+    Cmp::Equ,
+    Cmp::Neu,
+    Cmp::Ltu,
+    Cmp::Leu,
+    Cmp::Gtu,
+    Cmp::Geu,
+    Cmp::Num,
+    Cmp::Nan,
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -940,26 +965,7 @@ mod tests {
             (-0.0f64).to_bits(),
             2.5f64.to_bits(),
         ];
-        let cmps = [
-            Cmp::Eq,
-            Cmp::Ne,
-            Cmp::Lt,
-            Cmp::Le,
-            Cmp::Gt,
-            Cmp::Ge,
-            Cmp::Lo,
-            Cmp::Ls,
-            Cmp::Hi,
-            Cmp::Hs,
-            Cmp::Equ,
-            Cmp::Neu,
-            Cmp::Ltu,
-            Cmp::Leu,
-            Cmp::Gtu,
-            Cmp::Geu,
-            Cmp::Num,
-            Cmp::Nan,
-        ];
+        let cmps = ALL_CMPS;
         let tys = [
             Ty::S8,
             Ty::U8,

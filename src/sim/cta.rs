@@ -118,7 +118,7 @@ impl Cta {
                 let lanes = if n == 32 { u32::MAX } else { (1u32 << n) - 1 };
                 let mut warp = Warp {
                     id: w,
-                    frames: vec![Frame::new(kernel, f, ctx.code.funcs[kernel as usize].rows(), 0, 0, 0)],
+                    frames: vec![Frame::new(kernel, f, ctx.code.funcs[kernel as usize].frame_rows(), 0, 0, 0)],
                     stack: SimtStack { entries: vec![SimtEntry { pc: 0, rpc: EXIT_PC, mask: lanes }] },
                     lanes,
                     live: lanes,
@@ -243,7 +243,7 @@ impl Cta {
                 (BarRedOp::Popc, Some(d)) if d.reg != Dst::SINK => {
                     for l in 0..32 {
                         if r.lanes >> l & 1 != 0 {
-                            fr.regs[d.reg as usize][l] = popc as u64 & d.mask;
+                            fr.set_lane(d.reg as usize, l, popc as u64 & d.mask);
                         }
                     }
                 }

@@ -9,6 +9,14 @@
 //! interpreted from a copy of the IR instructions whose registers are renamed
 //! to frame slots ([`regalloc`](super::regalloc): a frame holds the live
 //! maximum of rows, not one per virtual register).
+//!
+//! Registers of 32 bits or fewer live in narrow rows of 32-bit lanes. An
+//! arithmetic, `cvt`, `mov`, `selp` or `setp` whose destination and register
+//! operands are all narrow gets a narrow form ([`Exec::Lanes32`],
+//! [`Exec::Mov32`], [`Exec::Selp32`], [`Exec::Setp32`]), which reads and
+//! writes 32-bit lanes (half the bytes); the others read a narrow operand
+//! zero-extended and truncate a narrow result, which is what a wide row
+//! would have held.
 
 use std::collections::HashMap;
 
@@ -27,9 +35,59 @@ use super::sfu::{self, SfuModel};
 /// 32 lanes of register bits.
 pub type Lanes = [u64; 32];
 
-/// An arithmetic operation over 32 lanes with its type and modifiers resolved:
-/// `f(a, b, c, out)` writes every lane of `out`.
-pub type LaneFn = fn(&Lanes, &Lanes, &Lanes, &mut Lanes);
+/// 32 lanes of a narrow row (registers of 32 bits or fewer).
+pub type Lanes32 = [u32; 32];
+
+/// A lane's word: `u64` in wide rows, `u32` in narrow ones. A narrow row
+/// holds what a wide one would, truncated: register values of 32 bits or
+/// fewer are zero-extended in wide rows.
+pub trait Word:
+    Copy + Default + std::ops::BitAnd<Output = Self> + std::ops::BitOr<Output = Self> + std::ops::Not<Output = Self>
+{
+    /// Lane functions of 64-bit results exist for this word.
+    const WIDE: bool;
+    /// `x` truncated to the word.
+    fn of(x: u64) -> Self;
+    /// The word zero-extended.
+    fn wide(self) -> u64;
+}
+
+impl Word for u64 {
+    const WIDE: bool = true;
+    #[inline(always)]
+    fn of(x: u64) -> u64 {
+        x
+    }
+    #[inline(always)]
+    fn wide(self) -> u64 {
+        self
+    }
+}
+
+impl Word for u32 {
+    const WIDE: bool = false;
+    #[inline(always)]
+    fn of(x: u64) -> u32 {
+        x as u32
+    }
+    #[inline(always)]
+    fn wide(self) -> u64 {
+        self as u64
+    }
+}
+
+/// An arithmetic operation over 32 lanes of words `W` with its type and
+/// modifiers resolved: `f(a, b, c, out)` writes every lane of `out`.
+pub type LaneFnOf<W> = fn(&[W; 32], &[W; 32], &[W; 32], &mut [W; 32]);
+
+/// A lane function over wide rows.
+pub type LaneFn = LaneFnOf<u64>;
+
+/// A lane function over narrow rows: the wide function's result truncated
+/// to 32 bits, for operands zero-extended from 32 bits (registers) or
+/// truncated to them (constants: every narrow function reads only its
+/// operands' low 32 bits).
+pub type LaneFn32 = LaneFnOf<u32>;
 
 /// A source operand of a compact instruction: a frame slot (below
 /// [`CONST`]), or row `o - CONST` of the function's constant table
@@ -120,6 +178,56 @@ pub enum Exec {
     /// `setp.cmp.ty p|q, a, b` (no combining predicate, not a half pair);
     /// `q` is [`PRED_FALSE`] (never written) when absent.
     Setp {
+        /// Comparison.
+        cmp: Cmp,
+        /// Operand type.
+        ty: Ty,
+        /// `.ftz`.
+        ftz: bool,
+        /// Where the comparison goes.
+        p: PredId,
+        /// Where its negation goes.
+        q: PredId,
+        /// Sources.
+        a: Opnd,
+        /// Sources.
+        b: Opnd,
+    },
+    /// `d = f(a, b, c)` on narrow rows: `d` and the register operands are
+    /// narrow rows (by index among them), the constants rows of
+    /// [`FnCode::consts32`].
+    Lanes32 {
+        /// The 32-lane function.
+        f: LaneFn32,
+        /// Destination (narrow index).
+        d: Dest,
+        /// Sources.
+        a: Opnd,
+        /// Sources.
+        b: Opnd,
+        /// Sources.
+        c: Opnd,
+    },
+    /// `mov d, a` on narrow rows.
+    Mov32 {
+        /// Destination (narrow index).
+        d: Dest,
+        /// Source.
+        a: Opnd,
+    },
+    /// `selp d, a, b, p` on narrow rows.
+    Selp32 {
+        /// Destination (narrow index).
+        d: Dest,
+        /// Where `p` holds.
+        a: Opnd,
+        /// Where it does not.
+        b: Opnd,
+        /// The selector.
+        p: PredSrc,
+    },
+    /// `setp` on narrow rows, of a type of 32 bits or fewer.
+    Setp32 {
         /// Comparison.
         cmp: Cmp,
         /// Operand type.
@@ -253,6 +361,8 @@ pub struct FnCode {
     pub insts: Vec<Inst>,
     /// The constants compact instructions read ([`Opnd`]).
     pub consts: Vec<Lanes>,
+    /// The constants the narrow forms read, truncated to 32 bits.
+    pub consts32: Vec<Lanes32>,
     /// The `add`/`sub` instructions ptxas would contract with a `mul`, by
     /// index ([`contract`]), operands renamed to slots; empty when
     /// contraction is off.
@@ -268,6 +378,12 @@ impl FnCode {
         self.alloc.rows as usize
     }
 
+    /// The (wide, narrow) rows of a register frame of this function.
+    #[inline]
+    pub fn frame_rows(&self) -> (usize, usize) {
+        (self.alloc.wide as usize, (self.alloc.rows - self.alloc.wide) as usize)
+    }
+
     /// The frame row of virtual register `r` (the IR's numbering).
     #[inline]
     pub fn slot(&self, r: RegId) -> usize {
@@ -275,14 +391,45 @@ impl FnCode {
     }
 }
 
-/// Builds a function's constant table while its instructions are compacted.
+/// Builds a function's constant tables while its instructions are compacted.
 #[derive(Default)]
 struct Consts {
     rows: Vec<Lanes>,
     index: HashMap<u64, Opnd>,
+    rows32: Vec<Lanes32>,
+    index32: HashMap<u32, Opnd>,
+    /// The first narrow slot ([`Allocation::wide`]).
+    wide: u16,
 }
 
 impl Consts {
+    /// The narrow form's operand of `s` (renamed): a narrow row's index or a
+    /// constant truncated to 32 bits; `None` for a wide register and what
+    /// [`Consts::opnd`] leaves out.
+    fn opnd32(&mut self, s: Src) -> Option<Opnd> {
+        match s {
+            Src::Reg(r) => Some(r).filter(|&r| r >= self.wide && r < CONST).map(|r| r - self.wide),
+            Src::Imm(v) => {
+                let v = v as u32;
+                if let Some(&o) = self.index32.get(&v) {
+                    return Some(o);
+                }
+                let o = CONST.checked_add(u16::try_from(self.rows32.len()).ok().filter(|&n| n < 0x7FFF)?)?;
+                self.rows32.push([v; 32]);
+                self.index32.insert(v, o);
+                Some(o)
+            }
+            _ => None,
+        }
+    }
+
+    /// The narrow form's destination of `d`: a narrow row (by index), not
+    /// the sink.
+    fn dest32(&self, d: Dst) -> Option<Dest> {
+        let d = Dest::of(d)?;
+        (d.slot != Dest::SINK && d.slot >= self.wide).then(|| Dest { slot: d.slot - self.wide, bits: d.bits })
+    }
+
     /// The compact operand of `s` (renamed): a slot or a constant row;
     /// `None` for special registers and addresses of variables, which are
     /// interpreted.
@@ -359,7 +506,8 @@ impl Code {
                     rename(&mut fz.b);
                     rename(&mut fz.c);
                 }
-                let mut consts = Consts::default();
+                let wide = u16::try_from(alloc.wide).unwrap_or(CONST);
+                let mut consts = Consts { wide, ..Consts::default() };
                 let leaders = counting_leaders(&insts);
                 let ops = insts
                     .iter()
@@ -368,17 +516,14 @@ impl Code {
                     .enumerate()
                     .map(|(k, ((i, info), &leader))| {
                         let fz = fused.get(&(k as u32));
-                        let exec = compact_form(i, fz, opts.sfu, &mut consts).unwrap_or(if fz.is_some() {
-                            Exec::Fused
-                        } else {
-                            Exec::Ir
-                        });
+                        let exec = narrow_form(i, fz, opts.sfu, &mut consts)
+                            .or_else(|| compact_form(i, fz, opts.sfu, &mut consts))
+                            .unwrap_or(if fz.is_some() { Exec::Fused } else { Exec::Ir });
                         let guard = i.guard.unwrap_or(PredSrc { reg: PRED_TRUE, neg: false });
                         Op { exec, guard, class: info.class, leader }
                     })
                     .collect();
-                let consts = consts.rows;
-                FnCode { ops, insts, consts, fused, alloc }
+                FnCode { ops, insts, consts: consts.rows, consts32: consts.rows32, fused, alloc }
             })
             .collect();
         Code { funcs, sfu: opts.sfu }
@@ -396,12 +541,7 @@ fn compact_form(i: &Inst, fz: Option<&Fused>, sfu: SfuModel, consts: &mut Consts
             if *ty != Ty::F32 || mode.ftz || mode.sat {
                 return None;
             }
-            let f: LaneFn = match (fz.neg_product, fz.neg_c) {
-                (false, false) => ffma,
-                (true, false) => ffma_neg_ab,
-                (false, true) => ffma_neg_c,
-                (true, true) => ffma_neg_ab_c,
-            };
+            let f = fused_fma(fz)?;
             Exec::Lanes { f, d: Dest::of(*d)?, a: consts.opnd(fz.a)?, b: consts.opnd(fz.b)?, c: consts.opnd(fz.c)? }
         }
         Kind::Arith { op, ty, mode, d, a, b, c } => {
@@ -461,22 +601,85 @@ fn compact_form(i: &Inst, fz: Option<&Fused>, sfu: SfuModel, consts: &mut Consts
     })
 }
 
+/// The fma lane function of an `add`/`sub` contracted with a `mul`: signs
+/// folded in as `arith::fused` folds them.
+fn fused_fma<W: Word>(fz: &Fused) -> Option<LaneFnOf<W>> {
+    Some(match (fz.neg_product, fz.neg_c) {
+        (false, false) => ffma::<W>,
+        (true, false) => ffma_neg_ab::<W>,
+        (false, true) => ffma_neg_c::<W>,
+        (true, true) => ffma_neg_ab_c::<W>,
+    })
+}
+
+/// The narrow form of instruction `i` (registers renamed): when its
+/// destination and register operands are all narrow rows and the operation
+/// has a narrow lane function (which reads its operands' low 32 bits only,
+/// so constants may be truncated). `None` otherwise ([`compact_form`]).
+fn narrow_form(i: &Inst, fz: Option<&Fused>, sfu: SfuModel, consts: &mut Consts) -> Option<Exec> {
+    Some(match &i.kind {
+        Kind::Arith { ty, mode, d, .. } if fz.is_some() => {
+            let fz = fz.expect("fused");
+            if *ty != Ty::F32 || mode.ftz || mode.sat {
+                return None;
+            }
+            let d = consts.dest32(*d)?;
+            Exec::Lanes32 {
+                f: fused_fma(fz)?,
+                d,
+                a: consts.opnd32(fz.a)?,
+                b: consts.opnd32(fz.b)?,
+                c: consts.opnd32(fz.c)?,
+            }
+        }
+        Kind::Arith { op, ty, mode, d, a, b, c } => {
+            let (f, reads_c) = resolve_arith_of::<u32>(*op, *ty, *mode, sfu)?;
+            let (d, a, b) = (consts.dest32(*d)?, consts.opnd32(*a)?, consts.opnd32(*b)?);
+            Exec::Lanes32 { f, d, a, b, c: if reads_c { consts.opnd32(*c)? } else { a } }
+        }
+        Kind::Cvt { dty, sty, mode, d, a } => {
+            let f = resolve_cvt_of::<u32>(*dty, *sty, *mode)?;
+            let (d, a) = (consts.dest32(*d)?, consts.opnd32(*a)?);
+            Exec::Lanes32 { f, d, a, b: a, c: a }
+        }
+        Kind::Mov { d, a } => Exec::Mov32 { d: consts.dest32(*d)?, a: consts.opnd32(*a)? },
+        Kind::Selp { d, a, b, p } => {
+            Exec::Selp32 { d: consts.dest32(*d)?, a: consts.opnd32(*a)?, b: consts.opnd32(*b)?, p: *p }
+        }
+        // integers and f32 compare their low `bits` bits only
+        Kind::Setp { cmp, ty, p, q, a, b, comb: None, ftz }
+            if ty.bits() <= 32 && (*ty == Ty::F32 || !ty.is_float()) && !matches!(ty, Ty::Pred) =>
+        {
+            Exec::Setp32 {
+                cmp: *cmp,
+                ty: *ty,
+                ftz: *ftz,
+                p: *p,
+                q: q.unwrap_or(PRED_FALSE),
+                a: consts.opnd32(*a)?,
+                b: consts.opnd32(*b)?,
+            }
+        }
+        _ => return None,
+    })
+}
+
 /// An address's base operand and its offset, when the offset fits 32 bits.
 fn address(a: &Address, consts: &mut Consts) -> Option<(Opnd, i32)> {
     Some((consts.opnd(a.base)?, i32::try_from(a.offset).ok()?))
 }
 
 #[inline(always)]
-fn map2(a: &Lanes, b: &Lanes, out: &mut Lanes, f: impl Fn(u64, u64) -> u64) {
+fn map2<W: Word>(a: &[W; 32], b: &[W; 32], out: &mut [W; 32], f: impl Fn(u64, u64) -> u64) {
     for l in 0..32 {
-        out[l] = f(a[l], b[l]);
+        out[l] = W::of(f(a[l].wide(), b[l].wide()));
     }
 }
 
 #[inline(always)]
-fn map3(a: &Lanes, b: &Lanes, c: &Lanes, out: &mut Lanes, f: impl Fn(u64, u64, u64) -> u64) {
+fn map3<W: Word>(a: &[W; 32], b: &[W; 32], c: &[W; 32], out: &mut [W; 32], f: impl Fn(u64, u64, u64) -> u64) {
     for l in 0..32 {
-        out[l] = f(a[l], b[l], c[l]);
+        out[l] = W::of(f(a[l].wide(), b[l].wide(), c[l].wide()));
     }
 }
 
@@ -515,7 +718,7 @@ fn minmax32(a: u64, b: u64, max: bool) -> u64 {
 
 macro_rules! lanefn2 {
     ($name:ident, |$x:ident, $y:ident| $e:expr) => {
-        fn $name(a: &Lanes, b: &Lanes, _c: &Lanes, out: &mut Lanes) {
+        fn $name<W: Word>(a: &[W; 32], b: &[W; 32], _c: &[W; 32], out: &mut [W; 32]) {
             map2(a, b, out, |$x, $y| $e)
         }
     };
@@ -523,7 +726,7 @@ macro_rules! lanefn2 {
 
 macro_rules! lanefn3 {
     ($name:ident, |$x:ident, $y:ident, $z:ident| $e:expr) => {
-        fn $name(a: &Lanes, b: &Lanes, c: &Lanes, out: &mut Lanes) {
+        fn $name<W: Word>(a: &[W; 32], b: &[W; 32], c: &[W; 32], out: &mut [W; 32]) {
             map3(a, b, c, out, |$x, $y, $z| $e)
         }
     };
@@ -584,20 +787,25 @@ lanefn2!(div_full_ftz, |x, y| sfu::div_full(x as u32, y as u32, true) as u64);
 /// The H200 table model's function of an f32 approximation, when `sfu` asks
 /// for it and the form has one (no `.sat`, no rounding modifier).
 pub fn resolve_sfu(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<LaneFn> {
+    resolve_sfu_of::<u64>(op, ty, mode, sfu)
+}
+
+/// [`resolve_sfu`] over words `W`.
+fn resolve_sfu_of<W: Word>(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<LaneFnOf<W>> {
     if sfu != SfuModel::Sm90 || ty != Ty::F32 || !mode.approx || mode.sat || mode.rnd.is_some() {
         return None;
     }
     Some(match (op, mode.ftz, mode.full) {
-        (ArithOp::Rcp, false, _) => mufu_rcp,
-        (ArithOp::Rcp, true, _) => mufu_rcp_ftz,
-        (ArithOp::Rsqrt, false, _) => mufu_rsq,
-        (ArithOp::Rsqrt, true, _) => mufu_rsq_ftz,
-        (ArithOp::Sqrt, false, _) => mufu_sqrt,
-        (ArithOp::Sqrt, true, _) => mufu_sqrt_ftz,
-        (ArithOp::Div, false, false) => div_approx,
-        (ArithOp::Div, true, false) => div_approx_ftz,
-        (ArithOp::Div, false, true) => div_full,
-        (ArithOp::Div, true, true) => div_full_ftz,
+        (ArithOp::Rcp, false, _) => mufu_rcp::<W>,
+        (ArithOp::Rcp, true, _) => mufu_rcp_ftz::<W>,
+        (ArithOp::Rsqrt, false, _) => mufu_rsq::<W>,
+        (ArithOp::Rsqrt, true, _) => mufu_rsq_ftz::<W>,
+        (ArithOp::Sqrt, false, _) => mufu_sqrt::<W>,
+        (ArithOp::Sqrt, true, _) => mufu_sqrt_ftz::<W>,
+        (ArithOp::Div, false, false) => div_approx::<W>,
+        (ArithOp::Div, true, false) => div_approx_ftz::<W>,
+        (ArithOp::Div, false, true) => div_full::<W>,
+        (ArithOp::Div, true, true) => div_full_ftz::<W>,
         _ => return None,
     })
 }
@@ -606,50 +814,58 @@ pub fn resolve_sfu(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Optio
 /// (`alu::arith`) reduce to a plain operation, and whether it reads `c`;
 /// `None` for the other forms, which the executor evaluates lane by lane.
 pub fn resolve_arith(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<(LaneFn, bool)> {
+    resolve_arith_of::<u64>(op, ty, mode, sfu)
+}
+
+/// [`resolve_arith`] over words `W`: over narrow rows (`u32`) only the
+/// forms of 32-bit results, every one of which reads its operands' low 32
+/// bits only.
+pub fn resolve_arith_of<W: Word>(op: ArithOp, ty: Ty, mode: FloatMode, sfu: SfuModel) -> Option<(LaneFnOf<W>, bool)> {
     use ArithOp as A;
     use Ty as T;
-    if let Some(f) = resolve_sfu(op, ty, mode, sfu) {
+    if let Some(f) = resolve_sfu_of::<W>(op, ty, mode, sfu) {
         return Some((f, false));
     }
     // Round-to-nearest is IEEE's default, so `.rn` and no rounding agree.
     let nearest = matches!(mode.rnd, None | Some(Rounding::Rn)) && !mode.ftz && !mode.sat;
     let int = !mode.sat;
-    let f: LaneFn = match (op, ty) {
-        (A::Add, T::S32 | T::U32 | T::B32) if int => add32,
-        (A::Add, T::S64 | T::U64 | T::B64) if int => add64,
-        (A::Sub, T::S32 | T::U32 | T::B32) if int => sub32,
-        (A::Sub, T::S64 | T::U64 | T::B64) if int => sub64,
-        (A::Mul, T::S32 | T::U32 | T::B32) => mul32,
-        (A::Mul, T::S64 | T::U64 | T::B64) => mul64,
-        (A::And, T::B32 | T::U32 | T::S32) => and32,
-        (A::Or, T::B32 | T::U32 | T::S32) => or32,
-        (A::Xor, T::B32 | T::U32 | T::S32) => xor32,
-        (A::And, T::B64 | T::U64 | T::S64) => and64,
-        (A::Or, T::B64 | T::U64 | T::S64) => or64,
-        (A::Xor, T::B64 | T::U64 | T::S64) => xor64,
-        (A::Shl, T::B32 | T::U32 | T::S32) => shl32,
-        (A::Shl, T::B64 | T::U64 | T::S64) => shl64,
-        (A::Shr, T::B32 | T::U32) => shr_u32,
-        (A::Shr, T::B64 | T::U64) => shr_u64,
-        (A::Shr, T::S32) => shr_s32,
-        (A::MulWide, T::S32) => mul_wide_s32,
-        (A::MulWide, T::U32) => mul_wide_u32,
-        (A::Min, T::S32) => min_s32,
-        (A::Max, T::S32) => max_s32,
-        (A::Min, T::U32) => min_u32,
-        (A::Max, T::U32) => max_u32,
-        (A::Mad, T::S32 | T::U32 | T::B32) => return Some((mad32, true)),
-        (A::Add, T::F32) if nearest => fadd,
-        (A::Sub, T::F32) if nearest => fsub,
-        (A::Mul, T::F32) if nearest => fmul,
-        (A::Div, T::F32) if nearest => fdiv,
-        (A::Rcp, T::F32) if nearest => frcp,
-        (A::Sqrt, T::F32) if nearest && !mode.approx => fsqrt,
-        (A::Min, T::F32) if !mode.ftz && !mode.sat => fmin,
-        (A::Max, T::F32) if !mode.ftz && !mode.sat => fmax,
-        (A::Neg, T::F32) if !mode.ftz && !mode.sat => fneg,
-        (A::Abs, T::F32) if !mode.ftz && !mode.sat => fabs,
-        (A::Mad, T::F32) if nearest => return Some((ffma, true)),
+    let wide = W::WIDE;
+    let f: LaneFnOf<W> = match (op, ty) {
+        (A::Add, T::S32 | T::U32 | T::B32) if int => add32::<W>,
+        (A::Add, T::S64 | T::U64 | T::B64) if int && wide => add64::<W>,
+        (A::Sub, T::S32 | T::U32 | T::B32) if int => sub32::<W>,
+        (A::Sub, T::S64 | T::U64 | T::B64) if int && wide => sub64::<W>,
+        (A::Mul, T::S32 | T::U32 | T::B32) => mul32::<W>,
+        (A::Mul, T::S64 | T::U64 | T::B64) if wide => mul64::<W>,
+        (A::And, T::B32 | T::U32 | T::S32) => and32::<W>,
+        (A::Or, T::B32 | T::U32 | T::S32) => or32::<W>,
+        (A::Xor, T::B32 | T::U32 | T::S32) => xor32::<W>,
+        (A::And, T::B64 | T::U64 | T::S64) if wide => and64::<W>,
+        (A::Or, T::B64 | T::U64 | T::S64) if wide => or64::<W>,
+        (A::Xor, T::B64 | T::U64 | T::S64) if wide => xor64::<W>,
+        (A::Shl, T::B32 | T::U32 | T::S32) => shl32::<W>,
+        (A::Shl, T::B64 | T::U64 | T::S64) if wide => shl64::<W>,
+        (A::Shr, T::B32 | T::U32) => shr_u32::<W>,
+        (A::Shr, T::B64 | T::U64) if wide => shr_u64::<W>,
+        (A::Shr, T::S32) => shr_s32::<W>,
+        (A::MulWide, T::S32) if wide => mul_wide_s32::<W>,
+        (A::MulWide, T::U32) if wide => mul_wide_u32::<W>,
+        (A::Min, T::S32) => min_s32::<W>,
+        (A::Max, T::S32) => max_s32::<W>,
+        (A::Min, T::U32) => min_u32::<W>,
+        (A::Max, T::U32) => max_u32::<W>,
+        (A::Mad, T::S32 | T::U32 | T::B32) => return Some((mad32::<W>, true)),
+        (A::Add, T::F32) if nearest => fadd::<W>,
+        (A::Sub, T::F32) if nearest => fsub::<W>,
+        (A::Mul, T::F32) if nearest => fmul::<W>,
+        (A::Div, T::F32) if nearest => fdiv::<W>,
+        (A::Rcp, T::F32) if nearest => frcp::<W>,
+        (A::Sqrt, T::F32) if nearest && !mode.approx => fsqrt::<W>,
+        (A::Min, T::F32) if !mode.ftz && !mode.sat => fmin::<W>,
+        (A::Max, T::F32) if !mode.ftz && !mode.sat => fmax::<W>,
+        (A::Neg, T::F32) if !mode.ftz && !mode.sat => fneg::<W>,
+        (A::Abs, T::F32) if !mode.ftz && !mode.sat => fabs::<W>,
+        (A::Mad, T::F32) if nearest => return Some((ffma::<W>, true)),
         _ => return None,
     };
     Some((f, false))
@@ -669,6 +885,12 @@ lanefn2!(s32_trunc_f32, |x, _y| f32::from_bits(x as u32) as i32 as i64 as u64);
 /// the value the interpreted `cvt` writes. `None` for the rest
 /// (saturation, `.ftz`, other types and roundings: interpreted).
 pub fn resolve_cvt(dty: Ty, sty: Ty, mode: FloatMode) -> Option<LaneFn> {
+    resolve_cvt_of::<u64>(dty, sty, mode)
+}
+
+/// [`resolve_cvt`] over words `W`: over narrow rows only the forms of
+/// 32-bit results.
+pub fn resolve_cvt_of<W: Word>(dty: Ty, sty: Ty, mode: FloatMode) -> Option<LaneFnOf<W>> {
     use Ty as T;
     if mode.sat || mode.ftz {
         return None;
@@ -676,14 +898,14 @@ pub fn resolve_cvt(dty: Ty, sty: Ty, mode: FloatMode) -> Option<LaneFn> {
     let int = mode.rnd.is_none();
     let nearest = matches!(mode.rnd, None | Some(Rounding::Rn));
     Some(match (dty, sty) {
-        (T::U64 | T::S64 | T::B64, T::U32 | T::B32) if int => zext32,
-        (T::U64 | T::S64 | T::B64, T::S32) if int => sext32,
-        (T::U32 | T::B32, T::U64 | T::S64 | T::B64 | T::U32 | T::S32 | T::B32) if int => zext32,
-        (T::S32, T::U64 | T::S64 | T::B64 | T::U32 | T::S32 | T::B32) if int => sext32,
-        (T::F32, T::S32) if nearest => f32_from_s32,
-        (T::F32, T::U32) if nearest => f32_from_u32,
-        (T::S32, T::F32) if mode.rnd == Some(Rounding::Rmi) => s32_floor_f32,
-        (T::S32, T::F32) if mode.rnd == Some(Rounding::Rzi) => s32_trunc_f32,
+        (T::U64 | T::S64 | T::B64, T::U32 | T::B32) if int && W::WIDE => zext32::<W>,
+        (T::U64 | T::S64 | T::B64, T::S32) if int && W::WIDE => sext32::<W>,
+        (T::U32 | T::B32, T::U64 | T::S64 | T::B64 | T::U32 | T::S32 | T::B32) if int => zext32::<W>,
+        (T::S32, T::U64 | T::S64 | T::B64 | T::U32 | T::S32 | T::B32) if int => sext32::<W>,
+        (T::F32, T::S32) if nearest => f32_from_s32::<W>,
+        (T::F32, T::U32) if nearest => f32_from_u32::<W>,
+        (T::S32, T::F32) if mode.rnd == Some(Rounding::Rmi) => s32_floor_f32::<W>,
+        (T::S32, T::F32) if mode.rnd == Some(Rounding::Rzi) => s32_trunc_f32::<W>,
         _ => return None,
     })
 }
@@ -885,8 +1107,12 @@ mod tests {
             f(-7.0),
         ];
         let sign = 1u64 << 31;
-        let forms: [(LaneFn, bool, bool); 4] =
-            [(ffma, false, false), (ffma_neg_ab, true, false), (ffma_neg_c, false, true), (ffma_neg_ab_c, true, true)];
+        let forms: [(LaneFn, bool, bool); 4] = [
+            (ffma::<u64>, false, false),
+            (ffma_neg_ab::<u64>, true, false),
+            (ffma_neg_c::<u64>, false, true),
+            (ffma_neg_ab_c::<u64>, true, true),
+        ];
         for (func, na, nc) in forms {
             for (i, &x) in vals.iter().enumerate() {
                 let a: Lanes = [x; 32];
@@ -898,6 +1124,148 @@ mod tests {
                     let (x, z) = (a[l] ^ if na { sign } else { 0 }, c[l] ^ if nc { sign } else { 0 });
                     let want = alu::arith(ArithOp::Mad, Ty::F32, FloatMode::default(), x, b[l], z);
                     assert_eq!(out[l], want, "neg_ab={na} neg_c={nc} a={:#x} b={:#x} c={:#x}", a[l], b[l], c[l]);
+                }
+            }
+        }
+    }
+
+    /// Integers with bits above 32 (constants keep them; narrow rows never
+    /// do), at the 8-, 16- and 32-bit sign boundaries, and f32 edges.
+    fn narrow_edge_values() -> Vec<u64> {
+        let f = |x: f32| x.to_bits() as u64;
+        let mut v = vec![
+            0,
+            1,
+            2,
+            31,
+            32,
+            33,
+            0x7F,
+            0x80,
+            0xFF,
+            0x7FFF,
+            0x8000,
+            0xFFFF,
+            0x7FFF_FFFF,
+            0x8000_0000,
+            0xFFFF_FFFF,
+            0xFFFF_FF9C, // -100
+            0x1_0000_0001,
+            0xDEAD_BEEF_8000_0001,
+            u64::MAX,
+            f(1.5),
+            f(-2.25),
+            f(3.0e38),
+            f(-3.0e9),
+            f(1.0 / 3.0),
+        ];
+        v.extend(FLOAT_EDGES);
+        v
+    }
+
+    /// Every narrow lane function (registers of 32 bits or fewer in rows of
+    /// 32-bit lanes) gives the low 32 bits of its wide twin's result, for
+    /// operands truncated to 32 bits: register values (which fit) and
+    /// constants with bits above 32 (which the narrow forms truncate). The
+    /// 64-bit forms have no narrow twin.
+    #[test]
+    fn narrow_lane_functions_are_the_wide_ones_truncated() {
+        let vals = narrow_edge_values();
+        let check = |name: &str, wide: LaneFn, narrow: LaneFn32| {
+            for i in 0..vals.len() {
+                let a: Lanes = [vals[i]; 32];
+                let b: Lanes = std::array::from_fn(|l| vals[l % vals.len()]);
+                let c: Lanes = std::array::from_fn(|l| vals[(l * 5 + i) % vals.len()]);
+                let t = |x: &Lanes| -> Lanes32 { std::array::from_fn(|l| x[l] as u32) };
+                let (mut w, mut n) = ([0u64; 32], [0u32; 32]);
+                wide(&a, &b, &c, &mut w);
+                narrow(&t(&a), &t(&b), &t(&c), &mut n);
+                for l in 0..32 {
+                    assert_eq!(n[l], w[l] as u32, "{name}: a={:#x} b={:#x} c={:#x}", a[l], b[l], c[l]);
+                }
+            }
+        };
+        let modes = [
+            FloatMode::default(),
+            FloatMode { rnd: Some(Rounding::Rn), ..FloatMode::default() },
+            FloatMode { ftz: true, ..FloatMode::default() },
+            FloatMode { approx: true, ..FloatMode::default() },
+            FloatMode { approx: true, ftz: true, ..FloatMode::default() },
+            FloatMode { approx: true, full: true, ..FloatMode::default() },
+        ];
+        let ops = [
+            ArithOp::Add,
+            ArithOp::Sub,
+            ArithOp::Mul,
+            ArithOp::MulWide,
+            ArithOp::Mad,
+            ArithOp::Div,
+            ArithOp::Rcp,
+            ArithOp::Sqrt,
+            ArithOp::Rsqrt,
+            ArithOp::Min,
+            ArithOp::Max,
+            ArithOp::Neg,
+            ArithOp::Abs,
+            ArithOp::And,
+            ArithOp::Or,
+            ArithOp::Xor,
+            ArithOp::Shl,
+            ArithOp::Shr,
+        ];
+        let tys = [Ty::S32, Ty::U32, Ty::B32, Ty::S64, Ty::U64, Ty::B64, Ty::F32, Ty::S16, Ty::U16];
+        let mut narrow = 0;
+        for op in ops {
+            for ty in tys {
+                for mode in modes {
+                    for sfu in [SfuModel::Sm90, SfuModel::CorrectlyRounded] {
+                        let Some((n, nc)) = resolve_arith_of::<u32>(op, ty, mode, sfu) else { continue };
+                        let (w, wc) = resolve_arith(op, ty, mode, sfu).expect("a narrow form has a wide one");
+                        assert_eq!(nc, wc);
+                        assert!(ty.bits() <= 32, "{op:?}.{ty:?} has a narrow form");
+                        check(&format!("{op:?}.{ty:?} {mode:?}"), w, n);
+                        narrow += 1;
+                    }
+                }
+            }
+        }
+        assert!(narrow > 40, "only {narrow} narrow forms");
+        for dty in tys {
+            for sty in tys {
+                for rnd in [None, Some(Rounding::Rn), Some(Rounding::Rmi), Some(Rounding::Rzi)] {
+                    let mode = FloatMode { rnd, ..FloatMode::default() };
+                    let Some(n) = resolve_cvt_of::<u32>(dty, sty, mode) else { continue };
+                    assert!(dty.bits() <= 32, "cvt.{dty:?}.{sty:?} has a narrow form");
+                    check(&format!("cvt.{dty:?}.{sty:?} {rnd:?}"), resolve_cvt(dty, sty, mode).unwrap(), n);
+                }
+            }
+        }
+        for (na, nc) in [(false, false), (true, false), (false, true), (true, true)] {
+            let fz = Fused { mul: 0, neg_product: na, neg_c: nc, a: Src::Imm(0), b: Src::Imm(0), c: Src::Imm(0) };
+            check("fused fma", fused_fma::<u64>(&fz).unwrap(), fused_fma::<u32>(&fz).unwrap());
+        }
+    }
+
+    /// `setp` on narrow rows (integers of 32 bits or fewer, f32, with and
+    /// without `.ftz`) gives what it gives on wide rows, for every
+    /// comparison, operands with bits above the type's width included
+    /// (constants).
+    #[test]
+    fn narrow_comparisons_agree_with_the_wide_ones() {
+        let vals = narrow_edge_values();
+        let a: Lanes = std::array::from_fn(|l| vals[l % vals.len()]);
+        let cmps = alu::ALL_CMPS;
+        let tys = [Ty::S32, Ty::U32, Ty::B32, Ty::S16, Ty::U16, Ty::B16, Ty::S8, Ty::U8, Ty::F32];
+        for i in 0..vals.len() {
+            let b: Lanes = std::array::from_fn(|l| vals[(l + i) % vals.len()]);
+            let t = |x: &Lanes| -> Lanes32 { std::array::from_fn(|l| x[l] as u32) };
+            for ty in tys {
+                for cmp in cmps {
+                    for ftz in [false, true] {
+                        let w = alu::compare_lanes(cmp, ty, ftz, &a, &b);
+                        let n = alu::compare_lanes(cmp, ty, ftz, &t(&a), &t(&b));
+                        assert_eq!(n, w, "setp.{cmp:?}.{ty:?} ftz={ftz}, b from {i}");
+                    }
                 }
             }
         }
@@ -942,20 +1310,26 @@ mod tests {
         let Exec::Ld { space: MemSpace::Global, offset: 8, wide: true, bits: 32, n: 1, .. } = ops[5].exec else {
             panic!("ld: {:?}", ops[5].exec)
         };
-        let Exec::Lanes { d, a, b, c, .. } = ops[6].exec else { panic!("add.rn.f32: {:?}", ops[6].exec) };
+        // 32-bit registers in narrow rows: the narrow forms, narrow constants
+        let Exec::Lanes32 { d, a, b, c, .. } = ops[6].exec else { panic!("add.rn.f32: {:?}", ops[6].exec) };
         assert!(d.slot < CONST && a < CONST && b >= CONST && c == a && d.bits == 32);
-        assert_eq!(fc.consts[(b - CONST) as usize], [0x3F80_0000; 32]);
-        assert!(matches!(ops[7].exec, Exec::Setp { q: PRED_FALSE, .. }));
-        assert!(matches!(ops[8].exec, Exec::Selp { .. }));
+        assert_eq!(fc.consts32[(b - CONST) as usize], [0x3F80_0000; 32]);
+        assert!(matches!(ops[7].exec, Exec::Setp32 { q: PRED_FALSE, .. }));
+        assert!(matches!(ops[8].exec, Exec::Selp32 { .. }));
         assert!(matches!(ops[9].exec, Exec::Bra { target: 11 }));
         assert!(ops[9].guard.reg > PRED_TRUE && !ops[9].guard.neg);
         assert_eq!(ops[8].guard, PredSrc { reg: PRED_TRUE, neg: false }, "unguarded: always true");
-        assert!(matches!(ops[10].exec, Exec::Mov { .. }));
+        assert!(matches!(ops[10].exec, Exec::Mov32 { .. }));
         assert!(matches!(ops[11].exec, Exec::St { space: MemSpace::Global, n: 1, .. }));
         assert!(matches!(ops[12].exec, Exec::Ir));
         // one row per distinct immediate
         let (_, code) = decode_body("mov.u32 %r1, 5;\nadd.s32 %r2, %r1, 5;\nadd.s32 %r3, %r2, 6;\nret;");
-        assert_eq!(code.funcs[0].consts.len(), 2);
+        assert_eq!((code.funcs[0].consts.len(), code.funcs[0].consts32.len()), (0, 2));
+        // a 64-bit destination of 32-bit sources: the wide form, its operands widened when read
+        let (_, code) = decode_body("mov.u32 %r1, 5;\nmul.wide.s32 %rd1, %r1, -3;\ncvt.u32.u64 %r2, %rd1;\nret;");
+        let ops = &code.funcs[0].ops;
+        assert!(matches!(ops[1].exec, Exec::Lanes { .. }) && matches!(ops[2].exec, Exec::Lanes { .. }));
+        assert_eq!(code.funcs[0].consts, [[-3i32 as u32 as u64; 32]]);
     }
 
     /// Counting blocks start at the first instruction, at branch targets and
@@ -998,11 +1372,12 @@ mod tests {
              st.global.f32 [%rd1], %f4;\n\
              ret;",
         );
-        let Exec::Lanes { f, .. } = code.funcs[0].ops[4].exec else { panic!("{:?}", code.funcs[0].ops[4].exec) };
+        // f32 registers: the narrow form
+        let Exec::Lanes32 { f, .. } = code.funcs[0].ops[4].exec else { panic!("{:?}", code.funcs[0].ops[4].exec) };
         // fma(-2, 3, 1) = -5; the other sign foldings give 7, 5 and -7
-        let (a, b, c) = ([2f32.to_bits() as u64; 32], [3f32.to_bits() as u64; 32], [1f32.to_bits() as u64; 32]);
+        let (a, b, c) = ([2f32.to_bits(); 32], [3f32.to_bits(); 32], [1f32.to_bits(); 32]);
         let mut out = [0; 32];
         f(&a, &b, &c, &mut out);
-        assert_eq!(out, [(-5f32).to_bits() as u64; 32], "c - a*b is fma(-a, b, c)");
+        assert_eq!(out, [(-5f32).to_bits(); 32], "c - a*b is fma(-a, b, c)");
     }
 }

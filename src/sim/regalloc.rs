@@ -32,6 +32,15 @@
 //! through the parameter area, and the callee has its own frame), so live
 //! ranges simply span it.
 //!
+//! **Two classes of rows.** Registers of 32 bits or fewer (most of a ray
+//! tracer's: `%r`, `%f`, `%h`) get *narrow* rows of 32-bit lanes, the others
+//! wide rows of 64-bit lanes; the scan keeps a pool of slots per class, and
+//! a slot never changes class, so a frame is its wide rows followed by its
+//! narrow ones ([`Allocation::wide`]). A narrow row holds exactly what a
+//! wide row would: every write is truncated to the register's width, so a
+//! wide row of such a register holds a zero-extended value. The executor's
+//! narrow forms work on half the bytes of the wide ones.
+//!
 //! **Adding an instruction.** Its register fields must be visited by
 //! `Kind::visit_regs_mut` (renaming and liveness come from there); if its
 //! handler writes fewer than all executing lanes, it must not kill (`effect`
@@ -47,6 +56,9 @@ use super::cfg::Cfg;
 use super::contract::Fused;
 use crate::ptx::ir::{Function, Inst, Kind, RegId, Src};
 
+/// The widest register mask that a narrow (32-bit) row holds.
+pub const NARROW_MASK: u64 = 0xFFFF_FFFF;
+
 /// Where each virtual register of one function lives in a frame.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Allocation {
@@ -55,16 +67,21 @@ pub struct Allocation {
     pub slot: Vec<RegId>,
     /// Rows a frame of the function needs.
     pub rows: u32,
+    /// Of them, the 64-bit rows: slots `0..wide`. The slots from `wide` on
+    /// are *narrow* rows of 32-bit lanes, given only to registers of 32 bits
+    /// or fewer ([`NARROW_MASK`]), whose values always fit them.
+    pub wide: u32,
     /// Registers that keep a slot of their own for the whole function (see
     /// the module documentation), in increasing order.
     pub pinned: Vec<RegId>,
 }
 
 impl Allocation {
-    /// One row per virtual register, in declaration order (no compaction).
+    /// One row per virtual register, in declaration order (no compaction),
+    /// every row wide.
     pub fn identity(f: &Function) -> Allocation {
         let n = f.reg_masks.len();
-        Allocation { slot: (0..n as RegId).collect(), rows: n as u32, pinned: Vec::new() }
+        Allocation { slot: (0..n as RegId).collect(), rows: n as u32, wide: n as u32, pinned: Vec::new() }
     }
 
     /// Compacts the registers of `f` by liveness over `cfg` and a linear scan.
@@ -87,32 +104,41 @@ impl Allocation {
             start[r as usize] = 0;
             stop[r as usize] = end;
         }
-        // linear scan over intervals sorted by start; the lowest free slot first
+        // linear scan over intervals sorted by start; the lowest free slot
+        // of the register's class (wide, narrow) first
         let mut order: Vec<usize> = (0..n).filter(|&r| start[r] <= stop[r]).collect();
         order.sort_by_key(|&r| (start[r], r));
+        let narrow = |r: usize| usize::from(f.reg_masks[r] <= NARROW_MASK);
         let mut slot = vec![0 as RegId; n];
-        let mut active: BinaryHeap<Reverse<(u32, RegId)>> = BinaryHeap::new();
-        let mut free: BinaryHeap<Reverse<RegId>> = BinaryHeap::new();
-        let mut rows: u32 = 0;
+        let mut active: BinaryHeap<Reverse<(u32, usize, RegId)>> = BinaryHeap::new();
+        let mut free: [BinaryHeap<Reverse<RegId>>; 2] = Default::default();
+        let mut rows = [0u32; 2];
         for r in order {
-            while let Some(&Reverse((e, s))) = active.peek() {
+            while let Some(&Reverse((e, c, s))) = active.peek() {
                 if e >= start[r] {
                     break;
                 }
                 active.pop();
-                free.push(Reverse(s));
+                free[c].push(Reverse(s));
             }
-            let s = match free.pop() {
+            let c = narrow(r);
+            let s = match free[c].pop() {
                 Some(Reverse(s)) => s,
                 None => {
-                    rows += 1;
-                    (rows - 1) as RegId
+                    rows[c] += 1;
+                    (rows[c] - 1) as RegId
                 }
             };
             slot[r] = s;
-            active.push(Reverse((stop[r], s)));
+            active.push(Reverse((stop[r], c, s)));
         }
-        Allocation { slot, rows, pinned }
+        // the narrow rows follow the wide ones
+        for (r, s) in slot.iter_mut().enumerate() {
+            if start[r] <= stop[r] && narrow(r) == 1 {
+                *s += rows[0] as RegId;
+            }
+        }
+        Allocation { slot, rows: rows[0] + rows[1], wide: rows[0], pinned }
     }
 }
 
@@ -367,8 +393,11 @@ mod tests {
         );
         let (a, l) = alloc(&p);
         assert_no_interference(&p, &a, &l);
-        // at most three values are ever live together (%r3, %r2 and the result)
-        assert!(a.rows <= 3, "{} rows: {:?}", a.rows, a.slot);
+        // at most three 32-bit values are ever live together (%r3, %r2 and
+        // the result): narrow rows; %rd1 has the one wide row, slot 0
+        assert!(a.wide == 1 && a.rows - a.wide <= 3, "{} rows, {} wide: {:?}", a.rows, a.wide, a.slot);
+        assert_eq!(a.slot[reg(&p, "%rd1") as usize], 0);
+        assert!(["%r1", "%r2", "%r3", "%r4", "%r5", "%r6"].iter().all(|r| a.slot[reg(&p, r) as usize] >= 1));
         assert!(a.pinned.is_empty(), "nothing is read before written: {:?}", a.pinned);
         // a value takes a slot freed before its instruction: %r6 the one of
         // %r4 (dead after pc 4), not the one of %r5, which pc 5 reads (an

@@ -209,7 +209,7 @@ impl<'a> Stepper<'a> {
         if let Some(i) = f.reg_names.iter().position(|n| n == name) {
             // by name through the decoded form's slot map (one row per register when stepping)
             let code = &self.module.stepping_code().funcs[fr.func as usize];
-            return fr.regs.get(code.slot(i as crate::ptx::ir::RegId)).copied();
+            return fr.row(code.slot(i as crate::ptx::ir::RegId));
         }
         let p = f.pred_names.iter().position(|n| n == name)?;
         let bits = fr.preds[p];

@@ -9,8 +9,13 @@ use crate::ptx::ir::{BarRedOp, Dst, Function, PredId};
 pub struct Frame {
     /// Function index in the program.
     pub func: u32,
-    /// Data registers, one 32-lane array each (structure of arrays).
+    /// Data registers, one 32-lane array each (structure of arrays): the
+    /// wide rows (slots `0..regs.len()`).
     pub regs: Vec<[u64; 32]>,
+    /// The narrow rows of 32-bit lanes (slot `regs.len() + i` is row `i`):
+    /// registers of 32 bits or fewer (`regalloc::Allocation::wide`), whose
+    /// values, zero-extended, are what a wide row would hold.
+    pub regs32: Vec<[u32; 32]>,
     /// Predicate registers as lane bitmasks (index 0 = false, 1 = true).
     pub preds: Vec<u32>,
     /// Per-lane parameter area: lane `l` at `l * param_size ..`.
@@ -28,14 +33,22 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// A fresh frame for `f` with `rows` register rows (zeroed): the slots
-    /// its decoded form allocates (`FnCode::rows`).
-    pub fn new(func: u32, f: &Function, rows: usize, local_base: u32, stack_base: usize, call_pc: u32) -> Frame {
+    /// A fresh frame for `f` with `rows` (wide, narrow) register rows
+    /// (zeroed): the slots its decoded form allocates (`FnCode::frame_rows`).
+    pub fn new(
+        func: u32,
+        f: &Function,
+        rows: (usize, usize),
+        local_base: u32,
+        stack_base: usize,
+        call_pc: u32,
+    ) -> Frame {
         let mut preds = vec![0u32; f.num_preds as usize];
         preds[1] = u32::MAX;
         Frame {
             func,
-            regs: vec![[0u64; 32]; rows],
+            regs: vec![[0u64; 32]; rows.0],
+            regs32: vec![[0u32; 32]; rows.1],
             preds,
             params: vec![0u8; f.frame_param_size as usize * 32],
             param_size: f.frame_param_size,
@@ -43,6 +56,26 @@ impl Frame {
             stack_base,
             call_pc,
             returned: 0,
+        }
+    }
+}
+
+impl Frame {
+    /// Row `slot` as 64-bit lanes (a narrow row zero-extended).
+    pub fn row(&self, slot: usize) -> Option<[u64; 32]> {
+        match self.regs.get(slot) {
+            Some(r) => Some(*r),
+            None => self.regs32.get(slot.checked_sub(self.regs.len())?).map(|n| std::array::from_fn(|l| n[l] as u64)),
+        }
+    }
+
+    /// Sets lane `l` of row `slot` to `v`, a value of the register's width.
+    pub fn set_lane(&mut self, slot: usize, l: usize, v: u64) {
+        let nw = self.regs.len();
+        if slot < nw {
+            self.regs[slot][l] = v;
+        } else {
+            self.regs32[slot - nw][l] = v as u32;
         }
     }
 }
@@ -113,7 +146,7 @@ impl Warp {
         &mut self,
         func: u32,
         f: &Function,
-        rows: usize,
+        rows: (usize, usize),
         local_base: u32,
         stack_base: usize,
         call_pc: u32,

@@ -311,7 +311,7 @@ pub(super) fn carry(
     exec: u32,
 ) {
     let (va, vb, vc) = (read(ctx, w, cta, a), read(ctx, w, cta, b), read(ctx, w, cta, c));
-    let vcc = w.frame().regs[cc as usize];
+    let vcc = read(ctx, w, cta, Src::Reg(cc));
     let mut r = [0u64; 32];
     let mut co = [0u64; 32];
     for l in 0..32 {

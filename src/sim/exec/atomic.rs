@@ -110,7 +110,7 @@ pub fn apply_pending(ctx: &Ctx, warps: &mut [Warp], pending: &mut Vec<PendingAto
             if let Some(d) = p.d
                 && d.reg != Dst::SINK
             {
-                w.frames.last_mut().expect("frame").regs[d.reg as usize][l as usize] = old & d.mask;
+                w.frames.last_mut().expect("frame").set_lane(d.reg as usize, l as usize, old & d.mask);
             }
         }
     }

@@ -47,7 +47,7 @@ pub(super) fn call(
         return Err(fault(FaultKind::LocalStackOverflow { needed: need, limit: ctx.local_limit as u64 }, None));
     }
     let (caller_func, caller_ps) = (caller.func, caller.param_size);
-    let rows = ctx.code.funcs[callee as usize].rows();
+    let rows = ctx.code.funcs[callee as usize].frame_rows();
     let mut nf = w.take_frame(callee, cf, rows, lb, w.stack.entries.len(), pc);
     let caller = w.frames.last().expect("caller");
     debug_assert_eq!(caller.func, caller_func);

@@ -943,6 +943,7 @@ mod tests {
         let frame = Frame {
             func: 0,
             regs: Vec::new(),
+            regs32: Vec::new(),
             preds: vec![0, u32::MAX],
             params: vec![0; param_size as usize * 32],
             param_size,

@@ -19,7 +19,7 @@ pub use call::call_chain;
 
 use super::cfg::Cfg;
 use super::counters::{Counters, InstProfile};
-use super::decode::{CONST, Code, Dest, Exec, Opnd};
+use super::decode::{CONST, Code, Dest, Exec, Lanes32, Opnd, Word};
 use super::fault::FaultKind;
 use super::memory::DeviceMemory;
 use super::observer::{MemObserver, ObserverFactory};
@@ -121,94 +121,160 @@ fn write(frame: &mut Frame, d: Dst, v: &Lanes, mask: u32) {
     if d.reg == Dst::SINK {
         return;
     }
-    store_row(&mut frame.regs[d.reg as usize], d.mask, v, mask);
+    store_slot(frame, d.reg as usize, d.mask, v, mask);
 }
 
-/// All-ones or all-zeros lane masks of four lanes, for each 4-bit group of
-/// a lane bitmask.
-static NIBBLE_MASKS: [[u64; 4]; 16] = {
-    let mut t = [[0u64; 4]; 16];
-    let mut n = 0;
-    while n < 16 {
-        let mut l = 0;
-        while l < 4 {
-            if n >> l & 1 != 0 {
-                t[n][l] = u64::MAX;
-            }
-            l += 1;
-        }
-        n += 1;
+/// Writes `v & width` into the lanes of the frame's row `slot` (wide or
+/// narrow) that `exec` names.
+#[inline(always)]
+fn store_slot(fr: &mut Frame, slot: usize, width: u64, v: &Lanes, exec: u32) {
+    let nw = fr.regs.len();
+    if slot < nw {
+        store_row(&mut fr.regs[slot], width, v, exec);
+    } else {
+        store_row(&mut fr.regs32[slot - nw], width as u32, v, exec);
     }
-    t
-};
+}
+
+/// All-ones or all-zeros lane masks of four lanes of type `$t`, for each
+/// 4-bit group of a lane bitmask.
+macro_rules! nibble_masks {
+    ($t:ty) => {{
+        let mut t = [[0 as $t; 4]; 16];
+        let mut n = 0;
+        while n < 16 {
+            let mut l = 0;
+            while l < 4 {
+                if n >> l & 1 != 0 {
+                    t[n][l] = <$t>::MAX;
+                }
+                l += 1;
+            }
+            n += 1;
+        }
+        t
+    }};
+}
+
+static NIBBLE_MASKS: [[u64; 4]; 16] = nibble_masks!(u64);
+static NIBBLE_MASKS32: [[u32; 4]; 16] = nibble_masks!(u32);
+
+/// A register row's lane word, with what [`store_row`] and [`lane_masks`]
+/// need of it.
+trait RowWord: Word + 'static {
+    /// Active lanes up to which [`store_row`] writes lane by lane: about 6
+    /// host instructions per active lane, against about 130 for the
+    /// branch-free select of 32 wide lanes and about half that of 32 narrow
+    /// ones (the ray-tracing kernels' warps average 13–14 active lanes).
+    const SPARSE_LANES: u32;
+    /// The lane masks of a 4-bit group.
+    fn nibble(n: u32) -> &'static [Self; 4];
+}
+
+impl RowWord for u64 {
+    const SPARSE_LANES: u32 = 16;
+    #[inline(always)]
+    fn nibble(n: u32) -> &'static [u64; 4] {
+        &NIBBLE_MASKS[n as usize]
+    }
+}
+
+impl RowWord for u32 {
+    const SPARSE_LANES: u32 = 10;
+    #[inline(always)]
+    fn nibble(n: u32) -> &'static [u32; 4] {
+        &NIBBLE_MASKS32[n as usize]
+    }
+}
 
 /// Lane `l` all ones where bit `l` of `bits` is set, else zero: selecting by
 /// a lane bitmask through it is branch-free and vectorises (a loop testing
 /// each bit compiles to a branch per lane, mispredicted when warps diverge).
 #[inline(always)]
-fn lane_masks(bits: u32) -> Lanes {
-    let mut m = [0u64; 32];
+fn lane_masks<W: RowWord>(bits: u32) -> [W; 32] {
+    let mut m = [W::default(); 32];
     for k in 0..8 {
-        m[k * 4..k * 4 + 4].copy_from_slice(&NIBBLE_MASKS[(bits >> (4 * k) & 0xF) as usize]);
+        m[k * 4..k * 4 + 4].copy_from_slice(W::nibble(bits >> (4 * k) & 0xF));
     }
     m
 }
 
 /// `a` where the lane's mask is set, else `b`.
 #[inline(always)]
-fn select(m: &Lanes, a: &Lanes, b: &Lanes, out: &mut Lanes) {
+fn select<W: Word>(m: &[W; 32], a: &[W; 32], b: &[W; 32], out: &mut [W; 32]) {
     for l in 0..32 {
         out[l] = (a[l] & m[l]) | (b[l] & !m[l]);
     }
 }
 
-/// Active lanes up to which [`store_row`] writes lane by lane: about 6 host
-/// instructions per active lane against about 130 for the branch-free
-/// select of all 32 (the ray-tracing kernels' warps average 13–14 active
-/// lanes).
-const SPARSE_LANES: u32 = 16;
-
-/// Writes `v & width` into the lanes of `row` that `exec` names.
+/// Writes `v & width` into the lanes of `row` that `exec` names (a wide
+/// value truncated to a narrow row's lanes, `width` of 32 bits or fewer
+/// then).
 #[inline(always)]
-fn store_row(row: &mut Lanes, width: u64, v: &Lanes, exec: u32) {
+fn store_row<T: RowWord, S: Word>(row: &mut [T; 32], width: T, v: &[S; 32], exec: u32) {
     if exec == u32::MAX {
         for l in 0..32 {
-            row[l] = v[l] & width;
+            row[l] = T::of(v[l].wide()) & width;
         }
-    } else if exec.count_ones() <= SPARSE_LANES {
+    } else if exec.count_ones() <= T::SPARSE_LANES {
         let mut m = exec;
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
-            row[l] = v[l] & width;
+            row[l] = T::of(v[l].wide()) & width;
         }
     } else {
-        let e = lane_masks(exec);
+        let e = lane_masks::<T>(exec);
         for l in 0..32 {
-            row[l] = (v[l] & width & e[l]) | (row[l] & !e[l]);
+            row[l] = (T::of(v[l].wide()) & width & e[l]) | (row[l] & !e[l]);
         }
     }
 }
 
-/// Writes a compact instruction's result.
+/// Writes a compact instruction's result (a wide row or a narrow one).
 #[inline(always)]
-fn put(regs: &mut [Lanes], d: Dest, v: &Lanes, exec: u32) {
+fn put(fr: &mut Frame, d: Dest, v: &Lanes, exec: u32) {
     if d.slot != Dest::SINK {
-        store_row(&mut regs[d.slot as usize], d.mask(), v, exec);
+        store_slot(fr, d.slot as usize, d.mask(), v, exec);
+    }
+}
+
+/// Writes a narrow form's result (`d.slot`: the narrow row's index).
+#[inline(always)]
+fn put32(fr: &mut Frame, d: Dest, v: &Lanes32, exec: u32) {
+    store_row(&mut fr.regs32[d.slot as usize], d.mask() as u32, v, exec);
+}
+
+/// Row `slot` of a frame as 64-bit lanes: a wide row borrowed, a narrow one
+/// zero-extended.
+#[inline(always)]
+fn row(fr: &Frame, slot: usize) -> Operand<'_> {
+    match fr.regs.get(slot) {
+        Some(r) => Operand::Reg(r),
+        None => {
+            let n = &fr.regs32[slot - fr.regs.len()];
+            Operand::Value(std::array::from_fn(|l| n[l] as u64))
+        }
     }
 }
 
 /// A compact instruction's operand: a register row or a constant row.
 #[inline(always)]
-fn opnd<'a>(regs: &'a [Lanes], consts: &'a [Lanes], o: Opnd) -> &'a Lanes {
-    if o < CONST { &regs[o as usize] } else { &consts[(o - CONST) as usize] }
+fn opnd<'a>(fr: &'a Frame, consts: &'a [Lanes], o: Opnd) -> Operand<'a> {
+    if o < CONST { row(fr, o as usize) } else { Operand::Reg(&consts[(o - CONST) as usize]) }
+}
+
+/// A narrow form's operand: a narrow row or a narrow constant row.
+#[inline(always)]
+fn opnd32<'a>(regs32: &'a [Lanes32], consts32: &'a [Lanes32], o: Opnd) -> &'a Lanes32 {
+    if o < CONST { &regs32[o as usize] } else { &consts32[(o - CONST) as usize] }
 }
 
 /// A compact memory instruction's addresses: base plus offset (32-bit bases
 /// wrap, then zero-extend).
 #[inline(always)]
-fn compact_addresses(regs: &[Lanes], consts: &[Lanes], base: Opnd, offset: i32, wide: bool) -> Lanes {
-    let b = opnd(regs, consts, base);
+fn compact_addresses(fr: &Frame, consts: &[Lanes], base: Opnd, offset: i32, wide: bool) -> Lanes {
+    let b = &*opnd(fr, consts, base);
     if wide {
         map1(b, |x| x.wrapping_add(offset as i64 as u64))
     } else {
@@ -247,7 +313,7 @@ fn lane_of_mask(m: u32) -> Option<usize> {
 fn read(ctx: &Ctx, w: &Warp, cta: &CtaMut, s: Src) -> Lanes {
     let f = w.frame();
     match s {
-        Src::Reg(r) => f.regs[r as usize],
+        Src::Reg(r) => *row(f, r as usize),
         Src::Imm(v) => [v; 32],
         Src::LocalAddr(o) => [(f.local_base + o) as u64; 32],
         Src::GlobalAddr(g, o) => [ctx.global_addrs[g as usize] + o as u64; 32],
@@ -279,7 +345,7 @@ impl std::ops::Deref for Operand<'_> {
 #[inline]
 fn operand<'a>(ctx: &Ctx, w: &'a Warp, cta: &CtaMut, s: Src) -> Operand<'a> {
     match s {
-        Src::Reg(r) => Operand::Reg(&w.frame().regs[r as usize]),
+        Src::Reg(r) => row(w.frame(), r as usize),
         other => Operand::Value(read(ctx, w, cta, other)),
     }
 }
@@ -355,6 +421,8 @@ fn advance(w: &mut Warp, pc: u32) {
     w.stack.top_mut().expect("top").pc = pc + 1;
 }
 
+// inlined into `step`, as it was before the narrow forms made it larger
+#[inline(always)]
 fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) -> Result<Effect, Box<ExecFault>> {
     let pc = top.pc;
     let code = &ctx.code.funcs[func as usize];
@@ -397,28 +465,56 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
         return Ok(Effect::Continue);
     }
     let consts = &code.consts[..];
+    let consts32 = &code.consts32[..];
     match op.exec {
+        Exec::Lanes32 { f, d, a, b, c } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let mut r = [0u32; 32];
+            let n = &fr.regs32;
+            f(opnd32(n, consts32, a), opnd32(n, consts32, b), opnd32(n, consts32, c), &mut r);
+            put32(fr, d, &r, exec);
+        }
+        Exec::Mov32 { d, a } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let r = *opnd32(&fr.regs32, consts32, a);
+            put32(fr, d, &r, exec);
+        }
+        Exec::Selp32 { d, a, b, p } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let m = lane_masks(pred_bits(fr, p));
+            let mut r = [0u32; 32];
+            select(&m, opnd32(&fr.regs32, consts32, a), opnd32(&fr.regs32, consts32, b), &mut r);
+            put32(fr, d, &r, exec);
+        }
+        Exec::Setp32 { cmp, ty, ftz, p, q, a, b } => {
+            let fr = w.frames.last_mut().expect("frame");
+            let n = &fr.regs32;
+            let t = super::alu::compare_lanes(cmp, ty, ftz, opnd32(n, consts32, a), opnd32(n, consts32, b));
+            set_pred(fr, p, t, exec);
+            // `q` is PRED_FALSE, never written, when absent
+            set_pred(fr, q, !t, exec);
+        }
         Exec::Lanes { f, d, a, b, c } => {
             let fr = w.frames.last_mut().expect("frame");
             let mut r = [0u64; 32];
-            f(opnd(&fr.regs, consts, a), opnd(&fr.regs, consts, b), opnd(&fr.regs, consts, c), &mut r);
-            put(&mut fr.regs, d, &r, exec);
+            f(&opnd(fr, consts, a), &opnd(fr, consts, b), &opnd(fr, consts, c), &mut r);
+            put(fr, d, &r, exec);
         }
         Exec::Mov { d, a } => {
             let fr = w.frames.last_mut().expect("frame");
-            let r = *opnd(&fr.regs, consts, a);
-            put(&mut fr.regs, d, &r, exec);
+            let r = *opnd(fr, consts, a);
+            put(fr, d, &r, exec);
         }
         Exec::Selp { d, a, b, p } => {
             let fr = w.frames.last_mut().expect("frame");
             let m = lane_masks(pred_bits(fr, p));
             let mut r = [0u64; 32];
-            select(&m, opnd(&fr.regs, consts, a), opnd(&fr.regs, consts, b), &mut r);
-            put(&mut fr.regs, d, &r, exec);
+            select(&m, &opnd(fr, consts, a), &opnd(fr, consts, b), &mut r);
+            put(fr, d, &r, exec);
         }
         Exec::Setp { cmp, ty, ftz, p, q, a, b } => {
             let fr = w.frames.last_mut().expect("frame");
-            let t = super::alu::compare_lanes(cmp, ty, ftz, opnd(&fr.regs, consts, a), opnd(&fr.regs, consts, b));
+            let t = super::alu::compare_lanes(cmp, ty, ftz, &opnd(fr, consts, a), &opnd(fr, consts, b));
             set_pred(fr, p, t, exec);
             // `q` is PRED_FALSE, never written, when absent
             set_pred(fr, q, !t, exec);
@@ -431,7 +527,7 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             arith::fused(ctx, w, cta, (*ty, *mode), *d, fz, exec);
         }
         Exec::Ld { space, ty, n, nc, wide, bits, base, offset, ds } => {
-            let addrs = compact_addresses(&w.frame().regs, consts, base, offset, wide);
+            let addrs = compact_addresses(w.frame(), consts, base, offset, wide);
             // a scalar load needs one lane array, not four
             let mut one = [[0u64; 32]; 1];
             let mut four;
@@ -444,15 +540,15 @@ fn exec(ctx: &Ctx, w: &mut Warp, cta: &mut CtaMut, func: u32, top: SimtEntry) ->
             memory::transfer(ctx, w, cta, (func, pc), space, ty, &addrs, false, nc, exec, vals)?;
             let fr = w.frames.last_mut().expect("frame");
             for (v, &slot) in vals.iter().zip(&ds) {
-                put(&mut fr.regs, Dest { slot, bits }, v, exec);
+                put(fr, Dest { slot, bits }, v, exec);
             }
         }
         Exec::St { space, ty, n, wide, base, offset, vals } => {
             let fr = w.frame();
-            let addrs = compact_addresses(&fr.regs, consts, base, offset, wide);
+            let addrs = compact_addresses(fr, consts, base, offset, wide);
             let mut vs = [[0u64; 32]; 4];
             for (v, &o) in vs.iter_mut().zip(&vals[..n as usize]) {
-                *v = *opnd(&fr.regs, consts, o);
+                *v = *opnd(fr, consts, o);
             }
             memory::transfer(ctx, w, cta, (func, pc), space, ty, &addrs, true, false, exec, &mut vs[..n as usize])?;
         }
@@ -581,7 +677,7 @@ fn exec_ir(
 
 #[cfg(test)]
 mod tests {
-    use super::{Lanes, SPARSE_LANES, store_row};
+    use super::{Lanes, RowWord, store_row};
 
     /// `store_row` writes `v & width` into exactly the lanes `exec` names
     /// and leaves the others, whether it goes lane by lane (few lanes), by
@@ -612,8 +708,26 @@ mod tests {
                 }
             }
         }
+        // narrow rows: the same lanes, of the values truncated
+        for &exec in &masks {
+            let old32: [u32; 32] = std::array::from_fn(|l| old[l] as u32);
+            for width in [0xFFFF_FFFFu32, 0xFFFF, 0xFF] {
+                let (mut row, mut row_of_narrow) = (old32, old32);
+                let v32: [u32; 32] = std::array::from_fn(|l| v[l] as u32);
+                store_row(&mut row, width, &v, exec);
+                store_row(&mut row_of_narrow, width, &v32, exec);
+                for l in 0..32 {
+                    let want = if exec >> l & 1 != 0 { v[l] as u32 & width } else { old32[l] };
+                    assert_eq!((row[l], row_of_narrow[l]), (want, want), "exec {exec:#x}, width {width:#x}, lane {l}");
+                }
+            }
+        }
         // both sides of the lane-by-lane threshold were exercised
-        let n = SPARSE_LANES as usize;
-        assert!(counts[1..=n].iter().sum::<usize>() > 20 && counts[n + 1..32].iter().sum::<usize>() > 20, "{counts:?}");
+        for n in [<u64 as RowWord>::SPARSE_LANES as usize, <u32 as RowWord>::SPARSE_LANES as usize] {
+            assert!(
+                counts[1..=n].iter().sum::<usize>() > 20 && counts[n + 1..32].iter().sum::<usize>() > 20,
+                "{counts:?}"
+            );
+        }
     }
 }
