@@ -102,3 +102,62 @@ fn the_table_renders_the_recorded_verdicts() {
     );
     assert!(t.checks.iter().all(|c| c.holds), "{:?}", t.checks);
 }
+
+/// Per-test f32 instruction counts of one kernel in the H200 fixture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Sass {
+    fadd: u64,
+    fmul: u64,
+    ffma: u64,
+}
+
+fn sass(v: &serde_json::Value, path: &[&str]) -> Sass {
+    let mut x = v;
+    for p in path {
+        x = &x[*p];
+    }
+    let n = |k: &str| x[k].as_u64().unwrap_or_else(|| panic!("{path:?}.{k} in the fixture"));
+    Sass { fadd: n("fadd"), fmul: n("fmul"), ffma: n("ffma") }
+}
+
+#[test]
+fn the_h200_executes_the_emulators_operations() {
+    // tests/fixtures/lin2017/h200_intersection_ops.json: ncu's per-thread
+    // FADD/FMUL/FFMA over 4096 hitting pairs (tools/device/intersect_ops.sh)
+    let f: serde_json::Value =
+        serde_json::from_str(include_str!("fixtures/lin2017/h200_intersection_ops.json")).expect("fixture");
+    assert_eq!(f["pairs"].as_u64(), Some(4096));
+    for d in ["nvcc", "clang_ptx_jit"] {
+        for k in ["tri_standard", "tri_affine"] {
+            assert_eq!(f["hits"][d][k].as_u64(), Some(4096), "{d} {k}");
+        }
+    }
+    let m = measure_on(&cornell()).expect("measure");
+    for r in &m {
+        let kernel = if r.routine == "standard" { "tri_standard" } else { "tri_affine" };
+        // the rcp/div fast path, the same in every compilation: taken out
+        let div = sass(&f, &["division_fast_path", kernel]);
+        let run = sass(&f, &["dynamic", if r.dialect == "clang" { "clang_ptx_jit" } else { "nvcc" }, kernel]);
+        let own = Sass { fadd: run.fadd - div.fadd, fmul: run.fmul - div.fmul, ffma: run.ffma - div.ffma };
+        // unfused, the hardware does the emulator's multiplications and additions
+        assert_eq!(own.fmul + own.ffma, r.ops.mul_unfused(), "{r:?} {own:?}");
+        assert_eq!(own.fadd + own.ffma, r.ops.add_unfused(), "{r:?} {own:?}");
+        match (r.dialect, r.routine) {
+            // mul.rn/add.rn: ptxas fuses none of clang's operations
+            ("clang", _) => assert_eq!((own.fmul, own.fadd, own.ffma), (r.ops.mul, r.ops.add, 0), "{r:?}"),
+            // nvcc's affine PTX compiles as written
+            (_, "affine") => assert_eq!((own.fmul, own.fadd, own.ffma), (r.ops.mul, r.ops.add, r.ops.fma), "{r:?}"),
+            // ptxas fuses six more of the standard test's mul/add pairs (plain mul.f32/add.f32)
+            _ => assert_eq!(own.ffma, r.ops.fma + 6, "{r:?} {own:?}"),
+        }
+    }
+    // the statically listed kernels agree with those executed; the one FADD
+    // more on tri_affine's division line negates the dividend for the slow path
+    for (st, dy) in [("clang", "clang_ptx_jit"), ("binary", "nvcc"), ("nvcc", "nvcc")] {
+        for k in ["tri_standard", "tri_affine"] {
+            let (s, d) = (sass(&f, &["static", st, k]), sass(&f, &["dynamic", dy, k]));
+            let extra = u64::from(k == "tri_affine");
+            assert_eq!(s, Sass { fadd: d.fadd + extra, ..d }, "{st} {k}");
+        }
+    }
+}
