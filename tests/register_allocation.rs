@@ -306,7 +306,7 @@ fn narrow_rows_compute_what_wide_rows_compute() {
         };
         let k = m.prog.kernel("narrow").unwrap() as usize;
         let narrow = |code: &warplight::sim::decode::Code| code.funcs[k].frame_rows().1;
-        (dev.read::<u32>(out, 32 * 40), counters, narrow(&m.code), narrow(&m.stepping_code()))
+        (dev.read::<u32>(out, 32 * 40), counters, narrow(&m.code), narrow(m.stepping_code()))
     };
     let (launched, stepped) = (run(false), run(true));
     assert!(launched.2 > 0 && stepped.3 == 0, "narrow rows: launch {}, stepper {}", launched.2, stepped.3);

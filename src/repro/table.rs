@@ -164,6 +164,20 @@ pub struct Cell {
     pub verdict: Option<Verdict>,
 }
 
+impl Cell {
+    /// Our value `ours` beside the thesis' `printed` text, with the verdict
+    /// under `tolerance` where both are numbers (and the column compares).
+    pub fn compared(ours: Option<f64>, printed: &str, tolerance: Option<crate::repro::compare::Tolerance>) -> Cell {
+        let tv = crate::repro::compare::parse_printed(printed);
+        Cell {
+            ours,
+            thesis: Some(printed.to_string()),
+            thesis_value: tv,
+            verdict: ours.zip(tv).zip(tolerance).map(|((o, t), tol)| tol.verdict(o, t)),
+        }
+    }
+}
+
 /// What a row is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum RowKind {

@@ -165,20 +165,8 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         fractions.push(frac);
         let running = busy.map(|b| b * 32.0 / SCALE as f64);
         let ours = [running, busy, frac];
-        let mut cells: Vec<Cell> = ours
-            .iter()
-            .zip(printed)
-            .zip(&columns)
-            .map(|((o, p), c)| {
-                let tv = crate::repro::compare::parse_printed(p);
-                Cell {
-                    ours: *o,
-                    thesis: Some(p.to_string()),
-                    thesis_value: tv,
-                    verdict: o.zip(tv).zip(c.tolerance).map(|((o, t), tol)| tol.verdict(o, t)),
-                }
-            })
-            .collect();
+        let mut cells: Vec<Cell> =
+            ours.iter().zip(printed).zip(&columns).map(|((o, p), c)| Cell::compared(*o, p, c.tolerance)).collect();
         cells.push(Cell { ours: active, ..Cell::default() });
         cells.push(Cell { ours: busy.map(|b| 32.0 * b), ..Cell::default() });
         rows.push(Row { label: label.into(), kind: RowKind::Scene, cells });

@@ -27,7 +27,7 @@ use crate::host::path::native::affine_test;
 use crate::host::rt_kernels::upload;
 use crate::host::scene::Scene;
 use crate::ptx::ir::Program;
-use crate::repro::compare::{Tolerance, parse_printed};
+use crate::repro::compare::Tolerance;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
@@ -351,20 +351,8 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     let mut rows = Vec::new();
     for (routine, _, _, printed) in ROUTINES {
         let ours = [get(routine, "clang", "mul"), get(routine, "clang", "add")];
-        let mut cells: Vec<Cell> = ours
-            .iter()
-            .zip(printed)
-            .zip(&columns)
-            .map(|((o, p), c)| {
-                let tv = parse_printed(p);
-                Cell {
-                    ours: *o,
-                    thesis: Some(p.to_string()),
-                    thesis_value: tv,
-                    verdict: o.zip(tv).zip(c.tolerance).map(|((o, t), tol)| tol.verdict(o, t)),
-                }
-            })
-            .collect();
+        let mut cells: Vec<Cell> =
+            ours.iter().zip(printed).zip(&columns).map(|((o, p), c)| Cell::compared(*o, p, c.tolerance)).collect();
         for (dialect, name) in [("clang", "div"), ("clang", "neg"), ("nvcc", "fma"), ("nvcc", "mul"), ("nvcc", "add")] {
             cells.push(Cell { ours: get(routine, dialect, name), ..Cell::default() });
         }
