@@ -89,23 +89,20 @@ impl Ops {
         [("mul", self.mul), ("add", self.add), ("fma", self.fma), ("div", self.div), ("neg", self.neg)]
     }
 
-    /// Adds `n` executions of the f32 instruction `opcode`; false if it is not a floating-point operation counted here.
-    fn add_opcode(&mut self, opcode: &str, n: u64) -> bool {
-        let mut parts = opcode.split('.');
-        let op = parts.next().unwrap_or("");
+    /// Adds `n` executions of `opcode` if it is an f32 operation counted here.
+    fn add_opcode(&mut self, opcode: &str, n: u64) {
         if !opcode.ends_with(".f32") {
-            return false;
+            return;
         }
-        let slot = match op {
-            "mul" => &mut self.mul,
-            "add" | "sub" => &mut self.add,
-            "fma" => &mut self.fma,
-            "div" | "rcp" => &mut self.div,
-            "neg" => &mut self.neg,
-            _ => return false,
+        let slot = match opcode.split('.').next() {
+            Some("mul") => &mut self.mul,
+            Some("add" | "sub") => &mut self.add,
+            Some("fma") => &mut self.fma,
+            Some("div" | "rcp") => &mut self.div,
+            Some("neg") => &mut self.neg,
+            _ => return,
         };
         *slot += n;
-        true
     }
 }
 
@@ -122,27 +119,28 @@ pub fn function_lines(source: &str, name: &str) -> Option<RangeInclusive<u32>> {
 
 /// Operations executed (lanes with their guard true) on `lines` of `source_file`, summed over `profile`.
 pub fn ops_on_lines(prog: &Program, profile: &InstProfile, source_file: &str, lines: &RangeInclusive<u32>) -> Ops {
-    let mut ops = Ops::default();
-    let Some(file) = prog.files.iter().position(|f| f.ends_with(source_file)) else { return ops };
-    for (f, counts) in profile.per_fn.iter().enumerate() {
-        for (pc, c) in counts.iter().enumerate() {
-            let info = &prog.functions[f].info[pc];
-            if info.src.is_some_and(|s| s.file as usize == file && lines.contains(&s.line)) {
-                ops.add_opcode(&info.opcode, c.pred_on);
-            }
-        }
-    }
-    ops
+    ops_where(prog, source_file, lines, |f, pc| profile.per_fn[f][pc].pred_on)
 }
 
 /// Operations on `lines` of `source_file` in the program's text (each instruction once).
 pub fn static_ops(prog: &Program, source_file: &str, lines: &RangeInclusive<u32>) -> Ops {
+    ops_where(prog, source_file, lines, |_, _| 1)
+}
+
+/// The operations of the instructions `.loc` places on `lines` of
+/// `source_file`, each counted `times(function, pc)` times.
+fn ops_where(
+    prog: &Program,
+    source_file: &str,
+    lines: &RangeInclusive<u32>,
+    times: impl Fn(usize, usize) -> u64,
+) -> Ops {
     let mut ops = Ops::default();
     let Some(file) = prog.files.iter().position(|f| f.ends_with(source_file)) else { return ops };
-    for func in &prog.functions {
-        for info in &func.info {
+    for (f, func) in prog.functions.iter().enumerate() {
+        for (pc, info) in func.info.iter().enumerate() {
             if info.src.is_some_and(|s| s.file as usize == file && lines.contains(&s.line)) {
-                ops.add_opcode(&info.opcode, 1);
+                ops.add_opcode(&info.opcode, times(f, pc));
             }
         }
     }
@@ -265,28 +263,31 @@ pub fn measure_on(scene: &Scene) -> Result<Vec<Measured>, OpsError> {
     let rows: Vec<[f32; 12]> = pairs.iter().map(|(v, _, _)| affine_rows(v)).collect();
     let row_floats: Vec<f32> = rows.iter().flatten().copied().collect();
     let plane: Vec<f64> = pairs.iter().map(|(v, o, d)| plane_distance(v, *o, *d)).collect();
+    let reference = |routine: &str| -> Vec<Option<f32>> {
+        pairs
+            .iter()
+            .zip(&rows)
+            .map(|((v, o, d), m)| match routine {
+                "standard" => standard_test(v, *o, *d, t_min, t_max),
+                _ => affine_test(m, (*o).into(), (*d).into(), t_min, t_max),
+            })
+            .collect()
+    };
+    let references = ROUTINES.map(|(routine, ..)| reference(routine));
     let mut out = Vec::new();
     for (dialect, ptx, file) in DIALECTS {
         let mut dev = Device::with_config(SimConfig { fidelity: Fidelity::Instructions, ..SimConfig::default() });
         let module = dev.load_ptx(ptx, file)?;
-        for (routine, entry, func, _) in ROUTINES {
+        let r = upload(&mut dev, &to_bytes(&rays), "rays")?;
+        for ((routine, entry, func, _), reference) in ROUTINES.into_iter().zip(&references) {
             let lines = function_lines(SOURCE, func).ok_or(OpsError::NoFunction(func))?;
             let data = if routine == "standard" { &verts } else { &row_floats };
-            let r = upload(&mut dev, &to_bytes(&rays), "rays")?;
             let t = upload(&mut dev, &to_bytes(data), "triangles")?;
             let o = dev.alloc_zeroed::<f32>(n.max(1));
             let args = [Arg::Ptr(r), Arg::Ptr(t), Arg::U32(n as u32), Arg::Ptr(o)];
             let grid = LaunchConfig::linear((n as u32).div_ceil(THREADS).max(1), THREADS);
             let stats = dev.launch(&module, entry, grid, &args)?;
             let got = dev.read::<f32>(o, n);
-            let reference: Vec<Option<f32>> = pairs
-                .iter()
-                .zip(&rows)
-                .map(|((v, o, d), m)| match routine {
-                    "standard" => standard_test(v, *o, *d, t_min, t_max),
-                    _ => affine_test(m, (*o).into(), (*d).into(), t_min, t_max),
-                })
-                .collect();
             let hits = got.iter().filter(|t| **t >= 0.0).count() as u64;
             let tests = n as u64;
             if hits != tests {
@@ -302,7 +303,7 @@ pub fn measure_on(scene: &Scene) -> Result<Vec<Measured>, OpsError> {
                 }
                 *slot = sum / tests;
             }
-            let exact = got.iter().zip(&reference).all(|(g, r)| r.is_some_and(|r| r.to_bits() == g.to_bits()));
+            let exact = got.iter().zip(reference).all(|(g, r)| r.is_some_and(|r| r.to_bits() == g.to_bits()));
             let max_rel_error = got.iter().zip(&plane).map(|(g, p)| ((*g as f64 - p) / p).abs()).fold(0.0f64, f64::max);
             out.push(Measured { routine, dialect, tests, hits, ops, exact, max_rel_error });
         }
