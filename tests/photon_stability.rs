@@ -163,16 +163,26 @@ fn cancelling_vertex_normals_fall_back_to_the_flat_mirror_and_stay_finite() {
 /// vertex's radial direction), so that the band focuses (eqs. 5.12–5.21) and
 /// the ground gets a curved caustic; the point light at `light`.
 fn curved_ring(light: [f32; 3]) -> (warplight::host::scene::Scene, warplight::host::kdtree::KdTree) {
+    ring_with_normals(light, |v| v.map(radial))
+}
+
+/// The horizontal unit direction from the ring's axis to `p`.
+fn radial(p: glam::Vec3) -> [f32; 3] {
+    glam::Vec3::new(p.x, 0.0, p.z).normalize().to_array()
+}
+
+/// The Ring with the band's vertex normals `band(vertices)` (the ground has
+/// none: all zero), the point light at `light`, and its SIROH tree.
+fn ring_with_normals(
+    light: [f32; 3],
+    band: impl Fn([glam::Vec3; 3]) -> [[f32; 3]; 3],
+) -> (warplight::host::scene::Scene, warplight::host::kdtree::KdTree) {
     use glam::Vec3;
     use warplight::host::kdtree::{BuildParams, Heuristic, build};
     use warplight::host::scene::{Light, Scene};
     let g = warplight::host::procedural::ring(false);
-    let radial = |p: Vec3| {
-        let h = Vec3::new(p.x, 0.0, p.z);
-        h.normalize().to_array()
-    };
     let normals: Vec<[[f32; 3]; 3]> =
-        g.triangles.iter().map(|t| if t.material == 1 { t.v.map(radial) } else { [[0.0; 3]; 3] }).collect();
+        g.triangles.iter().map(|t| if t.material == 1 { band(t.v) } else { [[0.0; 3]; 3] }).collect();
     let mut scene = Scene::assemble_with_vertices(
         "ring",
         std::path::Path::new("ring"),
@@ -185,6 +195,53 @@ fn curved_ring(light: [f32; 3]) -> (warplight::host::scene::Scene, warplight::ho
     let tris: Vec<[Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Siroh));
     (scene, tree)
+}
+
+/// Cancelling vertex normals on a chapter scene, through the kernel (the
+/// extract's §2.8 item 9): the Ring's band with the normal of each
+/// triangle's second vertex negated, n(λ) = n0 + u(n1 − n0) + v(n2 − n0)
+/// with n1 = −n0, so that on every band triangle the interpolated normal
+/// vanishes along a line (u = ½ where n2 = n0) and ∂n/∂p grows without bound
+/// beside it. The light above the rim sends most photons onto the band.
+/// photons.cu on the emulator stores exactly the native reference's photons,
+/// every stored value is finite, the cancelling normals change the photons
+/// that left the band (against the smooth cylinder's normals), and some of
+/// them reflected close enough to the cancelling line for their direction
+/// differentials to be hundreds of times the smooth cylinder's largest.
+#[test]
+fn cancelling_vertex_normals_on_the_ring_stay_finite_and_bit_for_bit_through_the_kernel() {
+    use warplight::repro::fabianowski2011::photons::Emission;
+    use warplight::sim::Device;
+    let light = [1.5, 3.0, 0.0];
+    let (scene, tree) = ring_with_normals(light, |v| {
+        let n = v.map(radial);
+        [n[0], n[1].map(|x| -x), n[2]]
+    });
+    let (smooth, _) = curved_ring(light);
+    let e = Emission::of(&scene, 16384).unwrap();
+    let native = photons::reference(&scene, &tree, &e);
+    let mut dev = Device::new();
+    let module = photons::load(&mut dev).unwrap();
+    let kernel = photons::trace_kernel(&mut dev, &module, &scene, &tree, &e).unwrap().photons;
+    let bits = |x: &[Option<Photon>; 2]| x.map(|p| p.map(|p| p.bits()));
+    let differ = kernel.iter().zip(&native).filter(|(a, b)| bits(a) != bits(b)).count();
+    assert_eq!(differ, 0, "photons differing emulated vs native");
+    for p in native.iter().flatten().flatten() {
+        let b = p.bits();
+        assert!(b[..21].iter().all(|x| f32::from_bits(*x).is_finite()), "{p:?}");
+    }
+    let reference = photons::reference(&smooth, &tree, &e);
+    let changed: Vec<usize> = (0..native.len()).filter(|&i| bits(&native[i]) != bits(&reference[i])).collect();
+    assert!(changed.len() > 600, "{} photons changed by the cancelling normals", changed.len());
+    let largest = |set: &Vec<[Option<Photon>; 2]>| {
+        changed
+            .iter()
+            .filter_map(|&i| set[i][0].as_ref())
+            .map(|p| len(p.dw[0]).max(len(p.dw[1])))
+            .fold(0.0f32, f32::max)
+    };
+    let (cancelling, cylinder) = (largest(&native), largest(&reference));
+    assert!(cancelling > 100.0 * cylinder, "largest ‖∂ω/∂p‖: {cancelling} cancelling, {cylinder} smooth");
 }
 
 /// Streaking along a curved caustic (the extract's §2.11 item 3, L2480:
