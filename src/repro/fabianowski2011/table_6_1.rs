@@ -7,7 +7,7 @@
 //! the notes and a check. The rows follow the extract's reconciliation (§3.9:
 //! the conversion lost the Ring row and shifted the last two labels).
 
-use super::vvh::{self, Builder, PM_BUILDERS, THRESHOLDS};
+use super::vvh::{self, Builder, THRESHOLDS};
 use crate::repro::compare::{Printed as P, Tolerance};
 use crate::repro::registry::Entry;
 use crate::repro::results::Results;
@@ -298,7 +298,7 @@ fn columns() -> Vec<Column> {
 }
 
 fn part(r: &Results, b: Builder, heading: &str, published: &Published, address: &str) -> Table {
-    let scenes = super::scenes_of(r, PM_BUILDERS);
+    let scenes = vvh::rows(r);
     let mut ours = Vec::new();
     let mut per_threshold = Vec::new();
     let mut trade = Vec::new();
@@ -328,7 +328,7 @@ fn part(r: &Results, b: Builder, heading: &str, published: &Published, address: 
             holds: trade.iter().all(|x| *x),
         });
     }
-    t.notes.push(super::run_note(r, &scenes, &format!("{} photon maps per threshold, native walks", b.name())));
+    t.notes.push(vvh::run_note(r, &scenes, &format!("{} photon maps per threshold, native walks", b.name())));
     t.notes.push(format!("n_T/n_I per query point by threshold: {}.", per_threshold.join("; ")));
     t
 }
@@ -338,10 +338,11 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
     let h = e.heading();
     let mut a = part(r, Builder::Vvh, &format!("{h}\n\n(a) VVH construction"), &THESIS_A, &format!("{}a", e.address()));
     a.notes.push(vvh::HOW.into());
+    a.notes.push(vvh::scenario_note(&vvh::rows(r)));
     a.notes.push(
         "Rows reconciled as in the extract (§3.9): the conversion lost the Ring row (VVH FPS with n_auto 9.40 by Table \
          6.3) and labels the Conference 2^19 row \"Passage\" and the Passage row \"Ring\"; two n_auto values are \
-         missing. The 2^18 and 2^19 scenarios are not run."
+         missing."
             .into(),
     );
     let b = part(r, Builder::Lbvh, "(b) LBVH construction", &THESIS_B, &format!("{}b", e.address()));

@@ -4,9 +4,9 @@
 //! Interactions and node counts (inner nodes and leaves, both built with
 //! n_auto) are measured by [`super::vvh`]; the LBVH construction times are a
 //! GTX 280's and not reproduced. The scenarios Scene 6 with 2^18 photons and
-//! Conference with 2^19 (§6.1.4) are not run.
+//! Conference with 2^19 (§6.1.4) are rows of their own ([`vvh::SCENARIOS`]).
 
-use super::vvh::{self, Builder, PM_BUILDERS};
+use super::vvh::{self, Builder};
 use crate::repro::compare::{Printed as P, Tolerance, mean_sd};
 use crate::repro::registry::Entry;
 use crate::repro::results::Results;
@@ -31,7 +31,7 @@ pub const THESIS: Published = Published {
 
 /// The table.
 pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
-    let scenes = super::scenes_of(r, PM_BUILDERS);
+    let scenes = vvh::rows(r);
     let ms_why = "LBVH construction times of the GTX 280 (CUDA kernels and radix sorts); no timing model is applied";
     let columns = vec![
         Column::measured("Interactions", Unit::Number(0), Tolerance::COUNT),
@@ -58,11 +58,12 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
             holds: m.abs() <= 15.0,
         });
     }
-    t.notes.push(super::run_note(r, &scenes, "VVH and LBVH photon maps with n_auto (native builds)"));
+    t.notes.push(vvh::run_note(r, &scenes, "VVH and LBVH photon maps with n_auto (native builds)"));
     t.notes.push(vvh::HOW.into());
+    t.notes.push(vvh::scenario_note(&scenes));
     t.notes.push(
         "Nodes count inner nodes and leaves. The thesis' interaction counts differ from its own Table 5.1 (extract \
-         erratum 9); ours are those of our Table 5.1 run. The 2^18 and 2^19 scenarios of §6.1.4 are not run."
+         erratum 9); ours are those of our Table 5.1 run."
             .into(),
     );
     vec![t]

@@ -5,7 +5,7 @@
 //! n_T and n_I are measured by [`super::vvh`] (both trees with n_auto); the
 //! frame rates are a GTX 280's rendering kernel's and not reproduced.
 
-use super::vvh::{self, Builder, PM_BUILDERS};
+use super::vvh::{self, Builder};
 use crate::repro::compare::{Printed as P, Tolerance, mean_sd};
 use crate::repro::registry::Entry;
 use crate::repro::results::Results;
@@ -57,7 +57,7 @@ pub const THESIS: Published = Published {
 
 /// The table.
 pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
-    let scenes = super::scenes_of(r, PM_BUILDERS);
+    let scenes = vvh::rows(r);
     let fps_why = "frame rates of the thesis' whole rendering kernel (code base I) on a GTX 280; no timing model is \
                    applied to the native walk";
     let columns = vec![
@@ -94,7 +94,8 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
             holds: nt > 0.0 && ni > 0.0,
         });
     }
-    t.notes.push(super::run_note(r, &scenes, "VVH and LBVH photon maps with n_auto, native walks"));
+    t.notes.push(vvh::run_note(r, &scenes, "VVH and LBVH photon maps with n_auto, native walks"));
     t.notes.push(vvh::HOW.into());
+    t.notes.push(vvh::scenario_note(&scenes));
     vec![t]
 }

@@ -182,6 +182,16 @@ fn shapes(scene: &Scene) -> &'static [Shape] {
 pub(super) fn vkde_maps(ws: &mut Workspace) -> Result<(photon_image::PhotonMaps, u32), MeasureError> {
     let (photons, spread) = parameters(&ws.scene.name)
         .ok_or_else(|| format!("{}: not a scene of Table 5.1 (its parameters are per scene)", ws.scene.name))?;
+    vkde_maps_with(ws, photons, spread)
+}
+
+/// [`vkde_maps`] with `photons` emitted and spread `spread` instead of
+/// Table 5.1's (the scenarios of §6.1.4, [`super::vvh::SCENARIOS`]).
+pub(super) fn vkde_maps_with(
+    ws: &mut Workspace,
+    photons: usize,
+    spread: f32,
+) -> Result<(photon_image::PhotonMaps, u32), MeasureError> {
     let o = Options {
         photons,
         spread,

@@ -14,7 +14,7 @@ use super::lbvh;
 use super::photon_image;
 use super::pm_layout::{self, Layout, Layouts, PmTree};
 use super::sah;
-use super::table_6_4::vkde_maps;
+use super::table_6_4::{vkde_maps, vkde_maps_with};
 use super::vkde::{Kernel, Shape};
 use crate::host::kdtree::Heuristic;
 use crate::host::raycast::Caster;
@@ -71,9 +71,82 @@ pub fn build(builder: Builder, kernels: &[Kernel], threshold: u32) -> PmTree {
     }
 }
 
-/// Measurement group [`PM_BUILDERS`].
+/// A scenario of §6.1.4 (L2623, "a wider range of image quality settings"):
+/// a scene of Table 5.1 with another photon count and spread, a row of its
+/// own in Tables 6.1–6.3.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scenario {
+    /// The scene it runs on.
+    pub scene: &'static str,
+    /// Its row's name in the tables (as [`super::table_6_2::THESIS`] names it).
+    pub row: &'static str,
+    /// Photons emitted.
+    pub photons: usize,
+    /// Spread s.
+    pub spread: f32,
+}
+
+/// Tables 6.1–6.3's two scenarios: Scene 6 with 2^18 photons and s = 28,
+/// Conference with 2^19 and s = 50 (the extract's §3.9 row reconciliation).
+pub const SCENARIOS: [Scenario; 2] = [
+    Scenario { scene: "scene6", row: "scene6 (2^18, s=28)", photons: 1 << 18, spread: 28.0 },
+    Scenario { scene: "conference", row: "conference (2^19, s=50)", photons: 1 << 19, spread: 50.0 },
+];
+
+/// The rows of Tables 6.1–6.3 that `r` has: its scenes of [`PM_BUILDERS`],
+/// each followed by its scenario's row where that was run (the thesis'
+/// order).
+pub fn rows(r: &crate::repro::results::Results) -> Vec<String> {
+    let has = |row: &str| r.samples.iter().any(|s| s.group == PM_BUILDERS && s.scene == row);
+    let mut v = Vec::new();
+    for s in super::scenes_of(r, PM_BUILDERS) {
+        let scenario = SCENARIOS.iter().find(|c| c.scene == s).filter(|c| has(c.row)).map(|c| c.row.to_string());
+        v.push(s);
+        v.extend(scenario);
+    }
+    v
+}
+
+/// [`super::run_note`] for `rows`, naming the scenes run (a scenario's row
+/// runs with its scene, [`scenario_note`]).
+pub fn run_note(r: &crate::repro::results::Results, rows: &[String], what: &str) -> String {
+    let scenes: Vec<String> = rows.iter().filter(|s| !SCENARIOS.iter().any(|c| c.row == *s)).cloned().collect();
+    super::run_note(r, &scenes, what)
+}
+
+/// The note on the scenarios' rows.
+pub fn scenario_note(rows: &[String]) -> String {
+    let run: Vec<&str> = SCENARIOS.iter().filter(|c| rows.iter().any(|r| r == c.row)).map(|c| c.row).collect();
+    format!(
+        "The scenarios of §6.1.4 (Scene 6 with 2^18 photons and s = 28, Conference with 2^19 and s = 50) run with \
+         their scene: the same flight, query points and builders over the photon maps of their photon count and \
+         spread; {}.",
+        if run.is_empty() { "none was run here".to_string() } else { format!("rows run: {}", run.join(", ")) }
+    )
+}
+
+/// Measurement group [`PM_BUILDERS`]: the scene with Table 5.1's photons and
+/// spread, and, for Scene 6 and Conference, their [`SCENARIOS`] as rows of
+/// their own.
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
-    let (maps, n_auto) = vkde_maps(ws)?;
+    let maps = vkde_maps(ws)?;
+    let name = ws.scene.name.clone();
+    let mut out = measure_maps(ws, maps, &name, tick)?;
+    for c in SCENARIOS.iter().filter(|c| c.scene == ws.scene.name) {
+        let maps = vkde_maps_with(ws, c.photons, c.spread)?;
+        out.extend(measure_maps(ws, maps, c.row, tick)?);
+    }
+    Ok(out)
+}
+
+/// Both builders at n_auto and every threshold over `maps`, gathered at the
+/// query points of each frame, recorded as row `row`.
+fn measure_maps(
+    ws: &mut Workspace,
+    (maps, n_auto): (photon_image::PhotonMaps, u32),
+    row: &str,
+    tick: &mut dyn FnMut(Tick),
+) -> Result<Vec<Sample>, MeasureError> {
     let tree = ws.tree(Heuristic::Siroh);
     let kernels = &maps.constructed.kernels;
     let mut maps_built = Vec::new();
@@ -108,7 +181,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
             ];
             out.push(Sample {
                 group: PM_BUILDERS.into(),
-                scene: ws.scene.name.clone(),
+                scene: row.to_string(),
                 frame: Some(f),
                 variant: name.clone(),
                 counters: c.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
@@ -156,3 +229,46 @@ pub const HOW: &str = "Photon maps over Table 5.1's kernels (native photon traci
      the LBVH with the dual merge (bit for bit lbvh.cu's); n_T and n_I counted by the native walk of the complete \
      layout (bit for bit pmgather.cu's) at the primary and reflection hits of each frame. n_auto follows §6.1.3 as \
      printed, and ours is far above the thesis' (see Table 6.4's note), so our leaves are larger.";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::repro::results::{Results, Sample};
+
+    /// A scenario's row is compared only if its name is the printed row's:
+    /// every table that shows it prints a row of that name, its scene is a
+    /// scene of Table 5.1, and the scenario doubles (Scene 6) or quadruples
+    /// (Conference) that scene's emissions, as §6.1.4 says.
+    #[test]
+    fn every_scenario_names_a_printed_row_of_tables_6_1_to_6_3() {
+        for c in SCENARIOS {
+            for (t, p) in [
+                ("6.1a", &super::super::table_6_1::THESIS_A),
+                ("6.1b", &super::super::table_6_1::THESIS_B),
+                ("6.2", &super::super::table_6_2::THESIS),
+                ("6.3", &super::super::table_6_3::THESIS),
+            ] {
+                assert!(p.row(c.row).is_some(), "Table {t} prints no row {:?}", c.row);
+            }
+            let (photons, _) = super::super::table_5_1::parameters(c.scene).expect("a scene of Table 5.1");
+            assert_eq!(c.photons / photons, if c.scene == "scene6" { 2 } else { 4 }, "{c:?}");
+        }
+    }
+
+    /// The scenario's row follows its scene, and only where it was run.
+    #[test]
+    fn rows_put_a_run_scenario_after_its_scene() {
+        let sample = |scene: &str| Sample {
+            group: PM_BUILDERS.into(),
+            scene: scene.into(),
+            frame: Some(0),
+            variant: variant(Builder::Vvh, None),
+            counters: Default::default(),
+        };
+        let mut r = Results::new("test", crate::repro::protocol::Protocol::quick(), Vec::new(), Vec::new());
+        r.samples = vec![sample("conference"), sample("scene6"), sample("scene6 (2^18, s=28)")];
+        assert_eq!(rows(&r), ["scene6", "scene6 (2^18, s=28)", "conference"]);
+        assert!(run_note(&r, &rows(&r), "x").contains("Scenes: scene6"));
+        assert!(!run_note(&r, &rows(&r), "x").contains("2^18"));
+    }
+}
