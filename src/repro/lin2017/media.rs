@@ -10,7 +10,7 @@
 use crate::host::camera::Camera;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::{LayoutError, PathScene};
-use crate::host::path::{FrameParams, Integrator, Traversal, render_native};
+use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, render_native};
 use crate::host::scene::{Jitter, Scene};
 
 /// One measurement: a pattern at a step count.
@@ -38,6 +38,9 @@ pub enum MediaError {
     /// The layout refused the scene.
     #[error(transparent)]
     Layout(#[from] LayoutError),
+    /// The renderer refused it.
+    #[error(transparent)]
+    Render(#[from] RenderError),
 }
 
 /// The variance of each pattern at each of `steps` (steps across the medium
@@ -75,7 +78,7 @@ pub fn march_variance(
             m[3] = diag / n.max(1) as f32;
             m[11] = if jitter == Jitter::PerStep { 1.0 } else { 0.0 };
             ps.medium = Some(m);
-            let r = render_native(&ps, &cam, p, frames, true, |_| {});
+            let r = render_native(&ps, &cam, p, frames, true, |_| {})?;
             let (variance, mean) = pixel_variance(&r.frame_images);
             out.push(MarchVariance { jitter, steps: n, variance, mean });
         }
