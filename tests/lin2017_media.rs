@@ -204,3 +204,19 @@ fn the_stratified_march_has_the_lower_variance() {
         assert!(at(j, 16).variance < at(j, 8).variance, "{j:?}: 16 steps not below 8");
     }
 }
+
+/// A step count past the kernel's march (1023 steps a ray) is refused: the
+/// march would stop after 1023 steps and leave the rest of the ray dark
+/// (before the fix `warplight chart media --steps 4000,16000` printed the
+/// smog room's mean falling from 0.0264 at 1000 steps to 0.0146 at 16000).
+#[test]
+fn a_step_count_past_the_march_is_refused() {
+    use warplight::repro::lin2017::media::{MediaError, march_variance};
+    let scene = scene_file::load(&scene_file::resolve("fog-emission")).expect("fog-emission");
+    for (steps, past) in [(&[1024u32][..], 1024), (&[4, 16_000][..], 16_000)] {
+        let e = march_variance(&scene, 2, 2, 1, steps, 1).map(|_| ()).unwrap_err();
+        assert!(matches!(e, MediaError::Steps(n) if n == past), "{steps:?}: {e:?}");
+        assert!(e.to_string().contains("at most 1023"), "{e}");
+    }
+    assert!(march_variance(&scene, 2, 2, 1, &[1023], 1).is_ok());
+}
