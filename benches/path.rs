@@ -39,7 +39,7 @@ fn params() -> FrameParams {
 }
 
 fn native(ps: &PathScene, cam: &Camera) -> f32 {
-    render_native(ps, cam, params(), 1, false, |_| {}).accum[0]
+    render_native(ps, cam, params(), 1, false, |_| {}).expect("render").accum[0]
 }
 
 fn emulated(ps: &PathScene, cam: &Camera, level: Fidelity) -> f32 {

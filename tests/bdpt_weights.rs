@@ -25,7 +25,7 @@ const FRAMES: u32 = 256;
 fn frames(integrator: Integrator, max_bounces: u32, seed: u32) -> Progressive {
     let (_, ps, cam) = scene_of("cornell-lambert", SIZE);
     let p = FrameParams { width: SIZE, height: SIZE, integrator, max_bounces, seed, traversal: Traversal::ShortStack };
-    render_native(&ps, &cam, p, FRAMES, true, |_| {})
+    render_native(&ps, &cam, p, FRAMES, true, |_| {}).expect("render")
 }
 
 /// Per pixel and channel, the variance of the frames' values (each frame: 4 paths per pixel).

@@ -108,14 +108,14 @@ fn bdpt_weights_a_direct_path_by_its_two_techniques() {
     let cam = camera(&scene, w, h);
     let run = |integrator, max_bounces, seed| {
         let p = FrameParams { width: w, height: h, integrator, max_bounces, seed, traversal: Traversal::ShortStack };
-        render_native(&ps, &cam, p, 1, false, |_| {}).accum
+        render_native(&ps, &cam, p, 1, false, |_| {}).expect("render").accum
     };
     assert_eq!(run(Integrator::Bdpt, 0, 5), run(Integrator::Pt, 0, 5), "0 bounces: the light seen directly");
     // 1 bounce, many frames: bdpt's mean equals nee's (both unbiased for direct light)
     let mean = |integrator| {
         let p =
             FrameParams { width: w, height: h, integrator, max_bounces: 1, seed: 9, traversal: Traversal::ShortStack };
-        let r = render_native(&ps, &cam, p, 64, false, |_| {});
+        let r = render_native(&ps, &cam, p, 64, false, |_| {}).expect("render");
         r.accum.iter().map(|&v| v as f64).sum::<f64>() / 64.0
     };
     let (b, n) = (mean(Integrator::Bdpt), mean(Integrator::Nee));
@@ -148,7 +148,7 @@ fn same_frames((scene, ps): (Scene, PathScene), integrators: &[Integrator]) {
     for &integrator in integrators {
         let params =
             FrameParams { width: w, height: h, integrator, max_bounces: 16, seed: 3, traversal: Traversal::ShortStack };
-        let native = render_native(&ps, &cam, params, 2, true, |_| {});
+        let native = render_native(&ps, &cam, params, 2, true, |_| {}).expect("render");
         let mut cfg = kernel::sim_config(&params);
         cfg.fidelity = Fidelity::Functional;
         let mut dev = Device::with_config(cfg);
@@ -246,7 +246,7 @@ fn fig_8_bdpt_beats_nee_under_the_inverted_light() {
     let image = |integrator, seed| {
         let p =
             FrameParams { width: w, height: h, integrator, max_bounces: 16, seed, traversal: Traversal::ShortStack };
-        render_native(&ps, &cam, p, 100, false, |_| {}).image().pixels
+        render_native(&ps, &cam, p, 100, false, |_| {}).expect("render").image().pixels
     };
     let spread = |integrator| {
         let (a, b) = (image(integrator, 1), image(integrator, 2));

@@ -14,7 +14,7 @@ mod lin2017_mitsuba;
 use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -31,7 +31,7 @@ fn same_frames((scene, ps): &(Scene, PathScene), integrator: Integrator, max_bou
     let cam = Camera { resolution: [w, h], ..scene.camera };
     let params =
         FrameParams { width: w, height: h, integrator, max_bounces, seed: 3, traversal: Traversal::ShortStack };
-    let native = render_native(ps, &cam, params, 2, true, |_| {});
+    let native = render_native(ps, &cam, params, 2, true, |_| {}).expect("render");
     let mut cfg = kernel::sim_config(&params);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);
@@ -110,6 +110,27 @@ fn bdpt_and_mlt_refuse_a_medium() {
     assert!(ps.check_integrator(&scene.name, Integrator::MisPower).is_ok());
     let (_, plain) = load("cornell-lambert");
     assert!(plain.check_integrator("cornell-lambert", Integrator::Bdpt).is_ok());
+    // the library's renderers refuse them too: before, the native bdpt ignored
+    // the medium (the image of the room without it) while kernel::render ran
+    // volume_frame with bdpt's integrator (a path tracer through the medium),
+    // so the twins differed in every value, and mlt ignored it on both sides
+    let cam = Camera { resolution: [4, 4], ..scene.camera };
+    for i in [Integrator::Bdpt, Integrator::Mlt] {
+        let p = FrameParams {
+            width: 4,
+            height: 4,
+            integrator: i,
+            max_bounces: 4,
+            seed: 1,
+            traversal: Traversal::ShortStack,
+        };
+        let e = render_native(&ps, &cam, p, 1, false, |_| {}).map(|_| ()).unwrap_err();
+        assert!(matches!(e, RenderError::Medium(n) if n == i.name()), "{i:?}: {e:?}");
+        let mut dev = Device::with_config(kernel::sim_config(&p));
+        let module = kernel::load(&mut dev).expect("load PTX");
+        let e = kernel::render(&mut dev, &module, &ps, &cam, p, 1, false, |_| {}).map(|_| ()).unwrap_err();
+        assert!(e.to_string().contains("participating medium") && e.to_string().contains(i.name()), "{i:?}: {e}");
+    }
 }
 
 const SMOG: &str = "tests/fixtures/mitsuba/smog-room-32";
@@ -182,4 +203,20 @@ fn the_stratified_march_has_the_lower_variance() {
     for j in [Jitter::Stratified, Jitter::PerStep] {
         assert!(at(j, 16).variance < at(j, 8).variance, "{j:?}: 16 steps not below 8");
     }
+}
+
+/// A step count past the kernel's march (1023 steps a ray) is refused: the
+/// march would stop after 1023 steps and leave the rest of the ray dark
+/// (before the fix `warplight chart media --steps 4000,16000` printed the
+/// smog room's mean falling from 0.0264 at 1000 steps to 0.0146 at 16000).
+#[test]
+fn a_step_count_past_the_march_is_refused() {
+    use warplight::repro::lin2017::media::{MediaError, march_variance};
+    let scene = scene_file::load(&scene_file::resolve("fog-emission")).expect("fog-emission");
+    for (steps, past) in [(&[1024u32][..], 1024), (&[4, 16_000][..], 16_000)] {
+        let e = march_variance(&scene, 2, 2, 1, steps, 1).map(|_| ()).unwrap_err();
+        assert!(matches!(e, MediaError::Steps(n) if n == past), "{steps:?}: {e:?}");
+        assert!(e.to_string().contains("at most 1023"), "{e}");
+    }
+    assert!(march_variance(&scene, 2, 2, 1, &[1023], 1).is_ok());
 }

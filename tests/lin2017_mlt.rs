@@ -43,7 +43,11 @@ const FRAMES: u32 = 64;
 /// The final images of `RUNS` independent MLT renders (seeds `seed`, `seed` + 1, ...).
 fn runs(ps: &PathScene, cam: &Camera, size: u32, seed: u32) -> Vec<FrameBuffer> {
     (0..RUNS)
-        .map(|r| render_native(ps, cam, params(size, Integrator::Mlt, seed + r), FRAMES, false, |_| {}).image())
+        .map(|r| {
+            render_native(ps, cam, params(size, Integrator::Mlt, seed + r), FRAMES, false, |_| {})
+                .expect("render")
+                .image()
+        })
         .collect()
 }
 

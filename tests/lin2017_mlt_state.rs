@@ -20,7 +20,9 @@ use std::collections::BTreeSet;
 use lin2017_mitsuba::scene_of;
 use warplight::host::camera::Camera;
 use warplight::host::path::mlt::{self, MltError};
-use warplight::host::path::{FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, Traversal, kernel};
+use warplight::host::path::{
+    self, FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, RenderError, Traversal, kernel,
+};
 use warplight::ptx::ir::MemSpace;
 use warplight::sim::access_log::AccessLog;
 use warplight::sim::{Arg, Device, Fidelity, LaunchConfig};
@@ -90,6 +92,12 @@ fn mlt_refuses_bounds_it_cannot_keep() {
         let p = params(2, 2, mb);
         let e = mlt::render_native(&ps, &cam, p, 1, false, |_| {}).map(|_| ()).unwrap_err();
         assert!(matches!(e, MltError::Params(FrameParamsError::TooManyBounces(b)) if b == mb), "{mb}: {e:?}");
+        // the integrators' entry point returns the same error (it panicked on it before)
+        let e = path::render_native(&ps, &cam, p, 1, false, |_| {}).map(|_| ()).unwrap_err();
+        assert!(
+            matches!(e, RenderError::Mlt(MltError::Params(FrameParamsError::TooManyBounces(b))) if b == mb),
+            "{mb}: {e:?}"
+        );
         let mut dev = Device::with_config(kernel::sim_config(&p));
         let module = kernel::load(&mut dev).expect("load PTX");
         let before = dev.memory().allocations().len();
@@ -114,4 +122,6 @@ fn mlt_refuses_bounds_it_cannot_keep() {
     // the native render refuses it before allocating (it would need 679 GB)
     let e = mlt::render_native(&ps, &cam, params(1920, 1080, MAX_BOUNCES), 1, false, |_| {}).map(|_| ()).unwrap_err();
     assert!(matches!(e, MltError::StateTooLarge { .. }), "{e:?}");
+    let e = path::render_native(&ps, &cam, params(1920, 1080, MAX_BOUNCES), 1, false, |_| {}).map(|_| ()).unwrap_err();
+    assert!(matches!(e, RenderError::Mlt(MltError::StateTooLarge { .. })), "{e:?}");
 }

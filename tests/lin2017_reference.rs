@@ -128,7 +128,7 @@ fn bdpt_agrees_with_mitsuba() {
     // heavy tail, and a few frames underestimate a block's variance
     // (docs/reproduction-lin2017.md, "Bidirectional path tracing").
     let p = params(size, Integrator::Bdpt, 301);
-    let native = render_native(&ps, &cam, p, 4, false, |_| {});
+    let native = render_native(&ps, &cam, p, 4, false, |_| {}).expect("render");
     let mut cfg = kernel::sim_config(&p);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);

@@ -71,7 +71,7 @@ fn emulated_traversals_equal_native_bit_for_bit_and_count_for_count() {
         let ps = layout(&s, c);
         for t in Traversal::ALL {
             let p = params(8, 6, t);
-            let native = render_native(&ps, &cam, p, 1, false, |_| {});
+            let native = render_native(&ps, &cam, p, 1, false, |_| {}).expect("render");
             let (emu, counted) = emulate(&ps, &cam, p);
             let diff = native.accum.iter().zip(&emu.accum).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
             assert_eq!(diff, 0, "{c:?} {t:?}: {diff} values differ");
@@ -97,8 +97,10 @@ fn stackless_traversals_visit_the_same_leaves_and_every_traversal_finds_the_same
     let cam = Camera { resolution: [w, h], ..s.camera };
     for c in Construction::ALL {
         let ps = layout(&s, c);
-        let runs: Vec<(Traversal, Progressive)> =
-            Traversal::ALL.iter().map(|&t| (t, render_native(&ps, &cam, params(w, h, t), 1, false, |_| {}))).collect();
+        let runs: Vec<(Traversal, Progressive)> = Traversal::ALL
+            .iter()
+            .map(|&t| (t, render_native(&ps, &cam, params(w, h, t), 1, false, |_| {}).expect("render")))
+            .collect();
         let (restart, backtrack) = (&runs[1].1.counts, &runs[2].1.counts);
         // the same leaves in the same order: the same leaf visits and triangle tests
         assert_eq!((restart.leaves, restart.tri_tests), (backtrack.leaves, backtrack.tri_tests), "{c:?}");
@@ -162,7 +164,7 @@ fn the_short_stacks_entries_move_8_bytes_and_the_standard_stacks_12() {
     // (a pop's loads are not compared: kd-restart's own local loads differ
     // from the stacks' non-stack loads, so they are no baseline)
     // natively too: the same image and walk
-    let native = render_native(&ps, &cam, params(8, 6, Traversal::FullStack), 1, false, |_| {});
+    let native = render_native(&ps, &cam, params(8, 6, Traversal::FullStack), 1, false, |_| {}).expect("render");
     assert!(same(&native.accum, &full_img));
     assert_eq!(native.counts, full);
     assert_eq!(Traversal::parse("stack12"), Some(Traversal::FullStack));

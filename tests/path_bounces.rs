@@ -50,7 +50,7 @@ fn a_huge_bound_renders_alike_natively_and_emulated() {
     for integrator in [Integrator::Nee, Integrator::Bdpt] {
         for max_bounces in [u32::MAX, 1 << 31] {
             let p = params(integrator, max_bounces);
-            let native = render_native(&ps, &cam, p, 1, false, |_| {});
+            let native = render_native(&ps, &cam, p, 1, false, |_| {}).expect("render");
             let mut cfg = kernel::sim_config(&p);
             cfg.fidelity = Fidelity::Functional;
             let mut dev = Device::with_config(cfg);
@@ -60,7 +60,7 @@ fn a_huge_bound_renders_alike_natively_and_emulated() {
             let differ = native.accum.iter().zip(&emu.image.accum).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
             assert_eq!(differ, 0, "{integrator:?} {max_bounces}: {differ} values differ");
             // and as with a large bound the kernel can hold
-            let same = render_native(&ps, &cam, params(integrator, MAX_BOUNCES), 1, false, |_| {});
+            let same = render_native(&ps, &cam, params(integrator, MAX_BOUNCES), 1, false, |_| {}).expect("render");
             assert!(same.accum.iter().sum::<f32>() > 0.0);
         }
     }

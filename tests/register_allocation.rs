@@ -348,3 +348,100 @@ fn narrow_rows_compute_what_wide_rows_compute() {
         assert_eq!(at(o, 21, t), r24, "partial masks, lane {t}");
     }
 }
+
+/// The forms of step 28's narrow rows that `narrow_rows_compute_what_wide_rows_compute`
+/// does not reach: a vector load into four narrow registers, atomics'
+/// old values written into narrow rows (on every lane and under a partial
+/// mask), `mul.hi` (interpreted, reading narrow operands zero-extended),
+/// `vote.ballot` and `shfl` (with its predicate) into narrow rows. Launched
+/// (narrow rows) and stepped (wide rows) write the same memory and count
+/// the same; the values are checked against Rust.
+#[test]
+fn narrow_rows_take_vector_loads_atomics_shuffles_and_high_products() {
+    let src = ".version 7.8\n.target sm_90\n.address_size 64\n\
+        .visible .entry narrow_mem(.param .u64 out, .param .u64 inp, .param .u64 ctr)\n{\n\
+        .reg .pred %p<3>;\n.reg .b32 %r<20>;\n.reg .b64 %rd<12>;\n\
+        ld.param.u64 %rd1, [out];\nld.param.u64 %rd2, [inp];\nld.param.u64 %rd3, [ctr];\n\
+        cvta.to.global.u64 %rd1, %rd1;\ncvta.to.global.u64 %rd2, %rd2;\ncvta.to.global.u64 %rd3, %rd3;\n\
+        mov.u32 %r1, %tid.x;\nmul.wide.u32 %rd4, %r1, 16;\nadd.s64 %rd5, %rd2, %rd4;\n\
+        ld.global.v4.u32 {%r2, %r3, %r4, %r5}, [%rd5];\n\
+        mul.wide.u32 %rd6, %r1, 4;\nadd.s64 %rd7, %rd3, %rd6;\n\
+        atom.global.add.u32 %r6, [%rd7], %r2;\natom.global.cas.b32 %r7, [%rd7], %r3, %r4;\n\
+        mul.hi.s32 %r8, %r2, %r3;\nmul.hi.u32 %r9, %r2, %r3;\nmul.hi.s32 %r10, %r2, 715827883;\n\
+        setp.lt.s32 %p1, %r2, 0;\nvote.sync.ballot.b32 %r11, %p1, -1;\n\
+        shfl.sync.idx.b32 %r12, %r4, 3, 31, -1;\nshfl.sync.down.b32 %r13|%p2, %r5, 2, 31, -1;\n\
+        selp.u32 %r14, 1, 0, %p2;\nmov.u32 %r15, 7;\n\
+        @%p1 bra SKIP;\natom.global.exch.b32 %r15, [%rd7], %r5;\nSKIP:\n\
+        add.s64 %rd8, %rd1, %rd6;\n\
+        st.global.u32 [%rd8], %r2;\nst.global.u32 [%rd8+128], %r3;\nst.global.u32 [%rd8+256], %r4;\n\
+        st.global.u32 [%rd8+384], %r5;\nst.global.u32 [%rd8+512], %r6;\nst.global.u32 [%rd8+640], %r7;\n\
+        st.global.u32 [%rd8+768], %r8;\nst.global.u32 [%rd8+896], %r9;\nst.global.u32 [%rd8+1024], %r10;\n\
+        st.global.u32 [%rd8+1152], %r11;\nst.global.u32 [%rd8+1280], %r12;\nst.global.u32 [%rd8+1408], %r13;\n\
+        st.global.u32 [%rd8+1536], %r14;\nst.global.u32 [%rd8+1664], %r15;\nret;\n}\n";
+    let xs: [u32; 32] = std::array::from_fn(|t| match t % 8 {
+        0 => t as u32,
+        1 => u32::MAX - t as u32,
+        2 => 0x8000_0000 | t as u32,
+        3 => 0x7FFF_FFF0 + t as u32,
+        4 => (-(100 * t as i32)) as u32,
+        5 => 0xDEAD_BEEF ^ t as u32,
+        6 => 0x0001_0000 * t as u32,
+        _ => 0xFFFF_0000 + t as u32,
+    });
+    let lane = |t: usize| -> [u32; 4] {
+        [xs[t], xs[(t * 7 + 3) % 32], xs[(t * 5 + 1) % 32], 0x0101_0101u32.wrapping_mul(t as u32)]
+    };
+    let inputs: Vec<u32> = (0..32).flat_map(lane).collect();
+    let ctr0: Vec<u32> = (0..32).map(|t| 1000 * t + 17).collect();
+    let run = |step: bool| {
+        let mut dev = device(1);
+        let m = dev.load_ptx(src, "narrow_mem.ptx").unwrap();
+        let out = dev.alloc_zeroed::<u32>(32 * 14);
+        let inp = dev.alloc_from(&inputs);
+        let ctr = dev.alloc_from(&ctr0);
+        let (cfg, args) = (LaunchConfig::linear(1, 32), [Arg::Ptr(out), Arg::Ptr(inp), Arg::Ptr(ctr)]);
+        let counters = if step {
+            let mut st = dev.stepper(&m, "narrow_mem", cfg, &args).unwrap();
+            while st.step().unwrap().is_some() {}
+            st.counters()
+        } else {
+            dev.launch(&m, "narrow_mem", cfg, &args).unwrap().totals
+        };
+        let k = m.prog.kernel("narrow_mem").unwrap() as usize;
+        let narrow = |code: &warplight::sim::decode::Code| code.funcs[k].frame_rows().1;
+        (dev.read::<u32>(out, 32 * 14), dev.read::<u32>(ctr, 32), counters, narrow(&m.code), narrow(m.stepping_code()))
+    };
+    let (launched, stepped) = (run(false), run(true));
+    assert!(launched.3 > 0 && stepped.4 == 0, "narrow rows: launch {}, stepper {}", launched.3, stepped.4);
+    assert_eq!(launched.2, stepped.2, "counters");
+    assert_eq!(launched.1, stepped.1, "the counters' memory");
+    let at = |v: &Vec<u32>, slot: usize, t: usize| v[slot * 32 + t];
+    for slot in 0..14 {
+        for t in 0..32 {
+            assert_eq!(at(&launched.0, slot, t), at(&stepped.0, slot, t), "result {slot}, lane {t}");
+        }
+    }
+    let o = &launched.0;
+    let ballot = (0..32).filter(|&t| (xs[t] as i32) < 0).fold(0u32, |b, t| b | 1 << t);
+    for t in 0..32 {
+        let [x, y, z, w] = lane(t);
+        for (k, v) in [x, y, z, w].into_iter().enumerate() {
+            assert_eq!(at(o, k, t), v, "ld.v4 component {k}, lane {t}");
+        }
+        assert_eq!(at(o, 4, t), ctr0[t], "atom.add's old value, lane {t}");
+        assert_eq!(at(o, 5, t), ctr0[t].wrapping_add(x), "atom.cas's old value, lane {t}");
+        assert_eq!(at(o, 6, t), ((x as i32 as i64 * y as i32 as i64) >> 32) as u32, "mul.hi.s32, lane {t}");
+        assert_eq!(at(o, 7, t), ((x as u64 * y as u64) >> 32) as u32, "mul.hi.u32, lane {t}");
+        assert_eq!(at(o, 8, t), ((x as i32 as i64 * 715_827_883) >> 32) as u32, "mul.hi.s32 by a constant, lane {t}");
+        assert_eq!(at(o, 9, t), ballot, "vote.ballot, lane {t}");
+        assert_eq!(at(o, 10, t), lane(3)[2], "shfl.idx, lane {t}");
+        let down = if t + 2 < 32 { (lane(t + 2)[3], 1) } else { (w, 0) };
+        assert_eq!((at(o, 11, t), at(o, 12, t)), down, "shfl.down and its predicate, lane {t}");
+        let cas = ctr0[t].wrapping_add(x);
+        let after_cas = if cas == y { z } else { cas };
+        let exch = if (x as i32) < 0 { 7 } else { after_cas };
+        assert_eq!(at(o, 13, t), exch, "atom.exch's old value under a partial mask, lane {t}");
+        assert_eq!(launched.1[t], if (x as i32) < 0 { after_cas } else { w }, "the counter, lane {t}");
+    }
+    assert!(ballot != 0 && ballot != u32::MAX, "a partial mask: {ballot:#x}");
+}

@@ -84,7 +84,7 @@ pub struct MediaArgs {
     /// The longest path in bounces (1: the camera ray's march and direct light only).
     #[arg(long, default_value_t = 1)]
     pub bounces: u32,
-    /// Step counts across the medium box's diagonal, comma-separated.
+    /// Step counts across the medium box's diagonal, comma-separated (1 to 1023, the kernel's march).
     #[arg(long, default_value = "2,4,8,16,32,64", value_delimiter = ',')]
     pub steps: Vec<u32>,
     /// Seed of the random numbers.

@@ -201,17 +201,13 @@ pub fn tagged_counts(
     select: impl Fn(&crate::sim::counters::InstCounts) -> u64,
 ) -> std::collections::BTreeMap<String, u64> {
     let mut out: std::collections::BTreeMap<String, u64> = tags.iter().map(|t| (t.name.clone(), 0)).collect();
-    let Some(file) = prog.files.iter().position(|f| f.ends_with(source_file)) else { return out };
-    for (f, counts) in profile.per_fn.iter().enumerate() {
-        for (pc, c) in counts.iter().enumerate() {
-            let info = &prog.functions[f].info[pc];
-            let Some(src) = info.src else { continue };
-            if src.file as usize != file || c.pred_on == 0 {
-                continue;
-            }
-            for t in tags.iter().filter(|t| t.line == src.line && t.opcode == info.opcode) {
-                *out.entry(t.name.clone()).or_default() += select(c);
-            }
+    for (f, pc, info, line) in prog.located_in(source_file) {
+        let Some(c) = profile.per_fn.get(f).and_then(|counts| counts.get(pc)) else { continue };
+        if c.pred_on == 0 {
+            continue;
+        }
+        for t in tags.iter().filter(|t| t.line == line && t.opcode == info.opcode) {
+            *out.entry(t.name.clone()).or_default() += select(c);
         }
     }
     out

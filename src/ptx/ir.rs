@@ -848,6 +848,20 @@ impl Program {
         exact.or_else(plain).map(|i| i as u32)
     }
 
+    /// The instructions that `.loc` places in the CUDA source `source_file`
+    /// (a suffix of a `.file` path, the first file that has it), in function
+    /// and pc order: (function index, pc, the instruction's info, its source
+    /// line). Nothing when no file has the suffix.
+    pub fn located_in<'a>(&'a self, source_file: &str) -> impl Iterator<Item = (usize, usize, &'a InstInfo, u32)> + 'a {
+        let file = self.files.iter().position(|f| f.ends_with(source_file));
+        self.functions.iter().enumerate().flat_map(move |(f, func)| {
+            func.info.iter().enumerate().filter_map(move |(pc, info)| {
+                let s = info.src?;
+                (Some(s.file as usize) == file).then_some((f, pc, info, s.line))
+            })
+        })
+    }
+
     /// Static shared memory `kernel` itself needs in bytes: the end of its
     /// layout ([`Program::kernel_shared_layout`]). The emulator still gives
     /// every CTA the whole module layout ([`Program::static_shared_size`]);

@@ -55,7 +55,7 @@ pub fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
 // each test crate that includes this module uses a part of it
 #[allow(dead_code)]
 pub fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32, reference: &Estimate) -> Outcome {
-    let r = render_native(ps, cam, p, frames, true, |_| {});
+    let r = render_native(ps, cam, p, frames, true, |_| {}).expect("render");
     let ours = from_frames(&r.frame_images, BLOCK).expect("two frames or more");
     welch_holm(&ours, reference, ALPHA).expect("same block grid")
 }

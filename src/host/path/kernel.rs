@@ -154,7 +154,9 @@ pub struct KernelRender {
 
 /// Renders `frames` frames of `camera`'s view on `dev` (with `module` loaded
 /// by [`load`]); `keep_frames` keeps each frame's image; `progress` is told
-/// each finished frame.
+/// each finished frame. Refused ([`SimError::BadLaunch`], naming why): mlt
+/// settings [`super::mlt::check`] refuses, and bdpt or mlt on a scene with a
+/// medium ([`PathScene::ignores_medium`]).
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     dev: &mut Device,
@@ -166,6 +168,10 @@ pub fn render(
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Result<KernelRender, SimError> {
+    if scene.ignores_medium(params.integrator) {
+        // volume_frame would run bdpt's integrator as a path tracer, mlt's kernels ignore the medium
+        return Err(SimError::BadLaunch(super::RenderError::Medium(params.integrator.name()).to_string()));
+    }
     if params.integrator == super::Integrator::Mlt {
         return super::mlt::render_emulated(dev, module, scene, camera, params, frames, keep_frames, progress)
             .map(KernelRender::from)

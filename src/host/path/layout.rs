@@ -278,9 +278,16 @@ impl PathScene {
 }
 
 impl PathScene {
+    /// Whether `integrator` ignores the scene's medium: bdpt and mlt, which
+    /// do not march it (`volume_frame` is the path tracer's). The renderers
+    /// refuse them on such a scene.
+    pub fn ignores_medium(&self, integrator: super::Integrator) -> bool {
+        self.medium.is_some() && matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt)
+    }
+
     /// Refuses an integrator that ignores the scene's medium (bdpt, mlt).
     pub fn check_integrator(&self, name: &str, integrator: super::Integrator) -> Result<(), LayoutError> {
-        if self.medium.is_some() && matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt) {
+        if self.ignores_medium(integrator) {
             return Err(LayoutError::MediumIntegrator(name.to_string(), integrator.name()));
         }
         Ok(())

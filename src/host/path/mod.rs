@@ -290,14 +290,27 @@ impl Progressive {
     }
 }
 
+/// Why a render was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// MLT settings [`mlt::check`] refuses (more than [`MAX_BOUNCES`]
+    /// bounces, or more chain state than [`mlt::MAX_STATE_BYTES`]).
+    #[error(transparent)]
+    Mlt(#[from] mlt::MltError),
+    /// An integrator that does not march the scene's participating medium
+    /// ([`layout::PathScene::ignores_medium`]).
+    #[error(
+        "the scene has a participating medium, which only pt, nee, mis and mis-power march (volume_frame); not {0}"
+    )]
+    Medium(&'static str),
+}
+
 /// Renders `frames` frames natively; `keep_frames` keeps each frame's image
-/// (mlt: [`mlt::render_native`]'s image).
-///
-/// # Panics
-/// For mlt with settings [`mlt::check`] refuses (more than [`MAX_BOUNCES`]
-/// bounces, or more chain state than [`mlt::MAX_STATE_BYTES`]); call
-/// [`mlt::render_native`] for the typed error. The other integrators take
-/// any bound (a longest path past the kernel's `int` saturates).
+/// (mlt: [`mlt::render_native`]'s image). Refused: mlt with settings
+/// [`mlt::check`] refuses, and bdpt or mlt on a scene with a medium (they
+/// would ignore it; the kernels refuse it too, [`kernel::render`]). The
+/// other integrators take any bound (a longest path past the kernel's `int`
+/// saturates).
 pub fn render_native(
     scene: &layout::PathScene,
     camera: &Camera,
@@ -305,12 +318,12 @@ pub fn render_native(
     frames: u32,
     keep_frames: bool,
     mut progress: impl FnMut(u32),
-) -> Progressive {
+) -> Result<Progressive, RenderError> {
+    if scene.ignores_medium(params.integrator) {
+        return Err(RenderError::Medium(params.integrator.name()));
+    }
     if params.integrator == Integrator::Mlt {
-        return match mlt::render_native(scene, camera, params, frames, keep_frames, progress) {
-            Ok(r) => r.image,
-            Err(e) => panic!("render_native: {e}"),
-        };
+        return Ok(mlt::render_native(scene, camera, params, frames, keep_frames, progress)?.image);
     }
     let eps = eps_for(scene.lo, scene.hi);
     let tracer = native::Tracer { scene, frame: frame_of(camera, eps), params };
@@ -325,5 +338,5 @@ pub fn render_native(
         }
         progress(f + 1);
     }
-    out
+    Ok(out)
 }

@@ -10,8 +10,9 @@
 use crate::host::camera::Camera;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::{LayoutError, PathScene};
-use crate::host::path::{FrameParams, Integrator, Traversal, render_native};
+use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, render_native};
 use crate::host::scene::{Jitter, Scene};
+use crate::host::scene_file::MAX_MEDIUM_STEPS;
 
 /// One measurement: a pattern at a step count.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -35,9 +36,16 @@ pub enum MediaError {
     /// Fewer than two frames: no variance.
     #[error("{0} frames: the variance needs at least 2")]
     Frames(u32),
+    /// A step count past the kernel's march: its steps beyond
+    /// [`MAX_MEDIUM_STEPS`] a ray would be dropped, not marched.
+    #[error("{0} steps across the medium's box: the march takes at most {MAX_MEDIUM_STEPS} a ray")]
+    Steps(u32),
     /// The layout refused the scene.
     #[error(transparent)]
     Layout(#[from] LayoutError),
+    /// The renderer refused it.
+    #[error(transparent)]
+    Render(#[from] RenderError),
 }
 
 /// The variance of each pattern at each of `steps` (steps across the medium
@@ -53,6 +61,9 @@ pub fn march_variance(
 ) -> Result<Vec<MarchVariance>, MediaError> {
     if frames < 2 {
         return Err(MediaError::Frames(frames));
+    }
+    if let Some(&n) = steps.iter().find(|&&n| n as f32 > MAX_MEDIUM_STEPS) {
+        return Err(MediaError::Steps(n));
     }
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
@@ -75,7 +86,7 @@ pub fn march_variance(
             m[3] = diag / n.max(1) as f32;
             m[11] = if jitter == Jitter::PerStep { 1.0 } else { 0.0 };
             ps.medium = Some(m);
-            let r = render_native(&ps, &cam, p, frames, true, |_| {});
+            let r = render_native(&ps, &cam, p, frames, true, |_| {})?;
             let (variance, mean) = pixel_variance(&r.frame_images);
             out.push(MarchVariance { jitter, steps: n, variance, mean });
         }

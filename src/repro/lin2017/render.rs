@@ -88,7 +88,7 @@ pub fn render(
     };
     let t0 = Instant::now();
     let (image, instructions) = match emulated {
-        None => (render_native(&ps, camera, params, frames, false, tick).image(), None),
+        None => (render_native(&ps, camera, params, frames, false, tick)?.image(), None),
         Some(set) => {
             let mut cfg = kernel::sim_config(&params);
             set(&mut cfg);

@@ -119,7 +119,7 @@ pub fn function_lines(source: &str, name: &str) -> Option<RangeInclusive<u32>> {
 
 /// Operations executed (lanes with their guard true) on `lines` of `source_file`, summed over `profile`.
 pub fn ops_on_lines(prog: &Program, profile: &InstProfile, source_file: &str, lines: &RangeInclusive<u32>) -> Ops {
-    ops_where(prog, source_file, lines, |f, pc| profile.per_fn[f][pc].pred_on)
+    ops_where(prog, source_file, lines, |f, pc| profile.per_fn.get(f).and_then(|c| c.get(pc)).map_or(0, |c| c.pred_on))
 }
 
 /// Operations on `lines` of `source_file` in the program's text (each instruction once).
@@ -136,12 +136,9 @@ fn ops_where(
     times: impl Fn(usize, usize) -> u64,
 ) -> Ops {
     let mut ops = Ops::default();
-    let Some(file) = prog.files.iter().position(|f| f.ends_with(source_file)) else { return ops };
-    for (f, func) in prog.functions.iter().enumerate() {
-        for (pc, info) in func.info.iter().enumerate() {
-            if info.src.is_some_and(|s| s.file as usize == file && lines.contains(&s.line)) {
-                ops.add_opcode(&info.opcode, times(f, pc));
-            }
+    for (f, pc, info, line) in prog.located_in(source_file) {
+        if lines.contains(&line) {
+            ops.add_opcode(&info.opcode, times(f, pc));
         }
     }
     ops
