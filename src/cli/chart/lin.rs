@@ -10,6 +10,49 @@ use crate::host::path::Integrator;
 use crate::repro::lin2017::convergence::{self, Convergence, Options, Reference};
 use crate::repro::lin2017::lanes::{self, Compaction};
 
+/// Where the charts and their data go, or come from.
+#[derive(Debug, clap::Args)]
+pub struct Out {
+    /// Redraw from this chart data (written by an earlier run) instead of measuring.
+    #[arg(long)]
+    pub from: Option<PathBuf>,
+    /// Output .svg or .png with `{}` for each chart's name (lin-convergence:
+    /// spp, seconds, instructions, mean; lin-compaction: lanes, paths); the
+    /// data goes beside them as `{}` = data, .json.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Size in pixels, WIDTHxHEIGHT (default 960x540).
+    #[arg(long)]
+    pub chart_size: Option<String>,
+}
+
+/// Reads the data from `--from` or measures (and saves) it, reports it, and draws its charts.
+fn chart_of<T: serde::Serialize + serde::de::DeserializeOwned>(
+    out: &Out,
+    names: &[&str],
+    measure: impl FnOnce() -> Result<T, Box<dyn std::error::Error>>,
+    report: impl Fn(&T),
+    charts: impl Fn(&T) -> Vec<crate::chart::Scatter>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let size = parse_size(out.chart_size.as_deref())?;
+    for name in names {
+        crate::chart::Format::of(&named(&out.output, name, false)?)?;
+    }
+    let data: T = match &out.from {
+        Some(f) => read_json(f)?,
+        None => {
+            let d = measure()?;
+            save(&d, &out.output)?;
+            d
+        }
+    };
+    report(&data);
+    for (c, name) in charts(&data).into_iter().zip(names) {
+        write(&Chart::Scatter(c), &named(&out.output, name, false)?, size)?;
+    }
+    Ok(())
+}
+
 /// Options of `warplight chart lin-convergence`.
 #[derive(Debug, clap::Args)]
 pub struct ConvergenceArgs {
@@ -35,16 +78,9 @@ pub struct ConvergenceArgs {
     /// Seed of the random numbers.
     #[arg(long, default_value_t = 1)]
     pub seed: u32,
-    /// Redraw from this chart data (written by an earlier run) instead of rendering.
-    #[arg(long)]
-    pub from: Option<PathBuf>,
-    /// Output .svg or .png with `{}` for the chart's name (spp, seconds,
-    /// instructions, mean); the data goes beside it as `{}` = data, .json.
-    #[arg(short, long)]
-    pub output: PathBuf,
-    /// Size in pixels, WIDTHxHEIGHT (default 960x540).
-    #[arg(long)]
-    pub chart_size: Option<String>,
+    /// The data and the charts.
+    #[command(flatten)]
+    pub out: Out,
 }
 
 /// Options of `warplight chart lin-compaction`.
@@ -59,16 +95,9 @@ pub struct CompactionArgs {
     /// Levels of the frame (the longest path depth − 1 bounces).
     #[arg(long, default_value_t = 30)]
     pub depth: u32,
-    /// Redraw from this chart data (written by an earlier run) instead of emulating.
-    #[arg(long)]
-    pub from: Option<PathBuf>,
-    /// Output .svg or .png with `{}` for the chart's name (lanes, paths); the
-    /// data goes beside it as `{}` = data, .json.
-    #[arg(short, long)]
-    pub output: PathBuf,
-    /// Size in pixels, WIDTHxHEIGHT (default 960x540).
-    #[arg(long)]
-    pub chart_size: Option<String>,
+    /// The data and the charts.
+    #[command(flatten)]
+    pub out: Out,
 }
 
 /// `out` with `{}` replaced by `name` (and, for the data, the extension .json).
@@ -84,18 +113,6 @@ fn named(out: &Path, name: &str, json: bool) -> Result<PathBuf, String> {
 fn read_json<T: serde::de::DeserializeOwned>(p: &Path) -> Result<T, String> {
     let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
     serde_json::from_str(&text).map_err(|e| format!("{}: not the chart data ({e})", p.display()))
-}
-
-fn draw(
-    charts: &[crate::chart::Scatter],
-    names: &[&str],
-    a_out: &Path,
-    size: Option<(u32, u32)>,
-) -> Result<(), Box<dyn std::error::Error>> {
-    for (c, name) in charts.iter().zip(names) {
-        write(&Chart::Scatter(c.clone()), &named(a_out, name, false)?, size)?;
-    }
-    Ok(())
 }
 
 fn save(data: &impl serde::Serialize, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
@@ -119,34 +136,30 @@ fn reference_prefix(given: Option<&Path>, scene: &str) -> PathBuf {
 
 /// Runs `chart lin-convergence`.
 pub fn lin_convergence(a: ConvergenceArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let size = parse_size(a.chart_size.as_deref())?;
-    named(&a.output, "spp", false)?;
-    crate::chart::Format::of(&named(&a.output, "spp", false)?)?;
-    let data: Convergence = match &a.from {
-        Some(f) => read_json(f)?,
-        None => {
-            let integrators = a
-                .integrators
-                .iter()
-                .map(|s| {
-                    Integrator::parse(s)
-                        .ok_or_else(|| format!("--integrators: unknown `{s}` (pt, nee, mis, mis-power, bdpt, mlt)"))
-                })
-                .collect::<Result<Vec<_>, _>>()?;
-            let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
-            let r = Reference::read(&reference_prefix(a.reference.as_deref(), &scene.name))?;
-            let o = Options {
-                integrators,
-                frames: a.frames,
-                emulated_frames: a.emulated_frames.iter().copied().filter(|&f| f > 0).collect(),
-                bounces: a.bounces,
-                seed: a.seed,
-            };
-            let d = convergence::measure(&scene, &r, &o, &mut |s| eprintln!("{s}"))?;
-            save(&d, &a.output)?;
-            d
-        }
+    let measure = || -> Result<Convergence, Box<dyn std::error::Error>> {
+        let integrators = a
+            .integrators
+            .iter()
+            .map(|s| {
+                Integrator::parse(s)
+                    .ok_or_else(|| format!("--integrators: unknown `{s}` (pt, nee, mis, mis-power, bdpt, mlt)"))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
+        let r = Reference::read(&reference_prefix(a.reference.as_deref(), &scene.name))?;
+        let o = Options {
+            integrators,
+            frames: a.frames,
+            emulated_frames: a.emulated_frames.iter().copied().filter(|&f| f > 0).collect(),
+            bounces: a.bounces,
+            seed: a.seed,
+        };
+        Ok(convergence::measure(&scene, &r, &o, &mut |s| eprintln!("{s}"))?)
     };
+    chart_of(&a.out, &convergence::CHARTS, measure, report_convergence, Convergence::charts)
+}
+
+fn report_convergence(data: &Convergence) {
     for c in &data.curves {
         let last = c.native.last();
         println!(
@@ -161,10 +174,11 @@ pub fn lin_convergence(a: ConvergenceArgs) -> Result<(), Box<dyn std::error::Err
         );
         for p in &c.emulated {
             println!(
-                "  emulated {} spp: {} warp instructions, RMSE {:.4e}",
+                "  emulated {} spp: {} warp instructions, RMSE {:.4e}, {:.2} s",
                 p.spp,
                 p.warp_instructions.unwrap_or(0),
-                p.rmse
+                p.rmse,
+                p.seconds
             );
         }
     }
@@ -174,31 +188,25 @@ pub fn lin_convergence(a: ConvergenceArgs) -> Result<(), Box<dyn std::error::Err
         data.reference_rmse,
         100.0 * data.reference_rel_mean
     );
-    draw(&data.charts(), &convergence::CHARTS, &a.output, size)
 }
 
 /// Runs `chart lin-compaction`.
 pub fn lin_compaction(a: CompactionArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let size = parse_size(a.chart_size.as_deref())?;
-    crate::chart::Format::of(&named(&a.output, "lanes", false)?)?;
-    let data: Compaction = match &a.from {
-        Some(f) => read_json(f)?,
-        None => {
-            let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
-            let d = lanes::measure(&scene, a.size, a.depth).map_err(|e| e.to_string())?;
-            save(&d, &a.output)?;
-            d
+    let measure = || -> Result<Compaction, Box<dyn std::error::Error>> {
+        let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
+        Ok(lanes::measure(&scene, a.size, a.depth).map_err(|e| e.to_string())?)
+    };
+    let report = |data: &Compaction| {
+        for (n, c) in data.normal.iter().zip(&data.compact) {
+            let pc = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.1} %"));
+            println!(
+                "level {}: active {}, useful lanes {} without, {} with compaction",
+                n.level,
+                c.active,
+                pc(n.useful_percent()),
+                pc(c.useful_percent())
+            );
         }
     };
-    for (n, c) in data.normal.iter().zip(&data.compact) {
-        let pc = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.1} %"));
-        println!(
-            "level {}: active {}, useful lanes {} without, {} with compaction",
-            n.level,
-            c.active,
-            pc(n.useful_percent()),
-            pc(c.useful_percent())
-        );
-    }
-    draw(&data.charts(), &lanes::CHARTS, &a.output, size)
+    chart_of(&a.out, &lanes::CHARTS, measure, report, Compaction::charts)
 }

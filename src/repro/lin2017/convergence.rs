@@ -322,8 +322,8 @@ pub fn measure(
         let mut native = Vec::new();
         for (f, img) in run.frame_images.iter().enumerate() {
             for (s, p) in sum.iter_mut().zip(&img.pixels) {
-                for c in 0..3 {
-                    s[c] += p[c] as f64;
+                for (a, &v) in s.iter_mut().zip(p) {
+                    *a += v as f64;
                 }
             }
             let frames = f as u32 + 1;
