@@ -6,6 +6,8 @@
 #                                             tolerance bands, from docs/results/fabianowski-quick.json
 #   docs/images/speed-accuracy-example.svg    the generic speed-against-accuracy plot,
 #                                             from tests/fixtures/scatter.json
+#   docs/images/lin-convergence-*-{spp,seconds,instructions,mean}.svg, lin-compaction-{lanes,paths}.svg
+#                                             thesis 003's charts, from their *-data.json beside them
 #
 # Drawing needs no emulation: the table comes from the committed raw measurements.
 # When those are missing they are measured first (minutes):
@@ -27,3 +29,10 @@ if [ ! -f "$RESULTS" ]; then
 fi
 "$WARPLIGHT" chart table fabianowski:4.5 --from "$RESULTS" -o docs/images/chart-4.5.svg
 "$WARPLIGHT" chart scatter tests/fixtures/scatter.json -o docs/images/speed-accuracy-example.svg
+# Thesis 003's charts, redrawn from their committed data (no rendering; the
+# commands that measured the data are in docs/reproduction-lin2017.md, "Charts"):
+for s in cornell-lambert cornell-rough; do
+  "$WARPLIGHT" chart lin-convergence --from "docs/images/lin-convergence-$s-data.json" \
+    -o "docs/images/lin-convergence-$s-{}.svg" > /dev/null
+done
+"$WARPLIGHT" chart lin-compaction --from docs/images/lin-compaction-data.json -o "docs/images/lin-compaction-{}.svg" > /dev/null

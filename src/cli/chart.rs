@@ -6,6 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
+mod lin;
+
 use crate::chart::{BarSeries, Bars, Chart, Format, Lines, Scatter, Series};
 use crate::repro::compare::Tolerance;
 use crate::repro::results::Results;
@@ -21,6 +23,8 @@ Examples:
   warplight chart table all --from r.json -o chart-{}.svg            one chart per table ({} = table id)
   warplight chart flight --from r.json --scene sponza --counter inner_nodes --per-ray -o f.svg
   warplight chart scatter tests/fixtures/scatter.json -o speed.svg   speed vs accuracy from JSON
+  warplight chart lin-convergence --scene cornell-rough -o c-{}.svg  thesis 003: error vs spp and time
+  warplight chart lin-compaction -o lanes-{}.svg                     thesis 003: Figs. 16/17 per level
 
 The format follows the output's extension: .svg or .png.")]
 pub struct ChartArgs {
@@ -67,6 +71,32 @@ log_x, log_y (logarithmic axes) and connect (join each series' points in order) 
 Example:
   warplight chart media --scene smog-room --size 16 --frames 64 -o march.svg")]
     Media(MediaArgs),
+    /// Thesis 003: error against the Mitsuba reference vs samples and vs time,
+    /// log-log, per integrator (pt, nee, mis, mis-power, bdpt, mlt).
+    ///
+    /// Renders the scene natively at the reference's size (points at 1, 2, 4,
+    /// ... frames; host seconds measured in the same run) and a few frames on
+    /// the emulator (warp instructions counted, a GPU-time proxy; each checked
+    /// equal to the native render bit for bit). Charts: RMS error vs spp, vs
+    /// native seconds, vs emulated warp instructions, and the mean luminance's
+    /// relative error vs spp, each with the reference's own noise.
+    #[command(
+        name = "lin-convergence",
+        after_help = "\
+Example:
+  warplight chart lin-convergence --scene cornell-rough --frames 1024 -o docs/images/lin-convergence-cornell-rough-{}.svg
+  warplight chart lin-convergence --from docs/images/lin-convergence-cornell-rough-data.json -o c-{}.png"
+    )]
+    LinConvergence(lin::ConvergenceArgs),
+    /// Thesis 003 Figs. 16/17 proxies: useful SIMT lanes and active paths per
+    /// level, with and without thread compaction, counted by the emulator.
+    #[command(
+        name = "lin-compaction",
+        after_help = "\
+Example:
+  warplight chart lin-compaction --size 32 --depth 30 -o docs/images/lin-compaction-{}.svg"
+    )]
+    LinCompaction(lin::CompactionArgs),
 }
 
 /// Options of `warplight chart media`.
@@ -180,6 +210,8 @@ pub fn run(a: ChartArgs) -> Result<(), Box<dyn std::error::Error>> {
         ChartCommand::Flight(f) => flight(f),
         ChartCommand::Scatter(s) => scatter(s),
         ChartCommand::Media(m) => media(m),
+        ChartCommand::LinConvergence(c) => lin::lin_convergence(c),
+        ChartCommand::LinCompaction(c) => lin::lin_compaction(c),
     }
 }
 

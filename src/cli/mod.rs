@@ -89,7 +89,9 @@ pub enum Command {
     /// `chart table 4.5 --from r.json -o t.svg`: a reproduced table's values
     /// beside the thesis' with the tolerance bands; `chart flight`: a counter
     /// frame by frame along a flight; `chart scatter`: speed against accuracy
-    /// from JSON.
+    /// from JSON; `chart media`, `chart lin-convergence`, `chart
+    /// lin-compaction`: thesis 003's march variance, error against Mitsuba
+    /// vs samples and time, and lanes and paths per level.
     Chart(chart::ChartArgs),
     /// Scenes: `warplight scene info NAME` prints triangles (and the thesis'
     /// count), extent, materials, lights, camera and flight.

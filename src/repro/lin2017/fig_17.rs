@@ -19,8 +19,9 @@ use std::collections::BTreeMap;
 use crate::host::camera::Camera;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::PathScene;
-use crate::host::path::wavefront::{self, Mode};
+use crate::host::path::wavefront::{self, Mode, WavefrontRender};
 use crate::host::path::{FrameParams, Integrator, Traversal};
+use crate::host::scene::Scene;
 use crate::repro::compare::Tolerance;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
@@ -67,31 +68,40 @@ fn deepest() -> u32 {
     PRINTED[PRINTED.len() - 1].0
 }
 
+/// One emulated frame of the wavefront form on `scene` at `side` x `side`
+/// pixels with next-event estimation, `depth` levels (the longest path
+/// `depth` − 1 bounces), compacted or not: the run behind every cell of the
+/// table and the per-level chart (`warplight chart lin-compaction`).
+pub fn run(scene: &Scene, side: u32, depth: u32, mode: Mode) -> Result<WavefrontRender, MeasureError> {
+    let camera = Camera { resolution: [side, side], ..scene.camera };
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+    let ps = PathScene::new(scene, &tree)?;
+    let params = FrameParams {
+        width: side,
+        height: side,
+        integrator: Integrator::Nee,
+        max_bounces: depth.saturating_sub(1),
+        seed: 0,
+        traversal: Traversal::ShortStack,
+    };
+    let (mut dev, m, c) = wavefront::device(&params, Fidelity::Instructions)?;
+    Ok(wavefront::render(&mut dev, &m, &c, &ps, &camera, params, 1, mode, false, |_| {})?)
+}
+
 /// Measurement group [`DEPTHS_GROUP`].
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let scene = ws.scene;
     let n = side(ws);
-    let camera = Camera { resolution: [n, n], ..scene.camera };
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(scene, &tree)?;
     let mut out = Vec::new();
     for mode in Mode::ALL {
         for (depth, _, _) in PRINTED {
             let v = variant(mode, depth);
             tick(Tick { frame: None, variant: &v });
-            let params = FrameParams {
-                width: n,
-                height: n,
-                integrator: Integrator::Nee,
-                max_bounces: depth - 1,
-                seed: 0,
-                traversal: Traversal::ShortStack,
-            };
-            let (mut dev, m, c) = wavefront::device(&params, Fidelity::Instructions)?;
-            let r = wavefront::render(&mut dev, &m, &c, &ps, &camera, params, 1, mode, false, |_| {})?;
+            let paths = (n * n * crate::host::path::SAMPLES_PER_FRAME) as usize;
+            let r = run(scene, n, depth, mode)?;
             let mut k = BTreeMap::new();
-            k.insert("paths".to_string(), params.paths() as f64);
+            k.insert("paths".to_string(), paths as f64);
             k.insert("warp_instructions".to_string(), r.totals.warp_instructions as f64);
             k.insert("thread_instructions".to_string(), r.totals.thread_instructions as f64);
             k.insert("compaction_warp_instructions".to_string(), r.compaction.warp_instructions as f64);

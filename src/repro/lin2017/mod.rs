@@ -12,9 +12,11 @@
 //! bytes counted; seconds not reproducible); [`sec_6_4`], the operations
 //! of the standard and the affine ray-triangle tests (§6.4's text), counted.
 
+pub mod convergence;
 pub mod fig_16;
 pub mod fig_17;
 pub mod fig_3;
+pub mod lanes;
 pub mod media;
 pub mod render;
 pub mod sec_6_4;

@@ -1,0 +1,212 @@
+//! `warplight chart lin-convergence` and `lin-compaction`: thesis 003's
+//! convergence and compaction charts (`crate::repro::lin2017::convergence`,
+//! `crate::repro::lin2017::lanes`), measured or redrawn from their JSON.
+
+use std::path::{Path, PathBuf};
+
+use super::{parse_size, write};
+use crate::chart::Chart;
+use crate::host::path::Integrator;
+use crate::repro::lin2017::convergence::{self, Convergence, Options, Reference};
+use crate::repro::lin2017::lanes::{self, Compaction};
+
+/// Where the charts and their data go, or come from.
+#[derive(Debug, clap::Args)]
+pub struct Out {
+    /// Redraw from this chart data (written by an earlier run) instead of measuring.
+    #[arg(long)]
+    pub from: Option<PathBuf>,
+    /// Output .svg or .png with `{}` for each chart's name (lin-convergence:
+    /// spp, seconds, instructions, mean; lin-compaction: lanes, paths); the
+    /// data goes beside them as `{}` = data, .json.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Size in pixels, WIDTHxHEIGHT (default 960x540).
+    #[arg(long)]
+    pub chart_size: Option<String>,
+}
+
+/// Reads the data from `--from` or measures (and saves) it, reports it, and draws its charts.
+fn chart_of<T: serde::Serialize + serde::de::DeserializeOwned>(
+    out: &Out,
+    names: &[&str],
+    measure: impl FnOnce() -> Result<T, Box<dyn std::error::Error>>,
+    report: impl Fn(&T),
+    charts: impl Fn(&T) -> Vec<crate::chart::Scatter>,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let size = parse_size(out.chart_size.as_deref())?;
+    for name in names {
+        crate::chart::Format::of(&named(&out.output, name, false)?)?;
+    }
+    let data: T = match &out.from {
+        Some(f) => read_json(f)?,
+        None => {
+            let d = measure()?;
+            save(&d, &out.output)?;
+            d
+        }
+    };
+    report(&data);
+    for (c, name) in charts(&data).into_iter().zip(names) {
+        write(&Chart::Scatter(c), &named(&out.output, name, false)?, size)?;
+    }
+    Ok(())
+}
+
+/// Options of `warplight chart lin-convergence`.
+#[derive(Debug, clap::Args)]
+pub struct ConvergenceArgs {
+    /// A scene with a committed Mitsuba reference (scenes/ name or path).
+    #[arg(long, default_value = "cornell-rough")]
+    pub scene: String,
+    /// The reference's files' prefix (PREFIX.exr, PREFIX-var.exr, PREFIX.json);
+    /// default tests/fixtures/mitsuba/SCENE-32. The render takes its size.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Integrators, comma-separated.
+    #[arg(long, default_value = "pt,nee,mis,mis-power,bdpt,mlt", value_delimiter = ',')]
+    pub integrators: Vec<String>,
+    /// Native frames (4 samples a pixel each); points at 1, 2, 4, ... frames and the last.
+    #[arg(long, default_value_t = 1024)]
+    pub frames: u32,
+    /// Emulated renders, in frames each, comma-separated (0: none).
+    #[arg(long, default_value = "1,2,4", value_delimiter = ',')]
+    pub emulated_frames: Vec<u32>,
+    /// The longest path in bounces (the references': 16).
+    #[arg(long, default_value_t = 16)]
+    pub bounces: u32,
+    /// Seed of the random numbers.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    /// The data and the charts.
+    #[command(flatten)]
+    pub out: Out,
+}
+
+/// Options of `warplight chart lin-compaction`.
+#[derive(Debug, clap::Args)]
+pub struct CompactionArgs {
+    /// The scene (Fig. 17's: the Lambertian Cornell box).
+    #[arg(long, default_value = "cornell-lambert")]
+    pub scene: String,
+    /// Image side in pixels (4 paths a pixel).
+    #[arg(long, default_value_t = 32)]
+    pub size: u32,
+    /// Levels of the frame (the longest path depth − 1 bounces).
+    #[arg(long, default_value_t = 30)]
+    pub depth: u32,
+    /// The data and the charts.
+    #[command(flatten)]
+    pub out: Out,
+}
+
+/// `out` with `{}` replaced by `name` (and, for the data, the extension .json).
+fn named(out: &Path, name: &str, json: bool) -> Result<PathBuf, String> {
+    let s = out.display().to_string();
+    if !s.contains("{}") {
+        return Err(format!("-o {s}: put {{}} in the name for each chart's name, e.g. lin-{{}}.svg"));
+    }
+    let p = PathBuf::from(s.replace("{}", name));
+    Ok(if json { p.with_extension("json") } else { p })
+}
+
+fn read_json<T: serde::de::DeserializeOwned>(p: &Path) -> Result<T, String> {
+    let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{}: not the chart data ({e})", p.display()))
+}
+
+fn save(data: &impl serde::Serialize, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    let p = named(out, "data", true)?;
+    let mut text = serde_json::to_string_pretty(data)?;
+    text.push('\n');
+    crate::cli::write_atomically(&p, text.as_bytes())?;
+    eprintln!("wrote {}", p.display());
+    Ok(())
+}
+
+/// The reference's prefix: as given, else tests/fixtures/mitsuba/SCENE-32 of the checkout.
+fn reference_prefix(given: Option<&Path>, scene: &str) -> PathBuf {
+    if let Some(p) = given {
+        return p.to_path_buf();
+    }
+    let rel = format!("tests/fixtures/mitsuba/{scene}-32");
+    let exr = crate::host::scene_file::data_file(Path::new(&format!("{rel}.exr")));
+    PathBuf::from(exr.display().to_string().trim_end_matches(".exr"))
+}
+
+/// Runs `chart lin-convergence`.
+pub fn lin_convergence(a: ConvergenceArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let measure = || -> Result<Convergence, Box<dyn std::error::Error>> {
+        let integrators = a
+            .integrators
+            .iter()
+            .map(|s| {
+                Integrator::parse(s)
+                    .ok_or_else(|| format!("--integrators: unknown `{s}` (pt, nee, mis, mis-power, bdpt, mlt)"))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
+        let r = Reference::read(&reference_prefix(a.reference.as_deref(), &scene.name))?;
+        let o = Options {
+            integrators,
+            frames: a.frames,
+            emulated_frames: a.emulated_frames.iter().copied().filter(|&f| f > 0).collect(),
+            bounces: a.bounces,
+            seed: a.seed,
+        };
+        Ok(convergence::measure(&scene, &r, &o, &mut |s| eprintln!("{s}"))?)
+    };
+    chart_of(&a.out, &convergence::CHARTS, measure, report_convergence, Convergence::charts)
+}
+
+fn report_convergence(data: &Convergence) {
+    for c in &data.curves {
+        let last = c.native.last();
+        println!(
+            "{}: slope {} (from 16 spp, the reference's noise taken out); at {} spp RMSE {:.4e}, mean {:.2} %, {:.2} s; emulated = native: {}",
+            c.integrator,
+            c.slope(16, data.reference_rmse).map_or("–".into(), |s| format!("{s:.3}")),
+            last.map_or(0, |p| p.spp),
+            last.map_or(f64::NAN, |p| p.rmse),
+            last.map_or(f64::NAN, |p| 100.0 * p.rel_mean),
+            last.map_or(f64::NAN, |p| p.seconds),
+            c.emulated_equals_native
+        );
+        for p in &c.emulated {
+            println!(
+                "  emulated {} spp: {} warp instructions, RMSE {:.4e}, {:.2} s",
+                p.spp,
+                p.warp_instructions.unwrap_or(0),
+                p.rmse,
+                p.seconds
+            );
+        }
+    }
+    println!(
+        "reference: {} spp, RMS standard error {:.4e}, mean luminance's relative standard error <= {:.3} %",
+        data.reference_spp,
+        data.reference_rmse,
+        100.0 * data.reference_rel_mean
+    );
+}
+
+/// Runs `chart lin-compaction`.
+pub fn lin_compaction(a: CompactionArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let measure = || -> Result<Compaction, Box<dyn std::error::Error>> {
+        let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
+        Ok(lanes::measure(&scene, a.size, a.depth).map_err(|e| e.to_string())?)
+    };
+    let report = |data: &Compaction| {
+        for (n, c) in data.normal.iter().zip(&data.compact) {
+            let pc = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.1} %"));
+            println!(
+                "level {}: active {}, useful lanes {} without, {} with compaction",
+                n.level,
+                c.active,
+                pc(n.useful_percent()),
+                pc(c.useful_percent())
+            );
+        }
+    };
+    chart_of(&a.out, &lanes::CHARTS, measure, report, Compaction::charts)
+}
