@@ -86,6 +86,9 @@ pub enum ConvergenceError {
     /// The emulator failed.
     #[error(transparent)]
     Sim(#[from] SimError),
+    /// The native renderer refused the settings.
+    #[error(transparent)]
+    Render(#[from] crate::host::path::RenderError),
 }
 
 /// A committed Mitsuba reference: its mean image, its variance of the mean, and its sample count.
@@ -317,7 +320,7 @@ pub fn measure(
         progress(&format!("{}: {} native frames", integrator.name(), o.frames));
         let mut at = Vec::with_capacity(o.frames as usize);
         let t0 = Instant::now();
-        let run = render_native(&ps, &camera, params, o.frames, true, |_| at.push(t0.elapsed().as_secs_f64()));
+        let run = render_native(&ps, &camera, params, o.frames, true, |_| at.push(t0.elapsed().as_secs_f64()))?;
         let mut sum = vec![[0.0f64; 3]; (size * size) as usize];
         let mut native = Vec::new();
         for (f, img) in run.frame_images.iter().enumerate() {
@@ -346,7 +349,7 @@ pub fn measure(
             let t = Instant::now();
             let k = kernel::render(&mut dev, &module, &ps, &camera, params, ef, false, |_| {})?;
             let seconds = t.elapsed().as_secs_f64();
-            let twin = render_native(&ps, &camera, params, ef, false, |_| {});
+            let twin = render_native(&ps, &camera, params, ef, false, |_| {})?;
             equal &= k.image.accum.len() == twin.accum.len()
                 && k.image.accum.iter().zip(&twin.accum).all(|(a, b)| a.to_bits() == b.to_bits());
             let mut p = Point::of(&k.image.image(), r, ef * SAMPLES_PER_FRAME, seconds);
