@@ -302,6 +302,21 @@ static __device__ __forceinline__ float fresnel_exact(float eta, float ci, float
   return 0.5f * (rs * rs + rp * rp);
 }
 
+// The Fresnel term of a smooth dielectric surface: the exact equations, or
+// Schlick's with R0 from the IOR and (1 - c)^5 by multiplication (003:L259),
+// c the cosine on the outer side; eta = n_i / n_t. translucent()'s; the glass
+// of scatter() computes the same inline (as written before SSS, so that the
+// existing kernels' PTX stays as it was in both dialects).
+static __device__ __forceinline__ float surface_fresnel(bool exact, float ior, bool into, float eta, float cos_i,
+                                                        float cos_t) {
+  if (exact) return fresnel_exact(eta, cos_i, cos_t);
+  float r0 = (1.0f - ior) / (1.0f + ior);
+  r0 = r0 * r0;
+  float c = 1.0f - (into ? cos_i : cos_t);
+  float c2 = c * c;
+  return r0 + (1.0f - r0) * (c2 * c2 * c);
+}
+
 // smallpt's tent warp of a uniform y in [0, 1) to [-1, 1).
 static __device__ __forceinline__ float tent(float y) {
   float r = 2.0f * y;
@@ -955,16 +970,7 @@ static __device__ __forceinline__ int translucent(const Scene &s, Path &P, K key
   float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
   if (k > 0.0f) {   // else total internal reflection
     float cos_t = sqrtf(k);
-    float fr;
-    if (m2.y > 0.0f) {
-      fr = fresnel_exact(eta, cos_i, cos_t);
-    } else {
-      float r0 = (1.0f - ior) / (1.0f + ior);
-      r0 = r0 * r0;
-      float c = 1.0f - (into ? cos_i : cos_t);
-      float c2 = c * c;
-      fr = r0 + (1.0f - r0) * (c2 * c2 * c);
-    }
+    float fr = surface_fresnel(m2.y > 0.0f, ior, into, eta, cos_i, cos_t);
     if (!(rng(key, dim + 6) < fr)) {
       if (!into || rng(key, dim + 7) < m2.w) {
         // refraction, into the medium (translucency) or out of it
