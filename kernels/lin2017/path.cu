@@ -59,6 +59,7 @@
 #define KIND_EMITTER 3
 #define KIND_CONDUCTOR 4     // rough mirror: Cook-Torrance, Beckmann
 #define KIND_ROUGH_GLASS 5   // rough glass: Walter et al. 2007, Beckmann
+#define KIND_TRANSLUCENT 6   // subsurface scattering (§5.3): sss_frame only
 #define PI_F 3.14159265358979324f
 #if defined(__NVCC__)
 #define FLOORF floorf
@@ -299,6 +300,21 @@ static __device__ __forceinline__ float fresnel_exact(float eta, float ci, float
   float rs = (eta * ci - ct) / (eta * ci + ct);
   float rp = (ci - eta * ct) / (ci + eta * ct);
   return 0.5f * (rs * rs + rp * rp);
+}
+
+// The Fresnel term of a smooth dielectric surface: the exact equations, or
+// Schlick's with R0 from the IOR and (1 - c)^5 by multiplication (003:L259),
+// c the cosine on the outer side; eta = n_i / n_t. translucent()'s; the glass
+// of scatter() computes the same inline (as written before SSS, so that the
+// existing kernels' PTX stays as it was in both dialects).
+static __device__ __forceinline__ float surface_fresnel(bool exact, float ior, bool into, float eta, float cos_i,
+                                                        float cos_t) {
+  if (exact) return fresnel_exact(eta, cos_i, cos_t);
+  float r0 = (1.0f - ior) / (1.0f + ior);
+  r0 = r0 * r0;
+  float c = 1.0f - (into ? cos_i : cos_t);
+  float c2 = c * c;
+  return r0 + (1.0f - r0) * (c2 * c2 * c);
 }
 
 // smallpt's tent warp of a uniform y in [0, 1) to [-1, 1).
@@ -727,10 +743,13 @@ static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, K key, unsigne
 #define MEDIUM_MAX_STEPS 1023   // per ray segment (the host refuses a step that needs more)
 
 // The path tracer's kernels have no medium: every hook below compiles to nothing.
-struct NoMedium {};
+struct NoMedium {
+  static const bool TRANSLUCENT = false;
+};
 // The medium as src/host/path/layout.rs lays it out: [lo, dt], [hi, g],
 // [sigma_a, sigma_s, 1 / H (0: uniform density), 1: an offset per step (0: per ray)], [L_ve, 0].
 struct Medium {
+  static const bool TRANSLUCENT = false;
   float4 lo, hi, c, e;
 };
 
@@ -833,6 +852,145 @@ static __device__ __forceinline__ void march(const Scene &s, Path &P, K key, con
   P.beta = scale3(P.beta, exp_neg(-sigma_t * medium_depth(m, o, d, ta, tb)));
 }
 
+// ---- Subsurface scattering (§5.3, 003:L388-403): sss_frame ----
+//
+// A translucent material (KIND_TRANSLUCENT) is a smooth dielectric boundary
+// (IOR; Schlick's or the exact Fresnel term) around a homogeneous medium:
+// scattering sigma_s (grey), absorption sigma_a (RGB), Henyey-Greenstein g.
+// At the surface from outside, the thesis' 3-way Fresnel switch (003:L259-265):
+// xi < F mirror reflection, else xi' < translucency refraction into the
+// medium, else Lambertian reflection with the colour (no light sample at a
+// translucent surface: emission after any of its branches counts in full).
+// From inside: reflect with F, else refract out. Weights: 1 for reflection
+// and refraction (no eta^2, as smooth glass: entering and leaving cancel),
+// the colour for the diffuse branch.
+// Inside, single scattering only (003:L396): on a leg from the entry (or an
+// internal reflection) the distance d = -ln(1 - xi) / sigma_s' with
+// sigma_s' = (1 - g) sigma_s, along the refracted ray. If d falls before the
+// exit surface, the path scatters there: weight e^(-sigma_a d) (the
+// absorption along d; d's pdf is sigma_s' e^(-sigma_s' d)), the next
+// direction sampled from HG(g) (weight 1), no light sample (a shadow ray
+// cannot pass the smooth boundary), one bounce. Else the leg reaches the
+// exit surface with weight e^(-sigma_a t) (d >= t has probability
+// e^(-sigma_s' t)). After the scattering no second one: the legs up to the
+// exit take the transmittance e^(-(sigma_a + sigma_s') t). The estimand is
+// thus the radiative transfer of a medium with sigma_s' and HG(g), each
+// stay inside scattered at most once (tools/mitsuba/reference.py: volpath
+// on such a medium at a depth limit that admits one scattering). Translucent
+// meshes must be closed and hold nothing: a leg ending on a translucent
+// surface's back side is taken to have run inside.
+// Random numbers of bounce b (dim = 2 + 8 b): 3-4 the direction (diffuse or
+// HG), 5 roulette, 6 the Fresnel switch, 7 the translucency test (from
+// outside) or the leg's distance (from inside; a scattering point's own).
+// Layout: [colour, kind] [sigma_a rgb, IOR] [sigma_s, exact Fresnel, g, translucency].
+
+// The state of sss_frame's path: whether it has scattered since it entered.
+struct Sss {
+  static const bool TRANSLUCENT = true;
+  mutable bool scattered;
+};
+
+template <class K>
+static __device__ __forceinline__ void march(const Scene &, Path &, K, const Sss &, V3, V3, float) {}
+static __device__ __forceinline__ float attenuate(const Sss &, float g, V3, V3, float) { return g; }
+
+// A direction from Henyey-Greenstein about the unit direction of travel d
+// (forward peak for g > 0, as hg()): cos = (1 + g^2 - ((1 - g^2) / (1 - g + 2 g y1))^2) / (2 g),
+// 1 - 2 y1 for |g| < 1e-3; the azimuth from y2.
+static __device__ __forceinline__ V3 hg_dir(float g, V3 d, float y1, float y2) {
+  float c;
+  if (fabsf(g) < 1e-3f) {
+    c = 1.0f - 2.0f * y1;
+  } else {
+    float q = (1.0f - g * g) / (1.0f - g + 2.0f * g * y1);
+    c = (1.0f + g * g - q * q) / (2.0f * g);
+  }
+  c = fminf(fmaxf(c, -1.0f), 1.0f);
+  float sn = sqrtf(fmaxf(1.0f - c * c, 0.0f)), ca, sa;
+  azimuth(y2, &ca, &sa);
+  V3 b1, b2;
+  basis(d, &b1, &b2);
+  return normalize3(add3(add3(scale3(b1, sn * ca), scale3(b2, sn * sa)), scale3(d, c)));
+}
+
+// Every kernel but sss_frame: no translucent material (-1: the surface as usual).
+template <class K, class M>
+static __device__ __forceinline__ int translucent(const Scene &, Path &, K, const M &, float4, int, float, V3, V3,
+                                                  float) {
+  return -1;
+}
+
+// sss_frame: the ray o + t' d hit triangle data td (kind, cos_d = d . n) at t.
+// -1 when it is not translucent; else the leg inside (if the ray left from
+// inside), then the surface's switch: 1 the path goes on (P the next ray),
+// 0 it ends.
+template <class K>
+static __device__ __forceinline__ int translucent(const Scene &s, Path &P, K key, const Sss &ss, float4 td, int kind,
+                                                  float cos_d, V3 o, V3 d, float t) {
+  if (kind != KIND_TRANSLUCENT) return -1;
+  const Params *p = s.p;
+  int bounce = P.bounce;
+  unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
+  const float4 *mt = s.mats + 3 * __float_as_int(td.w);
+  float4 m0 = mt[0], m1 = mt[1], m2 = mt[2];
+  bool into = cos_d < 0.0f;
+  if (!into) {
+    // the leg ran inside: sigma_s' = (1 - g) sigma_s (003:L396)
+    float sigma_r = (1.0f - m2.z) * m2.x;
+    float ext = 0.0f;
+    if (!ss.scattered) {
+      float dd = sigma_r > 0.0f ? -ln(1.0f - rng(key, dim + 7)) / sigma_r : __int_as_float(0x7f800000);
+      if (dd < t) {
+        // the single scattering point (003:L396): absorption along dd, the phase function's direction
+        if (bounce == p->max_bounces) return 0;
+        V3 wgt = v3(exp_neg(-m1.x * dd), exp_neg(-m1.y * dd), exp_neg(-m1.z * dd));
+        V3 next = hg_dir(m2.z, d, rng(key, dim + 3), rng(key, dim + 4));
+        if (!roulette(P.beta, wgt, key, dim)) return 0;
+        ss.scattered = true;
+        P.o = add3(o, scale3(d, dd));
+        P.d = next;
+        P.bounce = bounce + 1;
+        P.count_emission = true;
+        return 1;
+      }
+    } else {
+      ext = sigma_r;   // scattered once: no second scattering, the leg's transmittance
+    }
+    P.beta = v3(P.beta.x * exp_neg(-(m1.x + ext) * t), P.beta.y * exp_neg(-(m1.y + ext) * t),
+                P.beta.z * exp_neg(-(m1.z + ext) * t));
+  }
+  if (bounce == p->max_bounces) return 0;
+  V3 n = v3(td.x, td.y, td.z);
+  V3 ns = into ? n : v3(-n.x, -n.y, -n.z);   // faces the ray
+  float cos_i = -dot3(d, ns);
+  V3 next = add3(d, scale3(ns, 2.0f * cos_i));   // the mirror direction
+  V3 wgt = v3(1.0f, 1.0f, 1.0f);
+  float ior = m1.w;
+  float eta = into ? 1.0f / ior : ior;
+  float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+  if (k > 0.0f) {   // else total internal reflection
+    float cos_t = sqrtf(k);
+    float fr = surface_fresnel(m2.y > 0.0f, ior, into, eta, cos_i, cos_t);
+    if (!(rng(key, dim + 6) < fr)) {
+      if (!into || rng(key, dim + 7) < m2.w) {
+        // refraction, into the medium (translucency) or out of it
+        next = add3(scale3(d, eta), scale3(ns, eta * cos_i - cos_t));
+        ss.scattered = false;
+      } else {
+        float lz;
+        next = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4), &lz);
+        wgt = v3(m0.x, m0.y, m0.z);
+      }
+    }
+  }
+  if (!roulette(P.beta, wgt, key, dim)) return 0;
+  P.o = add3(o, scale3(d, t));
+  P.d = next;
+  P.bounce = bounce + 1;
+  P.count_emission = true;
+  return 1;
+}
+
 // One level of the inner loop (003:L119) for one path: trace its ray, gather
 // emission and the light sample, pick the next direction, Russian roulette.
 // False when the path ends (missed, hit an emitter, the longest path, or
@@ -857,6 +1015,11 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, cons
   float4 m0 = s.mats[3 * __float_as_int(td.w)];
   int kind = __float_as_int(m0.w);
   float cos_d = dot3(d, n);
+  // a translucent surface and the leg inside it (sss_frame's Sss only; nothing for the others)
+  if (M::TRANSLUCENT) {
+    int sub = translucent(s, P, key, med, td, kind, cos_d, o, d, t);
+    if (sub >= 0) return sub > 0;
+  }
   if (kind == KIND_EMITTER) {
     if (cos_d < 0.0f) {   // the front face emits
       float4 m1 = s.mats[3 * __float_as_int(td.w) + 1];
@@ -970,6 +1133,17 @@ extern "C" __global__ void volume_frame(const Params *params, const uint4 *nodes
                                         const float4 *medium, float *accum, float *last) {
   Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
   Medium m = {medium[0], medium[1], medium[2], medium[3]};
+  frame_path(s, accum, last, m);
+}
+
+// The megakernel with translucent materials (§5.3): path_frame's paths, each
+// translucent surface and the legs inside it by translucent() (single scattering).
+extern "C" __global__ void sss_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                     const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                     const float4 *lights, const float4 *boxes, const float4 *env, float *accum,
+                                     float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  Sss m = {false};
   frame_path(s, accum, last, m);
 }
 

@@ -80,6 +80,10 @@ pub struct RenderArgs {
     /// marched by pt, nee and mis (kernel volume_frame: steps of the scene's `step`
     /// with one random offset a ray, Beer's law, single scattering from direct
     /// light with a shadow ray at each sample); bdpt and mlt refuse it.
+    /// A scene with a `kind = "translucent"` material (subsurface scattering, §5.3:
+    /// bunny-jade) is traced by pt, nee and mis (kernel sss_frame: the 3-way
+    /// Fresnel switch at its surface, at most one scattering inside, at
+    /// d = -ln(xi) / ((1 - g) sigma_s), the direction from HG(g)); bdpt and mlt refuse it.
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
@@ -492,6 +496,8 @@ fn run_path(
             "  emulated {}: {w} warp instructions, {t} thread instructions",
             if scene.medium.is_some() {
                 crate::host::path::kernel::VOLUME_KERNEL
+            } else if scene.translucent.iter().any(Option::is_some) {
+                crate::host::path::kernel::SSS_KERNEL
             } else {
                 crate::host::path::kernel::entry(integrator)
             }

@@ -189,6 +189,29 @@ pub struct Scene {
     /// A participating medium (a scene file's `[medium]`; §5.2 of thesis
     /// 003). Only thesis 003's path tracer reads it.
     pub medium: Option<Medium>,
+    /// Per material, the subsurface scattering of a translucent material (a
+    /// scene file's `kind = "translucent"`, §5.3 of thesis 003; its kind is
+    /// glass of the same IOR, which the other renderers see; a material past
+    /// the end: none). Only thesis 003's path tracer reads it.
+    pub translucent: Vec<Option<Translucent>>,
+}
+
+/// A translucent material's interior and switch (thesis 003 §5.3, 003:L396;
+/// `docs/reproduction-lin2017.md`): a smooth dielectric boundary around a
+/// homogeneous medium, scattered at most once per stay.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Translucent {
+    /// Scattering coefficient σ_s (grey, per unit length); the free path is
+    /// drawn with the reduced σ_s' = (1 − g) σ_s.
+    pub sigma_s: f32,
+    /// Absorption coefficient σ_a per channel (per unit length).
+    pub sigma_a: [f32; 3],
+    /// Henyey-Greenstein asymmetry, in (−1, 1).
+    pub g: f32,
+    /// The Fresnel switch's second threshold (003:L265): the probability that
+    /// light not reflected specularly enters the medium (else it is reflected
+    /// diffusely with the colour), in [0, 1].
+    pub translucency: f32,
 }
 
 /// How the march places its samples in the steps of a ray (thesis 003, 003:L367).
@@ -306,7 +329,13 @@ impl Scene {
             environment: None,
             exact_fresnel: Vec::new(),
             medium: None,
+            translucent: Vec::new(),
         }
+    }
+
+    /// Material `m`'s subsurface scattering, if it is translucent.
+    pub fn translucent(&self, m: u32) -> Option<Translucent> {
+        self.translucent.get(m as usize).copied().flatten()
     }
 
     /// Material `m`'s Beckmann roughness α (0: smooth).

@@ -8,7 +8,9 @@ use glam::Vec3;
 
 use super::camera::{Camera, Flight};
 use super::procedural;
-use super::scene::{Jitter, Light, Material, MaterialKind, Medium, Scene, Surface, Texture, ThesisScene, Triangle};
+use super::scene::{
+    Jitter, Light, Material, MaterialKind, Medium, Scene, Surface, Texture, ThesisScene, Translucent, Triangle,
+};
 
 /// A scene file that could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -147,21 +149,39 @@ impl Cx<'_> {
 }
 
 /// A material, its Beckmann roughness (`roughness`, mirrors and glass only; 0
-/// is smooth) and whether its Fresnel term is exact (`fresnel = "exact"`,
-/// glass only; `"schlick"` the default).
-fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32, bool), SceneError> {
+/// is smooth), whether its Fresnel term is exact (`fresnel = "exact"`,
+/// glass and translucent only; `"schlick"` the default) and, for a
+/// translucent material (`kind = "translucent"`, a glass to every other
+/// renderer), its subsurface scattering. `text` is the file's text, for the
+/// lines the translucent keys' errors name.
+fn material(
+    cx: &Cx,
+    t: &toml::Table,
+    i: usize,
+    text: &str,
+) -> Result<(Material, f32, bool, Option<Translucent>), SceneError> {
     let p = format!("material[{i}].");
     let name = match t.get("name").and_then(|v| v.as_str()) {
         Some(n) => n.to_string(),
         None => return cx.err(&format!("{p}name"), "missing"),
     };
-    let kind = match t.get("kind").and_then(|v| v.as_str()).unwrap_or("diffuse") {
+    let kind_name = t.get("kind").and_then(|v| v.as_str()).unwrap_or("diffuse");
+    let kind = match kind_name {
         "diffuse" => MaterialKind::Diffuse,
         "mirror" => MaterialKind::Mirror,
-        "glass" => MaterialKind::Glass { ior: cx.float(t, "ior", &p, 1.5)? },
+        "glass" | "translucent" => MaterialKind::Glass { ior: cx.float(t, "ior", &p, 1.5)? },
         "emitter" => MaterialKind::Emitter,
-        other => return cx.err(&format!("{p}kind"), format!("`{other}`; expected diffuse, mirror, glass or emitter")),
+        other => {
+            return cx.err(
+                &format!("{p}kind"),
+                format!("`{other}`; expected diffuse, mirror, glass, translucent or emitter"),
+            );
+        }
     };
+    let translucent = translucent(cx, t, i, text, kind_name == "translucent")?;
+    if translucent.is_some() && t.contains_key("roughness") {
+        return cx.err(&format!("{p}roughness"), "a translucent material's boundary is smooth: no roughness");
+    }
     let roughness = cx.float(t, "roughness", &p, 0.0)?;
     if t.contains_key("roughness") && !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) {
         return cx.err(&format!("{p}roughness"), "only a mirror or glass has a roughness");
@@ -183,7 +203,8 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32, bool),
     let exact = match t.get("fresnel") {
         None => false,
         Some(_) if !matches!(kind, MaterialKind::Glass { .. }) => {
-            return cx.err(&format!("{p}fresnel"), "only glass has a Fresnel term to choose");
+            return cx
+                .err(&format!("{p}fresnel"), "only glass and translucent materials have a Fresnel term to choose");
         }
         Some(v) => match v.as_str() {
             Some("schlick") => false,
@@ -197,27 +218,117 @@ fn material(cx: &Cx, t: &toml::Table, i: usize) -> Result<(Material, f32, bool),
         color: cx.vec3(t, "color", &p, Some([0.8; 3]))?,
         emission: cx.vec3(t, "emission", &p, Some([0.0; 3]))?,
     };
-    Ok((m, roughness, exact))
+    Ok((m, roughness, exact, translucent))
+}
+
+/// The keys only a translucent material has.
+const TRANSLUCENT_KEYS: [&str; 5] = ["sigma_s", "sigma_a", "albedo", "g", "translucency"];
+
+/// The line of `key` in the `i`-th `[[material]]` table of `text` (1-based; the
+/// table's header line if the key is not written there; 0 if the file has no
+/// such `[[material]]` header), for the translucent keys' errors.
+fn material_line(text: &str, i: usize, key: &str) -> usize {
+    table_line(text, "[[material]]", i, key)
+}
+
+/// A translucent material's subsurface scattering (thesis 003 §5.3): `sigma_s`
+/// (grey), `sigma_a` or `albedo` = σ_s / (σ_s + σ_a) (a number or [r, g, b]),
+/// `g` (default 0), `translucency` (default 1). `None` for any other kind,
+/// which may not give these keys.
+fn translucent(cx: &Cx, t: &toml::Table, i: usize, text: &str, is: bool) -> Result<Option<Translucent>, SceneError> {
+    let at = |key: &str| match material_line(text, i, key) {
+        0 => format!("material[{i}].{key}"),
+        n => format!("material[{i}].{key} (line {n})"),
+    };
+    if !is {
+        return match TRANSLUCENT_KEYS.iter().find(|k| t.contains_key(**k)) {
+            Some(k) => cx.err(&at(k), "only a translucent material (kind = \"translucent\") has it"),
+            None => Ok(None),
+        };
+    }
+    let rgb = |key: &str| -> Result<Option<[f32; 3]>, SceneError> {
+        match t.get(key) {
+            None => Ok(None),
+            Some(toml::Value::Array(a)) if a.len() == 3 => {
+                Ok(Some([cx.num(&a[0], &at(key))?, cx.num(&a[1], &at(key))?, cx.num(&a[2], &at(key))?]))
+            }
+            Some(toml::Value::Array(_)) => cx.err(&at(key), "expected a number or [r, g, b]"),
+            Some(v) => cx.num(v, &at(key)).map(|x| Some([x; 3])),
+        }
+    };
+    let Some(sigma_s) = t.get("sigma_s").map(|v| cx.num(v, &at("sigma_s"))).transpose()? else {
+        return cx.err(&at("sigma_s"), "missing; a translucent material needs its scattering coefficient");
+    };
+    if sigma_s < 0.0 {
+        return cx.err(&at("sigma_s"), format!("{sigma_s} is negative; expected a coefficient >= 0 (per unit length)"));
+    }
+    let sigma_a = match (rgb("sigma_a")?, rgb("albedo")?) {
+        (Some(_), Some(_)) => return cx.err(&at("albedo"), "give either sigma_a or albedo, not both"),
+        (None, None) => return cx.err(&at("sigma_a"), "missing; give sigma_a or albedo"),
+        (Some(a), None) => {
+            if let Some(x) = a.iter().find(|x| **x < 0.0) {
+                return cx
+                    .err(&at("sigma_a"), format!("{x} is negative; expected coefficients >= 0 (per unit length)"));
+            }
+            a
+        }
+        (None, Some(al)) => {
+            if let Some(x) = al.iter().find(|x| !(**x > 0.0 && **x <= 1.0)) {
+                return cx
+                    .err(&at("albedo"), format!("{x}: expected an albedo sigma_s / (sigma_s + sigma_a) in (0, 1]"));
+            }
+            if sigma_s <= 0.0 {
+                return cx.err(&at("albedo"), "an albedo needs sigma_s > 0 (sigma_a = sigma_s (1 - albedo) / albedo)");
+            }
+            al.map(|a| sigma_s * (1.0 - a) / a)
+        }
+    };
+    let g = cx.float(t, "g", &format!("material[{i}]."), 0.0).map_err(|mut e| {
+        e.key = at("g");
+        e
+    })?;
+    if !(g > -1.0 && g < 1.0) {
+        return cx.err(&at("g"), format!("{g}: the Henyey-Greenstein asymmetry must lie strictly between -1 and 1"));
+    }
+    let translucency = t.get("translucency").map(|v| cx.num(v, &at("translucency"))).transpose()?.unwrap_or(1.0);
+    if !(0.0..=1.0).contains(&translucency) {
+        return cx.err(&at("translucency"), format!("{translucency}: expected a probability in [0, 1]"));
+    }
+    let ior = cx.float(t, "ior", &format!("material[{i}]."), 1.5)?;
+    if !(ior > 0.0) {
+        return cx.err(&at("ior"), format!("{ior}: expected an index of refraction > 0"));
+    }
+    Ok(Some(Translucent { sigma_s, sigma_a, g, translucency }))
 }
 
 /// The line of `key` in the `[medium]` table of `text` (1-based; the table's header line if
 /// the key is not written there), for the medium's errors.
 fn medium_line(text: &str, key: &str) -> usize {
-    let mut header = 0;
-    for (i, l) in text.lines().enumerate() {
+    table_line(text, "[medium]", 0, key)
+}
+
+/// The line of `key` in the `i`-th table headed `header` (`[medium]`,
+/// `[[material]]`) of `text` (1-based; the header's line if the key is not
+/// written there; 0 without such a table).
+fn table_line(text: &str, header: &str, i: usize, key: &str) -> usize {
+    let (mut seen, mut at) = (0usize, 0);
+    for (n, l) in text.lines().enumerate() {
         let l = l.trim();
         if l.starts_with('[') {
-            if header > 0 {
+            if at > 0 {
                 break;
             }
-            if l == "[medium]" {
-                header = i + 1;
+            if l == header {
+                if seen == i {
+                    at = n + 1;
+                }
+                seen += 1;
             }
-        } else if header > 0 && l.split('=').next().map(str::trim) == Some(key) {
-            return i + 1;
+        } else if at > 0 && l.split('=').next().map(str::trim) == Some(key) {
+            return n + 1;
         }
     }
-    header
+    at
 }
 
 /// The most march steps across the medium's box (its diagonal over the step): the
@@ -328,11 +439,13 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let mut materials: Vec<Material> = Vec::new();
     let mut roughness: Vec<f32> = Vec::new();
     let mut exact_fresnel: Vec<bool> = Vec::new();
+    let mut translucent: Vec<Option<Translucent>> = Vec::new();
     for (i, m) in cx.tables(&t, "material")?.into_iter().enumerate() {
-        let (m, r, exact) = material(&cx, m, i)?;
+        let (m, r, exact, sss) = material(&cx, m, i, &text)?;
         materials.push(m);
         roughness.push(r);
         exact_fresnel.push(exact);
+        translucent.push(sss);
     }
     let by_name = |ms: &[Material], n: &str| ms.iter().position(|m| m.name == n).map(|i| i as u32);
     let scale = cx.float(&t, "scale", "", 1.0)?;
@@ -400,6 +513,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     scene.surfaces = extra.surfaces;
     scene.roughness = roughness;
     scene.exact_fresnel = exact_fresnel;
+    scene.translucent = translucent;
     if let Some(e) = t.get("environment") {
         let Some(rel) = e.as_str() else { return cx.err("environment", "expected the file name of an OpenEXR map") };
         let file = dir.join(rel);

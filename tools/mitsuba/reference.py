@@ -72,6 +72,20 @@ with Mitsuba (0.0005, 0.266): at max_depth 2, volpath apparently loses a
 phase-sampled ray that passes the null boundary on its way to the light,
 while its MIS weights still count that technique. The committed scene's box
 therefore encloses the whole room (1 cm outside its walls).
+Translucent materials (thesis 003 §5.3, warplight's `kind = "translucent"`,
+path.cu's translucent()): a smooth `dielectric` (the IOR; only with
+`fresnel = "exact"` and `translucency = 1`: the diffuse branch of the
+thesis' 3-way switch is not exported) whose `interior` is `homogeneous`
+with sigma_t = sigma_s' + sigma_a, albedo sigma_s' / sigma_t and `hg` g,
+where sigma_s' = (1 - g) sigma_s is the reduced coefficient the thesis
+draws its free paths with; the integrator is `volpath`. warplight scatters
+at most once per stay inside; Mitsuba at every order. Both count a path by
+its interactions (surface events and medium scatterings; max_depth =
+bounces + 1), and a stay with two scatterings needs entry, two
+scatterings and exit, 4 interactions before the light: at `--bounces 3`
+(max_depth 4) and below, both count exactly the same paths (none, one
+scattering per stay; the unscattered legs' transmittance). `--all-orders`
+lifts the limit for the high-albedo comparison (not the same estimand).
 Variance: the reference is rendered in B independent batches (seeds
 0..B-1); the mean image is their mean and the variance image the batch
 variance divided by B (the variance of the mean).
@@ -93,6 +107,12 @@ Usage (the committed fixtures were made by):
   python3 tools/mitsuba/reference.py scenes/env-glass.toml \
       --size 32 --batches 16 --spp 1024 --bounces 16 \
       --out tests/fixtures/mitsuba/env-glass-32
+  python3 tools/mitsuba/reference.py scenes/sss-balls.toml \
+      --size 32 --batches 16 --spp 512 --bounces 3 \
+      --out tests/fixtures/mitsuba/sss-balls-32
+  python3 tools/mitsuba/reference.py scenes/sss-milk.toml \
+      --size 32 --batches 8 --spp 32 --bounces 999 --all-orders \
+      --out tests/fixtures/mitsuba/sss-milk-all-orders-32
 writes OUT.exr (mean), OUT-var.exr (variance of the mean) and OUT.json.
 """
 
@@ -167,7 +187,7 @@ def load_scene(toml_path):
             d = own[name]
             kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.8] * 3), d.get("emission", [0.0] * 3)
             rough = float(d.get("roughness", 0.0))
-            glass = (float(d.get("ior", 1.5)), d.get("fresnel", "schlick"))
+            glass = (float(d.get("ior", 1.5)), d.get("fresnel", "schlick"), d if kind == "translucent" else None)
         else:
             d = mtl.get(name, {})
             kd, ks, ke = d.get("Kd", [0.75] * 3), d.get("Ks", [0.0] * 3), d.get("Ke", [0.0] * 3)
@@ -180,7 +200,13 @@ def load_scene(toml_path):
         if kind == "glass" and glass[1] != "exact":
             sys.exit(f"{toml_path}: glass {name} uses Schlick's Fresnel (the thesis'), Mitsuba's dielectrics the exact "
                      "equations; not exported (fresnel = \"exact\" is comparable)")
-        if kind not in ("diffuse", "emitter", "mirror", "glass"):
+        if kind == "translucent" and glass[1] != "exact":
+            sys.exit(f"{toml_path}: translucent {name} uses Schlick's Fresnel (the thesis'); only fresnel = \"exact\" "
+                     "is Mitsuba's dielectric")
+        if kind == "translucent" and float(own[name].get("translucency", 1.0)) != 1.0:
+            sys.exit(f"{toml_path}: translucent {name} has translucency < 1: its diffuse branch of the Fresnel "
+                     "switch is not exported (only translucency = 1, a dielectric around a medium)")
+        if kind not in ("diffuse", "emitter", "mirror", "glass", "translucent"):
             sys.exit(f"{toml_path}: material {name} is {kind}: its Fresnel term (Schlick's) is not Mitsuba's; not exported")
         if kind == "mirror" and rough > 0 and any(c != 1.0 for c in color):
             sys.exit(f"{toml_path}: rough mirror {name} has colour {color}: Schlick's F equals Mitsuba's only for R0 = 1")
@@ -266,6 +292,32 @@ def add_medium(path, desc, m, shapes, bounces):
     }
 
 
+def sss_medium(d):
+    """A translucent material's interior (thesis 003 §5.3 as warplight builds
+    it, path.cu's translucent()): free paths drawn with the reduced
+    sigma_s' = (1 - g) sigma_s, absorption sigma_a (from `albedo` =
+    sigma_s / (sigma_s + sigma_a) as warplight's loader converts it), and
+    Henyey-Greenstein g for the direction: the radiative transfer of a
+    homogeneous medium with scattering sigma_s', absorption sigma_a, HG(g)."""
+    ss, g = float(d["sigma_s"]), float(d.get("g", 0.0))
+    if "albedo" in d:
+        al = d["albedo"] if isinstance(d["albedo"], list) else [d["albedo"]] * 3
+        sa = [ss * (1.0 - float(x)) / float(x) for x in al]
+    else:
+        sa = d["sigma_a"] if isinstance(d["sigma_a"], list) else [d["sigma_a"]] * 3
+        sa = [float(x) for x in sa]
+    sr = (1.0 - g) * ss
+    st = [sr + x for x in sa]
+    top = max(st)   # an RGB texture must lie in [0, 1]: sigma_t = scale x (st / top)
+    return {
+        "type": "homogeneous",
+        "scale": top,
+        "sigma_t": {"type": "rgb", "value": [x / top for x in st]},
+        "albedo": {"type": "rgb", "value": [sr / x if x > 0 else 0.0 for x in st]},
+        "phase": {"type": "hg", "g": g},
+    }
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scene")
@@ -275,6 +327,10 @@ def main():
     ap.add_argument("--bounces", type=int, default=16)
     ap.add_argument("--out")
     ap.add_argument("--check-envmap", action="store_true", help="only check the environment lookup")
+    ap.add_argument("--all-orders", action="store_true",
+                    help="translucent materials: every order of scattering (not warplight's estimand; the "
+                         "high-albedo comparison); no Russian roulette (its 0.95 cap makes the hundreds of "
+                         "scatterings of a high albedo a heavy tail)")
     a = ap.parse_args()
     if not a.out and not a.check_envmap:
         ap.error("--out is required")
@@ -311,7 +367,7 @@ def main():
             "sampler": {"type": "independent", "sample_count": a.spp},
         },
     }
-    triangles, light_area = 0, 0.0
+    triangles, light_area, sss = 0, 0.0, False
     for k, (name, (kind, color, em, tris, rough, glass)) in enumerate(sorted(shapes.items())):
         if not tris:
             continue
@@ -339,6 +395,10 @@ def main():
             }
             if rough > 0:
                 shape["bsdf"].update({"distribution": "beckmann", "alpha": rough})
+        elif kind == "translucent":
+            shape["bsdf"] = {"type": "dielectric", "int_ior": glass[0], "ext_ior": 1.0}
+            shape["interior"] = sss_medium(glass[2])
+            sss = True
         elif kind == "mirror" and rough > 0:
             shape["bsdf"] = {
                 "type": "twosided",
@@ -370,6 +430,12 @@ def main():
     medium = sc.get("medium")
     if medium is not None:
         add_medium(a.scene, desc, medium, shapes, a.bounces)
+    if sss:
+        if a.bounces > 3 and not a.all_orders:
+            sys.exit(f"{a.scene}: warplight's subsurface scattering scatters once per stay inside; only --bounces 3 "
+                     "or fewer (Mitsuba's max_depth 4) is the same light transport (or --all-orders)")
+        desc["integrator"] = {"type": "volpath", "max_depth": a.bounces + 1,
+                              "rr_depth": a.bounces + 2}
     scene = mi.load_dict(desc)
     t0 = time.time()
     batches = []
@@ -397,6 +463,7 @@ def main():
         "environment": sc.get("environment"),
         "medium": sc.get("medium"),
         "integrator": desc["integrator"]["type"],
+        "all_orders": a.all_orders,
         "envmap_check_max_rel_diff": env_check,
         "seconds": round(time.time() - t0, 1),
         "command": "python3 tools/mitsuba/reference.py " + " ".join(sys.argv[1:]),

@@ -30,10 +30,20 @@ pub fn entry(integrator: super::Integrator) -> &'static str {
 /// The entry point with a participating medium (pt, nee, mis; §5.2).
 pub const VOLUME_KERNEL: &str = "volume_frame";
 
+/// The entry point with translucent materials (pt, nee, mis; §5.3).
+pub const SSS_KERNEL: &str = "sss_frame";
+
 /// The entry point that renders `integrator` on `scene`: [`VOLUME_KERNEL`]
-/// when it has a medium, else [`entry`].
+/// when it has a medium, [`SSS_KERNEL`] when it has a translucent material,
+/// else [`entry`].
 pub fn entry_for(scene: &PathScene, integrator: super::Integrator) -> &'static str {
-    if scene.medium.is_some() { VOLUME_KERNEL } else { entry(integrator) }
+    if scene.medium.is_some() {
+        VOLUME_KERNEL
+    } else if scene.has_translucent() {
+        SSS_KERNEL
+    } else {
+        entry(integrator)
+    }
 }
 
 /// Threads per CTA.

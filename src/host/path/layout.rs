@@ -55,6 +55,16 @@ pub enum LayoutError {
         "scene `{0}` has a participating medium, which only pt, nee, mis and mis-power march (volume_frame); not {1}"
     )]
     MediumIntegrator(String, &'static str),
+    /// An integrator that does not run translucent materials.
+    #[error(
+        "scene `{0}` has a translucent material (subsurface scattering), which only pt, nee, mis and mis-power trace (sss_frame); not {1}"
+    )]
+    SssIntegrator(String, &'static str),
+    /// Translucent materials and a participating medium in one scene.
+    #[error(
+        "scene `{0}` has both a translucent material and a participating medium; the path tracer takes one or the other (sss_frame or volume_frame)"
+    )]
+    SssMedium(String),
     /// The environment map could not be read or is not one.
     #[error("environment map {path}: {msg}")]
     Environment {
@@ -80,6 +90,11 @@ pub const KIND_CONDUCTOR: u32 = 4;
 /// Rough glass: Walter et al. 2007's microfacet refraction, Beckmann's D,
 /// Schlick's F as the Fresnel switch (§5.1, 003:L357).
 pub const KIND_ROUGH_GLASS: u32 = 5;
+
+/// A translucent material (§5.3): a smooth dielectric boundary around a
+/// homogeneous medium scattered once (`sss_frame`); its three float4 are
+/// `[colour, kind] [σ_a rgb, IOR] [σ_s, exact Fresnel, g, translucency]`.
+pub const KIND_TRANSLUCENT: u32 = 6;
 
 /// Material kinds as the kernel numbers them; a mirror or glass with a
 /// positive Beckmann `roughness` is rough.
@@ -111,7 +126,9 @@ pub struct PathScene {
     pub tri_data: Vec<[f32; 4]>,
     /// Per material: colour, kind (u32 bits); emission, index of refraction;
     /// Beckmann α (0 for smooth kinds), 1 for a glass with the exact Fresnel
-    /// equations (0: Schlick's), 0, 0.
+    /// equations (0: Schlick's), 0, 0. A translucent material
+    /// ([`KIND_TRANSLUCENT`]): colour, kind; σ_a rgb, IOR; σ_s, exact Fresnel, g,
+    /// translucency.
     pub mats: Vec<[f32; 12]>,
     /// Per emitting triangle: v0, cumulative area fraction; e1, triangle (u32 bits); e2, 0.
     pub lights: Vec<[f32; 12]>,
@@ -212,7 +229,18 @@ impl PathScene {
                 let alpha = if matches!(kind, KIND_CONDUCTOR | KIND_ROUGH_GLASS) { alpha } else { 0.0 };
                 let glass = matches!(kind, KIND_GLASS | KIND_ROUGH_GLASS);
                 let exact = glass && scene.exact_fresnel.get(i).copied().unwrap_or(false);
-                [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, if exact { 1.0 } else { 0.0 }, 0.0, 0.0]
+                let exact = if exact { 1.0 } else { 0.0 };
+                if let Some(t) = scene.translucent(i as u32).filter(|_| kind == KIND_GLASS) {
+                    let [ar, ag, ab] = t.sigma_a;
+                    #[rustfmt::skip]
+                    let v = [
+                        r, g, b, f32::from_bits(KIND_TRANSLUCENT),
+                        ar, ag, ab, ior,
+                        t.sigma_s, exact, t.g, t.translucency,
+                    ];
+                    return v;
+                }
+                [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, exact, 0.0, 0.0]
             })
             .collect();
         let emitting: Vec<(usize, f64)> = scene
@@ -240,6 +268,10 @@ impl PathScene {
                 [v[0].x, v[0].y, v[0].z, cdf, e1.x, e1.y, e1.z, f32::from_bits(i as u32), e2.x, e2.y, e2.z, 0.0]
             })
             .collect();
+        let translucent = scene.translucent.iter().any(Option::is_some);
+        if translucent && scene.medium.is_some() {
+            return Err(LayoutError::SssMedium(scene.name.clone()));
+        }
         let medium = match scene.medium {
             None => None,
             Some(m) => {
@@ -278,19 +310,31 @@ impl PathScene {
 }
 
 impl PathScene {
-    /// Whether `integrator` ignores the scene's medium: bdpt and mlt, which
-    /// do not march it (`volume_frame` is the path tracer's). The renderers
+    /// Whether `integrator` ignores the scene's medium or the medium inside
+    /// its translucent materials: bdpt and mlt, which march neither
+    /// (`volume_frame` and `sss_frame` are the path tracer's). The renderers
     /// refuse them on such a scene.
     pub fn ignores_medium(&self, integrator: super::Integrator) -> bool {
-        self.medium.is_some() && matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt)
+        (self.medium.is_some() || self.has_translucent())
+            && matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt)
     }
 
-    /// Refuses an integrator that ignores the scene's medium (bdpt, mlt).
+    /// Refuses an integrator that ignores the scene's medium or its
+    /// translucent materials (bdpt, mlt).
     pub fn check_integrator(&self, name: &str, integrator: super::Integrator) -> Result<(), LayoutError> {
-        if self.ignores_medium(integrator) {
+        let unidirectional = !matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt);
+        if self.medium.is_some() && !unidirectional {
             return Err(LayoutError::MediumIntegrator(name.to_string(), integrator.name()));
         }
+        if self.has_translucent() && !unidirectional {
+            return Err(LayoutError::SssIntegrator(name.to_string(), integrator.name()));
+        }
         Ok(())
+    }
+
+    /// Whether a material is translucent (the renderer then launches `sss_frame`).
+    pub fn has_translucent(&self) -> bool {
+        self.mats.iter().any(|m| m[3].to_bits() == KIND_TRANSLUCENT)
     }
 }
 

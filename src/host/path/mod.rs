@@ -297,10 +297,10 @@ pub enum RenderError {
     /// bounces, or more chain state than [`mlt::MAX_STATE_BYTES`]).
     #[error(transparent)]
     Mlt(#[from] mlt::MltError),
-    /// An integrator that does not march the scene's participating medium
-    /// ([`layout::PathScene::ignores_medium`]).
+    /// An integrator that does not march the scene's participating medium or
+    /// its translucent materials' ([`layout::PathScene::ignores_medium`]).
     #[error(
-        "the scene has a participating medium, which only pt, nee, mis and mis-power march (volume_frame); not {0}"
+        "the scene has a participating medium or translucent materials, which only pt, nee, mis and mis-power render (volume_frame, sss_frame); not {0}"
     )]
     Medium(&'static str),
 }

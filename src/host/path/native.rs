@@ -10,7 +10,9 @@
 use rayon::prelude::*;
 
 use super::counts::Counts;
-use super::layout::{KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, LEAF_AXIS, PathScene};
+use super::layout::{
+    KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TRANSLUCENT, LEAF_AXIS, PathScene,
+};
 use super::rng::{Sample, azimuth, path_key, tent};
 use super::{FrameParams, Integrator, Traversal};
 
@@ -512,6 +514,7 @@ impl Tracer<'_> {
         let mut count_emission = true;
         let mut bsdf_pdf = 0.0f32;
         let mut bounce = 0u32;
+        let mut scattered = false; // sss_frame's Sss: scattered since it entered
         while bounce <= p.max_bounces {
             let hit = self.trace(o, d, cam.eps, f32::INFINITY, false, counts);
             if let Some(m) = &s.medium {
@@ -531,6 +534,15 @@ impl Tracer<'_> {
             let mat = &s.mats[td[3].to_bits() as usize];
             let kind = mat[3].to_bits();
             let cos_d = d.dot(n);
+            if kind == KIND_TRANSLUCENT {
+                // the kernel's translucent() (sss_frame)
+                let path = (&mut o, &mut d, &mut beta, &mut bounce, &mut scattered);
+                if !self.translucent(mat, n, cos_d, t, key, path) {
+                    break;
+                }
+                count_emission = true;
+                continue;
+            }
             if kind == KIND_EMITTER {
                 if cos_d < 0.0 {
                     let mut wgt = 1.0;
@@ -614,6 +626,87 @@ impl Tracer<'_> {
             bounce += 1;
         }
         [l.x, l.y, l.z]
+    }
+
+    /// The kernel's `translucent` (`sss_frame`, §5.3): the ray (`o`, `d`) hit
+    /// the translucent material `mat` (normal `n`, `cos_d` = d · n) at `t`. The
+    /// leg inside, if the ray left from inside (at most one scattering since
+    /// the path entered: `scattered`), then the surface's 3-way Fresnel switch;
+    /// the next ray, mask and bounce count in place; false when the path ends.
+    #[allow(clippy::too_many_arguments)]
+    fn translucent<S: Sample>(
+        &self,
+        mat: &[f32; 12],
+        n: V3,
+        cos_d: f32,
+        t: f32,
+        key: S,
+        (o, d, beta, bounce, scattered): (&mut V3, &mut V3, &mut V3, &mut u32, &mut bool),
+    ) -> bool {
+        let max = self.params.max_bounces;
+        let b = *bounce;
+        let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * b;
+        let into = cos_d < 0.0;
+        if !into {
+            // the leg ran inside: sigma_s' = (1 - g) sigma_s (003:L396)
+            let sigma_r = (1.0 - mat[10]) * mat[8];
+            let mut ext = 0.0f32;
+            if !*scattered {
+                let dd = if sigma_r > 0.0 { -ln(1.0 - key.at(dim + 7)) / sigma_r } else { f32::INFINITY };
+                if dd < t {
+                    if b == max {
+                        return false;
+                    }
+                    let wgt = v3(exp_neg(-mat[4] * dd), exp_neg(-mat[5] * dd), exp_neg(-mat[6] * dd));
+                    let next = hg_dir(mat[10], *d, key.at(dim + 3), key.at(dim + 4));
+                    if !roulette(beta, wgt, key, dim) {
+                        return false;
+                    }
+                    *scattered = true;
+                    *o = o.add(d.scale(dd));
+                    *d = next;
+                    *bounce = b + 1;
+                    return true;
+                }
+            } else {
+                ext = sigma_r;
+            }
+            *beta = v3(
+                beta.x * exp_neg(-(mat[4] + ext) * t),
+                beta.y * exp_neg(-(mat[5] + ext) * t),
+                beta.z * exp_neg(-(mat[6] + ext) * t),
+            );
+        }
+        if b == max {
+            return false;
+        }
+        let ns = if into { n } else { v3(-n.x, -n.y, -n.z) };
+        let cos_i = -d.dot(ns);
+        let mut next = d.add(ns.scale(2.0 * cos_i));
+        let mut wgt = v3(1.0, 1.0, 1.0);
+        let ior = mat[7];
+        let eta = if into { 1.0 / ior } else { ior };
+        let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+        if k > 0.0 {
+            let cos_t = k.sqrt();
+            let fr = surface_fresnel(mat, into, eta, cos_i, cos_t);
+            if !(key.at(dim + 6) < fr) {
+                if !into || key.at(dim + 7) < mat[11] {
+                    next = d.scale(eta).add(ns.scale(eta * cos_i - cos_t));
+                    *scattered = false;
+                } else {
+                    next = cosine_dir(ns, key.at(dim + 3), key.at(dim + 4)).0;
+                    wgt = xyz(mat, 0);
+                }
+            }
+        }
+        if !roulette(beta, wgt, key, dim) {
+            return false;
+        }
+        *o = o.add(d.scale(t));
+        *d = next;
+        *bounce = b + 1;
+        true
     }
 
     /// The kernel's `march`: the segment `o + t d`, t in [0, `t_end`], of a path
@@ -757,15 +850,7 @@ impl Tracer<'_> {
                 if k > 0.0 {
                     let cos_t = k.sqrt();
                     let tdir = d.scale(eta).add(ns.scale(eta * cos_i - cos_t));
-                    let fr = if mat[9] > 0.0 {
-                        fresnel_exact(eta, cos_i, cos_t)
-                    } else {
-                        let mut r0 = (1.0 - ior) / (1.0 + ior);
-                        r0 = r0 * r0;
-                        let cc = 1.0 - if into { cos_i } else { cos_t };
-                        let c2 = cc * cc;
-                        r0 + (1.0 - r0) * (c2 * c2 * cc)
-                    };
+                    let fr = surface_fresnel(mat, into, eta, cos_i, cos_t);
                     if !(key.at(dim + 6) < fr) {
                         next = tdir;
                     }
@@ -876,6 +961,40 @@ fn medium_transmittance(m: &[f32; 16], x: V3, w: V3, dist: f32) -> f32 {
 pub fn hg(g: f32, c: f32) -> f32 {
     let den = 1.0 + g * g - 2.0 * g * c;
     (1.0 - g * g) * (0.25 * INV_PI) / (den * den.sqrt())
+}
+
+/// The Fresnel term of a smooth dielectric surface (glass, translucent) of
+/// material `mat` (IOR `mat[7]`, exact when `mat[9]` > 0, else Schlick's
+/// with (1 − c)^5 by multiplication) for the ray entering (`into`) at
+/// `cos_i`, refracting at `cos_t` with `eta` = n_i / n_t: the kernel's
+/// switch in `scatter` (glass) and `translucent`.
+fn surface_fresnel(mat: &[f32; 12], into: bool, eta: f32, cos_i: f32, cos_t: f32) -> f32 {
+    if mat[9] > 0.0 {
+        return fresnel_exact(eta, cos_i, cos_t);
+    }
+    let ior = mat[7];
+    let mut r0 = (1.0 - ior) / (1.0 + ior);
+    r0 = r0 * r0;
+    let c = 1.0 - if into { cos_i } else { cos_t };
+    let c2 = c * c;
+    r0 + (1.0 - r0) * (c2 * c2 * c)
+}
+
+/// A direction from Henyey-Greenstein about the unit direction of travel `d`
+/// (forward peak for g > 0, as [`hg`]) from uniforms `y1` (the cosine) and
+/// `y2` (the azimuth): the kernel's `hg_dir`.
+fn hg_dir(g: f32, d: V3, y1: f32, y2: f32) -> V3 {
+    let mut c = if g.abs() < 1e-3 {
+        1.0 - 2.0 * y1
+    } else {
+        let q = (1.0 - g * g) / (1.0 - g + 2.0 * g * y1);
+        (1.0 + g * g - q * q) / (2.0 * g)
+    };
+    c = fmin(fmax(c, -1.0), 1.0);
+    let sn = fmax(1.0 - c * c, 0.0).sqrt();
+    let (ca, sa) = azimuth(y2);
+    let (b1, b2) = basis(d);
+    b1.scale(sn * ca).add(b2.scale(sn * sa)).add(d.scale(c)).normalize()
 }
 
 /// Russian roulette on the bounce's mask `wgt` = f cos / p: the kernel's
@@ -1044,6 +1163,41 @@ mod tests {
             assert!((mean - g as f64).abs() < 2e-3, "g {g}: mean cosine {mean}");
         }
         assert!((hg(0.0, 0.3) - 0.25 / std::f32::consts::PI).abs() < 1e-7);
+    }
+
+    /// `hg_dir` samples Henyey-Greenstein about the direction of travel: unit
+    /// directions whose mean cosine is g and whose cosines fall into 8 bins
+    /// as the density integrates over them (stratified cosines, hashed
+    /// azimuths), for forward, backward and (near) isotropic g.
+    #[test]
+    fn hg_dir_samples_henyey_greenstein() {
+        let d = v3(0.36, 0.48, 0.8);
+        for g in [-0.6f32, -0.3, 0.0, 0.0005, 0.5, 0.9] {
+            let n = 100_000u32;
+            let (mut mean, mut bins) = (0.0f64, [0u32; 8]);
+            for i in 0..n {
+                let y1 = (i as f32 + 0.5) / n as f32;
+                let y2 = (i.wrapping_mul(2_654_435_761) >> 8) as f32 / 16_777_216.0;
+                let w = hg_dir(g, d, y1, y2);
+                assert!((w.dot(w) - 1.0).abs() < 1e-5, "g {g}: not unit");
+                let c = w.dot(d).clamp(-1.0, 1.0) as f64;
+                mean += c;
+                bins[(((c + 1.0) * 4.0) as usize).min(7)] += 1;
+            }
+            mean /= n as f64;
+            assert!((mean - g as f64).abs() < 2e-3, "g {g}: mean cosine {mean}");
+            for (k, &b) in bins.iter().enumerate() {
+                // the density's mass in [c0, c1]: 2 pi x the midpoint sum of hg over the cosine
+                let (c0, m) = (-1.0 + 0.25 * k as f64, 2000);
+                let want: f64 =
+                    (0..m).map(|j| hg(g, (c0 + (j as f64 + 0.5) * 0.25 / m as f64) as f32) as f64).sum::<f64>() * 0.25
+                        / m as f64
+                        * 2.0
+                        * std::f64::consts::PI;
+                let got = b as f64 / n as f64;
+                assert!((got - want).abs() < 2e-3 + 0.01 * want, "g {g}, bin {k}: {got} against {want}");
+            }
+        }
     }
 
     /// The optical depth per unit σ_t: the segment's length inside the box
