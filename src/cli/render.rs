@@ -79,7 +79,10 @@ pub struct RenderArgs {
     /// A scene with a `[medium]` (participating media, §5.2: smog-room, fog-box) is
     /// marched by pt, nee and mis (kernel volume_frame: steps of the scene's `step`
     /// with one random offset a ray, Beer's law, single scattering from direct
-    /// light with a shadow ray at each sample); bdpt and mlt refuse it.
+    /// light with a shadow ray at each sample); bdpt and mlt refuse it. A scene with
+    /// texture maps (albedo, roughness, metalness, §5.4: cornell-scratched) is traced
+    /// by pt, nee and mis (kernel texture_frame: at each hit the metalness picks the
+    /// Lambertian or the Cook-Torrance lobe); bdpt and mlt refuse it.
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
