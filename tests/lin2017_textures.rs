@@ -11,12 +11,18 @@
 
 mod lin2017_mitsuba;
 
-use lin2017_mitsuba::scene_of;
+use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, params, reference_of, reference_samples, scene_of};
 use warplight::host::camera::Camera;
-use warplight::host::path::layout::{KIND_CONDUCTOR, KIND_DIFFUSE, KIND_TEXTURED, ROUGHNESS_LEVELS};
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::path::layout::{KIND_CONDUCTOR, KIND_DIFFUSE, KIND_TEXTURED, PathScene, ROUGHNESS_LEVELS};
+use warplight::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, kernel, render_native};
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
+
+const FIXTURE: &str = "tests/fixtures/mitsuba/cornell-scratched-white-32";
+/// Frames of a native render against the reference (4 paths a pixel each).
+const FRAMES: u32 = 256;
+/// Frames of the emulated render against the reference.
+const EMULATED_FRAMES: u32 = 16;
 
 /// The general metalness workflow (coloured metal: R0 = lerp(white, albedo, m)
 /// below 1): pt, nee and mis-power trace the same bits emulated and native
@@ -153,4 +159,57 @@ fn map_errors_name_the_file_and_line() {
         assert!(e.contains("texture maps") && e.contains(i.name()), "{e}");
     }
     assert!(ps.check_integrator("cornell-scratched", Integrator::MisPower).is_ok());
+}
+
+fn reference() -> (warplight::host::path::stats::Estimate, u32, f64) {
+    let (e, size, meta) = reference_of(FIXTURE);
+    let checks = meta["bitmap_check_max_diff"].as_object().expect("the maps were checked against Mitsuba's bitmaps");
+    assert_eq!(checks.len(), 3);
+    assert!(checks.values().all(|v| v.as_f64().is_some_and(|d| d < 1e-6)), "{checks:?}");
+    (e, size, reference_samples(&meta))
+}
+
+#[test]
+fn the_textured_box_agrees_with_mitsuba() {
+    let (reference, size, samples) = reference();
+    let (_, ps, cam) = scene_of("cornell-scratched-white", size);
+    for (k, integrator) in [Integrator::Pt, Integrator::MisPower].into_iter().enumerate() {
+        let o = native_outcome(&ps, &cam, params(size, integrator, 700 + k as u32), FRAMES, &reference);
+        eprintln!("textures {integrator:?}: {o:?}");
+        assert!(o.passed(), "{integrator:?} disagrees with Mitsuba on the textured box: {o:?}");
+        assert!(o.mean_rel_diff.abs() < 0.02, "{integrator:?}: mean off by {:.3}", o.mean_rel_diff);
+    }
+    let floor = samples / (SAMPLES_PER_FRAME * EMULATED_FRAMES) as f64;
+    let o = emulated_frames_outcome(&ps, &cam, params(size, Integrator::Nee, 71), EMULATED_FRAMES, &reference, floor);
+    eprintln!("textures emulated: {o:?}");
+    assert!(o.passed(), "the emulated kernel disagrees with Mitsuba on the textured box: {o:?}");
+}
+
+/// Mirrors every map left to right, or shifts its columns by `k` texels.
+fn edit_maps(ps: &mut PathScene, k: usize, mirror: bool) {
+    let t = ps.textures.as_mut().expect("maps");
+    for m in t.info.chunks(4) {
+        let (first, w, h) = (m[0] as usize, m[1] as usize, m[2] as usize);
+        for row in t.texels[first..first + w * h].chunks_mut(w) {
+            if mirror {
+                row.reverse();
+            } else {
+                row.rotate_left(k);
+            }
+        }
+    }
+}
+
+/// The test sees the maps: mirrored left to right, or shifted by a quarter of
+/// the wall (64 of 256 texels), they fail.
+#[test]
+fn a_mirrored_or_shifted_texture_fails() {
+    let (reference, size, _) = reference();
+    for (name, k, mirror) in [("mirrored", 0, true), ("shifted a quarter", 64, false)] {
+        let (_, mut ps, cam) = scene_of("cornell-scratched-white", size);
+        edit_maps(&mut ps, k, mirror);
+        let o = native_outcome(&ps, &cam, params(size, Integrator::MisPower, 81), FRAMES, &reference);
+        eprintln!("maps {name}: {o:?}");
+        assert!(!o.passed(), "the maps {name} passed: {o:?}");
+    }
 }
