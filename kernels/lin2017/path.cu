@@ -46,6 +46,7 @@
 
 #if defined(__clang__) && !defined(__NVCC__)
 #pragma clang fp contract(off)
+#pragma clang diagnostic ignored "-Wc++17-extensions"   // step()'s if constexpr (nvcc: C++17)
 #endif
 
 #define INTEGRATOR_PT 0
@@ -60,6 +61,7 @@
 #define KIND_CONDUCTOR 4     // rough mirror: Cook-Torrance, Beckmann
 #define KIND_ROUGH_GLASS 5   // rough glass: Walter et al. 2007, Beckmann
 #define KIND_TRANSLUCENT 6   // subsurface scattering (§5.3): sss_frame only
+#define KIND_TEXTURED 7      // texture maps, the metalness workflow: texture_frame alone (texture_hit())
 #define PI_F 3.14159265358979324f
 #if defined(__NVCC__)
 #define FLOORF floorf
@@ -991,13 +993,92 @@ static __device__ __forceinline__ int translucent(const Scene &s, Path &P, K key
   return 1;
 }
 
+// ---- Texture maps (§5.4, 003:L405-417): the hook of texture_frame ----
+//
+// A textured material (KIND_TEXTURED) has an albedo map (RGB, times its
+// colour), a metalness map and a roughness map (grey, the first channel),
+// 8-bit texels read through the read-only (texture) path, nearest texel,
+// repeated outside [0, 1) (thesis 000's lookup; the thesis states neither
+// resolution nor filtering). At each hit, the metalness workflow (003:L255-257,
+// L409) picks the BSDF's lobe: with probability m (the metalness texel) the
+// metal lobe, the rough conductor (Cook-Torrance, Schlick's F) whose specular
+// colour is lerp(white, albedo, m) and whose Beckmann alpha is the roughness
+// texel / 255 (at least 1e-4), else the Lambertian lobe with the albedo: the
+// BSDF (1 - m) albedo / pi + m f_CT, each lobe estimated with its own light
+// sample and sampling. The host lays out, per textured material, one
+// conductor row of mats per roughness level (256 with a roughness map, else
+// one with the material's alpha) from its first row on, so that the chosen
+// lobe is an existing kind and the shading below is path_frame's.
+struct NoTextures {
+  static constexpr bool MAPS = false;
+};
+// A textured scene's maps: per material [albedo, roughness, metalness map
+// (-1: none), first conductor row (-1: no metal lobe)]; per triangle its 3
+// vertices' texture coordinates (u, v); per map [first texel, width, height,
+// 0]; every map's texels, r | g << 8 | b << 16 | a << 24, rows top down.
+struct Textures {
+  static constexpr bool MAPS = true;
+  const int4 *mats;
+  const float *uvs;
+  const uint4 *info;
+  const unsigned *texels;
+};
+
+// The texel of map `map` at texture coordinates (tu, tv): nearest, repeated, v = 0 the bottom row.
+static __device__ __forceinline__ unsigned texel_at(const Textures &x, int map, float tu, float tv) {
+  const unsigned *ti = (const unsigned *)(x.info + map);
+  unsigned first = __ldg(ti);
+  int tw = (int)__ldg(ti + 1), th = (int)__ldg(ti + 2);
+  int px = __float2int_rd(tu * (float)tw) % tw;
+  int py = __float2int_rd((1.0f - tv) * (float)th) % th;
+  if (px < 0) px += tw;
+  if (py < 0) py += th;
+  return __ldg(x.texels + first + (unsigned)(py * tw + px));
+}
+
+// A hit on triangle tri at distance t along (o, d): a textured material
+// becomes the lobe the metalness picks (dimension dim + 6, the switch's),
+// *kind KIND_DIFFUSE with the albedo or KIND_CONDUCTOR with the specular
+// colour and td.w its roughness level's conductor row.
+template <class K>
+static __device__ __forceinline__ void texture_hit(const Textures &x, const Scene &s, int tri, V3 o, V3 d, float t,
+                                                   K key, unsigned dim, float4 &td, int &kind, V3 &color) {
+  if (kind != KIND_TEXTURED) return;
+  const int *tm = (const int *)(x.mats + __float_as_int(td.w));
+  int albedo = __ldg(tm), rough = __ldg(tm + 1), metal = __ldg(tm + 2), rows = __ldg(tm + 3);
+  // the barycentric weights of vertices 0 and 1, as the affine test computed them
+  const float4 *m = s.tris + 3 * tri;
+  float4 r0 = m[0], r1 = m[1];
+  float b0 = r0.x * o.x + r0.y * o.y + r0.z * o.z + r0.w + t * (r0.x * d.x + r0.y * d.y + r0.z * d.z);
+  float b1 = r1.x * o.x + r1.y * o.y + r1.z * o.z + r1.w + t * (r1.x * d.x + r1.y * d.y + r1.z * d.z);
+  float b2 = 1.0f - b0 - b1;
+  const float *uv = x.uvs + 6 * tri;
+  float tu = b0 * __ldg(uv) + b1 * __ldg(uv + 2) + b2 * __ldg(uv + 4);
+  float tv = b0 * __ldg(uv + 1) + b1 * __ldg(uv + 3) + b2 * __ldg(uv + 5);
+  if (albedo >= 0) {
+    unsigned a = texel_at(x, albedo, tu, tv);
+    color = v3(color.x * ((float)(a & 255u) / 255.0f), color.y * ((float)((a >> 8) & 255u) / 255.0f),
+               color.z * ((float)((a >> 16) & 255u) / 255.0f));
+  }
+  float mv = metal >= 0 ? (float)(texel_at(x, metal, tu, tv) & 255u) / 255.0f : 0.0f;
+  kind = KIND_DIFFUSE;
+  if (rows >= 0 && rng(key, dim + 6) < mv) {
+    int level = rough >= 0 ? (int)(texel_at(x, rough, tu, tv) & 255u) : 0;
+    td.w = __int_as_float(rows + level);
+    kind = KIND_CONDUCTOR;
+    float w = 1.0f - mv;   // lerp(white, albedo, m)
+    color = v3(w + mv * color.x, w + mv * color.y, w + mv * color.z);
+  }
+}
+
 // One level of the inner loop (003:L119) for one path: trace its ray, gather
 // emission and the light sample, pick the next direction, Russian roulette.
 // False when the path ends (missed, hit an emitter, the longest path, or
 // terminated); P then holds its final radiance.
 // M: NoMedium, or the Medium of volume_frame (march(), attenuate()).
-template <class K, class M = NoMedium>
-static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, const M &med = M()) {
+template <class K, class M = NoMedium, class T = NoTextures>
+static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, const M &med = M(),
+                                            const T &tex = T()) {
   const Params *p = s.p;
   int integrator = p->integrator;
   int bounce = P.bounce;
@@ -1041,6 +1122,7 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, cons
   V3 color = v3(m0.x, m0.y, m0.z);
   float cos_o = -dot3(d, ns);   // the viewer's side, > 0
   unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
+  if constexpr (T::MAPS) texture_hit(tex, s, tri, o, d, t, key, dim, td, kind, color);   // the lobe of a textured hit
   bool sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
   if (sampled_light && integrator != INTEGRATOR_PT && p->num_lights > 0 && bounce < p->max_bounces) {
     // next event estimation: a light triangle by area, a point on it uniformly
@@ -1103,15 +1185,16 @@ static __device__ __forceinline__ void finish(float *accum, float *last, int i, 
   l[2] = L.z;
 }
 
-// One thread's path of a megakernel frame, run to the end with medium m (or none).
-template <class M>
-static __device__ __forceinline__ void frame_path(const Scene &s, float *accum, float *last, const M &m) {
+// One thread's path of a megakernel frame, run to the end with medium m (or none) and textures tex (or none).
+template <class M, class T = NoTextures>
+static __device__ __forceinline__ void frame_path(const Scene &s, float *accum, float *last, const M &m,
+                                                  const T &tex = T()) {
   const Params *p = s.p;
   int i = (int)WL_TID;
   if (i >= p->num_paths) return;
   unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
   Path P = camera_path(p, i, key);
-  while (step(s, P, key, m)) {
+  while (step(s, P, key, m, tex)) {
   }
   finish(accum, last, i, P.L);
 }
@@ -1145,6 +1228,18 @@ extern "C" __global__ void sss_frame(const Params *params, const uint4 *nodes, c
   Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
   Sss m = {false};
   frame_path(s, accum, last, m);
+}
+
+// The megakernel of a scene with texture maps (§5.4): path_frame's paths, each
+// hit on a textured material shaded as the lobe its maps pick (texture_hit()).
+extern "C" __global__ void texture_frame(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                         const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                         const float4 *lights, const float4 *boxes, const float4 *env,
+                                         const int4 *tex_mats, const float *uvs, const uint4 *tex_info,
+                                         const unsigned *texels, float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  Textures x = {tex_mats, uvs, tex_info, texels};
+  frame_path(s, accum, last, NoMedium(), x);
 }
 
 // ---- Bidirectional path tracing (§4.7, 003:L295-308): bdpt_frame ----

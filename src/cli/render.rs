@@ -84,6 +84,9 @@ pub struct RenderArgs {
     /// bunny-jade) is traced by pt, nee and mis (kernel sss_frame: the 3-way
     /// Fresnel switch at its surface, at most one scattering inside, at
     /// d = -ln(xi) / ((1 - g) sigma_s), the direction from HG(g)); bdpt and mlt refuse it.
+    /// A scene with texture maps (albedo, roughness, metalness, §5.4:
+    /// cornell-scratched) is traced by pt, nee and mis (kernel texture_frame: at each
+    /// hit the metalness picks the Lambertian or the Cook-Torrance lobe); bdpt and mlt refuse it.
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).

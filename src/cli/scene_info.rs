@@ -158,7 +158,7 @@ mod tests {
         let mut s = Scene::assemble("t", Path::new("t.toml"), vec![tri(0), tri(0), tri(1)], mats);
         s.textures =
             vec![Texture { name: "textures/m.png".into(), width: 512, height: 256, texels: vec![0; 512 * 256] }];
-        s.surfaces = vec![Surface { texture: Some(0), reflect: [0.25, 0.25, 0.125] }];
+        s.surfaces = vec![Surface { texture: Some(0), reflect: [0.25, 0.25, 0.125], ..Default::default() }];
         s
     }
 

@@ -98,6 +98,11 @@ pub struct Texture {
 }
 
 impl Texture {
+    /// The texel index of (`u`, `v`) and the texel itself, packed as [`Texture::texels`].
+    pub fn texel(&self, u: f32, v: f32) -> u32 {
+        self.texels[Texture::index(self.width, self.height, u, v)]
+    }
+
     /// The texel that texture coordinates (`u`, `v`) fall in: nearest texel,
     /// repeated outside [0, 1), v = 0 the bottom row. The ray-tracing kernel
     /// (`direct` in `kernels/fabianowski2011/raytrace.cu`) computes the same
@@ -110,7 +115,7 @@ impl Texture {
 
     /// The colour of the texel at (`u`, `v`) ([`Texture::index`]), each channel in [0, 1].
     pub fn sample(&self, u: f32, v: f32) -> [f32; 3] {
-        let t = self.texels[Texture::index(self.width, self.height, u, v)];
+        let t = self.texel(u, v);
         [(t & 255) as f32 / 255.0, ((t >> 8) & 255) as f32 / 255.0, ((t >> 16) & 255) as f32 / 255.0]
     }
 }
@@ -126,6 +131,14 @@ pub struct Surface {
     /// `Kd` where `illum` is 3 to 7, the models that trace reflections, or a
     /// scene file's `[[reflect]]`).
     pub reflect: [f32; 3],
+    /// Thesis 003's roughness map (index into [`Scene::textures`]; a scene
+    /// file's `roughness_map`): per texel the Beckmann α of the metal lobe,
+    /// texel / 255 of its first channel. Only thesis 003's path tracer reads it.
+    pub roughness_map: Option<u32>,
+    /// Thesis 003's metalness map (a scene file's `metalness_map`): per texel
+    /// the metalness m = texel / 255 of its first channel, the probability of
+    /// the metal lobe. Only thesis 003's path tracer reads it.
+    pub metalness_map: Option<u32>,
 }
 
 /// What thesis 000 Table A.1 says of a scene.
@@ -358,6 +371,14 @@ impl Scene {
             MaterialKind::Diffuse => self.surface(m).reflect,
             MaterialKind::Emitter => [0.0; 3],
         }
+    }
+
+    /// Whether material `m` has a texture map (albedo, roughness or
+    /// metalness): thesis 003's path tracer shades it by the metalness
+    /// workflow (`kernels/lin2017/path.cu`, `texture_hit`).
+    pub fn textured(&self, m: u32) -> bool {
+        let s = self.surface(m);
+        s.texture.is_some() || s.roughness_map.is_some() || s.metalness_map.is_some()
     }
 
     /// Texture coordinates of triangle `t`'s vertices (zero when the scene has none).

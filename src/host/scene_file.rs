@@ -148,18 +148,70 @@ impl Cx<'_> {
     }
 }
 
-/// A material, its Beckmann roughness (`roughness`, mirrors and glass only; 0
-/// is smooth), whether its Fresnel term is exact (`fresnel = "exact"`,
-/// glass and translucent only; `"schlick"` the default) and, for a
-/// translucent material (`kind = "translucent"`, a glass to every other
-/// renderer), its subsurface scattering. `text` is the file's text, for the
+/// A diffuse material's texture maps as its scene file names them (thesis 003
+/// §5.4): albedo, roughness and metalness maps, and a planar mapping for
+/// triangles without texture coordinates.
+#[derive(Debug, Default, Clone, PartialEq)]
+struct Maps {
+    albedo: Option<String>,
+    roughness: Option<String>,
+    metalness: Option<String>,
+    /// `planar = { origin, u, v }`: texture coordinates ((p − origin)·u, (p − origin)·v).
+    planar: Option<[[f32; 3]; 3]>,
+}
+
+/// The keys of a material's texture maps.
+const MAP_KEYS: [&str; 4] = ["albedo_map", "roughness_map", "metalness_map", "planar"];
+
+/// A material's texture maps (`albedo_map`, `roughness_map`, `metalness_map`,
+/// `planar`; diffuse materials only).
+fn maps(cx: &Cx, t: &toml::Table, p: &str, kind: MaterialKind) -> Result<Maps, SceneError> {
+    if let Some(k) = MAP_KEYS.iter().find(|k| t.contains_key(**k))
+        && kind != MaterialKind::Diffuse
+    {
+        return cx.err(&format!("{p}{k}"), "only a diffuse material has texture maps");
+    }
+    let file = |key: &str| -> Result<Option<String>, SceneError> {
+        match t.get(key) {
+            None => Ok(None),
+            Some(v) => v.as_str().map(|f| Some(f.to_string())).map_or_else(
+                || cx.err(&format!("{p}{key}"), "expected the file name of a PNG map (relative to the scene file)"),
+                Ok,
+            ),
+        }
+    };
+    let planar = match t.get("planar") {
+        None => None,
+        Some(toml::Value::Table(pl)) => {
+            let k = format!("{p}planar.");
+            Some([cx.vec3(pl, "origin", &k, None)?, cx.vec3(pl, "u", &k, None)?, cx.vec3(pl, "v", &k, None)?])
+        }
+        Some(_) => {
+            return cx.err(&format!("{p}planar"), "expected { origin = [x, y, z], u = [x, y, z], v = [x, y, z] }");
+        }
+    };
+    Ok(Maps {
+        albedo: file("albedo_map")?,
+        roughness: file("roughness_map")?,
+        metalness: file("metalness_map")?,
+        planar,
+    })
+}
+
+/// A material, its Beckmann roughness (`roughness`, mirrors and glass, and
+/// the metal lobe of a diffuse material with a metalness map; 0 is smooth),
+/// whether its Fresnel term is exact (`fresnel = "exact"`, glass and
+/// translucent only; `"schlick"` the default), for a translucent material
+/// (`kind = "translucent"`, a glass to every other renderer) its subsurface
+/// scattering, and its texture maps. `text` is the file's text, for the
 /// lines the translucent keys' errors name.
+#[allow(clippy::type_complexity)]
 fn material(
     cx: &Cx,
     t: &toml::Table,
     i: usize,
     text: &str,
-) -> Result<(Material, f32, bool, Option<Translucent>), SceneError> {
+) -> Result<(Material, f32, bool, Option<Translucent>, Maps), SceneError> {
     let p = format!("material[{i}].");
     let name = match t.get("name").and_then(|v| v.as_str()) {
         Some(n) => n.to_string(),
@@ -183,8 +235,24 @@ fn material(
         return cx.err(&format!("{p}roughness"), "a translucent material's boundary is smooth: no roughness");
     }
     let roughness = cx.float(t, "roughness", &p, 0.0)?;
-    if t.contains_key("roughness") && !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) {
-        return cx.err(&format!("{p}roughness"), "only a mirror or glass has a roughness");
+    let maps = maps(cx, t, &p, kind)?;
+    let metal_lobe = maps.metalness.is_some();
+    if t.contains_key("roughness") && !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) && !metal_lobe
+    {
+        return cx.err(
+            &format!("{p}roughness"),
+            "only a mirror, glass or a diffuse material with a metalness_map has a roughness",
+        );
+    }
+    if maps.roughness.is_some() && !metal_lobe {
+        return cx
+            .err(&format!("{p}roughness_map"), "a roughness map shapes the metal lobe only: give a metalness_map too");
+    }
+    if metal_lobe && maps.roughness.is_none() && roughness <= 0.0 {
+        return cx.err(
+            &format!("{p}metalness_map"),
+            "the metal lobe needs a roughness_map or a roughness (a Beckmann alpha from 1e-4 to 1)",
+        );
     }
     // α² underflows in f32 below about 1e-19 and the pdf squared overflows from
     // about 1e-11: NaN pixels under MIS. Mitsuba 3 clamps α to 1e-4.
@@ -218,7 +286,7 @@ fn material(
         color: cx.vec3(t, "color", &p, Some([0.8; 3]))?,
         emission: cx.vec3(t, "emission", &p, Some([0.0; 3]))?,
     };
-    Ok((m, roughness, exact, translucent))
+    Ok((m, roughness, exact, translucent, maps))
 }
 
 /// The keys only a translucent material has.
@@ -440,12 +508,14 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let mut roughness: Vec<f32> = Vec::new();
     let mut exact_fresnel: Vec<bool> = Vec::new();
     let mut translucent: Vec<Option<Translucent>> = Vec::new();
+    let mut maps: Vec<Maps> = Vec::new();
     for (i, m) in cx.tables(&t, "material")?.into_iter().enumerate() {
-        let (m, r, exact, sss) = material(&cx, m, i, &text)?;
+        let (m, r, exact, sss, mp) = material(&cx, m, i, &text)?;
         materials.push(m);
         roughness.push(r);
         exact_fresnel.push(exact);
         translucent.push(sss);
+        maps.push(mp);
     }
     let by_name = |ms: &[Material], n: &str| ms.iter().position(|m| m.name == n).map(|i| i as u32);
     let scale = cx.float(&t, "scale", "", 1.0)?;
@@ -487,6 +557,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     };
     let tris: Vec<Triangle> =
         tris.into_iter().map(|tr| Triangle { v: tr.v.map(|p| p * scale + translate), material: tr.material }).collect();
+    texture_maps(&cx, &text, dir, &maps, &tris, &mut extra)?;
     for (i, r) in cx.tables(&t, "reflect")?.into_iter().enumerate() {
         let p = format!("reflect[{i}].");
         let Some(name) = r.get("material").and_then(|v| v.as_str()) else {
@@ -626,8 +697,11 @@ struct ObjExtras {
     textures: Vec<Texture>,
     /// Per material index, its texture and specular part.
     surfaces: Vec<Surface>,
-    /// Per triangle, its vertices' texture coordinates (empty when the OBJ has none).
+    /// Per triangle, its vertices' texture coordinates (zero where the OBJ gives
+    /// none; emptied at the end when the scene has no texture).
     uvs: Vec<[[f32; 2]; 3]>,
+    /// Per triangle, whether the OBJ gives its texture coordinates.
+    has_uv: Vec<bool>,
     /// Per triangle, its vertices' normals (empty when the OBJ has none; all
     /// zero for a triangle of a group without them).
     normals: Vec<[[f32; 3]; 3]>,
@@ -641,24 +715,76 @@ impl ObjExtras {
         &mut self.surfaces[m]
     }
 
-    /// The texture read from `file` (relative to the OBJ's folder), read once.
-    fn texture(&mut self, cx: &Cx, dir: &Path, file: &str) -> Result<u32, SceneError> {
+    /// The texture read from `file` (relative to `dir`, the OBJ's or the
+    /// scene file's folder), read once; an error names `key`.
+    fn texture(&mut self, cx: &Cx, dir: &Path, file: &str, key: &str) -> Result<u32, SceneError> {
         if let Some(i) = self.textures.iter().position(|t| t.name == file) {
             return Ok(i as u32);
         }
         let path = dir.join(file);
         let img = image::open(&path)
-            .map_err(|e| SceneError {
-                file: cx.file.into(),
-                key: "obj".into(),
-                msg: format!("{}: {e}", path.display()),
-            })?
+            .map_err(|e| SceneError { file: cx.file.into(), key: key.into(), msg: format!("{}: {e}", path.display()) })?
             .to_rgb8();
         let (width, height) = img.dimensions();
         let texels = img.pixels().map(|p| p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | 255 << 24).collect();
         self.textures.push(Texture { name: file.to_string(), width, height, texels });
         Ok(self.textures.len() as u32 - 1)
     }
+}
+
+/// Reads the scene file's texture maps (`maps`, per material of the file)
+/// into `extra` and gives the triangles of a material with a `planar`
+/// mapping their texture coordinates; refuses a textured material whose
+/// triangles have no texture coordinates. Drops the texture coordinates when
+/// the scene has no texture (thesis 000's kernels then read none).
+fn texture_maps(
+    cx: &Cx,
+    text: &str,
+    dir: &Path,
+    maps: &[Maps],
+    tris: &[Triangle],
+    extra: &mut ObjExtras,
+) -> Result<(), SceneError> {
+    for (i, mp) in maps.iter().enumerate() {
+        if *mp == Maps::default() {
+            continue;
+        }
+        let at = |key: &str| format!("material[{i}].{key} (line {})", table_line(text, "[[material]]", i, key));
+        let mut load = |file: &Option<String>, key: &str| -> Result<Option<u32>, SceneError> {
+            file.as_deref().map(|f| extra.texture(cx, dir, f, &at(key))).transpose()
+        };
+        let (a, r, m) = (
+            load(&mp.albedo, "albedo_map")?,
+            load(&mp.roughness, "roughness_map")?,
+            load(&mp.metalness, "metalness_map")?,
+        );
+        let sf = extra.surface(i);
+        (sf.texture, sf.roughness_map, sf.metalness_map) = (a.or(sf.texture), r, m);
+        if extra.uvs.len() != tris.len() {
+            extra.uvs = vec![[[0.0; 2]; 3]; tris.len()];
+            extra.has_uv = vec![false; tris.len()];
+        }
+        let mine = tris.iter().enumerate().filter(|(_, t)| t.material == i as u32).map(|(k, _)| k);
+        if let Some([o, u, v]) = mp.planar {
+            let (o, u, v) = (Vec3::from(o), Vec3::from(u), Vec3::from(v));
+            for k in mine {
+                extra.uvs[k] = tris[k].v.map(|p| [(p - o).dot(u), (p - o).dot(v)]);
+            }
+        } else if let Some(k) = mine.into_iter().find(|&k| !extra.has_uv[k]) {
+            let line = table_line(text, "[[material]]", i, "name");
+            return cx.err(
+                &format!("material[{i}] (line {line})"),
+                format!(
+                    "has texture maps, but triangle {k} has no texture coordinates (no `vt` in the OBJ); give \
+                     planar = {{ origin = [x, y, z], u = [x, y, z], v = [x, y, z] }}"
+                ),
+            );
+        }
+    }
+    if extra.textures.is_empty() {
+        extra.uvs.clear();
+    }
+    Ok(())
 }
 
 /// Loads an OBJ (polygons split as fans) with its MTL materials where present:
@@ -740,16 +866,17 @@ fn load_obj(
         let i = materials.len() - 1;
         if kind == MaterialKind::Diffuse {
             let texture = match &m.diffuse_texture {
-                Some(f) => Some(extra.texture(cx, obj_dir, f)?),
+                Some(f) => Some(extra.texture(cx, obj_dir, f, "obj")?),
                 None => None,
             };
             let traced = m.illumination_model.is_some_and(|n| (3..=7).contains(&n));
-            *extra.surface(i) = Surface { texture, reflect: if traced { ks } else { [0.0; 3] } };
+            *extra.surface(i) = Surface { texture, reflect: if traced { ks } else { [0.0; 3] }, ..Default::default() };
         }
         Ok(i as u32)
     };
     let mut out = Vec::new();
     let mut uvs = Vec::new();
+    let mut has_uvs = Vec::new();
     let mut normals = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
@@ -786,6 +913,7 @@ fn load_obj(
             } else {
                 [[0.0; 3]; 3]
             });
+            has_uvs.push(has_uv);
             uvs.push(if has_uv {
                 let c = &mesh.texcoord_indices[3 * n..3 * n + 3];
                 [uv(c[0]), uv(c[1]), uv(c[2])]
@@ -794,10 +922,9 @@ fn load_obj(
             });
         }
     }
-    // texture coordinates matter only where a texture is
-    if !extra.textures.is_empty() {
-        extra.uvs = uvs;
-    }
+    // texture coordinates matter only where a texture is (`texture_maps` drops them otherwise)
+    extra.uvs = uvs;
+    extra.has_uv = has_uvs;
     // vertex normals only where the OBJ gives them on every face: for a face
     // without, tobj makes up the previous face's
     if normals.iter().any(|n| *n != [[0.0; 3]; 3]) && every_face_has_normals(path) {

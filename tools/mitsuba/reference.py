@@ -86,6 +86,25 @@ scatterings and exit, 4 interactions before the light: at `--bounces 3`
 (max_depth 4) and below, both count exactly the same paths (none, one
 scattering per stay; the unscattered legs' transmittance). `--all-orders`
 lifts the limit for the high-albedo comparison (not the same estimand).
+Texture maps (thesis 003 §5.4): a diffuse material with `albedo_map`,
+`roughness_map` and `metalness_map` is, in warplight's path tracer, the
+blend (1 - m) albedo / pi + m f_CT of a Lambertian lobe and a Cook-Torrance
+conductor with Beckmann alpha = roughness texel / 255 (at least 1e-4) and
+Schlick's F with R0 = lerp(white, albedo, m), m the metalness texel, picked
+per hit with probability m (texture_hit in kernels/lin2017/path.cu); 8-bit
+maps, linear (no sRGB decoding), nearest texel, repeated. It is exported as
+`twosided` over a `blendbsdf` whose `weight` is the metalness map, of a
+`diffuse` with the albedo map as reflectance and a `roughconductor`
+(`beckmann`, `material = "none"`, `alpha` a float map of the same alphas)
+with specular reflectance 1: every map a `bitmap` with `filter_type =
+"nearest"`, `raw = true`, wrapped by repetition. Mitsuba's conductor
+reflects its colour at every angle, Schlick's only when R0 = 1: the tool
+refuses a map set whose metal (metalness > 0) is not white in the albedo
+map, and a colour other than white. The texture coordinates are the scene
+file's `planar` mapping, written as the OBJ's `vt` (Mitsuba flips v on
+load, so its row floor((1 - v) H) is warplight's); before rendering, the
+tool checks Mitsuba's nearest lookup against warplight's texel rule at
+4,096 random coordinates per map (`check_bitmap()`).
 Variance: the reference is rendered in B independent batches (seeds
 0..B-1); the mean image is their mean and the variance image the batch
 variance divided by B (the variance of the mean).
@@ -113,6 +132,9 @@ Usage (the committed fixtures were made by):
   python3 tools/mitsuba/reference.py scenes/sss-milk.toml \
       --size 32 --batches 8 --spp 32 --bounces 999 --all-orders \
       --out tests/fixtures/mitsuba/sss-milk-all-orders-32
+  python3 tools/mitsuba/reference.py scenes/cornell-scratched-white.toml \
+      --size 32 --batches 16 --spp 256 --bounces 16 \
+      --out tests/fixtures/mitsuba/cornell-scratched-white-32
 writes OUT.exr (mean), OUT-var.exr (variance of the mean) and OUT.json.
 """
 
@@ -188,6 +210,8 @@ def load_scene(toml_path):
             kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.8] * 3), d.get("emission", [0.0] * 3)
             rough = float(d.get("roughness", 0.0))
             glass = (float(d.get("ior", 1.5)), d.get("fresnel", "schlick"), d if kind == "translucent" else None)
+            if any(k in d for k in ("albedo_map", "roughness_map", "metalness_map")):
+                kind, glass = "textured", textured(toml_path, name, d)
         else:
             d = mtl.get(name, {})
             kd, ks, ke = d.get("Kd", [0.75] * 3), d.get("Ks", [0.0] * 3), d.get("Ke", [0.0] * 3)
@@ -206,7 +230,7 @@ def load_scene(toml_path):
         if kind == "translucent" and float(own[name].get("translucency", 1.0)) != 1.0:
             sys.exit(f"{toml_path}: translucent {name} has translucency < 1: its diffuse branch of the Fresnel "
                      "switch is not exported (only translucency = 1, a dielectric around a medium)")
-        if kind not in ("diffuse", "emitter", "mirror", "glass", "translucent"):
+        if kind not in ("diffuse", "emitter", "mirror", "glass", "translucent", "textured"):
             sys.exit(f"{toml_path}: material {name} is {kind}: its Fresnel term (Schlick's) is not Mitsuba's; not exported")
         if kind == "mirror" and rough > 0 and any(c != 1.0 for c in color):
             sys.exit(f"{toml_path}: rough mirror {name} has colour {color}: Schlick's F equals Mitsuba's only for R0 = 1")
@@ -214,6 +238,61 @@ def load_scene(toml_path):
         keep = [t for t in tris if np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0]))) > 0]
         shapes.setdefault(name, (kind, color, em, [], rough, glass))[3].extend(keep)
     return sc, shapes
+
+
+def read_png(path):
+    """An 8-bit PNG as a H x W x C uint8 array (Mitsuba's reader, no conversion)."""
+    import mitsuba as mi
+    return np.array(mi.Bitmap(path), dtype=np.uint8).reshape(*mi.Bitmap(path).size()[::-1], -1)
+
+
+def textured(toml_path, name, d):
+    """A textured material's maps (absolute paths) and planar mapping;
+    exits where it is not comparable (see the docstring)."""
+    base = os.path.dirname(toml_path)
+    maps = {k: os.path.join(base, d[k]) for k in ("albedo_map", "roughness_map", "metalness_map") if k in d}
+    if len(maps) != 3:
+        sys.exit(f"{toml_path}: textured material {name}: only the full set (albedo, roughness, metalness maps) is exported")
+    if "planar" not in d:
+        sys.exit(f"{toml_path}: textured material {name}: only a planar mapping is exported (no OBJ vt)")
+    if any(c != 1.0 for c in d.get("color", [0.8] * 3)):
+        sys.exit(f"{toml_path}: textured material {name}: a colour other than white is not exported")
+    albedo, metal = read_png(maps["albedo_map"]), read_png(maps["metalness_map"])
+    if albedo.shape[:2] != metal.shape[:2] or np.any(albedo[metal[..., 0] > 0] != 255):
+        sys.exit(f"{toml_path}: textured material {name}: the metal (metalness > 0) is not white in the albedo map: "
+                 "Schlick's F equals Mitsuba's conductor only for R0 = 1")
+    pl = d["planar"]
+    return {"maps": maps, "planar": (pl["origin"], pl["u"], pl["v"])}
+
+
+def texel_rule(img, u, v):
+    """warplight's texel (host::scene::Texture::index): nearest, repeated, v = 0 the bottom row."""
+    h, w = img.shape[:2]
+    x = np.floor(np.float32(u) * np.float32(w)).astype(np.int64) % w
+    y = np.floor((np.float32(1) - np.float32(v)) * np.float32(h)).astype(np.int64) % h
+    return img[y, x]
+
+
+def check_bitmap(mi, path, data):
+    """The largest difference between Mitsuba's nearest `bitmap` (raw, as
+    exported) at (u, 1 - v) (its OBJ loader flips v) and warplight's texel
+    rule at (u, v), over 4,096 random coordinates in [-1, 2); exits when above 1e-6."""
+    tex = mi.load_dict({"type": "bitmap", "filename": path, "filter_type": "nearest", "raw": True})
+    rng = np.random.default_rng(2)
+    uv = rng.uniform(-1, 2, size=(4096, 2)).astype(np.float32)
+    ours = texel_rule(data, uv[:, 0], uv[:, 1])
+    worst = 0.0
+    for k in range(len(uv)):
+        si = mi.SurfaceInteraction3f()
+        si.uv = mi.Point2f(float(uv[k, 0]), float(np.float32(1) - uv[k, 1]))
+        theirs = np.array(tex.eval(si) if data.shape[2] == 3 else [tex.eval_1(si)], dtype=np.float64)
+        want = ours[k] / 255.0 if data.dtype == np.uint8 else ours[k]
+        worst = max(worst, float(np.max(np.abs(theirs - want))))
+    print(f"bitmap check {os.path.basename(path)}: {len(uv)} coordinates, largest difference {worst:.2e}",
+          file=sys.stderr)
+    if worst > 1e-6:
+        sys.exit(f"{path}: warplight's texel rule differs from Mitsuba's nearest bitmap ({worst:.3g})")
+    return worst
 
 
 def lookup(tex, d):
@@ -368,6 +447,7 @@ def main():
         },
     }
     triangles, light_area, sss = 0, 0.0, False
+    bitmap_checks = {}
     for k, (name, (kind, color, em, tris, rough, glass)) in enumerate(sorted(shapes.items())):
         if not tris:
             continue
@@ -376,8 +456,17 @@ def main():
             for t in tris:
                 for v in t:
                     o.write("v %r %r %r\n" % tuple(v))
-            for i in range(len(tris)):
-                o.write(f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}\n")
+            if kind == "textured":
+                org, pu, pv = (np.array(x, dtype=float) for x in glass["planar"])
+                for t in tris:
+                    for v in t:
+                        q = np.array(v, dtype=float) - org
+                        o.write("vt %r %r\n" % (float(q @ pu), float(q @ pv)))
+                for i in range(len(tris)):
+                    o.write(f"f {3 * i + 1}/{3 * i + 1} {3 * i + 2}/{3 * i + 2} {3 * i + 3}/{3 * i + 3}\n")
+            else:
+                for i in range(len(tris)):
+                    o.write(f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}\n")
         triangles += len(tris)
         shape = {"type": "obj", "filename": f, "face_normals": True}
         if kind == "emitter":
@@ -399,6 +488,32 @@ def main():
             shape["bsdf"] = {"type": "dielectric", "int_ior": glass[0], "ext_ior": 1.0}
             shape["interior"] = sss_medium(glass[2])
             sss = True
+        elif kind == "textured":
+            mp = glass["maps"]
+            level = read_png(mp["roughness_map"])[..., :1]
+            alpha = np.maximum(level.astype(np.float32) / np.float32(255), np.float32(1e-4))
+            alpha_exr = os.path.join(tmp, f"{k}-alpha.exr")
+            mi.Bitmap(alpha).write(alpha_exr)
+            for key, path, data in [("albedo_map", mp["albedo_map"], read_png(mp["albedo_map"])),
+                                    ("metalness_map", mp["metalness_map"], read_png(mp["metalness_map"])[..., :1]),
+                                    ("alpha", alpha_exr, alpha)]:
+                bitmap_checks[f"{name}.{key}"] = check_bitmap(mi, path, data)
+            bm = lambda path: {"type": "bitmap", "filename": path, "filter_type": "nearest", "raw": True}
+            shape["bsdf"] = {
+                "type": "twosided",
+                "bsdf": {
+                    "type": "blendbsdf",
+                    "weight": bm(mp["metalness_map"]),
+                    "bsdf_0": {"type": "diffuse", "reflectance": bm(mp["albedo_map"])},
+                    "bsdf_1": {
+                        "type": "roughconductor",
+                        "distribution": "beckmann",
+                        "alpha": bm(alpha_exr),
+                        "material": "none",
+                        "specular_reflectance": 1.0,
+                    },
+                },
+            }
         elif kind == "mirror" and rough > 0:
             shape["bsdf"] = {
                 "type": "twosided",
@@ -465,6 +580,7 @@ def main():
         "integrator": desc["integrator"]["type"],
         "all_orders": a.all_orders,
         "envmap_check_max_rel_diff": env_check,
+        "bitmap_check_max_diff": bitmap_checks or None,
         "seconds": round(time.time() - t0, 1),
         "command": "python3 tools/mitsuba/reference.py " + " ".join(sys.argv[1:]),
         "mean_rgb": [float(v) for v in mean.reshape(-1, 3).mean(axis=0)],

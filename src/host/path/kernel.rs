@@ -33,14 +33,19 @@ pub const VOLUME_KERNEL: &str = "volume_frame";
 /// The entry point with translucent materials (pt, nee, mis; §5.3).
 pub const SSS_KERNEL: &str = "sss_frame";
 
+/// The entry point with texture maps (pt, nee, mis; §5.4).
+pub const TEXTURE_KERNEL: &str = "texture_frame";
+
 /// The entry point that renders `integrator` on `scene`: [`VOLUME_KERNEL`]
 /// when it has a medium, [`SSS_KERNEL`] when it has a translucent material,
-/// else [`entry`].
+/// [`TEXTURE_KERNEL`] when it has texture maps, else [`entry`].
 pub fn entry_for(scene: &PathScene, integrator: super::Integrator) -> &'static str {
     if scene.medium.is_some() {
         VOLUME_KERNEL
     } else if scene.has_translucent() {
         SSS_KERNEL
+    } else if scene.textures.is_some() {
+        TEXTURE_KERNEL
     } else {
         entry(integrator)
     }
@@ -197,7 +202,17 @@ pub fn render(
     let last = dev.alloc_zeroed::<f32>(n);
     // volume_frame takes the medium between the scene and the buffers
     let medium = scene.medium.map(|m| upload(dev, &to_bytes(&m), "medium")).transpose()?;
-    let args: Vec<Arg> = bufs.scene_args().into_iter().chain(medium).chain([accum, last]).map(Arg::Ptr).collect();
+    // texture_frame takes the maps there
+    let mut maps = Vec::new();
+    if let Some(t) = &scene.textures {
+        let m: Vec<i32> = t.mats.iter().flatten().copied().collect();
+        maps.push(upload(dev, &to_bytes(&m), "tex_mats")?);
+        maps.push(upload(dev, &to_bytes(&flat(&t.uvs)), "uvs")?);
+        maps.push(upload(dev, &to_bytes(&t.info), "tex_info")?);
+        maps.push(upload(dev, &to_bytes(&t.texels), "texels")?);
+    }
+    let args: Vec<Arg> =
+        bufs.scene_args().into_iter().chain(medium).chain(maps).chain([accum, last]).map(Arg::Ptr).collect();
     let ctas = params.paths().div_ceil(THREADS as usize) as u32;
     let mut out = Progressive::new(params.width, params.height);
     let mut totals = Counters::default();

@@ -65,6 +65,17 @@ pub enum LayoutError {
         "scene `{0}` has both a translucent material and a participating medium; the path tracer takes one or the other (sss_frame or volume_frame)"
     )]
     SssMedium(String),
+    /// Texture maps and a participating medium in one scene (`texture_frame` marches none).
+    #[error("scene `{0}` has texture maps and a participating medium: the path tracer renders either, not both")]
+    TexturedMedium(String),
+    /// An integrator that does not read texture maps.
+    #[error("scene `{0}` has texture maps, which only pt, nee, mis and mis-power read (texture_frame); not {1}")]
+    TexturedIntegrator(String, &'static str),
+    /// Texture maps and translucent materials in one scene.
+    #[error(
+        "scene `{0}` has texture maps and a translucent material: the path tracer renders either (texture_frame or sss_frame), not both"
+    )]
+    TexturedTranslucent(String),
     /// The environment map could not be read or is not one.
     #[error("environment map {path}: {msg}")]
     Environment {
@@ -95,6 +106,61 @@ pub const KIND_ROUGH_GLASS: u32 = 5;
 /// homogeneous medium scattered once (`sss_frame`); its three float4 are
 /// `[colour, kind] [σ_a rgb, IOR] [σ_s, exact Fresnel, g, translucency]`.
 pub const KIND_TRANSLUCENT: u32 = 6;
+/// A diffuse material with texture maps (§5.4): `texture_frame` alone
+/// shades it, as the lobe its metalness picks at each hit (`texture_hit`).
+pub const KIND_TEXTURED: u32 = 7;
+/// The roughness levels of an 8-bit roughness map: one conductor row of
+/// [`PathScene::mats`] each.
+pub const ROUGHNESS_LEVELS: usize = 256;
+
+/// A textured scene's maps as `texture_frame` reads them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathTextures {
+    /// Per material: albedo, roughness and metalness map (-1: none), the
+    /// first conductor row in [`PathScene::mats`] (-1: no metal lobe).
+    pub mats: Vec<[i32; 4]>,
+    /// Per triangle, its vertices' texture coordinates (u0, v0, u1, v1, u2, v2).
+    pub uvs: Vec<[f32; 6]>,
+    /// Per map: first texel, width, height, 0 (thesis 000's texture table).
+    pub info: Vec<u32>,
+    /// Every map's texels (`host::scene::Texture::texels`), one after the other.
+    pub texels: Vec<u32>,
+}
+
+impl PathTextures {
+    /// The scene's maps, or `None` when no material has one. Appends to
+    /// `mats` the conductor rows of each textured material's metal lobe: one
+    /// per roughness level (α = level / 255, at least
+    /// [`crate::host::scene_file::MIN_ROUGHNESS`]) with a roughness map, else
+    /// one with the material's `roughness`.
+    fn new(scene: &Scene, mats: &mut Vec<[f32; 12]>) -> Option<PathTextures> {
+        if !(0..scene.materials.len() as u32).any(|m| scene.textured(m)) {
+            return None;
+        }
+        let id = |t: Option<u32>| t.map_or(-1, |t| t as i32);
+        let conductor =
+            |alpha: f32| [1.0, 1.0, 1.0, f32::from_bits(KIND_CONDUCTOR), 0.0, 0.0, 0.0, 1.0, alpha, 0.0, 0.0, 0.0];
+        let mut tmats = Vec::with_capacity(scene.materials.len());
+        for m in 0..scene.materials.len() as u32 {
+            let s = scene.surface(m);
+            let mut rows = -1;
+            if scene.textured(m) && s.metalness_map.is_some() {
+                rows = mats.len() as i32;
+                match s.roughness_map {
+                    Some(_) => mats.extend(
+                        (0..ROUGHNESS_LEVELS)
+                            .map(|l| conductor((l as f32 / 255.0).max(crate::host::scene_file::MIN_ROUGHNESS))),
+                    ),
+                    None => mats.push(conductor(scene.roughness(m))),
+                }
+            }
+            tmats.push([id(s.texture), id(s.roughness_map), id(s.metalness_map), rows]);
+        }
+        let uvs = scene.uvs.iter().map(|t| [t[0][0], t[0][1], t[1][0], t[1][1], t[2][0], t[2][1]]).collect();
+        let (info, texels) = crate::host::rt_kernels::texture_tables(scene);
+        Some(PathTextures { mats: tmats, uvs, info, texels })
+    }
+}
 
 /// Material kinds as the kernel numbers them; a mirror or glass with a
 /// positive Beckmann `roughness` is rough.
@@ -136,6 +202,8 @@ pub struct PathScene {
     pub light_area: f32,
     /// The environment map seen by rays that miss every triangle (§5.4), if any.
     pub env: Option<Environment>,
+    /// The texture maps (§5.4), when a material has one (`texture_frame`).
+    pub textures: Option<PathTextures>,
     /// The participating medium (§5.2), as `volume_frame` reads it: [lo, Δt],
     /// [hi, g], [σ_a, σ_s, 1/H (0: uniform density), 1 for an offset per
     /// step (0: one a ray)], [L_ve, 0]; `None`: no medium (`path_frame`).
@@ -216,7 +284,7 @@ impl PathScene {
                 [n[0], n[1], n[2], f32::from_bits(t.material)]
             })
             .collect();
-        let mats = scene
+        let mut mats: Vec<[f32; 12]> = scene
             .materials
             .iter()
             .enumerate()
@@ -225,7 +293,7 @@ impl PathScene {
                 let [r, g, b] = m.color;
                 let [er, eg, eb] = m.emission;
                 let alpha = scene.roughness(i as u32);
-                let kind = kind_code(m.kind, alpha);
+                let kind = if scene.textured(i as u32) { KIND_TEXTURED } else { kind_code(m.kind, alpha) };
                 let alpha = if matches!(kind, KIND_CONDUCTOR | KIND_ROUGH_GLASS) { alpha } else { 0.0 };
                 let glass = matches!(kind, KIND_GLASS | KIND_ROUGH_GLASS);
                 let exact = glass && scene.exact_fresnel.get(i).copied().unwrap_or(false);
@@ -243,6 +311,10 @@ impl PathScene {
                 [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, exact, 0.0, 0.0]
             })
             .collect();
+        let textures = PathTextures::new(scene, &mut mats);
+        if textures.is_some() && scene.medium.is_some() {
+            return Err(LayoutError::TexturedMedium(scene.name.clone()));
+        }
         let emitting: Vec<(usize, f64)> = scene
             .triangles
             .iter()
@@ -272,6 +344,9 @@ impl PathScene {
         if translucent && scene.medium.is_some() {
             return Err(LayoutError::SssMedium(scene.name.clone()));
         }
+        if translucent && textures.is_some() {
+            return Err(LayoutError::TexturedTranslucent(scene.name.clone()));
+        }
         let medium = match scene.medium {
             None => None,
             Some(m) => {
@@ -293,6 +368,7 @@ impl PathScene {
             }
         };
         Ok(PathScene {
+            textures,
             medium,
             nodes,
             up,
@@ -310,17 +386,17 @@ impl PathScene {
 }
 
 impl PathScene {
-    /// Whether `integrator` ignores the scene's medium or the medium inside
-    /// its translucent materials: bdpt and mlt, which march neither
-    /// (`volume_frame` and `sss_frame` are the path tracer's). The renderers
-    /// refuse them on such a scene.
+    /// Whether `integrator` ignores the scene's medium, the medium inside
+    /// its translucent materials or its texture maps: bdpt and mlt, which
+    /// read none of them (`volume_frame`, `sss_frame` and `texture_frame` are
+    /// the path tracer's). The renderers refuse them on such a scene.
     pub fn ignores_medium(&self, integrator: super::Integrator) -> bool {
-        (self.medium.is_some() || self.has_translucent())
+        (self.medium.is_some() || self.has_translucent() || self.textures.is_some())
             && matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt)
     }
 
-    /// Refuses an integrator that ignores the scene's medium or its
-    /// translucent materials (bdpt, mlt).
+    /// Refuses an integrator that ignores the scene's medium its
+    /// translucent materials or its texture maps (bdpt, mlt).
     pub fn check_integrator(&self, name: &str, integrator: super::Integrator) -> Result<(), LayoutError> {
         let unidirectional = !matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt);
         if self.medium.is_some() && !unidirectional {
@@ -328,6 +404,9 @@ impl PathScene {
         }
         if self.has_translucent() && !unidirectional {
             return Err(LayoutError::SssIntegrator(name.to_string(), integrator.name()));
+        }
+        if self.textures.is_some() && !unidirectional {
+            return Err(LayoutError::TexturedIntegrator(name.to_string(), integrator.name()));
         }
         Ok(())
     }

@@ -297,10 +297,11 @@ pub enum RenderError {
     /// bounces, or more chain state than [`mlt::MAX_STATE_BYTES`]).
     #[error(transparent)]
     Mlt(#[from] mlt::MltError),
-    /// An integrator that does not march the scene's participating medium or
-    /// its translucent materials' ([`layout::PathScene::ignores_medium`]).
+    /// An integrator that ignores the scene's participating medium, its
+    /// translucent materials or its texture maps
+    /// ([`layout::PathScene::ignores_medium`]).
     #[error(
-        "the scene has a participating medium or translucent materials, which only pt, nee, mis and mis-power render (volume_frame, sss_frame); not {0}"
+        "the scene has a participating medium, translucent materials or texture maps, which only pt, nee, mis and mis-power render (volume_frame, sss_frame, texture_frame); not {0}"
     )]
     Medium(&'static str),
 }

@@ -11,7 +11,8 @@ use rayon::prelude::*;
 
 use super::counts::Counts;
 use super::layout::{
-    KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TRANSLUCENT, LEAF_AXIS, PathScene,
+    KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TEXTURED, KIND_TRANSLUCENT, LEAF_AXIS,
+    PathScene,
 };
 use super::rng::{Sample, azimuth, path_key, tent};
 use super::{FrameParams, Integrator, Traversal};
@@ -563,6 +564,8 @@ impl Tracer<'_> {
             let color = xyz(mat, 0);
             let cos_o = -d.dot(ns);
             let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
+            // textures: the lobe of the hit
+            let (mat, kind, color) = self.texture_hit((tri, t), (o, d), key, dim, (td[3].to_bits(), kind, color));
             let sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
             if sampled_light && integrator != Integrator::Pt && !s.lights.is_empty() && bounce < p.max_bounces {
                 let (lg, q) = self.light_point(key, dim);
@@ -707,6 +710,55 @@ impl Tracer<'_> {
         *d = next;
         *bounce = b + 1;
         true
+    }
+
+    /// The kernel's `texture_hit`: at a hit on triangle `tri` at distance `t`
+    /// along (`o`, `d`), a textured material (`m`, `kind`, `color`) becomes the
+    /// lobe its metalness texel picks with dimension `dim + 6`: the Lambertian
+    /// lobe with the albedo, or the conductor row of its roughness texel with
+    /// the specular colour lerp(white, albedo, m). Any other material is
+    /// returned as it is, with its row of the materials.
+    fn texture_hit<S: Sample>(
+        &self,
+        (tri, t): (u32, f32),
+        (o, d): (V3, V3),
+        key: S,
+        dim: u32,
+        (m, kind, color): (u32, u32, V3),
+    ) -> (&[f32; 12], u32, V3) {
+        let s = self.scene;
+        let mat = &s.mats[m as usize];
+        let Some(x) = s.textures.as_ref().filter(|_| kind == KIND_TEXTURED) else { return (mat, kind, color) };
+        let [albedo, rough, metal, rows] = x.mats[m as usize];
+        // the barycentric weights of vertices 0 and 1, as the affine test computed them
+        let r = &s.tris[tri as usize];
+        let b0 = r[0] * o.x + r[1] * o.y + r[2] * o.z + r[3] + t * (r[0] * d.x + r[1] * d.y + r[2] * d.z);
+        let b1 = r[4] * o.x + r[5] * o.y + r[6] * o.z + r[7] + t * (r[4] * d.x + r[5] * d.y + r[6] * d.z);
+        let b2 = 1.0 - b0 - b1;
+        let uv = &x.uvs[tri as usize];
+        let tu = b0 * uv[0] + b1 * uv[2] + b2 * uv[4];
+        let tv = b0 * uv[1] + b1 * uv[3] + b2 * uv[5];
+        let texel = |map: i32| {
+            let i = &x.info[4 * map as usize..4 * map as usize + 3];
+            x.texels[i[0] as usize + crate::host::scene::Texture::index(i[1], i[2], tu, tv)]
+        };
+        let byte = |t: u32, shift: u32| ((t >> shift) & 255) as f32 / 255.0;
+        let mut color = color;
+        if albedo >= 0 {
+            let a = texel(albedo);
+            color = v3(color.x * byte(a, 0), color.y * byte(a, 8), color.z * byte(a, 16));
+        }
+        let mv = if metal >= 0 { byte(texel(metal), 0) } else { 0.0 };
+        if rows >= 0 && key.at(dim + 6) < mv {
+            let level = if rough >= 0 { (texel(rough) & 255) as i32 } else { 0 };
+            let w = 1.0 - mv; // lerp(white, albedo, m)
+            return (
+                &s.mats[(rows + level) as usize],
+                KIND_CONDUCTOR,
+                v3(w + mv * color.x, w + mv * color.y, w + mv * color.z),
+            );
+        }
+        (mat, KIND_DIFFUSE, color)
     }
 
     /// The kernel's `march`: the segment `o + t d`, t in [0, `t_end`], of a path
