@@ -48,3 +48,30 @@ extern "C" __global__ void compact_scatter(const float4 *in, const unsigned *fla
   dst[2] = src[2];
   dst[3] = src[3];
 }
+
+// The 3-way Fresnel regroup (003:L536, kernels/lin2017/path.cu's regroup_*):
+// states of REGROUP_STATE float4, the next hit's branch in the fifth's z.
+// regroup_flag flags the active states of one branch (REGROUP_ANY: every
+// active state, plain compaction); regroup_scatter appends them, in order,
+// at out's state `base` (the states the earlier compactions of the level
+// placed).
+#define REGROUP_STATE 5
+#define REGROUP_ANY 0xffffffffu
+
+extern "C" __global__ void regroup_flag(const float4 *states, unsigned n, unsigned branch, unsigned *flags) {
+  unsigned j = WL_TID;
+  if (j >= n) return;
+  const float4 *st = states + REGROUP_STATE * j;
+  bool active = (__float_as_uint(st[3].w) & PATH_ACTIVE) != 0u;
+  flags[j] = active && (branch == REGROUP_ANY || __float_as_uint(st[4].z) == branch) ? 1u : 0u;
+}
+
+extern "C" __global__ void regroup_scatter(const float4 *in, const unsigned *flags, const unsigned *offsets,
+                                           const unsigned *sums, unsigned n, unsigned base, float4 *out) {
+  unsigned j = WL_TID;
+  if (j >= n || flags[j] == 0u) return;
+  unsigned k = base + sums[blockIdx.x] + offsets[j];
+  const float4 *src = in + REGROUP_STATE * j;
+  float4 *dst = out + REGROUP_STATE * k;
+  for (int w = 0; w < REGROUP_STATE; w++) dst[w] = src[w];
+}

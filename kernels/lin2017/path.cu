@@ -1071,20 +1071,32 @@ static __device__ __forceinline__ void texture_hit(const Textures &x, const Scen
   }
 }
 
-// One level of the inner loop (003:L119) for one path: trace its ray, gather
-// emission and the light sample, pick the next direction, Russian roulette.
-// False when the path ends (missed, hit an emitter, the longest path, or
-// terminated); P then holds its final radiance.
-// M: NoMedium, or the Medium of volume_frame (march(), attenuate()).
-template <class K, class M = NoMedium, class T = NoTextures>
-static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, const M &med = M(),
-                                            const T &tex = T()) {
+// The next ray's hit: the triangle (< 0: none) and its distance in *t.
+static __device__ __forceinline__ int trace_next(const Scene &s, const Path &P, float *t) {
+  return trace(s, P.o, P.d, s.p->eps, __int_as_float(0x7f800000), false, t);
+}
+
+// One bounce of path P: its next ray traced (Traced false: step()) or, for the
+// regrouped wavefront (Traced true), already traced to hit_tri (< 0: none) at
+// distance hit_t by trace_next(); then emission, the light sample, the next
+// direction and Russian roulette; false when the path ends.
+// M: NoMedium, the Medium of volume_frame (march(), attenuate()) or the Sss of
+// sss_frame (translucent()); T: NoTextures, or the Textures of texture_frame.
+template <bool Traced, class K, class M = NoMedium, class T = NoTextures>
+static __device__ __forceinline__ bool step_at(const Scene &s, Path &P, K key, const M &med, const T &tex,
+                                               int hit_tri, float hit_t) {
   const Params *p = s.p;
   int integrator = p->integrator;
   int bounce = P.bounce;
   V3 o = P.o, d = P.d;
   float t;
-  int tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
+  int tri;
+  if (Traced) {
+    t = hit_t;
+    tri = hit_tri;
+  } else {
+    tri = trace(s, o, d, p->eps, __int_as_float(0x7f800000), false, &t);
+  }
   march(s, P, key, med, o, d, tri < 0 ? __int_as_float(0x7f800000) : t);
   if (tri < 0) {
     // the environment: not light-sampled, so its radiance counts in full after any bounce
@@ -1171,6 +1183,16 @@ static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, cons
   P.d = d;
   P.bounce = bounce + 1;
   return true;
+}
+
+// One level of the inner loop (003:L119) for one path: trace its ray, gather
+// emission and the light sample, pick the next direction, Russian roulette.
+// False when the path ends (missed, hit an emitter, the longest path, or
+// terminated); P then holds its final radiance.
+template <class K, class M = NoMedium, class T = NoTextures>
+static __device__ __forceinline__ bool step(const Scene &s, Path &P, K key, const M &med = M(),
+                                            const T &tex = T()) {
+  return step_at<false>(s, P, key, med, tex, 0, 0.0f);
 }
 
 // Adds path i's radiance to its slot of the accumulation buffer and stores it in `last`.
@@ -1450,6 +1472,96 @@ extern "C" __global__ void path_level(const Params *params, const uint4 *nodes, 
   P.count_emission = (flags & PATH_COUNT_EMISSION) != 0u;
   unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
   if (step(s, P, key)) {
+    store_path(st, i, P, PATH_ACTIVE);
+  } else {
+    finish(accum, last, i, P.L);
+    st[3].w = __uint_as_float(0u);
+  }
+}
+
+// ---- The 3-way Fresnel regroup (§6.3, 003:L536): regroup_init, regroup_trace, regroup_shade ----
+//
+// The wavefront form with trace and shade as separate launches, so that the
+// branch a path's next shading takes is known before it runs: a level is
+// regroup_trace (the next ray of every active state traced, its hit and that
+// hit's branch stored) and then regroup_shade (the stored hit shaded: step()'s
+// emission, light sample, next direction and roulette, step_at<true>). Between
+// the two the host compacts the states three times (kernels/lin2017/compact.cu:
+// regroup_flag, compact_scan, compact_scan_sums, regroup_scatter), once per
+// branch, appending each into the second buffer, and swaps the buffers: the
+// thesis' "3 stream compaction operations" into a double buffer (003:L536).
+// Without regrouping the host compacts once (every active state) or not at all.
+// The state is path_level's 4 float4 and a fifth [t, triangle, branch, 0]:
+// 80 bytes. The branches are the Fresnel switch's three (003:L259-265):
+// specular reflection (mirror, rough mirror), transmission (glass, rough glass:
+// their reflect-or-refract choice is a select, not a branch, in scatter()) and
+// diffuse reflection, with the paths that end at their next hit (an emitter or
+// a miss) in the diffuse group. Path i's random numbers depend on i and its
+// bounce only, so every order traces the megakernel's paths bit for bit.
+#define REGROUP_STATE 5              // float4 per state
+#define BRANCH_SPECULAR 0u
+#define BRANCH_DIFFUSE 1u
+#define BRANCH_TRANSMISSION 2u
+
+// The Fresnel branch the shading of hit tri takes (tri < 0: a miss).
+static __device__ __forceinline__ unsigned next_branch(const Scene &s, int tri) {
+  if (tri < 0) return BRANCH_DIFFUSE;
+  int kind = __float_as_int(s.mats[3 * __float_as_int(s.tri_data[tri].w)].w);
+  if (kind == KIND_MIRROR || kind == KIND_CONDUCTOR) return BRANCH_SPECULAR;
+  if (kind == KIND_GLASS || kind == KIND_ROUGH_GLASS) return BRANCH_TRANSMISSION;
+  return BRANCH_DIFFUSE;
+}
+
+extern "C" __global__ void regroup_init(const Params *params, float4 *states) {
+  const Params *p = params;
+  int i = (int)WL_TID;
+  if (i >= p->num_paths) return;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  store_path(states + REGROUP_STATE * i, i, camera_path(p, i, key), PATH_ACTIVE);
+}
+
+extern "C" __global__ void regroup_trace(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                         const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                         const float4 *lights, const float4 *boxes, const float4 *env,
+                                         float4 *states, unsigned n) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  unsigned j = WL_TID;
+  if (j >= n) return;
+  float4 *st = states + REGROUP_STATE * j;
+  if (!(__float_as_uint(st[3].w) & PATH_ACTIVE)) return;
+  float4 a = st[0], b = st[1];
+  Path P;
+  P.o = v3(a.x, a.y, a.z);
+  P.d = v3(b.x, b.y, b.z);
+  float t;
+  int tri = trace_next(s, P, &t);
+  st[4] = make_float4(t, __int_as_float(tri), __uint_as_float(next_branch(s, tri)), 0.0f);
+}
+
+extern "C" __global__ void regroup_shade(const Params *params, const uint4 *nodes, const unsigned *refs,
+                                         const float4 *tris, const float4 *tri_data, const float4 *mats,
+                                         const float4 *lights, const float4 *boxes, const float4 *env,
+                                         float4 *states, unsigned n, float *accum, float *last) {
+  Scene s = {params, nodes, refs, tris, tri_data, mats, lights, boxes, env};
+  const Params *p = params;
+  unsigned j = WL_TID;
+  if (j >= n) return;
+  float4 *st = states + REGROUP_STATE * j;
+  float4 e = st[3];
+  unsigned flags = __float_as_uint(e.w);
+  if (!(flags & PATH_ACTIVE)) return;
+  float4 a = st[0], b = st[1], c = st[2], h = st[4];
+  int i = __float_as_int(a.w);
+  Path P;
+  P.o = v3(a.x, a.y, a.z);
+  P.d = v3(b.x, b.y, b.z);
+  P.bounce = __float_as_int(b.w);
+  P.beta = v3(c.x, c.y, c.z);
+  P.bsdf_pdf = c.w;
+  P.L = v3(e.x, e.y, e.z);
+  P.count_emission = (flags & PATH_COUNT_EMISSION) != 0u;
+  unsigned key = path_key((unsigned)i, (unsigned)p->frame, (unsigned)p->seed);
+  if (step_at<true>(s, P, key, NoMedium(), NoTextures(), __float_as_int(h.y), h.x)) {
     store_path(st, i, P, PATH_ACTIVE);
   } else {
     finish(accum, last, i, P.L);

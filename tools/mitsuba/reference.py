@@ -405,6 +405,12 @@ def main():
     ap.add_argument("--spp", type=int, default=1024, help="samples per film pixel (subpixel) per batch")
     ap.add_argument("--bounces", type=int, default=16)
     ap.add_argument("--out")
+    ap.add_argument(
+        "--integrator",
+        choices=["path", "ptracer"],
+        default="path",
+        help="Mitsuba's path tracer, or its particle tracer (light paths connected to the camera)",
+    )
     ap.add_argument("--check-envmap", action="store_true", help="only check the environment lookup")
     ap.add_argument("--all-orders", action="store_true",
                     help="translucent materials: every order of scattering (not warplight's estimand; the "
@@ -429,7 +435,7 @@ def main():
     tmp = tempfile.mkdtemp(prefix="warplight-mitsuba-")
     desc = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": a.bounces + 1, "rr_depth": a.bounces + 2},
+        "integrator": {"type": a.integrator, "max_depth": a.bounces + 1, "rr_depth": a.bounces + 2},
         "sensor": {
             "type": "perspective",
             "fov": cam["fov"],

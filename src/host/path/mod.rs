@@ -18,6 +18,7 @@ pub mod kernel;
 pub mod layout;
 pub mod mlt;
 pub mod native;
+pub mod regroup;
 pub mod rng;
 pub mod stats;
 pub mod wavefront;

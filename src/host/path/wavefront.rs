@@ -144,6 +144,44 @@ impl Compactor {
         to: DevicePtr,
         n: u32,
     ) -> Result<(u32, Counters), SimError> {
+        let flag = ("compact_flag", vec![Arg::Ptr(from), Arg::U32(n), Arg::Ptr(self.flags)]);
+        self.pass(dev, module, n, flag, ("compact_scatter", vec![Arg::Ptr(from)]), &[Arg::U32(n), Arg::Ptr(to)])
+    }
+
+    /// The 3-way regroup's compaction of one branch (`compact.cu`'s
+    /// `regroup_flag` and `regroup_scatter`, 80-byte states of
+    /// [`super::regroup`]): the active ones of the first `n` states of `from`
+    /// whose next branch is `branch` ([`super::regroup::ANY`]: every active
+    /// one) appended, in order, to `to` from state `base` on; returns how
+    /// many, and the launches' counters.
+    #[allow(clippy::too_many_arguments)]
+    pub fn compact_branch(
+        &self,
+        dev: &mut Device,
+        module: &Module,
+        from: DevicePtr,
+        to: DevicePtr,
+        n: u32,
+        branch: u32,
+        base: u32,
+    ) -> Result<(u32, Counters), SimError> {
+        let flag = ("regroup_flag", vec![Arg::Ptr(from), Arg::U32(n), Arg::U32(branch), Arg::Ptr(self.flags)]);
+        let tail = [Arg::U32(n), Arg::U32(base), Arg::Ptr(to)];
+        self.pass(dev, module, n, flag, ("regroup_scatter", vec![Arg::Ptr(from)]), &tail)
+    }
+
+    /// Flag (the kernel and its arguments), scan, scan the CTA sums, scatter
+    /// (the kernel, its arguments before the flags, offsets and sums, and
+    /// those after them).
+    fn pass(
+        &self,
+        dev: &mut Device,
+        module: &Module,
+        n: u32,
+        flag: (&str, Vec<Arg>),
+        scatter: (&str, Vec<Arg>),
+        scatter_tail: &[Arg],
+    ) -> Result<(u32, Counters), SimError> {
         let mut c = Counters::default();
         if n == 0 {
             return Ok((0, c));
@@ -151,12 +189,14 @@ impl Compactor {
         let blocks = n.div_ceil(THREADS);
         let grid = LaunchConfig::linear(blocks, THREADS);
         let (f, o, s) = (Arg::Ptr(self.flags), Arg::Ptr(self.offsets), Arg::Ptr(self.sums));
-        c.merge(&dev.launch(module, "compact_flag", grid, &[Arg::Ptr(from), Arg::U32(n), f.clone()])?.totals);
+        c.merge(&dev.launch(module, flag.0, grid, &flag.1)?.totals);
         c.merge(&dev.launch(module, "compact_scan", grid, &[f.clone(), Arg::U32(n), o.clone(), s.clone()])?.totals);
         let one = LaunchConfig::linear(1, THREADS);
         c.merge(&dev.launch(module, "compact_scan_sums", one, &[s.clone(), Arg::U32(blocks)])?.totals);
-        let args = [Arg::Ptr(from), f, o, s, Arg::U32(n), Arg::Ptr(to)];
-        c.merge(&dev.launch(module, "compact_scatter", grid, &args)?.totals);
+        let mut args = scatter.1;
+        args.extend([f, o, s]);
+        args.extend_from_slice(scatter_tail);
+        c.merge(&dev.launch(module, scatter.0, grid, &args)?.totals);
         let total = dev.try_read::<u32>(self.sums, blocks as usize + 1)?[blocks as usize];
         Ok((total, c))
     }
