@@ -26,7 +26,7 @@ fn same_frames(scene: &Scene, ps: &PathScene, integrator: Integrator, max_bounce
     let cam = Camera { resolution: [w, h], ..scene.camera };
     let params =
         FrameParams { width: w, height: h, integrator, max_bounces, seed: 7, traversal: Traversal::ShortStack };
-    let native = render_native(ps, &cam, params, 2, true, |_| {});
+    let native = render_native(ps, &cam, params, 2, true, |_| {}).unwrap();
     let mut cfg = kernel::sim_config(&params);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);
@@ -208,7 +208,7 @@ fn single_scattering_underestimates_a_high_albedo() {
     eprintln!("sss-milk, single scattering against every order: {o:?}");
     assert!(!o.passed() && o.worst.3 < 0.0, "single scattering not below every order: {o:?}");
     assert!(o.mean_rel_diff < -0.05, "single scattering's image only {:.3} below", o.mean_rel_diff);
-    let r = render_native(&ps, &cam, params, 4, false, |_| {});
+    let r = render_native(&ps, &cam, params, 4, false, |_| {}).unwrap();
     assert!(r.accum.iter().all(|v| v.is_finite() && *v >= 0.0), "a NaN, infinite or negative value");
     let milk = translucent(&ps);
     for (what, at, value) in
@@ -218,7 +218,7 @@ fn single_scattering_underestimates_a_high_albedo() {
         for &i in &milk {
             extreme.mats[i][at] = value;
         }
-        let r = render_native(&extreme, &cam, params, 2, false, |_| {});
+        let r = render_native(&extreme, &cam, params, 2, false, |_| {}).unwrap();
         let bad = r.accum.iter().filter(|v| !v.is_finite() || **v < 0.0).count();
         assert_eq!(bad, 0, "{what}: {bad} values NaN, infinite or negative");
     }

@@ -47,7 +47,7 @@ fn textured_frames_equal_native_frames_bit_for_bit() {
             seed: 3,
             traversal: Traversal::ShortStack,
         };
-        let native = render_native(&ps, &cam, p, 2, true, |_| {});
+        let native = render_native(&ps, &cam, p, 2, true, |_| {}).unwrap();
         let mut cfg = kernel::sim_config(&p);
         cfg.fidelity = Fidelity::Functional;
         let mut dev = Device::with_config(cfg);
@@ -71,7 +71,10 @@ fn textured_frames_equal_native_frames_bit_for_bit() {
         seed: 3,
         traversal: Traversal::ShortStack,
     };
-    let (a, b) = (render_native(&ps, &cam, p, 2, false, |_| {}), render_native(&plain, &cam, p, 2, false, |_| {}));
+    let (a, b) = (
+        render_native(&ps, &cam, p, 2, false, |_| {}).unwrap(),
+        render_native(&plain, &cam, p, 2, false, |_| {}).unwrap(),
+    );
     assert_ne!(a.accum, b.accum);
 }
 

@@ -11,8 +11,8 @@ use rayon::prelude::*;
 
 use super::counts::Counts;
 use super::layout::{
-    KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TEXTURED, KIND_TRANSLUCENT, LEAF_AXIS,
-    PathScene,
+    KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TEXTURED, KIND_TRANSLUCENT,
+    LEAF_AXIS, PathScene,
 };
 use super::rng::{Sample, azimuth, path_key, tent};
 use super::{FrameParams, Integrator, Traversal};
