@@ -423,13 +423,13 @@ fn narrow_rows_take_vector_loads_atomics_shuffles_and_high_products() {
     }
     let o = &launched.0;
     let ballot = (0..32).filter(|&t| (xs[t] as i32) < 0).fold(0u32, |b, t| b | 1 << t);
-    for t in 0..32 {
+    for (t, &c0) in ctr0.iter().enumerate() {
         let [x, y, z, w] = lane(t);
         for (k, v) in [x, y, z, w].into_iter().enumerate() {
             assert_eq!(at(o, k, t), v, "ld.v4 component {k}, lane {t}");
         }
-        assert_eq!(at(o, 4, t), ctr0[t], "atom.add's old value, lane {t}");
-        assert_eq!(at(o, 5, t), ctr0[t].wrapping_add(x), "atom.cas's old value, lane {t}");
+        assert_eq!(at(o, 4, t), c0, "atom.add's old value, lane {t}");
+        assert_eq!(at(o, 5, t), c0.wrapping_add(x), "atom.cas's old value, lane {t}");
         assert_eq!(at(o, 6, t), ((x as i32 as i64 * y as i32 as i64) >> 32) as u32, "mul.hi.s32, lane {t}");
         assert_eq!(at(o, 7, t), ((x as u64 * y as u64) >> 32) as u32, "mul.hi.u32, lane {t}");
         assert_eq!(at(o, 8, t), ((x as i32 as i64 * 715_827_883) >> 32) as u32, "mul.hi.s32 by a constant, lane {t}");
@@ -437,7 +437,7 @@ fn narrow_rows_take_vector_loads_atomics_shuffles_and_high_products() {
         assert_eq!(at(o, 10, t), lane(3)[2], "shfl.idx, lane {t}");
         let down = if t + 2 < 32 { (lane(t + 2)[3], 1) } else { (w, 0) };
         assert_eq!((at(o, 11, t), at(o, 12, t)), down, "shfl.down and its predicate, lane {t}");
-        let cas = ctr0[t].wrapping_add(x);
+        let cas = c0.wrapping_add(x);
         let after_cas = if cas == y { z } else { cas };
         let exch = if (x as i32) < 0 { 7 } else { after_cas };
         assert_eq!(at(o, 13, t), exch, "atom.exch's old value under a partial mask, lane {t}");

@@ -363,7 +363,7 @@ fn translucent(cx: &Cx, t: &toml::Table, i: usize, text: &str, is: bool) -> Resu
         return cx.err(&at("translucency"), format!("{translucency}: expected a probability in [0, 1]"));
     }
     let ior = cx.float(t, "ior", &format!("material[{i}]."), 1.5)?;
-    if !(ior > 0.0) {
+    if ior.is_nan() || ior <= 0.0 {
         return cx.err(&at("ior"), format!("{ior}: expected an index of refraction > 0"));
     }
     Ok(Some(Translucent { sigma_s, sigma_a, g, translucency }))
