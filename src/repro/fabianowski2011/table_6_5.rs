@@ -552,7 +552,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         x.notes.push(registers.clone());
         x.notes.push(format!(
             "Modelled FPS: {}. A frame here is the traversal kernel (scenebvh.cu) for every ray of the frame, its \
-             spill traffic at the cap added as DRAM bytes, scaled to the thesis' {side} x {side} and predicted as one \
+             spill traffic at the cap added as DRAM bytes, scaled to the thesis' {side} x {side}{} and predicted as one \
              persistent launch at the thesis' registers (B {REGISTERS_B}, C {REGISTER_CAP}: one CTA of 256 threads \
              an SM either way) instead of chapter 4's 54. Not modelled: the shading and ray generation of the \
              thesis' whole rendering kernel. Our traversal's PTX executes three to four times the instructions per \
@@ -560,6 +560,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
              low; the relative FPS C compares two kernels of the same code. FPS B within {}, FPS C (C against B) \
              within {}.",
             timing::describe(),
+            if side == 512 { "" } else { " (the thesis' side of part (a), not the 512 x 512 above)" },
             timing::FPS_TOLERANCE.describe(),
             Tolerance::RATIO.describe()
         ));
