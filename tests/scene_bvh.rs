@@ -166,3 +166,74 @@ fn part_a_baseline_stacks_t_a_for_primary_rays_only_and_its_bytes_follow() {
     let b_walk = scene_bvh::trace_all(&b, Layout::Complete, &fr.rays).1;
     assert!(walk.nodes <= b_walk.nodes && walk.pops <= b_walk.pops, "{walk:?} vs {b_walk:?}");
 }
+
+/// Table 6.5's frame rates through the GTX 280 timing model on a quick run
+/// (Scene 6, one frame at 16 x 16): both parts get finite modelled FPS B and
+/// FPS C cells with verdicts; part (b)'s FPS B is the model's prediction on
+/// the recorded traversal counters by hand (scaled to 512 x 512, 61
+/// registers), and part (b)'s FPS C is negative (the thesis' sign: more
+/// instructions for fewer bytes); and a results file without the timing
+/// counters gives empty cells and says so.
+#[test]
+fn table_6_5s_frame_rates_are_modelled_on_the_recorded_counters() {
+    use warplight::repro::fabianowski2011::table_6_5::{self, FRAME, REGISTERS_B, SCENE_BVH, SCENE_BVH_A};
+    use warplight::repro::protocol::Protocol;
+    use warplight::repro::registry::{Workspace, resolve};
+    use warplight::repro::results::Results;
+    use warplight::timing::{GTX_280, KernelCounts, Launch, LaunchShape, predict};
+    let s = scene("scene6");
+    let side = 16;
+    let mut ws = Workspace::new(&s, 0..1, side);
+    let protocol = Protocol { name: "custom".into(), frames: 1, resolution: side };
+    let groups = vec![SCENE_BVH.into(), SCENE_BVH_A.into()];
+    let mut r = Results::new("test", protocol, vec!["fabianowski:6.5".into()], groups);
+    r.samples = table_6_5::measure(&mut ws, &mut |_| {}).unwrap();
+    r.samples.extend(table_6_5::measure_a(&mut ws, &mut |_| {}).unwrap());
+    let e = resolve(&["fabianowski:6.5".into()]).unwrap().remove(0);
+    let render = e.table.render.unwrap();
+    let tables = render(&e, &r);
+    assert_eq!(tables.len(), 2);
+    for t in &tables {
+        let col = |n: &str| t.columns.iter().position(|c| c.name == n).unwrap();
+        let row = t.rows.iter().find(|x| x.label == "scene6").unwrap();
+        for c in [col("FPS B"), col("FPS C")] {
+            assert!(row.cells[c].ours.is_some_and(f64::is_finite), "{}: {:?}", t.heading, row.cells[c]);
+            assert!(row.cells[c].verdict.is_some());
+        }
+        assert!(row.cells[col("FPS B")].ours.unwrap() > 0.0);
+        let per_cell = |n: &&String| n.starts_with("Per-cell error (ours - thesis): scene6:");
+        assert!(t.notes.iter().find(per_cell).is_some_and(|n| n.contains("FPS B ") && n.contains("FPS C ")));
+    }
+    // by hand: part (b)'s B, the recorded counters scaled to 512 x 512, one persistent launch at 61 registers
+    let b = table_6_5::frame_rates(&r, "scene6")[0];
+    let counts = KernelCounts::from_counters(|n| r.sum(SCENE_BVH, "scene6", "B", &format!("{FRAME}.{n}")))
+        .unwrap()
+        .scaled((512.0 / side as f64).powi(2));
+    let shape = LaunchShape { ctas: 30, threads_per_cta: 256, registers_per_thread: REGISTERS_B, shared_per_cta: 0 };
+    let p = predict(&GTX_280, &Launch { counts, shape }).unwrap();
+    assert!((p.fps() / b - 1.0).abs() < 1e-9, "{} against {b}", p.fps());
+    let tb = &tables[1];
+    let fb = tb.columns.iter().position(|c| c.name == "FPS B").unwrap();
+    assert_eq!(tb.rows.iter().find(|x| x.label == "scene6").unwrap().cells[fb].ours, Some(b));
+    // (b): C executes more instructions for fewer bytes, and the model makes it slower, as the thesis prints
+    let c = |n: &str| {
+        tb.rows.iter().find(|x| x.label == "scene6").unwrap().cells
+            [tb.columns.iter().position(|c| c.name == n).unwrap()]
+        .ours
+        .unwrap()
+    };
+    assert!(c("Instr. C") > 0.0 && c("Bytes C") < 0.0);
+    assert!(c("FPS C") < 0.0, "FPS C {:+.2}%", c("FPS C"));
+    // without the timing counters: no frame rates, and a note says why
+    for x in &mut r.samples {
+        x.counters.retain(|k, _| !k.starts_with(&format!("{FRAME}.")));
+    }
+    for t in render(&e, &r) {
+        let row = t.rows.iter().find(|x| x.label == "scene6").unwrap();
+        let n = t.columns.len();
+        assert!(row.cells[n - 2].ours.is_none() && row.cells[n - 1].ours.is_none());
+        assert!(row.cells[n - 2].verdict.is_none() && row.cells[n - 1].verdict.is_none());
+        assert!(t.notes.iter().any(|x| x.starts_with("Frame rates not measured for scene6")), "{:?}", t.notes);
+        assert!(!t.markdown().contains("NaN"));
+    }
+}

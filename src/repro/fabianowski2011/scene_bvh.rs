@@ -585,6 +585,8 @@ pub struct Traced {
     /// Entry distances t_a written and read on the stack (part (a)'s baseline
     /// alone: its closest-hit rays' pushes and pops), read off the `@count` lines.
     pub ta_words: u64,
+    /// Everything the memory model counted.
+    pub memory: crate::model::ModelStats,
     /// The launch.
     pub launch: LaunchStats,
 }
@@ -661,7 +663,7 @@ pub fn trace_kernel_with(
     };
     let hits = run.out.chunks_exact(4).map(|h| Best { t: h[0], u: h[1], v: h[2], tri: h[3].to_bits() }).collect();
     let ta_words = get("push_ta") + get("pop_ta");
-    Ok(Traced { hits, walk, traffic: run.traffic, ta_words, launch: run.launch })
+    Ok(Traced { hits, walk, traffic: run.traffic, ta_words, memory: run.memory, launch: run.launch })
 }
 
 /// The native traversals of `rays` (results per ray, the walks summed).

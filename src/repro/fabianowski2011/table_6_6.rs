@@ -37,7 +37,6 @@ use super::vkde::{self, Constructed, Settings, Shape};
 use crate::host::camera::Camera;
 use crate::host::kdtree::{Heuristic, KdTree};
 use crate::host::raycast::Caster;
-use crate::host::rt_kernels::{self, CTAS, THREADS, Variant};
 use crate::host::scene::Scene;
 use crate::model::{Model, ModelStats, Profile};
 use crate::ptx::Program;
@@ -98,10 +97,6 @@ fn stage_counts(prog: &Program, launches: &[LaunchStats], memory: &ModelStats) -
         merged.profile.merge(&l.profile);
     }
     super::timing::counts_of(prog, &merged, memory)
-}
-
-fn record(c: &mut Vec<(String, f64)>, stage: &str, k: &KernelCounts) {
-    c.extend(k.counters().into_iter().map(|(n, v)| (format!("{stage}.{n}"), v)));
 }
 
 /// One frame of the pipeline on the emulator: what it counted and each
@@ -202,13 +197,7 @@ pub fn frame(
     let (built, ll) = lbvh::build_kernel_per_launch(dev, &k.lbvh, kernels, n_auto, Profile::Gt200)?;
     let build = by_grid(&k.lbvh.prog, &ll);
     // rendering: the camera rays, then the gathers
-    let mut config = rt_kernels::sim_config(cam);
-    Profile::Gt200.configure(&mut config, None);
-    let mut rt_dev = Device::with_config(config);
-    let rm = rt_kernels::load(&mut rt_dev)?;
-    let light = glam::Vec3::from(offset);
-    let rk = rt_kernels::render(&mut rt_dev, &rm, scene, tree, cam, light, Variant::Stack, Profile::Gt200)?;
-    let rt = super::timing::counts_of(&rm.prog, &rk.launch, &rk.memory);
+    let rt = super::timing::camera_rays(scene, tree, cam, offset)?;
     let layouts = Layouts::new(&built.tree(), kernels);
     let q = photon_image::queries(&Caster::new(scene, tree), cam);
     let mut out = Frame {
@@ -262,11 +251,11 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
                 ("contributions".to_string(), fr.contributions[i] as f64),
                 ("light_x".to_string(), fr.light[0] as f64),
             ];
-            record(&mut c, "trace", &fr.trace);
+            super::timing::record(&mut c, "trace", &fr.trace);
             for (shape, counts) in &fr.lbvh {
-                record(&mut c, &grid_stage("lbvh", shape), counts);
+                super::timing::record(&mut c, &grid_stage("lbvh", shape), counts);
             }
-            record(&mut c, "render", &fr.render[i]);
+            super::timing::record(&mut c, "render", &fr.render[i]);
             out.push(Sample {
                 group: PIPELINE.into(),
                 scene: scene.name.clone(),
@@ -330,12 +319,7 @@ fn parse_grid_stage(stage: &str, name: &str) -> Option<LaunchShape> {
 /// 256 threads at chapter 4's 54 registers (L1896; the thesis gives no
 /// register count for these kernels).
 fn shape() -> LaunchShape {
-    LaunchShape {
-        ctas: CTAS,
-        threads_per_cta: THREADS,
-        registers_per_thread: super::timing::REGISTERS,
-        shared_per_cta: 0,
-    }
+    super::timing::persistent(super::timing::REGISTERS)
 }
 
 /// Predicted milliseconds of `stage` of `variant` on `scene`, a mean frame;

@@ -10,13 +10,16 @@
 //! names of [`KernelCounts::counters`] (`timing_*`) beside their own; a
 //! results file without them yields no frame rates (the table says so).
 
-use crate::host::rt_kernels::{CTAS, THREADS};
-use crate::model::ModelStats;
+use crate::host::camera::Camera;
+use crate::host::kdtree::KdTree;
+use crate::host::rt_kernels::{self, CTAS, THREADS, Variant};
+use crate::host::scene::Scene;
+use crate::model::{ModelStats, Profile};
 use crate::ptx::Program;
 use crate::repro::compare::Tolerance;
 use crate::repro::results::Results;
 use crate::repro::table::{RowKind, Table};
-use crate::sim::LaunchStats;
+use crate::sim::{Device, LaunchStats, SimError};
 use crate::timing::{GTX_280, KernelCounts, Launch, LaunchShape, Prediction, predict, waits};
 
 /// Registers per thread of the thesis' kernel: "a single CUDA kernel using 54
@@ -100,6 +103,104 @@ pub fn frame(r: &Results, group: &str, scene: &str, variant: &str) -> Option<Pre
 /// Predicted frames per second, or NaN when not measured.
 pub fn fps(r: &Results, group: &str, scene: &str, variant: &str) -> f64 {
     frame(r, group, scene, variant).map_or(f64::NAN, |p| p.fps())
+}
+
+/// The timing counters of the camera rays of a photon-mapped frame: chapter
+/// 4's stack kernel (`raytrace.cu`, primary, reflection and shadow rays) on
+/// the SIROH tree `tree` under the gt200 memory model, the light moved by
+/// `light_offset`. Tables 6.4 and 6.6 add the gather's counters to these: the
+/// thesis' frame is ray tracing and density estimation (§A.2).
+pub fn camera_rays(
+    scene: &Scene,
+    tree: &KdTree,
+    cam: &Camera,
+    light_offset: [f32; 3],
+) -> Result<KernelCounts, SimError> {
+    let mut config = rt_kernels::sim_config(cam);
+    Profile::Gt200.configure(&mut config, None);
+    let mut dev = Device::with_config(config);
+    let module = rt_kernels::load(&mut dev)?;
+    let light = glam::Vec3::from(light_offset);
+    let rk = rt_kernels::render(&mut dev, &module, scene, tree, cam, light, Variant::Stack, Profile::Gt200)?;
+    Ok(counts_of(&module.prog, &rk.launch, &rk.memory))
+}
+
+/// Appends `k`'s counters as `stage.` + [`KernelCounts::counters`]' names.
+pub fn record(c: &mut Vec<(String, f64)>, stage: &str, k: &KernelCounts) {
+    c.extend(k.counters().into_iter().map(|(n, v)| (format!("{stage}.{n}"), v)));
+}
+
+/// The mean frame of `variant` of `group` on `scene` recorded under `stage`
+/// ([`record`]): the counters summed over the variant's samples, divided by
+/// their number and scaled from the run's resolution to a `side` × `side`
+/// image; `None` when the results lack the counters (measured before they were
+/// recorded).
+pub fn stage_frame(
+    r: &Results,
+    group: &str,
+    scene: &str,
+    variant: &str,
+    stage: &str,
+    side: u32,
+) -> Option<KernelCounts> {
+    let frames = r.samples.iter().filter(|s| s.group == group && s.scene == scene && s.variant == variant).count();
+    let c = KernelCounts::from_counters(|n| r.sum(group, scene, variant, &format!("{stage}.{n}")))?;
+    let res = r.protocol.resolution.max(1) as f64;
+    Some(c.scaled((side as f64 / res).powi(2) / frames.max(1) as f64))
+}
+
+/// The persistent launch of `registers` registers a thread (30 CTAs of 256
+/// threads, no shared memory): how the photon-map and scene-BVH tables'
+/// frames are modelled.
+pub fn persistent(registers: u32) -> LaunchShape {
+    LaunchShape { ctas: CTAS, threads_per_cta: THREADS, registers_per_thread: registers, shared_per_cta: 0 }
+}
+
+/// Predicted milliseconds of a [`stage_frame`] run as `shape` on the GTX
+/// 280; `None` when not measured with the timing counters.
+#[allow(clippy::too_many_arguments)]
+pub fn stage_ms(
+    r: &Results,
+    group: &str,
+    scene: &str,
+    variant: &str,
+    stage: &str,
+    side: u32,
+    shape: LaunchShape,
+) -> Option<f64> {
+    let counts = stage_frame(r, group, scene, variant, stage, side)?;
+    predict(&GTX_280, &Launch { counts, shape }).ok().map(|p| p.seconds * 1e3)
+}
+
+/// Predicted frames per second of a [`stage_ms`], NaN when not measured
+/// with the timing counters (the table then prints no value).
+#[allow(clippy::too_many_arguments)]
+pub fn stage_fps(
+    r: &Results,
+    group: &str,
+    scene: &str,
+    variant: &str,
+    stage: &str,
+    side: u32,
+    shape: LaunchShape,
+) -> f64 {
+    stage_ms(r, group, scene, variant, stage, side, shape).map_or(f64::NAN, |ms| 1e3 / ms)
+}
+
+/// What the frame-rate columns of a table are called modelled by.
+pub const MODEL: &str = "GTX 280 timing model on the emulator's counters";
+
+/// A note for a table whose frame-rate columns lack their counters, or
+/// `None` when every row has them.
+pub fn unmeasured_note(rows: &[(String, f64)]) -> Option<String> {
+    let missing: Vec<&str> = rows.iter().filter(|(_, v)| !v.is_finite()).map(|(l, _)| l.as_str()).collect();
+    (!missing.is_empty()).then(|| {
+        format!(
+            "Frame rates not measured for {}: the results were recorded without the timing counters (timing_*); \
+             re-measure to model them.",
+            missing.join(", ")
+        )
+    })
 }
 
 /// One line naming the model.

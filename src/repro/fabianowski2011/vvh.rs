@@ -15,11 +15,47 @@ use super::photon_image;
 use super::pm_layout::{self, Layout, Layouts, PmTree};
 use super::sah;
 use super::table_6_4::{vkde_maps, vkde_maps_with};
+use super::timing;
 use super::vkde::{Kernel, Shape};
 use crate::host::kdtree::Heuristic;
 use crate::host::raycast::Caster;
 use crate::repro::registry::{MeasureError, Tick, Workspace};
-use crate::repro::results::Sample;
+use crate::repro::results::{Results, Sample};
+use crate::sim::Device;
+
+/// The stage name of a frame's timing counters in [`PM_BUILDERS`]' samples:
+/// `raytrace.cu`'s camera rays and `pmgather.cu`'s gather through the
+/// complete layout of the variant's photon map, on the emulator.
+pub const FRAME: &str = "render";
+
+/// The modelled frame rate of `variant` of row `row` (the camera rays and the
+/// gather at 512 x 512 on the GTX 280, one persistent launch at chapter 4's 54
+/// registers), NaN when measured without the timing counters.
+pub fn frame_rate(r: &Results, row: &str, variant: &str) -> f64 {
+    timing::stage_fps(
+        r,
+        PM_BUILDERS,
+        row,
+        variant,
+        FRAME,
+        timing::THESIS_RESOLUTION,
+        timing::persistent(timing::REGISTERS),
+    )
+}
+
+/// What the frame-rate columns of Tables 6.1 and 6.3 model, for their notes.
+pub fn fps_note() -> String {
+    format!(
+        "Modelled FPS: {}. A frame is the thesis' (§A.2): ray tracing and density estimation at 512 x 512, here \
+         raytrace.cu's stack kernel for the camera, reflection and shadow rays plus pmgather.cu through the complete \
+         layout of the variant's photon map on the emulator (the extract infers the thesis measured Tables 6.1-6.3 \
+         with the compact one), their counters of each frame summed and predicted as one persistent launch (30 CTAs \
+         x 256 threads, 54 registers). Absolute FPS within {}, relative columns within {}.",
+        timing::describe(),
+        timing::FPS_TOLERANCE.describe(),
+        crate::repro::compare::Tolerance::RATIO.describe()
+    )
+}
 
 /// Group: VVH and LBVH photon maps, gathered natively over the flight.
 pub const PM_BUILDERS: &str = "fabianowski/pm-builders";
@@ -96,7 +132,7 @@ pub const SCENARIOS: [Scenario; 2] = [
 /// The rows of Tables 6.1–6.3 that `r` has: its scenes of [`PM_BUILDERS`],
 /// each followed by its scenario's row where that was run (the thesis'
 /// order).
-pub fn rows(r: &crate::repro::results::Results) -> Vec<String> {
+pub fn rows(r: &Results) -> Vec<String> {
     let has = |row: &str| r.samples.iter().any(|s| s.group == PM_BUILDERS && s.scene == row);
     let mut v = Vec::new();
     for s in super::scenes_of(r, PM_BUILDERS) {
@@ -160,14 +196,22 @@ fn measure_maps(
         }
     }
     let caster = Caster::new(ws.scene, tree);
+    let mut dev = Device::new();
+    let module = pm_layout::load(&mut dev)?;
     let mut out = Vec::new();
     for f in ws.frames.clone() {
         let cam = super::flight::camera(ws.scene, f, ws.resolution);
         let q = photon_image::queries(&caster, &cam);
         let queries = q.iter().flatten().count() as f64;
+        // the frame's camera rays, the same for every photon map
+        let rays = timing::camera_rays(ws.scene, tree, &cam, [0.0; 3])?;
         for (name, layouts, stats, seconds) in &maps_built {
             tick(Tick { frame: Some(f), variant: name });
             let (_, walk) = pm_layout::gather_all(layouts, Layout::Complete, &q, Shape::Uniform);
+            // the frame's timing counters: the camera rays and the gather through this map on the emulator
+            let g = pm_layout::gather_kernel(&mut dev, &module, layouts, Layout::Complete, &q, Shape::Uniform)?;
+            let mut frame = rays;
+            frame.add(&timing::counts_of(&module.prog, &g.launch, &g.memory));
             let c = [
                 ("queries", queries),
                 ("n_t", walk.nodes as f64),
@@ -179,12 +223,14 @@ fn measure_maps(
                 ("n_auto", n_auto as f64),
                 ("build_seconds", *seconds),
             ];
+            let mut c: Vec<(String, f64)> = c.iter().map(|(n, v)| (n.to_string(), *v)).collect();
+            timing::record(&mut c, FRAME, &frame);
             out.push(Sample {
                 group: PM_BUILDERS.into(),
                 scene: row.to_string(),
                 frame: Some(f),
                 variant: name.clone(),
-                counters: c.iter().map(|(n, v)| (n.to_string(), *v)).collect(),
+                counters: c.into_iter().collect(),
             });
         }
     }
