@@ -329,13 +329,22 @@ fn shape() -> LaunchShape {
 /// as a whole (every stage before the LBVH was recorded by grid) is one
 /// persistent launch ([`predicted_ms`]).
 fn stage_ms(r: &Results, scene: &str, variant: &str, stage: &str) -> Option<f64> {
-    let samples = || r.samples.iter().filter(|s| s.group == PIPELINE && s.scene == scene && s.variant == variant);
-    let frames = samples().count();
+    let frames = r.samples.iter().filter(|s| s.group == PIPELINE && s.scene == scene && s.variant == variant).count();
     let mut k = 1.0 / frames.max(1) as f64;
     if stage == "render" {
         let res = r.protocol.resolution.max(1) as f64;
         k *= (super::timing::THESIS_RESOLUTION as f64 / res).powi(2);
     }
+    recorded_ms(r, PIPELINE, scene, variant, stage, k)
+}
+
+/// Predicted milliseconds of the counters `group`'s samples of `variant` on
+/// `scene` recorded under `stage`, summed and scaled by `k`: by grid where
+/// they were recorded by grid ([`grid_stage`]; each shape at its own grid,
+/// [`grid_ms`]), else as one persistent launch ([`predicted_ms`]); `None`
+/// when the results lack them.
+pub fn recorded_ms(r: &Results, group: &str, scene: &str, variant: &str, stage: &str, k: f64) -> Option<f64> {
+    let samples = || r.samples.iter().filter(|s| s.group == group && s.scene == scene && s.variant == variant);
     let mut shapes: Vec<LaunchShape> = Vec::new();
     for name in samples().flat_map(|s| s.counters.keys()) {
         let Some(shape) = name.split_once('.').and_then(|(g, _)| parse_grid_stage(stage, g)) else { continue };
@@ -344,14 +353,14 @@ fn stage_ms(r: &Results, scene: &str, variant: &str, stage: &str) -> Option<f64>
         }
     }
     if shapes.is_empty() {
-        let c = KernelCounts::from_counters(|n| r.sum(PIPELINE, scene, variant, &format!("{stage}.{n}")))?;
+        let c = KernelCounts::from_counters(|n| r.sum(group, scene, variant, &format!("{stage}.{n}")))?;
         return predicted_ms(&c.scaled(k));
     }
     let groups = shapes
         .into_iter()
         .map(|shape| {
             let g = grid_stage(stage, &shape);
-            let c = KernelCounts::from_counters(|n| r.sum(PIPELINE, scene, variant, &format!("{g}.{n}")))?;
+            let c = KernelCounts::from_counters(|n| r.sum(group, scene, variant, &format!("{g}.{n}")))?;
             Some((shape, c.scaled(k)))
         })
         .collect::<Option<Vec<_>>>()?;

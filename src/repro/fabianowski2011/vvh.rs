@@ -175,6 +175,10 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     Ok(out)
 }
 
+/// The stage name of the LBVH build's timing counters (`lbvh@...`, [`super::table_6_6::grid_stage`]),
+/// recorded once per row with the first frame of `lbvh-auto`.
+pub const LBVH_BUILD: &str = "lbvh";
+
 /// Both builders at n_auto and every threshold over `maps`, gathered at the
 /// query points of each frame, recorded as row `row`.
 fn measure_maps(
@@ -198,6 +202,14 @@ fn measure_maps(
     let caster = Caster::new(ws.scene, tree);
     let mut dev = Device::new();
     let module = pm_layout::load(&mut dev)?;
+    // Table 6.2's LBVH ms: the LBVH with n_auto built once by lbvh.cu on the
+    // emulator, each launch under its own gt200 model, recorded by grid with
+    // the first frame's sample
+    let lbvh_module = lbvh::load(&mut dev)?;
+    let (_, launches) =
+        lbvh::build_kernel_per_launch(&mut dev, &lbvh_module, kernels, n_auto, crate::model::Profile::Gt200)?;
+    let lbvh_build = super::table_6_6::by_grid(&lbvh_module.prog, &launches);
+    let lbvh_auto = variant(Builder::Lbvh, None);
     let mut out = Vec::new();
     for f in ws.frames.clone() {
         let cam = super::flight::camera(ws.scene, f, ws.resolution);
@@ -225,6 +237,11 @@ fn measure_maps(
             ];
             let mut c: Vec<(String, f64)> = c.iter().map(|(n, v)| (n.to_string(), *v)).collect();
             timing::record(&mut c, FRAME, &frame);
+            if *name == lbvh_auto && f == ws.frames.start {
+                for (shape, counts) in &lbvh_build {
+                    timing::record(&mut c, &super::table_6_6::grid_stage(LBVH_BUILD, shape), counts);
+                }
+            }
             out.push(Sample {
                 group: PM_BUILDERS.into(),
                 scene: row.to_string(),
