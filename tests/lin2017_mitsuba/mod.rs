@@ -95,3 +95,38 @@ pub fn emulated_frames_outcome(
     let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
     welch_holm_floored(&ours, reference, ALPHA, floor).expect("same block grid")
 }
+
+/// `e` without the cells of `blocks` ((x, y) of the block grid), as one row
+/// of the remaining blocks: the test of [`welch_holm`] over the others (both
+/// estimates cut alike).
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
+pub fn without_blocks(e: &Estimate, blocks: &[(u32, u32)]) -> Estimate {
+    let keep = |i: usize| {
+        let b = (i / 3) as u32;
+        !blocks.contains(&(b % e.blocks_x, b / e.blocks_x))
+    };
+    let mean: Vec<f64> = e.mean.iter().enumerate().filter(|(i, _)| keep(*i)).map(|(_, v)| *v).collect();
+    let var: Vec<f64> = e.var.iter().enumerate().filter(|(i, _)| keep(*i)).map(|(_, v)| *v).collect();
+    Estimate { blocks_x: (mean.len() / 3) as u32, blocks_y: 1, mean, var, dof: e.dof }
+}
+
+/// A native render of `frames` frames against `reference`, both without
+/// the cells of `blocks` ([`without_blocks`]).
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
+pub fn native_outcome_without(
+    ps: &PathScene,
+    cam: &Camera,
+    p: FrameParams,
+    frames: u32,
+    reference: &Estimate,
+    blocks: &[(u32, u32)],
+) -> (Outcome, Outcome) {
+    let r = render_native(ps, cam, p, frames, true, |_| {}).expect("render");
+    let ours = from_frames(&r.frame_images, BLOCK).expect("two frames or more");
+    let all = welch_holm(&ours, reference, ALPHA).expect("same block grid");
+    let rest =
+        welch_holm(&without_blocks(&ours, blocks), &without_blocks(reference, blocks), ALPHA).expect("same block grid");
+    (all, rest)
+}
