@@ -7,6 +7,8 @@
 //! where a stay inside can hold at most one scattering: the same light
 //! transport, `tools/mitsuba/reference.py`), the translucent balls pass the
 //! Welch-Holm test natively and emulated; a wrong sigma_s or g fails it.
+//! Fig. 12's jade bunny (exact Fresnel, translucency 1) passes natively away
+//! from the blocks near the 5 holes in the mesh's base, which differ.
 //! The thesis' failure case (003:L396-398): at a milk-like albedo, single
 //! scattering falls far below every order of scattering, and stays finite.
 
