@@ -11,19 +11,28 @@
 //! The same for the Cornell box with a rough-mirror back wall (Figs. 6 and
 //! 7's scene; Cook-Torrance with Beckmann α 0.2 against Mitsuba's
 //! `roughconductor`, `cornell-rough-32`), where a mirror of α 0.3 fails.
+//!
+//! Fig. 8's scene (the light turned to the ceiling): pt passes against
+//! Mitsuba's path tracer (`cornell-inverted-path-32`), bdpt's image mean
+//! agrees (its blocks are heavy-tailed there), and Mitsuba's particle tracer
+//! (`cornell-inverted-32`) is darker than its path tracer.
 
 mod lin2017_mitsuba;
 
-use lin2017_mitsuba::{emulated_outcome, native_outcome, params, reference_of, scene_of};
+use lin2017_mitsuba::{ALPHA, BLOCK, emulated_outcome, native_outcome, params, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::stats::Estimate;
+use warplight::host::path::stats::{Estimate, from_frames, welch_holm};
 use warplight::host::path::{Integrator, kernel, render_native};
 use warplight::host::scene::{MaterialKind, Scene};
 use warplight::sim::{Device, Fidelity};
 
 const FIXTURE: &str = "tests/fixtures/mitsuba/cornell-lambert-32";
 const ROUGH_FIXTURE: &str = "tests/fixtures/mitsuba/cornell-rough-32";
+/// Fig. 8's scene by Mitsuba's particle tracer (`ptracer`).
+const INVERTED_PTRACER: &str = "tests/fixtures/mitsuba/cornell-inverted-32";
+/// Fig. 8's scene by Mitsuba's path tracer (`path`: next-event estimation and BSDF sampling under MIS).
+const INVERTED_PATH: &str = "tests/fixtures/mitsuba/cornell-inverted-path-32";
 
 fn reference() -> (Estimate, u32) {
     let (e, size, _) = reference_of(FIXTURE);
@@ -164,4 +173,77 @@ fn bdpt_with_a_dim_light_fails() {
     let o = native_outcome(&ps, &cam, params(size, Integrator::Bdpt, 303), 96, &reference);
     eprintln!("bdpt dim light: {o:?}");
     assert!(!o.passed(), "bdpt with a light 10 % too dim passed: {o:?}");
+}
+
+/// Fig. 8's scene (003:L305, the light turned to the ceiling,
+/// `cornell-inverted`) against Mitsuba's path tracer: pt, the control,
+/// passes the block test at 6,144 frames.
+#[test]
+fn fig_8_pt_agrees_with_mitsuba_under_the_inverted_light() {
+    let (reference, size, meta) = reference_of(INVERTED_PATH);
+    assert_eq!(meta["integrator"].as_str(), Some("path"));
+    let (_, ps, cam) = scene_of("cornell-inverted", size);
+    let o = native_outcome(&ps, &cam, params(size, Integrator::Pt, 510), 6144, &reference);
+    eprintln!("fig 8, pt: {o:?}");
+    assert!(o.passed(), "pt disagrees with Mitsuba under the inverted light: {o:?}");
+    assert!(o.mean_rel_diff.abs() < 0.02, "pt: mean off by {:.3}", o.mean_rel_diff);
+}
+
+/// bdpt under the inverted light: its image mean agrees with Mitsuba's path
+/// tracer within 3 of its frames' standard errors at 6,144 frames. The
+/// block test is reported, not asserted: bdpt's uniform weights (003:L303)
+/// keep 1 / c of next-event estimation's 1 / d^2 spikes at eye vertices in
+/// the 1 cm crevice, single frames hold up to a third of a block's sum, and
+/// blocks that have not drawn their share come out below with too small a
+/// variance (6 to 14 of 192 cells rejected at 6,144 and 24,576 frames, all
+/// ours below; docs/reproduction-lin2017.md, "Bidirectional path tracing").
+#[test]
+fn fig_8_bdpt_under_the_inverted_light_agrees_in_the_mean() {
+    let (reference, size, _) = reference_of(INVERTED_PATH);
+    let (_, ps, cam) = scene_of("cornell-inverted", size);
+    let r = render_native(&ps, &cam, params(size, Integrator::Bdpt, 511), 6144, true, |_| {}).expect("render");
+    let sums: Vec<f64> = r
+        .frame_images
+        .iter()
+        .map(|im| {
+            let mut t = 0.0f64;
+            for y in 0..size {
+                for x in 0..size {
+                    t += im.get(x, y).iter().map(|&v| v as f64).sum::<f64>();
+                }
+            }
+            t
+        })
+        .collect();
+    let n = sums.len() as f64;
+    let mean = sums.iter().sum::<f64>() / n;
+    let se = (sums.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let target = reference.mean.iter().sum::<f64>() * f64::from(BLOCK * BLOCK);
+    let ours = from_frames(&r.frame_images, BLOCK).expect("frames");
+    let o = welch_holm(&ours, &reference, ALPHA).expect("same block grid");
+    eprintln!(
+        "fig 8, bdpt: image mean {:+.2} % +- {:.2} % of Mitsuba's; block test (not asserted) {o:?}",
+        100.0 * (mean / target - 1.0),
+        100.0 * se / target
+    );
+    assert!((mean - target).abs() < 3.0 * se, "bdpt's image mean {mean} against {target} +- {se}");
+    assert!(se / target < 0.05, "bdpt's image mean too uncertain to say anything: {se} of {target}");
+}
+
+/// The committed particle-tracer reference of Fig. 8's scene is darker than
+/// Mitsuba's path tracer's by about 2.5 % over the whole image, many
+/// standard errors; in the Lambertian box the two agree inside the image
+/// (docs). The bdpt test therefore uses the path tracer's reference.
+#[test]
+fn the_particle_tracer_reference_of_fig_8_is_darker_than_the_path_tracers() {
+    let sum = |fixture: &str| {
+        let (e, _, _) = reference_of(fixture);
+        let m: f64 = e.mean.iter().sum();
+        let v: f64 = e.var.iter().sum();
+        (m, v)
+    };
+    let ((mp, vp), (mt, vt)) = (sum(INVERTED_PATH), sum(INVERTED_PTRACER));
+    let z = (mp - mt) / (vp + vt).sqrt();
+    eprintln!("fig 8: path / ptracer = {:.4}, z = {z:.1}", mp / mt);
+    assert!(z > 5.0 && (mp / mt - 1.0) > 0.01, "path / ptracer = {:.4}, z = {z:.1}", mp / mt);
 }

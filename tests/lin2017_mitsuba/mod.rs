@@ -23,6 +23,11 @@ pub const ALPHA: f64 = 0.01;
 
 /// A reference's estimate, its image size and its metadata.
 pub fn reference_of(fixture: &str) -> (Estimate, u32, serde_json::Value) {
+    reference_in_blocks(fixture, BLOCK)
+}
+
+/// [`reference_of`] in blocks of `block` x `block` pixels.
+pub fn reference_in_blocks(fixture: &str, block: u32) -> (Estimate, u32, serde_json::Value) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mean = read_exr(&root.join(format!("{fixture}.exr"))).expect("reference mean");
     let var = read_exr(&root.join(format!("{fixture}-var.exr"))).expect("reference variance");
@@ -31,7 +36,7 @@ pub fn reference_of(fixture: &str) -> (Estimate, u32, serde_json::Value) {
             .expect("json");
     let batches = meta["batches"].as_u64().expect("batches") as u32;
     assert_eq!(meta["size"].as_u64(), Some(mean.width as u64));
-    (from_reference(&mean, &var, BLOCK, batches), mean.width, meta)
+    (from_reference(&mean, &var, block, batches), mean.width, meta)
 }
 
 /// Scene `name` of `scenes/`, laid out, and its camera at `size` x `size` pixels.
@@ -55,8 +60,23 @@ pub fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
 // each test crate that includes this module uses a part of it
 #[allow(dead_code)]
 pub fn native_outcome(ps: &PathScene, cam: &Camera, p: FrameParams, frames: u32, reference: &Estimate) -> Outcome {
+    native_outcome_in_blocks(ps, cam, p, frames, reference, BLOCK)
+}
+
+/// [`native_outcome`] in blocks of `block` x `block` pixels (`reference`
+/// made with the same, [`reference_in_blocks`]).
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
+pub fn native_outcome_in_blocks(
+    ps: &PathScene,
+    cam: &Camera,
+    p: FrameParams,
+    frames: u32,
+    reference: &Estimate,
+    block: u32,
+) -> Outcome {
     let r = render_native(ps, cam, p, frames, true, |_| {}).expect("render");
-    let ours = from_frames(&r.frame_images, BLOCK).expect("two frames or more");
+    let ours = from_frames(&r.frame_images, block).expect("two frames or more");
     welch_holm(&ours, reference, ALPHA).expect("same block grid")
 }
 
@@ -94,4 +114,39 @@ pub fn emulated_frames_outcome(
     let r = kernel::render(&mut dev, &module, ps, cam, p, frames, true, |_| {}).expect("launch");
     let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
     welch_holm_floored(&ours, reference, ALPHA, floor).expect("same block grid")
+}
+
+/// `e` without the cells of `blocks` ((x, y) of the block grid), as one row
+/// of the remaining blocks: the test of [`welch_holm`] over the others (both
+/// estimates cut alike).
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
+pub fn without_blocks(e: &Estimate, blocks: &[(u32, u32)]) -> Estimate {
+    let keep = |i: usize| {
+        let b = (i / 3) as u32;
+        !blocks.contains(&(b % e.blocks_x, b / e.blocks_x))
+    };
+    let mean: Vec<f64> = e.mean.iter().enumerate().filter(|(i, _)| keep(*i)).map(|(_, v)| *v).collect();
+    let var: Vec<f64> = e.var.iter().enumerate().filter(|(i, _)| keep(*i)).map(|(_, v)| *v).collect();
+    Estimate { blocks_x: (mean.len() / 3) as u32, blocks_y: 1, mean, var, dof: e.dof }
+}
+
+/// A native render of `frames` frames against `reference`, both without
+/// the cells of `blocks` ([`without_blocks`]).
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
+pub fn native_outcome_without(
+    ps: &PathScene,
+    cam: &Camera,
+    p: FrameParams,
+    frames: u32,
+    reference: &Estimate,
+    blocks: &[(u32, u32)],
+) -> (Outcome, Outcome) {
+    let r = render_native(ps, cam, p, frames, true, |_| {}).expect("render");
+    let ours = from_frames(&r.frame_images, BLOCK).expect("two frames or more");
+    let all = welch_holm(&ours, reference, ALPHA).expect("same block grid");
+    let rest =
+        welch_holm(&without_blocks(&ours, blocks), &without_blocks(reference, blocks), ALPHA).expect("same block grid");
+    (all, rest)
 }

@@ -132,6 +132,9 @@ Usage (the committed fixtures were made by):
   python3 tools/mitsuba/reference.py scenes/sss-milk.toml \
       --size 32 --batches 8 --spp 32 --bounces 999 --all-orders \
       --out tests/fixtures/mitsuba/sss-milk-all-orders-32
+  python3 tools/mitsuba/reference.py scenes/bunny-jade-exact.toml \
+      --size 32 --batches 16 --spp 4096 --bounces 3 \
+      --out tests/fixtures/mitsuba/bunny-jade-exact-32
   python3 tools/mitsuba/reference.py scenes/cornell-scratched-white.toml \
       --size 32 --batches 16 --spp 256 --bounces 16 \
       --out tests/fixtures/mitsuba/cornell-scratched-white-32
@@ -203,7 +206,8 @@ def load_scene(toml_path):
     over = {o["group"]: o["material"] for o in sc.get("override", [])}
     shapes = {}   # material name -> (kind, colour, emission, triangles, roughness, glass: (ior, fresnel))
     for g, m, tris in groups:
-        name = over.get(g) or (over.get(m) if m else None) or m or "default"
+        # as warplight's loader: a group without an MTL material takes the scene's default_material
+        name = over.get(g) or (over.get(m) if m else None) or m or sc.get("default_material", "default")
         rough, glass = 0.0, None
         if name in own:
             d = own[name]
