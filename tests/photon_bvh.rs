@@ -413,7 +413,7 @@ fn table_6_4s_frame_rates_are_modelled_on_the_recorded_counters() {
 /// and a results file without the timing counters gives empty cells and
 /// says so.
 #[test]
-fn tables_6_1_and_6_3s_frame_rates_are_modelled_on_the_recorded_counters() {
+fn tables_6_1_to_6_3s_frame_rates_and_lbvh_times_are_modelled_on_the_recorded_counters() {
     use warplight::repro::fabianowski2011::vvh::{self, Builder, FRAME, PM_BUILDERS, THRESHOLDS};
     use warplight::repro::protocol::Protocol;
     use warplight::repro::registry::{Workspace, resolve};
@@ -477,10 +477,51 @@ fn tables_6_1_and_6_3s_frame_rates_are_modelled_on_the_recorded_counters() {
             assert_eq!(fa, vvh_fps);
         }
     }
+    // 6.2: LBVH ms, lbvh.cu's launches recorded by grid once per row, each shape predicted at its grid
+    let e62 = resolve(&["fabianowski:6.2".into()]).unwrap();
+    let t62 = &(e62[0].table.render.unwrap())(&e62[0], &r)[0];
+    let cell = &row_of(t62).cells[col(t62, "LBVH ms")];
+    let ms = cell.ours.expect("LBVH ms modelled");
+    assert!(cell.verdict.is_some() && ms > 0.0 && ms.is_finite(), "{cell:?}");
+    let lbvh_auto = vvh::variant(Builder::Lbvh, None);
+    let mut shapes: Vec<String> = r
+        .samples
+        .iter()
+        .filter(|x| x.variant == lbvh_auto)
+        .flat_map(|x| x.counters.keys())
+        .filter(|k| k.starts_with("lbvh@"))
+        .map(|k| k.split_once('.').unwrap().0.to_string())
+        .collect();
+    shapes.sort();
+    shapes.dedup();
+    assert!(shapes.len() >= 2, "the build's launches come in several grids: {shapes:?}");
+    let by_hand: f64 = shapes
+        .iter()
+        .map(|g| {
+            let (ctas, rest) = g["lbvh@".len()..].split_once('x').unwrap();
+            let (threads, shared) = rest.split_once('+').unwrap();
+            let shape = LaunchShape {
+                ctas: ctas.parse().unwrap(),
+                threads_per_cta: threads.parse().unwrap(),
+                registers_per_thread: 54,
+                shared_per_cta: shared.parse().unwrap(),
+            };
+            let counts =
+                KernelCounts::from_counters(|n| r.sum(PM_BUILDERS, "passage", &lbvh_auto, &format!("{g}.{n}")))
+                    .unwrap();
+            predict(&GTX_280, &Launch { counts, shape }).unwrap().seconds * 1e3
+        })
+        .sum();
+    assert!((by_hand / ms - 1.0).abs() < 1e-9, "{by_hand} against {ms}");
+    let build_samples = r.samples.iter().filter(|x| x.counters.keys().any(|k| k.starts_with("lbvh@"))).count();
+    assert_eq!(build_samples, 1, "the build is recorded once per row");
     // without the timing counters: no frame rates, and each table says so
     for s in &mut r.samples {
-        s.counters.retain(|k, _| !k.starts_with(&format!("{FRAME}.")));
+        s.counters.retain(|k, _| !k.starts_with(&format!("{FRAME}.")) && !k.starts_with("lbvh@"));
     }
+    let t62 = &(e62[0].table.render.unwrap())(&e62[0], &r)[0];
+    assert!(row_of(t62).cells[col(t62, "LBVH ms")].ours.is_none());
+    assert!(t62.notes.iter().any(|x| x.starts_with("Frame rates not measured for passage")), "{:?}", t62.notes);
     for t in render_all(&r) {
         let row = row_of(&t);
         for (c, cell) in t.columns.iter().zip(&row.cells) {
