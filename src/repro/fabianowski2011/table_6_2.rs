@@ -67,7 +67,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
         None => format!(
             "LBVH ms (modelled): lbvh.cu's launches building the LBVH with n_auto on the emulator (Morton codes, the \
              radix sorts by code and by level, runs, levels, merges), each launch's gt200 counters predicted at its \
-             own grid by the {} and summed, as Table 6.6's LBVH ms; within ±15 % relative. The thesis' times include \
+             own grid by the {} (the build's counts are not scaled: they do not depend on the image) and summed, as Table 6.6's LBVH ms; within ±15 % relative. The thesis' times include \
              what our launches do not model (driver and launch overheads, its own radix sort).",
             timing::describe()
         ),
