@@ -572,3 +572,40 @@ fn render_refuses_options_that_do_not_apply() {
         assert!(!ok && err.contains(want), "{a:?}: {err}");
     }
 }
+
+/// `render --method path --variant emulated` names the kernel it launched:
+/// texture_frame for a scene with texture maps, sss_frame for translucent
+/// materials, volume_frame for a medium, else the integrator's.
+#[test]
+fn path_render_names_the_kernel_it_launched() {
+    let dir = tempdir();
+    for (scene, kernel) in [
+        ("cornell-scratched", "texture_frame"),
+        ("sss-balls", "sss_frame"),
+        ("smog-room", "volume_frame"),
+        ("cornell-lambert", "path_frame"),
+    ] {
+        let out = dir.join(format!("{scene}.png"));
+        let (ok, stdout, stderr) = warplight(&[
+            "render",
+            "--method",
+            "path",
+            "--scene",
+            scene,
+            "--integrator",
+            "nee",
+            "--spp",
+            "4",
+            "--resolution",
+            "8x8",
+            "--variant",
+            "emulated",
+            "--fidelity",
+            "functional",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{scene}: {stderr}");
+        assert!(stdout.contains(&format!("emulated {kernel}:")), "{scene}: {stdout}");
+    }
+}

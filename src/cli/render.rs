@@ -495,16 +495,7 @@ fn run_path(
         if emulated.is_some() { " (emulated)" } else { " (native)" }
     );
     if let Some((w, t)) = r.instructions {
-        println!(
-            "  emulated {}: {w} warp instructions, {t} thread instructions",
-            if scene.medium.is_some() {
-                crate::host::path::kernel::VOLUME_KERNEL
-            } else if scene.translucent.iter().any(Option::is_some) {
-                crate::host::path::kernel::SSS_KERNEL
-            } else {
-                crate::host::path::kernel::entry(integrator)
-            }
-        );
+        println!("  emulated {}: {w} warp instructions, {t} thread instructions", r.kernel);
     }
     println!("  wrote {}", a.output.display());
     Ok(())

@@ -24,6 +24,8 @@ pub struct PathRender {
     pub seconds: f64,
     /// The emulator's warp and thread instructions, when emulated.
     pub instructions: Option<(u64, u64)>,
+    /// The kernel that renders the scene ([`kernel::entry_for`]).
+    pub kernel: &'static str,
 }
 
 /// Frames for `spp` samples per pixel: `spp` must be a positive multiple of 4.
@@ -101,5 +103,6 @@ pub fn render(
     if let Some(pb) = pb {
         pb.finish_and_clear();
     }
-    Ok(PathRender { image, frames, seconds: t0.elapsed().as_secs_f64(), instructions })
+    let kernel = kernel::entry_for(&ps, params.integrator);
+    Ok(PathRender { image, frames, seconds: t0.elapsed().as_secs_f64(), instructions, kernel })
 }
