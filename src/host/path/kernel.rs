@@ -171,7 +171,7 @@ pub struct KernelRender {
 /// by [`load`]); `keep_frames` keeps each frame's image; `progress` is told
 /// each finished frame. Refused ([`SimError::BadLaunch`], naming why): mlt
 /// settings [`super::mlt::check`] refuses, and bdpt or mlt on a scene with a
-/// medium ([`PathScene::ignores_medium`]).
+/// medium, translucent materials or texture maps ([`PathScene::ignores_medium`]).
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     dev: &mut Device,
@@ -184,7 +184,7 @@ pub fn render(
     mut progress: impl FnMut(u32),
 ) -> Result<KernelRender, SimError> {
     if scene.ignores_medium(params.integrator) {
-        // volume_frame would run bdpt's integrator as a path tracer, mlt's kernels ignore the medium
+        // volume_frame, sss_frame and texture_frame would run bdpt's integrator as a path tracer, mlt's kernels ignore them
         return Err(SimError::BadLaunch(super::RenderError::Medium(params.integrator.name()).to_string()));
     }
     if params.integrator == super::Integrator::Mlt {

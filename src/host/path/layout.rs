@@ -389,26 +389,29 @@ impl PathScene {
     /// Whether `integrator` ignores the scene's medium, the medium inside
     /// its translucent materials or its texture maps: bdpt and mlt, which
     /// read none of them (`volume_frame`, `sss_frame` and `texture_frame` are
-    /// the path tracer's). The renderers refuse them on such a scene.
+    /// the path tracer's). The renderers refuse them on such a scene; the
+    /// rule is [`PathScene::check_integrator`]'s.
     pub fn ignores_medium(&self, integrator: super::Integrator) -> bool {
-        (self.medium.is_some() || self.has_translucent() || self.textures.is_some())
-            && matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt)
+        self.check_integrator("", integrator).is_err()
     }
 
-    /// Refuses an integrator that ignores the scene's medium its
-    /// translucent materials or its texture maps (bdpt, mlt).
+    /// Refuses an integrator that ignores the scene's medium, its
+    /// translucent materials or its texture maps (bdpt, mlt), naming scene
+    /// `name` and what it has.
     pub fn check_integrator(&self, name: &str, integrator: super::Integrator) -> Result<(), LayoutError> {
-        let unidirectional = !matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt);
-        if self.medium.is_some() && !unidirectional {
-            return Err(LayoutError::MediumIntegrator(name.to_string(), integrator.name()));
+        if !matches!(integrator, super::Integrator::Bdpt | super::Integrator::Mlt) {
+            return Ok(());
         }
-        if self.has_translucent() && !unidirectional {
-            return Err(LayoutError::SssIntegrator(name.to_string(), integrator.name()));
+        let (name, i) = (name.to_string(), integrator.name());
+        if self.medium.is_some() {
+            Err(LayoutError::MediumIntegrator(name, i))
+        } else if self.has_translucent() {
+            Err(LayoutError::SssIntegrator(name, i))
+        } else if self.textures.is_some() {
+            Err(LayoutError::TexturedIntegrator(name, i))
+        } else {
+            Ok(())
         }
-        if self.textures.is_some() && !unidirectional {
-            return Err(LayoutError::TexturedIntegrator(name.to_string(), integrator.name()));
-        }
-        Ok(())
     }
 
     /// Whether a material is translucent (the renderer then launches `sss_frame`).
