@@ -45,7 +45,10 @@ use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Check, Column, Published, PublishedRow as Row, Table, Unit};
 use crate::sim::{Device, Fidelity, LaunchStats, SimConfig};
-use crate::timing::{GTX_280, KernelCounts, Launch, LaunchShape, predict};
+use crate::timing::{KernelCounts, LaunchShape};
+
+/// Re-exported where Table 6.6's grid model was first written.
+pub use super::timing::predicted_ms_at;
 
 /// Group: the pipeline on the emulator, every frame with the light moved.
 pub const PIPELINE: &str = "fabianowski/pipeline";
@@ -372,11 +375,6 @@ pub fn recorded_ms(r: &Results, group: &str, scene: &str, variant: &str, stage: 
 /// 30-CTA launch on 30), summed.
 pub fn grid_ms(groups: &[(LaunchShape, KernelCounts)]) -> Option<f64> {
     groups.iter().map(|(shape, c)| predicted_ms_at(c, *shape)).sum()
-}
-
-/// The GTX 280 timing model's milliseconds for `counts` run as `shape`.
-pub fn predicted_ms_at(counts: &KernelCounts, shape: LaunchShape) -> Option<f64> {
-    predict(&GTX_280, &Launch { counts: *counts, shape }).ok().map(|p| p.seconds * 1e3)
 }
 
 /// The GTX 280 timing model's milliseconds for `counts` run as one

@@ -95,9 +95,7 @@ pub fn mean_frame(r: &Results, group: &str, scene: &str, variant: &str) -> Optio
 /// `tests/timing_model.rs` against each kernel's PTX through [`shape`]).
 pub fn frame(r: &Results, group: &str, scene: &str, variant: &str) -> Option<Prediction> {
     let counts = mean_frame(r, group, scene, variant)?;
-    let shape =
-        LaunchShape { ctas: CTAS, threads_per_cta: THREADS, registers_per_thread: REGISTERS, shared_per_cta: 0 };
-    predict(&GTX_280, &Launch { counts, shape }).ok()
+    predict(&GTX_280, &Launch { counts, shape: persistent(REGISTERS) }).ok()
 }
 
 /// Predicted frames per second, or NaN when not measured.
@@ -168,8 +166,12 @@ pub fn stage_ms(
     side: u32,
     shape: LaunchShape,
 ) -> Option<f64> {
-    let counts = stage_frame(r, group, scene, variant, stage, side)?;
-    predict(&GTX_280, &Launch { counts, shape }).ok().map(|p| p.seconds * 1e3)
+    predicted_ms_at(&stage_frame(r, group, scene, variant, stage, side)?, shape)
+}
+
+/// The GTX 280 timing model's milliseconds for `counts` run as `shape`.
+pub fn predicted_ms_at(counts: &KernelCounts, shape: LaunchShape) -> Option<f64> {
+    predict(&GTX_280, &Launch { counts: *counts, shape }).ok().map(|p| p.seconds * 1e3)
 }
 
 /// Predicted frames per second of a [`stage_ms`], NaN when not measured
