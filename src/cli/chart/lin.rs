@@ -129,9 +129,7 @@ fn reference_prefix(given: Option<&Path>, scene: &str) -> PathBuf {
     if let Some(p) = given {
         return p.to_path_buf();
     }
-    let rel = format!("tests/fixtures/mitsuba/{scene}-32");
-    let exr = crate::host::scene_file::data_file(Path::new(&format!("{rel}.exr")));
-    PathBuf::from(exr.display().to_string().trim_end_matches(".exr"))
+    Reference::default_prefix(scene)
 }
 
 /// Runs `chart lin-convergence`.

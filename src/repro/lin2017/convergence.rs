@@ -105,6 +105,13 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// The committed reference of `scene`: `tests/fixtures/mitsuba/SCENE-32` of the checkout.
+    pub fn default_prefix(scene: &str) -> PathBuf {
+        let rel = format!("tests/fixtures/mitsuba/{scene}-32");
+        let exr = crate::host::scene_file::data_file(Path::new(&format!("{rel}.exr")));
+        PathBuf::from(exr.display().to_string().trim_end_matches(".exr"))
+    }
+
     /// Reads `PREFIX.exr`, `PREFIX-var.exr` and `PREFIX.json` (`tools/mitsuba/reference.py`'s files).
     pub fn read(prefix: &Path) -> Result<Reference, ConvergenceError> {
         let with = |suffix: &str| PathBuf::from(format!("{}{suffix}", prefix.display()));
