@@ -440,13 +440,32 @@ pub fn own_starts(boot: &[f32], seed: u32) -> Vec<u32> {
 
 /// Chain `c`'s bootstrap samples' luminances into `boot` (the kernel's `mlt_init`).
 fn boot_chain(target: &impl Target, p: &FrameParams, c: u32, boot: &mut [f32], counts: &mut Counts) {
+    boot_samples(target, p, BOOTSTRAP * c, boot, counts);
+}
+
+/// The luminances of bootstrap samples `first`, `first + 1`, ... into `boot`.
+fn boot_samples(target: &impl Target, p: &FrameParams, first: u32, boot: &mut [f32], counts: &mut Counts) {
     // a large step reads no current sample; the sampler's length is the state's
     let u = vec![0.0f32; slots(p.max_bounces)];
     for (j, y) in boot.iter_mut().enumerate() {
-        let key = bootstrap_key(BOOTSTRAP * c + j as u32, p.seed);
+        let key = bootstrap_key(first + j as u32, p.seed);
         let m = Sampler { u: &u, key, max_bounces: p.max_bounces, large: true };
         *y = luminance(target.sample(m, counts).1);
     }
+}
+
+/// The luminances of the first `per_chain` x W x H bootstrap samples, in
+/// key order (the chains' [`BOOTSTRAP`] each are the first 16 W H of them):
+/// [`b_of`] their first `k` W H is the b of `k` samples a chain, and at
+/// `k` = [`BOOTSTRAP`] the kernel's b bit for bit. For the study of b
+/// against the bootstrap count (003:L330).
+pub fn bootstrap_luminances(target: &impl Target, params: &FrameParams, per_chain: u32) -> Vec<f32> {
+    let n = (params.width * params.height) as usize;
+    let mut boot = vec![0.0f32; per_chain as usize * n];
+    boot.par_chunks_mut(BOOTSTRAP as usize).enumerate().for_each(|(c, boot)| {
+        boot_samples(target, params, BOOTSTRAP * c as u32, boot, &mut Counts::default());
+    });
+    boot
 }
 
 /// A chain's start at bootstrap sample `start` (the kernel's `mlt_start`):

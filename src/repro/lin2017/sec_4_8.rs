@@ -1,0 +1,194 @@
+//! Thesis 003 §4.8's normalisation of MLT (003:L330): "the estimation of
+//! global radiance r̄ = ‖∫ f dX‖ [...] at the beginning will affect the
+//! overall luminance of the final result. [...] r̄ functions as a scaling
+//! factor for all samples. As a result, in the case where the rendered
+//! result is required to be physically authentic, more sample should be
+//! taken to estimate the global radiance, although it causes a considerable
+//! overhead." The bootstrap count is not stated.
+//!
+//! Ours: b (our r̄), the mean luminance of the bootstrap samples (bdpt large
+//! steps, `mlt_init` in `kernels/lin2017/path.cu`; 16 a chain there), over
+//! [`COUNTS`] samples a chain, natively on the boxes of Fig. 9 at 32 × 32,
+//! [`RUNS`] runs each, against the Mitsuba reference's mean luminance; the
+//! samples of k a chain are the first k W H of one sequence, so at 16 b is
+//! the kernel's bit for bit. Beside it: an MLT render's mean luminance
+//! against its b, emulated (the splats carry b: each iteration adds b F / Y
+//! with weights summing to 1), and the start-up's cost in bdpt frames.
+
+use std::collections::BTreeMap;
+
+use crate::host::camera::Camera;
+use crate::host::kdtree::{BuildParams, Heuristic, build};
+use crate::host::path::layout::PathScene;
+use crate::host::path::native::Tracer;
+use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, eps_for, frame_of, kernel, mlt};
+use crate::repro::lin2017::convergence::{Reference, mean_luminance};
+use crate::repro::lin2017::fig_9;
+use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
+use crate::repro::results::{Results, Sample};
+use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
+use crate::sim::{Device, Fidelity};
+
+/// Measurement group.
+pub const BOOTSTRAP_GROUP: &str = "lin/mlt-bootstrap";
+
+/// Bootstrap samples a chain (a pixel) measured; the kernel's is 16.
+pub const COUNTS: [u32; 6] = [1, 4, 16, 64, 256, 1024];
+
+/// Independent runs (seeds `SEED0 + r`).
+pub const RUNS: u32 = 8;
+
+/// The runs' first seed.
+pub const SEED0: u32 = 900;
+
+/// The image side.
+pub const SIDE: u32 = 32;
+
+/// How far an MLT image's mean luminance may lie from its b (the fixed-point
+/// splats truncate; the image's pixels are rounded to f32).
+const B_SCALES_IMAGE: f64 = 1e-4;
+
+/// Measurement group [`BOOTSTRAP_GROUP`]: per run `r` and count `k`,
+/// `b_k{k}_r{r}` (b relative to the truth's mean luminance, minus 1); one
+/// emulated MLT frame's mean luminance relative to its b (`image_vs_b`).
+pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    let scene = ws.scene;
+    let truth = Reference::read(&Reference::default_prefix(fig_9::truth_of(&scene.name)))?;
+    let truth_y = mean_luminance(&truth.mean);
+    let n = SIDE;
+    let camera = Camera { resolution: [n, n], ..scene.camera };
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+    let ps = PathScene::new(scene, &tree)?;
+    let params = |seed: u32| FrameParams {
+        width: n,
+        height: n,
+        integrator: Integrator::Mlt,
+        max_bounces: fig_9::BOUNCES,
+        seed,
+        traversal: Traversal::ShortStack,
+    };
+    mlt::check(&params(SEED0))?;
+    let mut k = BTreeMap::new();
+    let most = COUNTS[COUNTS.len() - 1];
+    for r in 0..RUNS {
+        tick(Tick { frame: None, variant: "bootstrap" });
+        let p = params(SEED0 + r);
+        let tracer = Tracer { scene: &ps, frame: frame_of(&camera, eps_for(ps.lo, ps.hi)), params: p };
+        let boot = mlt::bootstrap_luminances(&tracer, &p, most);
+        for c in COUNTS {
+            let b = mlt::b_of(&boot[..(c * n * n) as usize]);
+            k.insert(format!("b_k{c}_r{r}"), b as f64 / truth_y - 1.0);
+        }
+    }
+    tick(Tick { frame: None, variant: "emulated" });
+    let p = params(SEED0);
+    let mut cfg = kernel::sim_config(&p);
+    cfg.fidelity = Fidelity::Functional;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev)?;
+    let e = mlt::render_emulated(&mut dev, &module, &ps, &camera, p, 1, false, |_| {})?;
+    let b = e.b;
+    let tracer = Tracer { scene: &ps, frame: frame_of(&camera, eps_for(ps.lo, ps.hi)), params: p };
+    let ours = mlt::b_of(&mlt::bootstrap_luminances(&tracer, &p, mlt::BOOTSTRAP));
+    k.insert("image_vs_b".into(), mean_luminance(&e.image.image()) / b as f64 - 1.0);
+    k.insert("kernel_b_is_ours".into(), (ours.to_bits() == b.to_bits()) as u8 as f64);
+    Ok(vec![Sample {
+        group: BOOTSTRAP_GROUP.into(),
+        scene: scene.name.clone(),
+        frame: None,
+        variant: "b".into(),
+        counters: k,
+    }])
+}
+
+/// b's relative error at `c` samples a chain: the RMS over runs and the largest.
+fn b_error(r: &Results, scene: &str, c: u32) -> Option<(f64, f64)> {
+    let mut s = 0.0f64;
+    let mut worst = 0.0f64;
+    for run in 0..RUNS {
+        let v = r.sum(BOOTSTRAP_GROUP, scene, "b", &format!("b_k{c}_r{run}"))?;
+        s += v * v;
+        worst = worst.max(v.abs());
+    }
+    Some(((s / RUNS as f64).sqrt(), worst))
+}
+
+/// The table: a row per scene and bootstrap count.
+pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
+    let columns = vec![
+        Column::ours_only("bootstrap samples a pixel", Unit::Count),
+        Column::ours_only("b vs truth, RMS over runs", Unit::Percent),
+        Column::ours_only("largest of the runs", Unit::Percent),
+        Column::ours_only("RMS x sqrt(samples)", Unit::Number(2)),
+        Column::ours_only("start-up in bdpt frames", Unit::Number(2)),
+    ];
+    let scenes: Vec<&str> =
+        fig_9::SCENES.iter().copied().filter(|s| r.sum(BOOTSTRAP_GROUP, s, "b", "image_vs_b").is_some()).collect();
+    let mut rows = Vec::new();
+    for &scene in &scenes {
+        for c in COUNTS {
+            let err = b_error(r, scene, c);
+            rows.push(Row {
+                label: format!("{scene}: {c}{}", if c == mlt::BOOTSTRAP { " (the kernel's)" } else { "" }),
+                kind: RowKind::Scene,
+                cells: vec![
+                    Cell { ours: Some(c as f64), ..Cell::default() },
+                    Cell { ours: err.map(|e| 100.0 * e.0), ..Cell::default() },
+                    Cell { ours: err.map(|e| 100.0 * e.1), ..Cell::default() },
+                    Cell { ours: err.map(|e| e.0 * (c as f64).sqrt()), ..Cell::default() },
+                    Cell { ours: Some(c as f64 / SAMPLES_PER_FRAME as f64), ..Cell::default() },
+                ],
+            });
+        }
+    }
+    let mut table =
+        Table { address: e.address(), heading: e.heading(), columns, rows, checks: Vec::new(), notes: Vec::new() };
+    for &scene in &scenes {
+        let get = |c: &str| r.sum(BOOTSTRAP_GROUP, scene, "b", c);
+        let dev = get("image_vs_b");
+        table.checks.push(Check {
+            claim: format!("{scene}: r̄ scales every sample, so it sets the image's overall luminance (003:L330)"),
+            evidence: format!(
+                "measured on the emulator, one MLT frame (seed {SEED0}): the image's mean luminance {} from b \
+                 (holds within {B_SCALES_IMAGE:e}); the kernel's b equals the native bootstrap's: {}",
+                dev.map_or("–".into(), |d| format!("{:+.2e}", d)),
+                get("kernel_b_is_ours") == Some(1.0)
+            ),
+            holds: dev.is_some_and(|d| d.abs() <= B_SCALES_IMAGE) && get("kernel_b_is_ours") == Some(1.0),
+        });
+        let first = b_error(r, scene, COUNTS[0]).map(|e| e.0);
+        let last = b_error(r, scene, COUNTS[COUNTS.len() - 1]).map(|e| e.0);
+        let kernel = b_error(r, scene, mlt::BOOTSTRAP).map(|e| e.0);
+        table.checks.push(Check {
+            claim: format!(
+                "{scene}: more bootstrap samples estimate the brightness better, at a considerable overhead (003:L330)"
+            ),
+            evidence: format!(
+                "measured over {RUNS} runs: b's RMS error {} at {} a pixel, {} at 16 (the kernel's), {} at {} \
+                 ({} bdpt frames of start-up); holds if it falls by at least half the 1/sqrt law's {:.0}x",
+                first.map_or("–".into(), |e| format!("{:.1} %", 100.0 * e)),
+                COUNTS[0],
+                kernel.map_or("–".into(), |e| format!("{:.1} %", 100.0 * e)),
+                last.map_or("–".into(), |e| format!("{:.2} %", 100.0 * e)),
+                COUNTS[COUNTS.len() - 1],
+                COUNTS[COUNTS.len() - 1] / SAMPLES_PER_FRAME,
+                ((COUNTS[COUNTS.len() - 1] / COUNTS[0]) as f64).sqrt()
+            ),
+            holds: first
+                .zip(last)
+                .is_some_and(|(f, l)| l * 0.5 * ((COUNTS[COUNTS.len() - 1] / COUNTS[0]) as f64).sqrt() <= f),
+        });
+    }
+    table.notes.push(format!(
+        "Ours: b = the mean luminance (Y = 0.212671 R + 0.715160 G + 0.072169 B, 003:L322) of k x W x H bootstrap \
+         samples (bdpt large steps; mlt::bootstrap_luminances, the kernel's mlt_init for k = 16), {} at {SIDE} x \
+         {SIDE}, {} bounces, {RUNS} runs (seeds {SEED0}-{}), against the Mitsuba reference's mean luminance \
+         (tests/fixtures/mitsuba/). 'RMS x sqrt(samples)' is constant where the error falls as 1/sqrt(k); \
+         the start-up costs k / 4 bdpt frames (a frame traces 4 paths a pixel). Fixtures: docs/fixtures.md.",
+        scenes.iter().map(|s| format!("`scenes/{s}.toml`")).collect::<Vec<_>>().join(" and "),
+        fig_9::BOUNCES,
+        SEED0 + RUNS - 1
+    ));
+    vec![table]
+}
