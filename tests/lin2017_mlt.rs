@@ -244,7 +244,10 @@ fn strip_bias(start: mlt::Start, runs: u32) -> [(f64, f64); 2] {
             seed,
             traversal: Traversal::ShortStack,
         };
-        let img = mlt::render_target(&Strip, p, start, FRAMES, false, |_| {}).expect("render").image.image();
+        let img = mlt::render_target(&Strip, p, mlt::Chains::starting(start), FRAMES, false, |_| {})
+            .expect("render")
+            .image
+            .image();
         let mut sums = [[0.0f64; 2]; 2];
         for (px, v) in img.pixels.iter().enumerate() {
             let t = strip_t(px as u32) as f64;
@@ -336,7 +339,9 @@ fn start_up_bias_chart_data() {
                 frame: warplight::host::path::frame_of(&cam, warplight::host::path::eps_for(ps.lo, ps.hi)),
                 params: params(ref_img.width, Integrator::Mlt, 700 + r),
             };
-            let out = mlt::render_target(&tracer, tracer.params, start, CHART_FRAMES, true, |_| {}).expect("render");
+            let out =
+                mlt::render_target(&tracer, tracer.params, mlt::Chains::starting(start), CHART_FRAMES, true, |_| {})
+                    .expect("render");
             for (f, img) in out.image.frame_images.iter().enumerate() {
                 for k in 0..2 {
                     rel[f][k] += (region(img, k == 0) / reference[k] - 1.0) * 100.0 / CHART_RUNS as f64;

@@ -56,6 +56,9 @@ pub enum MltError {
         /// The state's bytes (`None`: past 2^64).
         bytes: Option<u64>,
     },
+    /// A large-step probability outside [0, 1] ([`Chains::p_large`]).
+    #[error("mlt: a large-step probability of {0}: expected a probability in [0, 1]")]
+    LargeStep(f32),
     /// The emulator faulted.
     #[error(transparent)]
     Sim(#[from] SimError),
@@ -328,6 +331,28 @@ pub enum Start {
     Own,
 }
 
+/// How the chains run natively: where they start and how often they take a
+/// large step. The kernels' are [`Chains::KERNEL`]; the others are for the
+/// studies of the thesis' start-up bias and large-step probability
+/// (003:L318-324), native only.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chains {
+    /// Where the chains start.
+    pub start: Start,
+    /// The probability of a large step, in [0, 1].
+    pub p_large: f32,
+}
+
+impl Chains {
+    /// The kernels' chains: started from the pool, large steps with [`P_LARGE`].
+    pub const KERNEL: Chains = Chains { start: Start::Pool, p_large: P_LARGE };
+
+    /// The kernels' large steps with `start`.
+    pub fn starting(start: Start) -> Chains {
+        Chains { start, ..Chains::KERNEL }
+    }
+}
+
 /// Renders `frames` frames of MLT natively (`params.integrator` is mlt);
 /// settings [`check`] refuses are an error.
 pub fn render_native(
@@ -339,21 +364,25 @@ pub fn render_native(
     progress: impl FnMut(u32),
 ) -> Result<MltRender, MltError> {
     let tracer = Tracer { scene, frame: frame_of(camera, eps_for(scene.lo, scene.hi)), params };
-    render_target(&tracer, params, Start::Pool, frames, keep_frames, progress)
+    render_target(&tracer, params, Chains::KERNEL, frames, keep_frames, progress)
 }
 
-/// Renders `frames` frames of MLT natively over `target` with chains that
-/// start at `start` (`params` gives the image size, the state's length by
-/// its bounces, and the seed); settings [`check`] refuses are an error.
+/// Renders `frames` frames of MLT natively over `target` with `chains`
+/// (`params` gives the image size, the state's length by its bounces, and
+/// the seed); settings [`check`] refuses are an error, and so is a large-step
+/// probability outside [0, 1].
 pub fn render_target(
     target: &impl Target,
     params: FrameParams,
-    start: Start,
+    chains: Chains,
     frames: u32,
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Result<MltRender, MltError> {
     check(&params)?;
+    if !(0.0..=1.0).contains(&chains.p_large) {
+        return Err(MltError::LargeStep(chains.p_large));
+    }
     let (m, n) = (slots(params.max_bounces), (params.width * params.height) as usize);
     let mut boot = vec![0.0f32; BOOTSTRAP as usize * n];
     let mut counts = boot
@@ -366,7 +395,7 @@ pub fn render_target(
         })
         .reduce(Counts::default, add);
     let b = b_of(&boot);
-    let start = match start {
+    let start = match chains.start {
         Start::Pool => starts(&boot, n as u32, params.seed),
         Start::Own => own_starts(&boot, params.seed),
     };
@@ -393,7 +422,7 @@ pub fn render_target(
             .enumerate()
             .map(|(c, (u, cur))| {
                 let mut counts = Counts::default();
-                frame_chain(target, &params, c as u32, f, b, u, cur, &image, &mut counts);
+                frame_chain(target, &params, c as u32, f, b, chains.p_large, u, cur, &image, &mut counts);
                 counts
             })
             .reduce(Counts::default, add);
@@ -487,6 +516,7 @@ fn frame_chain(
     c: u32,
     f: u32,
     b: f32,
+    p_large: f32,
     u: &mut [f32],
     cur: &mut Current,
     image: &[AtomicU64],
@@ -496,7 +526,7 @@ fn frame_chain(
     let mut next = vec![0.0f32; u.len()];
     for t in 0..STEPS {
         let key = path_key(STEPS * c + t, f, p.seed);
-        let m = Sampler { u, key, max_bounces: p.max_bounces, large: rng(key, DIM_LARGE) < P_LARGE };
+        let m = Sampler { u, key, max_bounces: p.max_bounces, large: rng(key, DIM_LARGE) < p_large };
         let (i, l) = target.sample(m, counts);
         let y = luminance(l);
         let a = if yc > 0.0 { 1.0f32.min(y / yc) } else { 1.0 };

@@ -24,13 +24,13 @@ use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::PathScene;
-use crate::host::path::{FrameParams, Integrator, Traversal, kernel, render_native, stats};
+use crate::host::path::{FrameParams, Integrator, Traversal, render_native};
 use crate::host::raycast::{Caster, TraceStats};
 use crate::host::scene::Scene;
+use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
-use crate::sim::{Device, Fidelity};
 
 /// Measurement group.
 pub const MIS_BSDF: &str = "lin/mis-bsdf";
@@ -106,13 +106,7 @@ fn region_rmse(img: &FrameBuffer, truth: &FrameBuffer, region: &[Option<usize>])
 /// region `k`; `pixels{k}`; `emulated_same`.
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let scene = ws.scene;
-    let truth_path = crate::host::scene_file::data_file(std::path::Path::new(TRUTH));
-    let truth = stats::read_exr(&truth_path)?;
-    if (truth.width, truth.height) != (SIDE, SIDE) {
-        return Err(
-            format!("{}: {}x{}, expected {SIDE}x{SIDE}", truth_path.display(), truth.width, truth.height).into()
-        );
-    }
+    let truth = runs::read_truth(TRUTH, SIDE)?;
     let camera = Camera { resolution: [SIDE, SIDE], ..scene.camera };
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
@@ -139,16 +133,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
             }
         }
         // seed 0's first MIS_FRAMES frames emulated, bit for bit the native ones
-        let p = params(integrator, 0);
-        let mut cfg = kernel::sim_config(&p);
-        cfg.fidelity = Fidelity::Functional;
-        let mut dev = Device::with_config(cfg);
-        let module = kernel::load(&mut dev)?;
-        let e = kernel::render(&mut dev, &module, &ps, &camera, p, MIS_FRAMES, false, |_| {})?;
-        let twin = render_native(&ps, &camera, p, MIS_FRAMES, false, |_| {})?;
-        same &= e.image.accum.iter().zip(&twin.accum).all(|(a, b)| a.to_bits() == b.to_bits())
-            && e.image.accum.len() == twin.accum.len();
-        k.insert("emulated_warps".into(), e.totals.warp_instructions as f64);
+        same &= runs::emulate_twin(&ps, &camera, params(integrator, 0), MIS_FRAMES)?.same;
         out.push(Sample {
             group: MIS_BSDF.into(),
             scene: scene.name.clone(),
@@ -174,11 +159,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
 
 /// A row's RMS error over the runs in region `i` (the runs' mean square).
 fn error(r: &Results, variant: &str, i: usize) -> Option<f64> {
-    let mut s = 0.0;
-    for run in 0..RUNS {
-        s += r.sum(MIS_BSDF, SCENE, variant, &format!("rmse{i}_r{run}"))?.powi(2);
-    }
-    Some((s / RUNS as f64).sqrt())
+    runs::rms((0..RUNS).map(|run| r.sum(MIS_BSDF, SCENE, variant, &format!("rmse{i}_r{run}"))))
 }
 
 /// Runs in which `a`'s error in region `i` is below `b`'s.

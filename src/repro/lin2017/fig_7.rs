@@ -11,7 +11,7 @@
 //! - the scene `scenes/cornell-rough.toml` (the back wall a white rough
 //!   mirror, Beckmann α 0.2) at [`SIDE`] × [`SIDE`], 16 bounces;
 //! - [`FRAMES`] of our frames, 4 paths a pixel each (12 paths, the nearest to
-//!   the thesis' 10 frames of one path a pixel, 003:L286), the same seed for
+//!   the thesis' 10 frames of one path a pixel, 003:L288), the same seed for
 //!   both heuristics ("both cases use the same seed", 003:L293);
 //! - the ground truth, like the thesis' (its own MLT at 80,000 frames), our
 //!   own renderer converged: next-event estimation at 16,384 paths a pixel,
@@ -34,20 +34,17 @@ use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
-use crate::host::path::layout::PathScene;
-use crate::host::path::stats;
-use crate::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use crate::host::path::{FrameParams, Integrator, Traversal, render_native};
 use crate::repro::lin2017::convergence::{Reference, mean_luminance, rmse};
+use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
-use crate::sim::{Device, Fidelity};
 
 /// Measurement group: both heuristics, seed 0 emulated, seeds 0-15 native.
 pub const HEURISTICS: &str = "lin/mis-heuristics";
 
-/// The scene: "the same Cornell box scene with moderately rough back mirror" (003:L291).
+/// The scene: "the same Cornell box scene with moderately rough back mirror" (003:L293).
 pub const SCENE: &str = "cornell-rough";
 
 /// Our frames (4 paths a pixel each): 12 paths a pixel, the nearest to the thesis' 10.
@@ -76,6 +73,8 @@ pub const PRINTED: [&str; 2] = ["0.7488", "0.7517"];
 /// reference (or 3 of the reference's standard errors, if more).
 const TRUTH_Y_TOLERANCE: f64 = 0.01;
 
+const _: () = assert!(SEEDS == 16, "T_CRIT_15 and SIGN_TEST_16 are for 16 seeds");
+
 /// Wins of 16 that a one-sided sign test at 5 % needs: P(X ≥ 12) = 0.038 for X ~ B(16, ½).
 const SIGN_TEST_16: usize = 12;
 
@@ -86,12 +85,14 @@ const T_CRIT_15: f64 = 2.131;
 pub const ROWS: [(Integrator, &str); 2] =
     [(Integrator::MisBalance, "balance heuristic"), (Integrator::MisPower, "power heuristic")];
 
-/// The 8-bit grey image OpenCV's `cvtColor(..., COLOR_BGR2GRAY)` makes of
-/// `fb`'s 8-bit sRGB image (exposure 0): round(0.299 R + 0.587 G + 0.114 B).
+/// The 8-bit grey image OpenCV's `cvtColor(..., COLOR_RGB2GRAY)` makes of
+/// `fb`'s 8-bit sRGB image (exposure 0): its fixed-point
+/// (4899 R + 9617 G + 1868 B + 2^13) >> 14, the weights 0.299, 0.587, 0.114
+/// in units of 2^-14.
 pub fn gray8(fb: &FrameBuffer) -> Vec<u8> {
     fb.to_srgb8(0.0)
         .chunks_exact(3)
-        .map(|p| (0.299 * p[0] as f64 + 0.587 * p[1] as f64 + 0.114 * p[2] as f64).round().min(255.0) as u8)
+        .map(|p| ((4899 * p[0] as u32 + 9617 * p[1] as u32 + 1868 * p[2] as u32 + (1 << 13)) >> 14).min(255) as u8)
         .collect()
 }
 
@@ -105,10 +106,15 @@ pub fn histogram(gray: &[u8], bins: usize) -> Vec<f64> {
     h
 }
 
-/// OpenCV's `HISTCMP_CORREL` of two histograms: Σ (a − ā)(b − b̄) / √(Σ (a − ā)² Σ (b − b̄)²);
-/// 1 for two equal flat histograms, 0 for a flat against a varying one.
+/// OpenCV's `HISTCMP_CORREL` of two histograms: Σ (a − ā)(b − b̄) / √(Σ (a − ā)² Σ (b − b̄)²),
+/// and 1 where that denominator's square is at most `f64::EPSILON` (OpenCV's
+/// rule: a flat histogram correlates 1 with anything). NaN for histograms of
+/// different lengths.
 pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len()) as f64;
+    if a.len() != b.len() || a.is_empty() {
+        return f64::NAN;
+    }
+    let n = a.len() as f64;
     let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
     let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
     for (x, y) in a.iter().zip(b) {
@@ -116,11 +122,8 @@ pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
         aa += (x - ma) * (x - ma);
         bb += (y - mb) * (y - mb);
     }
-    if aa == 0.0 && bb == 0.0 {
+    if (aa * bb).abs() <= f64::EPSILON {
         return 1.0;
-    }
-    if aa == 0.0 || bb == 0.0 {
-        return 0.0;
     }
     ab / (aa * bb).sqrt()
 }
@@ -143,19 +146,11 @@ fn metrics(k: &mut BTreeMap<String, f64>, suffix: &str, img: &FrameBuffer, truth
 /// natively (`corr256_s3`, `rmse_s3`, ...), against [`TRUTH`].
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let scene = ws.scene;
-    let truth_path = crate::host::scene_file::data_file(std::path::Path::new(TRUTH));
-    let truth = stats::read_exr(&truth_path)?;
-    if (truth.width, truth.height) != (SIDE, SIDE) {
-        return Err(
-            format!("{}: {}x{}, expected {SIDE}x{SIDE}", truth_path.display(), truth.width, truth.height).into()
-        );
-    }
+    let truth = runs::read_truth(TRUTH, SIDE)?;
     let mitsuba = Reference::read(&Reference::default_prefix(&scene.name))?;
     let n = SIDE;
     let camera = Camera { resolution: [n, n], ..scene.camera };
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(scene, &tree)?;
+    let ps = runs::path_scene(scene)?;
     let truth_y = [mean_luminance(&truth), mean_luminance(&mitsuba.mean), mitsuba.noise().1];
     let mut out = Vec::new();
     for (integrator, _) in ROWS {
@@ -170,14 +165,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
         };
         params(0).check()?;
         let mut k = BTreeMap::new();
-        let mut cfg = kernel::sim_config(&params(0));
-        cfg.fidelity = Fidelity::Functional;
-        let mut dev = Device::with_config(cfg);
-        let module = kernel::load(&mut dev)?;
-        let emulated = kernel::render(&mut dev, &module, &ps, &camera, params(0), FRAMES, false, |_| {})?;
-        let twin = render_native(&ps, &camera, params(0), FRAMES, false, |_| {})?;
-        let same = emulated.image.accum.len() == twin.accum.len()
-            && emulated.image.accum.iter().zip(&twin.accum).all(|(a, b)| a.to_bits() == b.to_bits());
+        let runs::Twin { emulated, same } = runs::emulate_twin(&ps, &camera, params(0), FRAMES)?;
         metrics(&mut k, "", &emulated.image.image(), &truth);
         k.insert("truth_y".into(), truth_y[0]);
         k.insert("mitsuba_y".into(), truth_y[1]);
@@ -377,15 +365,17 @@ mod tests {
         // Σ = 1.5 − 0.5 − 0.5 + 1.5 = 2; √(5 · 4) = √20
         let b = [0.0, 2.0, 0.0, 2.0];
         assert!((correlation(&a, &b) - 2.0 / 20f64.sqrt()).abs() < 1e-12);
-        assert_eq!(correlation(&[1.0; 4], &a), 0.0);
+        // OpenCV: a flat histogram correlates 1 (its denominator is 0)
+        assert_eq!(correlation(&[1.0; 4], &a), 1.0);
         assert_eq!(correlation(&[1.0; 4], &[2.0; 4]), 1.0);
+        assert!(correlation(&a, &[1.0; 3]).is_nan());
     }
 
     #[test]
     fn grey_levels_and_bins_are_opencvs() {
         let mut fb = FrameBuffer::new(3, 1);
-        fb.set(0, 0, [1.0, 0.0, 0.0]); // 0.299 · 255 = 76.2
-        fb.set(1, 0, [0.0, 1.0, 1.0]); // (0.587 + 0.114) · 255 = 178.8
+        fb.set(0, 0, [1.0, 0.0, 0.0]); // (4899 · 255 + 8192) >> 14 = 76
+        fb.set(1, 0, [0.0, 1.0, 1.0]); // ((9617 + 1868) · 255 + 8192) >> 14 = 179
         fb.set(2, 0, [5.0, 5.0, 5.0]); // clamped white
         assert_eq!(gray8(&fb), vec![76, 179, 255]);
         // 16 bins of 16 levels: 76 → 4, 179 → 11, 255 → 15

@@ -1,4 +1,7 @@
-//! Thesis 003 §4.8's normalisation of MLT (003:L330): "the estimation of
+//! Thesis 003 §4.8's MLT parameters: the bootstrap count and the
+//! large-step probability.
+//!
+//! The normalisation (003:L330): "the estimation of
 //! global radiance r̄ = ‖∫ f dX‖ [...] at the beginning will affect the
 //! overall luminance of the final result. [...] r̄ functions as a scaling
 //! factor for all samples. As a result, in the case where the rendered
@@ -14,16 +17,25 @@
 //! the kernel's bit for bit. Beside it: an MLT render's mean luminance
 //! against its b, emulated (the splats carry b: each iteration adds b F / Y
 //! with weights summing to 1), and the start-up's cost in bdpt frames.
+//!
+//! The large-step probability. The thesis' example (003:L318): "If, for
+//! example, the random number is lower than the threshold 0.25, it means on
+//! average there is 1 large mutation and 3 small (local) mutations out of 4
+//! mutations." Its advice (003:L324): "In practice, if the scene contains
+//! mostly diffuse surfaces, large mutation rate can be set larger. On the
+//! other hand, if the intricate optical effects are the emphasis of
+//! rendering, large mutation rate should be set much smaller." Ours: MLT's
+//! error after 100 mutations a chain at [`LARGE_STEPS`] on a diffuse box and
+//! one with a glossy back wall, natively ([`mlt::Chains`]; the kernel's is
+//! the constant 0.25).
 
 use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
-use crate::host::path::layout::PathScene;
 use crate::host::path::native::Tracer;
 use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, eps_for, frame_of, kernel, mlt};
 use crate::repro::lin2017::convergence::{Reference, mean_luminance};
-use crate::repro::lin2017::fig_9;
+use crate::repro::lin2017::{fig_9, runs};
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
@@ -53,13 +65,11 @@ const B_SCALES_IMAGE: f64 = 1e-4;
 /// emulated MLT frame's mean luminance relative to its b (`image_vs_b`).
 pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let scene = ws.scene;
-    let truth = Reference::read(&Reference::default_prefix(fig_9::truth_of(&scene.name)))?;
+    let truth = Reference::read(&Reference::default_prefix(fig_9::truth_of(&scene.name)?))?;
     let truth_y = mean_luminance(&truth.mean);
     let n = SIDE;
     let camera = Camera { resolution: [n, n], ..scene.camera };
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(scene, &tree)?;
+    let ps = runs::path_scene(scene)?;
     let params = |seed: u32| FrameParams {
         width: n,
         height: n,
@@ -187,6 +197,122 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
          (tests/fixtures/mitsuba/). 'RMS x sqrt(samples)' is constant where the error falls as 1/sqrt(k); \
          the start-up costs k / 4 bdpt frames (a frame traces 4 paths a pixel). Fixtures: docs/fixtures.md.",
         scenes.iter().map(|s| format!("`scenes/{s}.toml`")).collect::<Vec<_>>().join(" and "),
+        fig_9::BOUNCES,
+        SEED0 + RUNS - 1
+    ));
+    vec![table]
+}
+
+/// Measurement group of the large-step study.
+pub const LARGE_STEP_GROUP: &str = "lin/mlt-large-step";
+
+/// The large-step probabilities measured (the kernel's: 0.25, 003:L318's example).
+pub const LARGE_STEPS: [f32; 5] = [0.05, 0.1, 0.25, 0.5, 1.0];
+
+/// The study's scenes: a diffuse box and one with a glossy back wall.
+pub const LARGE_STEP_SCENES: [&str; 2] = ["cornell-lambert", "cornell-rough"];
+
+/// Frames a run: the thesis' 100 (of one mutation a chain; ours 4 a frame).
+pub const LARGE_STEP_FRAMES: u32 = 25;
+
+/// Measurement group [`LARGE_STEP_GROUP`]: per large-step probability
+/// (variant `p0.25`) and run `r`, the image's RMS error against the truth
+/// after [`LARGE_STEP_FRAMES`] frames with its brightness (b) removed,
+/// `noise_r{r}`. Native: the kernel's probability is a constant.
+pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
+    let scene = ws.scene;
+    let truth = Reference::read(&Reference::default_prefix(&scene.name))?;
+    let truth_y = mean_luminance(&truth.mean);
+    let n = truth.mean.width;
+    let camera = Camera { resolution: [n, n], ..scene.camera };
+    let ps = runs::path_scene(scene)?;
+    let mut out = Vec::new();
+    for p_large in LARGE_STEPS {
+        let variant = format!("p{p_large}");
+        tick(Tick { frame: None, variant: &variant });
+        let mut k = BTreeMap::new();
+        for r in 0..RUNS {
+            let p = FrameParams {
+                width: n,
+                height: n,
+                integrator: Integrator::Mlt,
+                max_bounces: fig_9::BOUNCES,
+                seed: SEED0 + r,
+                traversal: Traversal::ShortStack,
+            };
+            let tracer = Tracer { scene: &ps, frame: frame_of(&camera, eps_for(ps.lo, ps.hi)), params: p };
+            let chains = mlt::Chains { p_large, ..mlt::Chains::KERNEL };
+            let img = mlt::render_target(&tracer, p, chains, LARGE_STEP_FRAMES, false, |_| {})?.image.image();
+            k.insert(
+                format!("noise_r{r}"),
+                crate::repro::lin2017::convergence::rmse(&fig_9::scaled(&img, truth_y), &truth.mean),
+            );
+        }
+        out.push(Sample {
+            group: LARGE_STEP_GROUP.into(),
+            scene: scene.name.clone(),
+            frame: None,
+            variant,
+            counters: k,
+        });
+    }
+    Ok(out)
+}
+
+/// The RMS over runs of the brightness-removed error at large-step probability `p`.
+fn large_step_noise(r: &Results, scene: &str, p: f32) -> Option<f64> {
+    runs::rms((0..RUNS).map(|run| r.sum(LARGE_STEP_GROUP, scene, &format!("p{p}"), &format!("noise_r{run}"))))
+}
+
+/// The large-step probability of least noise on `scene`.
+pub fn best_large_step(r: &Results, scene: &str) -> Option<f32> {
+    LARGE_STEPS
+        .iter()
+        .map(|&p| large_step_noise(r, scene, p).map(|e| (p, e)))
+        .collect::<Option<Vec<_>>>()?
+        .into_iter()
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(p, _)| p)
+}
+
+/// The large-step table: a row per probability, a column per scene.
+pub fn render_large_step(e: &Entry, r: &Results) -> Vec<Table> {
+    let columns = LARGE_STEP_SCENES
+        .iter()
+        .map(|s| Column::ours_only(&format!("{s}: RMS error, brightness removed"), Unit::Number(4)))
+        .collect();
+    let rows = LARGE_STEPS
+        .iter()
+        .map(|&p| Row {
+            label: format!("large steps {p}{}", if p == mlt::P_LARGE { " (the kernel's)" } else { "" }),
+            kind: RowKind::Scene,
+            cells: LARGE_STEP_SCENES
+                .iter()
+                .map(|s| Cell { ours: large_step_noise(r, s, p), ..Cell::default() })
+                .collect(),
+        })
+        .collect();
+    let mut table =
+        Table { address: e.address(), heading: e.heading(), columns, rows, checks: Vec::new(), notes: Vec::new() };
+    let [diffuse, glossy] = LARGE_STEP_SCENES.map(|s| best_large_step(r, s));
+    let show = |p: Option<f32>| p.map_or("–".into(), |p| p.to_string());
+    table.checks.push(Check {
+        claim: "a larger large-step rate suits diffuse scenes, a smaller one intricate effects (003:L324)".into(),
+        evidence: format!(
+            "measured over {RUNS} runs of {LARGE_STEP_FRAMES} frames: the least error at large steps {} on the \
+             diffuse box, {} on the box with the glossy back wall (holds if the diffuse box's is the larger)",
+            show(diffuse),
+            show(glossy)
+        ),
+        holds: diffuse.zip(glossy).is_some_and(|(d, g)| d > g),
+    });
+    table.notes.push(format!(
+        "Ours: MLT over bdpt natively (mlt::render_target with mlt::Chains {{ p_large, start from the pool }}; the \
+         kernel's probability is the constant 0.25), {} at 32 x 32, {} bounces, {RUNS} runs (seeds {SEED0}-{}) of \
+         {LARGE_STEP_FRAMES} frames (the thesis' 100 mutations a chain); the error: RMS over pixels and channels \
+         against the Mitsuba reference with each image scaled to its mean luminance first (b's error removed: \
+         lin:s4.8-bootstrap), the runs' mean square. Small steps: Kelemen's s1 = 1/1024, s2 = 1/64.",
+        LARGE_STEP_SCENES.iter().map(|s| format!("`scenes/{s}.toml`")).collect::<Vec<_>>().join(" and "),
         fig_9::BOUNCES,
         SEED0 + RUNS - 1
     ));
