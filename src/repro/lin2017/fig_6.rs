@@ -24,7 +24,7 @@ use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::PathScene;
-use crate::host::path::{FrameParams, Integrator, Traversal, render_native};
+use crate::host::path::{Integrator, render_native};
 use crate::host::raycast::{Caster, TraceStats};
 use crate::host::scene::Scene;
 use crate::repro::lin2017::runs;
@@ -112,14 +112,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
     let ps = PathScene::new(scene, &tree)?;
     let region = regions(scene, &camera, &tree);
-    let params = |integrator: Integrator, seed: u32| FrameParams {
-        width: SIDE,
-        height: SIDE,
-        integrator,
-        max_bounces: BOUNCES,
-        seed,
-        traversal: Traversal::ShortStack,
-    };
+    let params = |integrator: Integrator, seed: u32| runs::square(SIDE, integrator, BOUNCES, seed);
     let mut out = Vec::new();
     let mut same = true;
     for (variant, integrator, frames, _) in ROWS {

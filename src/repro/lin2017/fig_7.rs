@@ -34,7 +34,7 @@ use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
-use crate::host::path::{FrameParams, Integrator, Traversal, render_native};
+use crate::host::path::{Integrator, render_native};
 use crate::repro::lin2017::convergence::{Reference, mean_luminance, rmse};
 use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
@@ -155,14 +155,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     let mut out = Vec::new();
     for (integrator, _) in ROWS {
         tick(Tick { frame: None, variant: integrator.name() });
-        let params = |seed: u32| FrameParams {
-            width: n,
-            height: n,
-            integrator,
-            max_bounces: BOUNCES,
-            seed,
-            traversal: Traversal::ShortStack,
-        };
+        let params = |seed: u32| runs::square(n, integrator, BOUNCES, seed);
         params(0).check()?;
         let mut k = BTreeMap::new();
         let runs::Twin { emulated, same } = runs::emulate_twin(&ps, &camera, params(0), FRAMES)?;

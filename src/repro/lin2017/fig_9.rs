@@ -41,7 +41,7 @@ use std::collections::BTreeMap;
 use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::path::native::Tracer;
-use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, eps_for, frame_of, mlt, render_native};
+use crate::host::path::{Integrator, SAMPLES_PER_FRAME, eps_for, frame_of, mlt, render_native};
 use crate::repro::lin2017::convergence::{Reference, rmse};
 use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
@@ -188,14 +188,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     let lit = Lit::of(&truth.mean);
     let camera = Camera { resolution: [n, n], ..scene.camera };
     let ps = runs::path_scene(scene)?;
-    let params = |integrator: Integrator, seed: u32| FrameParams {
-        width: n,
-        height: n,
-        integrator,
-        max_bounces: BOUNCES,
-        seed,
-        traversal: Traversal::ShortStack,
-    };
+    let params = |integrator: Integrator, seed: u32| runs::square(n, integrator, BOUNCES, seed);
     params(Integrator::Mlt, SEED0).check()?;
     mlt::check(&params(Integrator::Mlt, SEED0))?;
     let record = |k: &mut BTreeMap<String, f64>, r: u32, at: Vec<(u32, FrameBuffer)>| {

@@ -6,7 +6,7 @@
 use crate::host::camera::Camera;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::{LayoutError, PathScene};
-use crate::host::path::{FrameParams, RenderError, kernel, render_native};
+use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel, render_native};
 use crate::host::scene::Scene;
 use crate::sim::{Device, Fidelity, SimError};
 
@@ -15,6 +15,12 @@ pub fn path_scene(scene: &Scene) -> Result<PathScene, LayoutError> {
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
     PathScene::new(scene, &tree)
+}
+
+/// A square image of `side` pixels traced with `integrator`, at most
+/// `bounces` bounces, `seed`, on the 8-byte short stack (the figures' settings).
+pub fn square(side: u32, integrator: Integrator, bounces: u32, seed: u32) -> FrameParams {
+    FrameParams { width: side, height: side, integrator, max_bounces: bounces, seed, traversal: Traversal::ShortStack }
 }
 
 /// Why an emulated render could not be compared with its native twin.

@@ -33,7 +33,7 @@ use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
 use crate::host::path::native::Tracer;
-use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, eps_for, frame_of, kernel, mlt};
+use crate::host::path::{Integrator, SAMPLES_PER_FRAME, eps_for, frame_of, kernel, mlt};
 use crate::repro::lin2017::convergence::{Reference, mean_luminance};
 use crate::repro::lin2017::{fig_9, runs};
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
@@ -70,14 +70,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     let n = SIDE;
     let camera = Camera { resolution: [n, n], ..scene.camera };
     let ps = runs::path_scene(scene)?;
-    let params = |seed: u32| FrameParams {
-        width: n,
-        height: n,
-        integrator: Integrator::Mlt,
-        max_bounces: fig_9::BOUNCES,
-        seed,
-        traversal: Traversal::ShortStack,
-    };
+    let params = |seed: u32| runs::square(n, Integrator::Mlt, fig_9::BOUNCES, seed);
     mlt::check(&params(SEED0))?;
     let mut k = BTreeMap::new();
     let most = COUNTS[COUNTS.len() - 1];
@@ -232,14 +225,7 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
         tick(Tick { frame: None, variant: &variant });
         let mut k = BTreeMap::new();
         for r in 0..RUNS {
-            let p = FrameParams {
-                width: n,
-                height: n,
-                integrator: Integrator::Mlt,
-                max_bounces: fig_9::BOUNCES,
-                seed: SEED0 + r,
-                traversal: Traversal::ShortStack,
-            };
+            let p = runs::square(n, Integrator::Mlt, fig_9::BOUNCES, SEED0 + r);
             let tracer = Tracer { scene: &ps, frame: frame_of(&camera, eps_for(ps.lo, ps.hi)), params: p };
             let chains = mlt::Chains { p_large, ..mlt::Chains::KERNEL };
             let img = mlt::render_target(&tracer, p, chains, LARGE_STEP_FRAMES, false, |_| {})?.image.image();
