@@ -225,7 +225,7 @@ static TABLES: [TableDef; 14] = [
         title: "Upper: Monte Carlo Lower: Metropolis (Both use bi-directional path tracing)",
         lines: "L332-336",
         status: Status::Partly,
-        note: "IMAGE: frames 1, 30, 100 on Fig. 8's box; error against Mitsuba and the lit ceiling's brightness measured over 8 runs, the frames Monte Carlo needs for MLT's error measured, the frame cost modelled by emulated warp instructions",
+        note: "IMAGE: frames 1, 30, 100 on Fig. 8's box and the original; error against Mitsuba and the lit ceiling's brightness measured over 8 runs, the frames Monte Carlo needs for MLT's error measured, the frame cost modelled by emulated warp instructions",
         scenes: &fig_9::SCENES,
         groups: &[fig_9::MC_MLT],
         render: Some(fig_9::render),
