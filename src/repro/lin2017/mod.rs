@@ -273,7 +273,7 @@ static TABLES: [TableDef; 14] = [
     TableDef {
         id: "s4.8-bootstrap",
         title: "4.8 Metropolis Light Transport",
-        lines: "L330",
+        lines: "L310-330",
         status: Status::Reproduced,
         note: "r-bar, the start-up's global radiance estimate, against the bootstrap count (not stated): b's error over 8 runs measured natively, b setting the image's luminance measured on the emulator",
         scenes: &fig_9::SCENES,
@@ -283,7 +283,7 @@ static TABLES: [TableDef; 14] = [
     TableDef {
         id: "s4.8-large-step",
         title: "4.8 Metropolis Light Transport",
-        lines: "L318-324",
+        lines: "L310-324",
         status: Status::Reproduced,
         note: "the large-step probability (0.25 the thesis' example) against the error on a diffuse and a glossy box: measured natively (the kernel's probability is a constant)",
         scenes: &sec_4_8::LARGE_STEP_SCENES,
