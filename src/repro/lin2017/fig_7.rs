@@ -21,7 +21,7 @@
 //!   renderer passes pixel by pixel at 32 × 32 (`tests/lin2017_reference.rs`);
 //! - the metric: OpenCV's `compareHist(..., HISTCMP_CORREL)`, which the
 //!   thesis probably used (OpenCV appears in its Table 4, 003:L615), on the
-//!   8-bit grey image OpenCV's `cvtColor(BGR2GRAY)` makes from our 8-bit sRGB
+//!   8-bit grey image OpenCV's `cvtColor(RGB2GRAY)` makes from our 8-bit sRGB
 //!   image (exposure 0, [`gray8`]), with 256 bins over 0-255
 //!   ([`histogram_correlation`]); 64 and 16 bins beside it.
 //!
@@ -333,7 +333,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
          light sampling with the balance and the power (β = 2) heuristic, seed 0 for both, on the emulator \
          (kernels/lin2017/path.cu, path_frame). Ground truth: our native renderer, next-event estimation at 16,384 \
          paths a pixel ({TRUTH}), as the thesis' was its own (MLT, 80,000 frames). Metric: OpenCV's \
-         HISTCMP_CORREL of the grey-level histograms (BGR2GRAY of the 8-bit sRGB images, exposure 0) with 256, 64 \
+         HISTCMP_CORREL of the grey-level histograms (OpenCV's RGB2GRAY of the 8-bit sRGB images, exposure 0) with 256, 64 \
          and 16 bins; fixtures chosen, docs/fixtures.md."
     ));
     table.notes.push(

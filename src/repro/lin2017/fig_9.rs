@@ -20,8 +20,8 @@
 //!   frames 1, 8, 25 (4, 32, 100 paths a pixel) ([`OUR_FRAMES`]);
 //! - the truth: Mitsuba 3's path-tracer references
 //!   (`tests/fixtures/mitsuba/cornell-inverted-path-32`, `cornell-lambert-32`);
-//!   "the directly lit ceiling": their pixels brighter than [`LIT`] of the
-//!   brightest;
+//!   the thesis' "part of the ceiling directly illuminated by the light" is
+//!   their pixels brighter than [`LIT`] of the brightest;
 //! - MLT with our start (each chain from the pool of all bootstrap samples,
 //!   in proportion to Y) and with the start before issue 15's fix (each chain
 //!   among its own 16 samples, natively only), [`RUNS`] independent runs
@@ -280,7 +280,11 @@ fn at(r: &Results, scene: &str, variant: &str, f: u32) -> Option<At> {
         lit += get("lit")?;
     }
     let n = RUNS as f64;
-    let out = |s: f64| (s / n - floor * floor).max(0.0).sqrt();
+    // a NaN error stays NaN (f64::max would make it 0)
+    let out = |s: f64| {
+        let v = s / n - floor * floor;
+        if v.is_nan() { f64::NAN } else { v.max(0.0).sqrt() }
+    };
     Some(At { error: out(e2), noise: out(n2), lit: lit / n })
 }
 

@@ -2,7 +2,7 @@
 //! large-step probability.
 //!
 //! The normalisation (003:L330): "the estimation of
-//! global radiance r̄ = ‖∫ f dX‖ [...] at the beginning will affect the
+//! global radiance r̄ = ‖∫_S f dX‖ [...] at the beginning will affect the
 //! overall luminance of the final result. [...] r̄ functions as a scaling
 //! factor for all samples. As a result, in the case where the rendered
 //! result is required to be physically authentic, more sample should be
@@ -214,9 +214,15 @@ pub const LARGE_STEP_FRAMES: u32 = 25;
 /// `noise_r{r}`. Native: the kernel's probability is a constant.
 pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let scene = ws.scene;
+    if !LARGE_STEP_SCENES.contains(&scene.name.as_str()) {
+        return Err(format!("{}: the large-step study runs on {LARGE_STEP_SCENES:?} only", scene.name).into());
+    }
     let truth = Reference::read(&Reference::default_prefix(&scene.name))?;
     let truth_y = mean_luminance(&truth.mean);
-    let n = truth.mean.width;
+    let n = SIDE;
+    if (truth.mean.width, truth.mean.height) != (n, n) {
+        return Err(format!("{}: expected {n}x{n}", truth.prefix.display()).into());
+    }
     let camera = Camera { resolution: [n, n], ..scene.camera };
     let ps = runs::path_scene(scene)?;
     let mut out = Vec::new();
@@ -294,7 +300,7 @@ pub fn render_large_step(e: &Entry, r: &Results) -> Vec<Table> {
     });
     table.notes.push(format!(
         "Ours: MLT over bdpt natively (mlt::render_target with mlt::Chains {{ p_large, start from the pool }}; the \
-         kernel's probability is the constant 0.25), {} at 32 x 32, {} bounces, {RUNS} runs (seeds {SEED0}-{}) of \
+         kernel's probability is the constant 0.25), {} at {SIDE} x {SIDE}, {} bounces, {RUNS} runs (seeds {SEED0}-{}) of \
          {LARGE_STEP_FRAMES} frames (the thesis' 100 mutations a chain); the error: RMS over pixels and channels \
          against the Mitsuba reference with each image scaled to its mean luminance first (b's error removed: \
          lin:s4.8-bootstrap), the runs' mean square. Small steps: Kelemen's s1 = 1/1024, s2 = 1/64.",
