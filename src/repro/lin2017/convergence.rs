@@ -32,11 +32,10 @@ use serde::{Deserialize, Serialize};
 use crate::chart::{Scatter, Series};
 use crate::host::camera::Camera;
 use crate::host::image::{FrameBuffer, ImageError};
-use crate::host::kdtree::{BuildParams, Heuristic, build};
-use crate::host::path::layout::{LayoutError, PathScene};
-use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, kernel, mlt, render_native, stats};
+use crate::host::path::layout::LayoutError;
+use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, mlt, render_native, stats};
 use crate::host::scene::Scene;
-use crate::sim::{Device, Fidelity, SimError};
+use crate::repro::lin2017::runs;
 
 /// The integrators charted, in the order of the thesis' chapter 4.
 pub const INTEGRATORS: [Integrator; 6] =
@@ -83,9 +82,9 @@ pub enum ConvergenceError {
     /// MLT refused the settings.
     #[error(transparent)]
     Mlt(#[from] mlt::MltError),
-    /// The emulator failed.
+    /// The emulated or the native render failed.
     #[error(transparent)]
-    Sim(#[from] SimError),
+    Twin(#[from] runs::TwinError),
     /// The native renderer refused the settings.
     #[error(transparent)]
     Render(#[from] crate::host::path::RenderError),
@@ -303,9 +302,7 @@ pub fn measure(
             "expected at least one integrator, a positive frame count and positive emulated frame counts".into(),
         ));
     }
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(scene, &tree)?;
+    let ps = runs::path_scene(scene)?;
     let camera = Camera { resolution: [size, size], ..scene.camera };
     let (ref_rmse, ref_rel) = r.noise();
     let marks = checkpoints(o.frames);
@@ -328,37 +325,16 @@ pub fn measure(
         let mut at = Vec::with_capacity(o.frames as usize);
         let t0 = Instant::now();
         let run = render_native(&ps, &camera, params, o.frames, true, |_| at.push(t0.elapsed().as_secs_f64()))?;
-        let mut sum = vec![[0.0f64; 3]; (size * size) as usize];
-        let mut native = Vec::new();
-        for (f, img) in run.frame_images.iter().enumerate() {
-            for (s, p) in sum.iter_mut().zip(&img.pixels) {
-                for (a, &v) in s.iter_mut().zip(p) {
-                    *a += v as f64;
-                }
-            }
-            let frames = f as u32 + 1;
-            if marks.contains(&frames) {
-                let mut running = FrameBuffer::new(size, size);
-                for (q, s) in running.pixels.iter_mut().zip(&sum) {
-                    *q = s.map(|v| (v / frames as f64) as f32);
-                }
-                native.push(Point::of(&running, r, frames * SAMPLES_PER_FRAME, at[f]));
-            }
-        }
+        let native = runs::running_means(&run.frame_images, &marks)
+            .into_iter()
+            .map(|(frames, mean)| Point::of(&mean, r, frames * SAMPLES_PER_FRAME, at[frames as usize - 1]))
+            .collect();
         let mut emulated = Vec::new();
         let mut equal = true;
         for &ef in &o.emulated_frames {
             progress(&format!("{}: {ef} emulated frame(s)", integrator.name()));
-            let mut cfg = kernel::sim_config(&params);
-            cfg.fidelity = Fidelity::Functional;
-            let mut dev = Device::with_config(cfg);
-            let module = kernel::load(&mut dev)?;
-            let t = Instant::now();
-            let k = kernel::render(&mut dev, &module, &ps, &camera, params, ef, false, |_| {})?;
-            let seconds = t.elapsed().as_secs_f64();
-            let twin = render_native(&ps, &camera, params, ef, false, |_| {})?;
-            equal &= k.image.accum.len() == twin.accum.len()
-                && k.image.accum.iter().zip(&twin.accum).all(|(a, b)| a.to_bits() == b.to_bits());
+            let runs::Twin { emulated: k, same, seconds } = runs::emulate_twin(&ps, &camera, params, ef)?;
+            equal &= same;
             let mut p = Point::of(&k.image.image(), r, ef * SAMPLES_PER_FRAME, seconds);
             p.warp_instructions = Some(k.totals.warp_instructions);
             p.thread_instructions = Some(k.totals.thread_instructions);

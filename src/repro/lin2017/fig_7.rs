@@ -158,7 +158,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
         let params = |seed: u32| runs::square(n, integrator, BOUNCES, seed);
         params(0).check()?;
         let mut k = BTreeMap::new();
-        let runs::Twin { emulated, same } = runs::emulate_twin(&ps, &camera, params(0), FRAMES)?;
+        let runs::Twin { emulated, same, .. } = runs::emulate_twin(&ps, &camera, params(0), FRAMES)?;
         metrics(&mut k, "", &emulated.image.image(), &truth);
         k.insert("truth_y".into(), truth_y[0]);
         k.insert("mitsuba_y".into(), truth_y[1]);

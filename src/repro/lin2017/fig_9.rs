@@ -151,30 +151,6 @@ pub fn scaled(img: &FrameBuffer, y: f64) -> FrameBuffer {
     out
 }
 
-/// The running means of `frames` (the image after f frames) at `marks`.
-fn running(frames: &[FrameBuffer], marks: &[u32]) -> Vec<(u32, FrameBuffer)> {
-    let Some(first) = frames.first() else { return Vec::new() };
-    let (w, h) = (first.width, first.height);
-    let mut sum = vec![[0.0f64; 3]; (w * h) as usize];
-    let mut out = Vec::new();
-    for (f, img) in frames.iter().enumerate() {
-        for (s, p) in sum.iter_mut().zip(&img.pixels) {
-            for (a, &v) in s.iter_mut().zip(p) {
-                *a += v as f64;
-            }
-        }
-        let n = f as u32 + 1;
-        if marks.contains(&n) {
-            let mut fb = FrameBuffer::new(w, h);
-            for (q, s) in fb.pixels.iter_mut().zip(&sum) {
-                *q = s.map(|v| (v / n as f64) as f32);
-            }
-            out.push((n, fb));
-        }
-    }
-    out
-}
-
 /// Measurement group [`MC_MLT`]: per variant and run `r`, at each mark `f`
 /// the RMS error `rmse_f{f}_r{r}` and the lit ceiling's relative luminance
 /// `lit_f{f}_r{r}`; `emulated_same` and the emulated frames' warp
@@ -219,7 +195,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
                 }
             };
             let marks = if variant == "mc" { mc_marks() } else { OUR_FRAMES.to_vec() };
-            record(&mut k, r, running(&frames, &marks));
+            record(&mut k, r, runs::running_means(&frames, &marks));
         }
         out.push(Sample {
             group: MC_MLT.into(),
@@ -280,11 +256,7 @@ fn at(r: &Results, scene: &str, variant: &str, f: u32) -> Option<At> {
         lit += get("lit")?;
     }
     let n = RUNS as f64;
-    // a NaN error stays NaN (f64::max would make it 0)
-    let out = |s: f64| {
-        let v = s / n - floor * floor;
-        if v.is_nan() { f64::NAN } else { v.max(0.0).sqrt() }
-    };
+    let out = |s: f64| runs::above_floor((s / n).sqrt(), floor);
     Some(At { error: out(e2), noise: out(n2), lit: lit / n })
 }
 

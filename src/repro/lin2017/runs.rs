@@ -4,6 +4,7 @@
 //! of an error over independent runs.
 
 use crate::host::camera::Camera;
+use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::{LayoutError, PathScene};
 use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel, render_native};
@@ -41,21 +42,26 @@ pub struct Twin {
     pub emulated: kernel::KernelRender,
     /// Whether its accumulation buffer equals the native render's bit for bit.
     pub same: bool,
+    /// Host seconds the emulated render took (the native twin not counted).
+    pub seconds: f64,
 }
 
 /// `frames` frames of `params` on the emulator at functional fidelity (the
 /// path kernel's simulator settings otherwise), and natively: the emulated
-/// render, and whether the two accumulation buffers are equal bit for bit.
+/// render, whether the two accumulation buffers are equal bit for bit, and
+/// the emulated render's host time.
 pub fn emulate_twin(ps: &PathScene, camera: &Camera, params: FrameParams, frames: u32) -> Result<Twin, TwinError> {
     let mut cfg = kernel::sim_config(&params);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);
     let module = kernel::load(&mut dev)?;
+    let t0 = std::time::Instant::now();
     let emulated = kernel::render(&mut dev, &module, ps, camera, params, frames, false, |_| {})?;
+    let seconds = t0.elapsed().as_secs_f64();
     let twin = render_native(ps, camera, params, frames, false, |_| {})?;
     let same = emulated.image.accum.len() == twin.accum.len()
         && emulated.image.accum.iter().zip(&twin.accum).all(|(a, b)| a.to_bits() == b.to_bits());
-    Ok(Twin { emulated, same })
+    Ok(Twin { emulated, same, seconds })
 }
 
 /// A committed ground truth (`rel`, relative to the checkout) of
@@ -83,6 +89,39 @@ pub fn rms(errors: impl IntoIterator<Item = Option<f64>>) -> Option<f64> {
     (n > 0).then(|| (s / n as f64).sqrt())
 }
 
+/// `rms`, an RMS error against a reference, with the reference's own RMS
+/// noise `floor` taken out in quadrature (0 where the floor exceeds it; a
+/// NaN stays NaN).
+pub fn above_floor(rms: f64, floor: f64) -> f64 {
+    let v = rms * rms - floor * floor;
+    if v.is_nan() { f64::NAN } else { v.max(0.0).sqrt() }
+}
+
+/// The running means of `frames` (frame images of one run, in order) after
+/// each count of frames in `marks`, as `(frames, mean image)`; sums in f64.
+pub fn running_means(frames: &[FrameBuffer], marks: &[u32]) -> Vec<(u32, FrameBuffer)> {
+    let Some(first) = frames.first() else { return Vec::new() };
+    let (w, h) = (first.width, first.height);
+    let mut sum = vec![[0.0f64; 3]; (w * h) as usize];
+    let mut out = Vec::new();
+    for (f, img) in frames.iter().enumerate() {
+        for (s, p) in sum.iter_mut().zip(&img.pixels) {
+            for (a, &v) in s.iter_mut().zip(p) {
+                *a += v as f64;
+            }
+        }
+        let n = f as u32 + 1;
+        if marks.contains(&n) {
+            let mut fb = FrameBuffer::new(w, h);
+            for (q, s) in fb.pixels.iter_mut().zip(&sum) {
+                *q = s.map(|v| (v / n as f64) as f32);
+            }
+            out.push((n, fb));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -92,5 +131,22 @@ mod tests {
         assert_eq!(rms([Some(3.0), Some(4.0)]), Some(12.5f64.sqrt()));
         assert_eq!(rms([Some(3.0), None]), None);
         assert_eq!(rms(std::iter::empty()), None);
+    }
+
+    #[test]
+    fn running_means_at_the_marks() {
+        let frame = |v: f32| FrameBuffer { width: 1, height: 1, pixels: vec![[v, 2.0 * v, 0.0]] };
+        let at = running_means(&[frame(1.0), frame(3.0), frame(8.0)], &[1, 3]);
+        assert_eq!(at.iter().map(|(n, _)| *n).collect::<Vec<_>>(), [1, 3]);
+        assert_eq!(at[0].1.pixels[0], [1.0, 2.0, 0.0]);
+        assert_eq!(at[1].1.pixels[0], [4.0, 8.0, 0.0]);
+        assert!(running_means(&[], &[1]).is_empty());
+    }
+
+    #[test]
+    fn floor_taken_out_in_quadrature() {
+        assert_eq!(above_floor(5.0, 3.0), 4.0);
+        assert_eq!(above_floor(3.0, 5.0), 0.0);
+        assert!(above_floor(f64::NAN, 1.0).is_nan());
     }
 }

@@ -1,0 +1,87 @@
+//! Thesis 003's Fig. 8 (003:L305-308): bidirectional against eye path
+//! tracing in the box with the light turned to the ceiling (`warplight
+//! tables lin:fig8`). The recorded errors, the modelled frame rate and its
+//! verdict, the checks following the evidence, and the study refusing
+//! another scene.
+
+use warplight::repro::compare::Verdict;
+use warplight::repro::lin2017::fig_8::{self, BDPT_NEE, SCENE};
+use warplight::repro::protocol::Protocol;
+use warplight::repro::registry::{Workspace, resolve};
+use warplight::repro::results::{Results, Sample};
+use warplight::repro::table::Table;
+
+fn table_of(samples: &[Sample]) -> Table {
+    let mut r = Results::new("test", Protocol::quick(), vec!["lin:fig8".into()], vec![BDPT_NEE.into()]);
+    r.samples = samples.to_vec();
+    let e = resolve(&["lin:fig8".into()]).expect("registered").remove(0);
+    (e.table.render.expect("rendered"))(&e, &r).remove(0)
+}
+
+fn load(name: &str) -> warplight::host::scene::Scene {
+    warplight::host::scene_file::load(&warplight::host::scene_file::resolve(name)).expect("scene")
+}
+
+/// Per row (bdpt, nee, pt): RMS error of the radiance, of the displayed
+/// image, and the frame rate relative to nee's in percent (modelled).
+const RECORDED: [[f64; 3]; 3] = [[0.0985, 0.0781, 50.06], [0.4876, 0.1226, 100.0], [0.0332, 0.1520, 124.35]];
+
+/// bdpt against nee (radiance, display), against pt (radiance, display), emulated = native.
+const CHECKS: [bool; 5] = [true, false, false, true, true];
+
+#[test]
+fn fig8_records_its_errors_rate_and_checks() {
+    let scene = load(SCENE);
+    let mut ws = Workspace::new(&scene, 0..1, 32);
+    let mut samples = fig_8::measure(&mut ws, &mut |_| {}).expect("measure");
+    let t = table_of(&samples);
+    for c in &t.checks {
+        eprintln!("{} {}: {}", if c.holds { "✓" } else { "✗" }, c.claim, c.evidence);
+    }
+    for (row, want) in t.rows.iter().zip(RECORDED) {
+        let got: Vec<f64> = row.cells.iter().map(|c| c.ours.expect("measured")).collect();
+        eprintln!("{}: {got:?}", row.label);
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 5e-3 * w.abs().max(0.01), "{}: {got:?} against {want:?}", row.label);
+        }
+    }
+    assert_eq!(t.rows[0].cells[2].verdict, Some(Verdict::Within), "bdpt's modelled frame rate is the thesis' 50%");
+    assert_eq!(t.checks.iter().map(|c| c.holds).collect::<Vec<_>>(), CHECKS);
+
+    // bdpt's and nee's errors swapped: bdpt no longer beats nee under either measure
+    let mut swapped = samples.clone();
+    for s in &mut swapped {
+        s.variant = match s.variant.as_str() {
+            "bdpt" => "nee".into(),
+            "nee" => "bdpt".into(),
+            other => other.into(),
+        };
+    }
+    let t = table_of(&swapped);
+    assert_eq!(&t.checks.iter().map(|c| c.holds).collect::<Vec<_>>()[..2], [false, false]);
+
+    // a bdpt frame costing three of nee's: 33 %, outside the thesis' 50 % ± 10 %
+    let nee = samples.iter().find(|s| s.variant == "nee").expect("nee").counters["frame_warps"];
+    let bdpt = samples.iter_mut().find(|s| s.variant == "bdpt").expect("bdpt");
+    bdpt.counters.insert("frame_warps".into(), 3.0 * nee);
+    assert_eq!(table_of(&samples).rows[0].cells[2].verdict, Some(Verdict::Outside));
+}
+
+#[test]
+fn fig8_refuses_another_scene() {
+    let scene = load("cornell-lambert");
+    let mut ws = Workspace::new(&scene, 0..1, 32);
+    let err = fig_8::measure(&mut ws, &mut |_| {}).expect_err("refused").to_string();
+    assert!(err.contains("cornell-inverted"), "{err}");
+}
+
+#[test]
+fn display_error_is_of_the_clipped_srgb_image() {
+    use warplight::host::image::FrameBuffer;
+    let mut a = FrameBuffer::new(2, 1);
+    let b = FrameBuffer::new(2, 1);
+    assert_eq!(fig_8::display_rmse(&a, &b), 0.0);
+    // one pixel far above 1 after exposure: clipped to white, full scale in its 3 channels of 6
+    a.pixels[0] = [100.0; 3];
+    assert!((fig_8::display_rmse(&a, &b) - 0.5f64.sqrt()).abs() < 1e-12);
+}
