@@ -7,7 +7,8 @@
 #   docs/images/lin-fig6-{mis,bsdf}.png;
 # - Fig. 8 (003:L305-308): bdpt, nee and pt at the thesis' 100 frames of one
 #   path a pixel (our 100), scenes/cornell-inverted.toml, exposure +2, seed
-#   800 (the first run of `warplight tables lin:fig8`):
+#   800 (the seed of the first run of `warplight tables lin:fig8`, which
+#   renders 32 x 32):
 #   docs/images/lin-fig8-{bdpt,nee,pt}.png;
 # - Fig. 9 (003:L332-336): Monte Carlo (bdpt) and MLT over bdpt at its frames
 #   1, 30 and 100 (our 4, 32 and 100 paths a pixel), on Fig. 8's box with the

@@ -157,12 +157,8 @@ fn error(r: &Results, variant: &str, i: usize) -> Option<f64> {
 
 /// Runs in which `a`'s error in region `i` is below `b`'s.
 fn wins(r: &Results, a: &str, b: &str, i: usize) -> Option<u32> {
-    let mut w = 0;
-    for run in 0..RUNS {
-        let key = format!("rmse{i}_r{run}");
-        w += u32::from(r.sum(MIS_BSDF, SCENE, a, &key)? < r.sum(MIS_BSDF, SCENE, b, &key)?);
-    }
-    Some(w)
+    let e = |v: &str, run: u32| r.sum(MIS_BSDF, SCENE, v, &format!("rmse{i}_r{run}"));
+    runs::count(RUNS, |run| Some(e(a, run)? < e(b, run)?))
 }
 
 /// The table.

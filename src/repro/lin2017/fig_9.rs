@@ -248,16 +248,13 @@ struct At {
 
 fn at(r: &Results, scene: &str, variant: &str, f: u32) -> Option<At> {
     let floor = r.sum(MC_MLT, scene, "emulated", "truth_noise").unwrap_or(0.0);
-    let (mut e2, mut n2, mut lit) = (0.0, 0.0, 0.0);
+    let get = |c: &str, run: u32| r.sum(MC_MLT, scene, variant, &format!("{c}_f{f}_r{run}"));
+    let over_runs = |c: &str| runs::rms((0..RUNS).map(|run| get(c, run))).map(|e| runs::above_floor(e, floor));
+    let mut lit = 0.0;
     for run in 0..RUNS {
-        let get = |c: &str| r.sum(MC_MLT, scene, variant, &format!("{c}_f{f}_r{run}"));
-        e2 += get("rmse")?.powi(2);
-        n2 += get("noise")?.powi(2);
-        lit += get("lit")?;
+        lit += get("lit", run)?;
     }
-    let n = RUNS as f64;
-    let out = |s: f64| runs::above_floor((s / n).sqrt(), floor);
-    Some(At { error: out(e2), noise: out(n2), lit: lit / n })
+    Some(At { error: over_runs("rmse")?, noise: over_runs("noise")?, lit: lit / RUNS as f64 })
 }
 
 /// The thesis frames (paths a pixel) from which on Monte Carlo's RMS error

@@ -238,7 +238,7 @@ static TABLES: [TableDef; 15] = [
         title: "Left: Bi-directional path tracing Right: Uni-directional (eye) path tracing",
         lines: "L305-308",
         status: Status::Partly,
-        note: "IMAGE + TIMING ratio: bdpt against nee (the text) and pt (the caption) at 100 frames on the inverted-light box, the RMS error against Mitsuba measured over 8 runs; the frame rate (50%) modelled by emulated warp instructions",
+        note: "IMAGE + TIMING ratio: bdpt against nee (the text) and pt (the caption) at 100 paths a pixel (the thesis' 100 frames) on the inverted-light box, the RMS error against Mitsuba measured over 8 runs; the frame rate (50%) modelled by emulated warp instructions",
         scenes: &[fig_8::SCENE],
         groups: &[fig_8::BDPT_NEE],
         render: Some(fig_8::render),

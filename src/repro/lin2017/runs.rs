@@ -89,6 +89,16 @@ pub fn rms(errors: impl IntoIterator<Item = Option<f64>>) -> Option<f64> {
     (n > 0).then(|| (s / n as f64).sqrt())
 }
 
+/// The runs `0..runs` for which `holds` is true; `None` if it is `None`
+/// for any (a value missing).
+pub fn count(runs: u32, mut holds: impl FnMut(u32) -> Option<bool>) -> Option<u32> {
+    let mut n = 0;
+    for run in 0..runs {
+        n += u32::from(holds(run)?);
+    }
+    Some(n)
+}
+
 /// `rms`, an RMS error against a reference, with the reference's own RMS
 /// noise `floor` taken out in quadrature (0 where the floor exceeds it; a
 /// NaN stays NaN).
@@ -141,6 +151,12 @@ mod tests {
         assert_eq!(at[0].1.pixels[0], [1.0, 2.0, 0.0]);
         assert_eq!(at[1].1.pixels[0], [4.0, 8.0, 0.0]);
         assert!(running_means(&[], &[1]).is_empty());
+    }
+
+    #[test]
+    fn count_of_runs() {
+        assert_eq!(count(3, |r| Some(r != 1)), Some(2));
+        assert_eq!(count(3, |r| (r != 2).then_some(true)), None);
     }
 
     #[test]
