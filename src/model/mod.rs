@@ -16,6 +16,7 @@
 //! assert_eq!(stats.counters.global_st.sectors, 8); // 2 warps x 128 contiguous bytes
 //! ```
 
+pub mod atomic_tally;
 pub mod atomics;
 pub mod banks;
 pub mod cache;

@@ -352,6 +352,8 @@ pub struct Device {
     printf: super::printf::PrintfSink,
     progress: Option<super::grid::ProgressHook>,
     textures: Vec<super::texture::Object>,
+    /// The observer of launches made without one ([`Device::set_observer`]).
+    observer: Option<std::sync::Arc<dyn ObserverFactory + Send>>,
 }
 
 impl Default for Device {
@@ -378,6 +380,7 @@ impl Device {
             printf: Default::default(),
             progress: DEFAULT_PROGRESS.read().ok().and_then(|h| h.clone()),
             textures: Vec::new(),
+            observer: None,
         }
     }
 
@@ -386,6 +389,14 @@ impl Device {
     /// progress bars and ETAs (`render`, `launch`, `tables`).
     pub fn set_progress(&mut self, hook: Option<super::grid::ProgressHook>) {
         self.progress = hook;
+    }
+
+    /// Sets (or clears) the observer of every launch made by
+    /// [`Device::launch`] (fidelity `memory` or above): for code that launches
+    /// on its own (a renderer's frames) while a caller tallies the accesses.
+    /// A launch given an observer ([`Device::launch_observed`]) uses that one.
+    pub fn set_observer(&mut self, observer: Option<std::sync::Arc<dyn ObserverFactory + Send>>) {
+        self.observer = observer;
     }
 
     /// The configuration.
@@ -598,7 +609,8 @@ impl Device {
         self.printf.take()
     }
 
-    /// Runs a kernel to completion. On a fault, memory keeps what the kernel wrote
+    /// Runs a kernel to completion (observed by the device's observer, if one
+    /// is set: [`Device::set_observer`]). On a fault, memory keeps what the kernel wrote
     /// before it, and the error names the instruction, CTA, warp and lane.
     pub fn launch(
         &mut self,
@@ -607,7 +619,8 @@ impl Device {
         cfg: LaunchConfig,
         args: &[Arg],
     ) -> Result<LaunchStats, SimError> {
-        self.launch_observed(m, kernel, cfg, args, None)
+        let observer = self.observer.clone();
+        self.launch_observed(m, kernel, cfg, args, observer.as_deref().map(|o| o as &dyn ObserverFactory))
     }
 
     /// As [`Device::launch`], with a counter model observing every memory access.

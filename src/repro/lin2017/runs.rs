@@ -9,6 +9,7 @@ use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::{LayoutError, PathScene};
 use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel, render_native};
 use crate::host::scene::Scene;
+use crate::model::atomic_tally::{AtomicSharing, AtomicTally};
 use crate::sim::{Device, Fidelity, SimError};
 
 /// `scene` laid out for the path tracer on the thesis' SAH kd-tree.
@@ -62,6 +63,25 @@ pub fn emulate_twin(ps: &PathScene, camera: &Camera, params: FrameParams, frames
     let same = emulated.image.accum.len() == twin.accum.len()
         && emulated.image.accum.iter().zip(&twin.accum).all(|(a, b)| a.to_bits() == b.to_bits());
     Ok(Twin { emulated, same, seconds })
+}
+
+/// The global atomics of `frames` frames of `params` on the emulator at
+/// memory fidelity (the path kernel's simulator settings otherwise), tallied
+/// by address over every launch of the render ([`AtomicTally`]).
+pub fn atomic_sharing(
+    ps: &PathScene,
+    camera: &Camera,
+    params: FrameParams,
+    frames: u32,
+) -> Result<AtomicSharing, SimError> {
+    let mut cfg = kernel::sim_config(&params);
+    cfg.fidelity = Fidelity::Memory;
+    let mut dev = Device::with_config(cfg);
+    let module = kernel::load(&mut dev)?;
+    let tally = std::sync::Arc::new(AtomicTally::new());
+    dev.set_observer(Some(tally.clone()));
+    kernel::render(&mut dev, &module, ps, camera, params, frames, false, |_| {})?;
+    Ok(tally.sharing())
 }
 
 /// A committed ground truth (`rel`, relative to the checkout) of
