@@ -25,7 +25,6 @@ use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::PathScene;
 use crate::host::path::{Integrator, render_native};
-use crate::host::raycast::{Caster, TraceStats};
 use crate::host::scene::Scene;
 use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
@@ -73,18 +72,10 @@ pub const ROWS: [(&str, Integrator, u32, &str); 2] = [
 /// Per pixel, the index into [`REGIONS`] of the region its centre's camera
 /// ray first hits (by its material's name), if any but the last.
 pub fn regions(scene: &Scene, camera: &Camera, tree: &crate::host::kdtree::KdTree) -> Vec<Option<usize>> {
-    let caster = Caster::new(scene, tree);
-    let mut st = TraceStats::default();
-    let [w, h] = camera.resolution;
-    let mut out = Vec::with_capacity((w * h) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let hit = caster.intersect(&camera.ray(x, y), 0.0, f32::INFINITY, false, &mut st);
-            let name = hit.map(|h| scene.materials[scene.triangles[h.tri as usize].material as usize].name.as_str());
-            out.push(name.and_then(|n| REGIONS.iter().position(|(_, m)| m.contains(&n))));
-        }
-    }
-    out
+    runs::first_hit_materials(scene, camera, tree)
+        .into_iter()
+        .map(|name| name.and_then(|n| REGIONS.iter().position(|(_, m)| m.contains(&n))))
+        .collect()
 }
 
 /// The RMS error of `img` against `truth` over pixels and channels, per region

@@ -308,7 +308,7 @@ static TABLES: [TableDef; 15] = [
         title: "4.8 Metropolis Light Transport",
         lines: "L310-324",
         status: Status::Reproduced,
-        note: "the large-step probability (0.25 the thesis' example) against the error on a diffuse and a glossy box: measured natively (the kernel's probability is a constant)",
+        note: "the large-step probability (0.25 the thesis' example) against the error on a diffuse, a glossy and a caustic box: measured natively (the kernel's probability is a constant)",
         scenes: &sec_4_8::LARGE_STEP_SCENES,
         groups: &[sec_4_8::LARGE_STEP_GROUP],
         render: Some(sec_4_8::render_large_step),

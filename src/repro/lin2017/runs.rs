@@ -5,9 +5,10 @@
 
 use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
+use crate::host::kdtree::{BuildParams, Heuristic, KdTree, build};
 use crate::host::path::layout::{LayoutError, PathScene};
 use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel, render_native};
+use crate::host::raycast::{Caster, TraceStats};
 use crate::host::scene::Scene;
 use crate::model::atomic_tally::{AtomicSharing, AtomicTally};
 use crate::sim::{Device, Fidelity, SimError};
@@ -17,6 +18,22 @@ pub fn path_scene(scene: &Scene) -> Result<PathScene, LayoutError> {
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
     PathScene::new(scene, &tree)
+}
+
+/// Per pixel of `camera`, the name of the material its centre's camera ray
+/// hits first on `tree` (of `scene`), if any.
+pub fn first_hit_materials<'s>(scene: &'s Scene, camera: &Camera, tree: &KdTree) -> Vec<Option<&'s str>> {
+    let caster = Caster::new(scene, tree);
+    let mut st = TraceStats::default();
+    let [w, h] = camera.resolution;
+    let mut out = Vec::with_capacity((w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let hit = caster.intersect(&camera.ray(x, y), 0.0, f32::INFINITY, false, &mut st);
+            out.push(hit.map(|h| scene.materials[scene.triangles[h.tri as usize].material as usize].name.as_str()));
+        }
+    }
+    out
 }
 
 /// A square image of `side` pixels traced with `integrator`, at most

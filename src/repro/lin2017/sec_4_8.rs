@@ -25,13 +25,15 @@
 //! mostly diffuse surfaces, large mutation rate can be set larger. On the
 //! other hand, if the intricate optical effects are the emphasis of
 //! rendering, large mutation rate should be set much smaller." Ours: MLT's
-//! error after 100 mutations a chain at [`LARGE_STEPS`] on a diffuse box and
-//! one with a glossy back wall, natively ([`mlt::Chains`]; the kernel's is
+//! error after 100 mutations a chain at [`LARGE_STEPS`] on a diffuse box,
+//! one with a glossy back wall and one with a glass caustic, natively ([`mlt::Chains`]; the kernel's is
 //! the constant 0.25).
 
 use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
+use crate::host::image::FrameBuffer;
+use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::native::Tracer;
 use crate::host::path::{Integrator, SAMPLES_PER_FRAME, eps_for, frame_of, kernel, mlt};
 use crate::repro::lin2017::convergence::{Reference, mean_luminance};
@@ -202,8 +204,24 @@ pub const LARGE_STEP_GROUP: &str = "lin/mlt-large-step";
 /// The large-step probabilities measured (the kernel's: 0.25, 003:L318's example).
 pub const LARGE_STEPS: [f32; 5] = [0.05, 0.1, 0.25, 0.5, 1.0];
 
-/// The study's scenes: a diffuse box and one with a glossy back wall.
-pub const LARGE_STEP_SCENES: [&str; 2] = ["cornell-lambert", "cornell-rough"];
+/// The study's scenes: a diffuse box, one with a glossy back wall and one
+/// with a caustic (the tall box smooth glass).
+pub const LARGE_STEP_SCENES: [&str; 3] = ["cornell-lambert", "cornell-rough", "cornell-caustic"];
+
+/// The intricate effect of each scene that has one: the material whose
+/// pixels (the camera ray's first hit) the region error is taken over.
+pub const INTRICATE: [(&str, &str, &str); 2] =
+    [("cornell-rough", "roughMirror", "the glossy back wall"), ("cornell-caustic", "clearGlass", "the glass box")];
+
+/// The RMS difference of `a` and `b` over the pixels of `mask` and their channels.
+fn masked_rmse(a: &FrameBuffer, b: &FrameBuffer, mask: &[bool]) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for ((x, y), _) in a.pixels.iter().zip(&b.pixels).zip(mask).filter(|(_, m)| **m) {
+        s += (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>();
+        n += 3;
+    }
+    (s / n.max(1) as f64).sqrt()
+}
 
 /// Frames a run: the thesis' 100 (of one mutation a chain; ours 4 a frame).
 pub const LARGE_STEP_FRAMES: u32 = 25;
@@ -211,7 +229,9 @@ pub const LARGE_STEP_FRAMES: u32 = 25;
 /// Measurement group [`LARGE_STEP_GROUP`]: per large-step probability
 /// (variant `p0.25`) and run `r`, the image's RMS error against the truth
 /// after [`LARGE_STEP_FRAMES`] frames with its brightness (b) removed,
-/// `noise_r{r}`. Native: the kernel's probability is a constant.
+/// `noise_r{r}`, and on the scenes of [`INTRICATE`] the same over the
+/// pixels that see their intricate material, `region_r{r}`. Native: the
+/// kernel's probability is a constant.
 pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let scene = ws.scene;
     if !LARGE_STEP_SCENES.contains(&scene.name.as_str()) {
@@ -225,6 +245,11 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
     }
     let camera = Camera { resolution: [n, n], ..scene.camera };
     let ps = runs::path_scene(scene)?;
+    let region: Option<Vec<bool>> = INTRICATE.iter().find(|(s, _, _)| *s == scene.name).map(|(_, material, _)| {
+        let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+        let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+        runs::first_hit_materials(scene, &camera, &tree).iter().map(|m| *m == Some(*material)).collect()
+    });
     let mut out = Vec::new();
     for p_large in LARGE_STEPS {
         let variant = format!("p{p_large}");
@@ -235,10 +260,11 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
             let tracer = Tracer { scene: &ps, frame: frame_of(&camera, eps_for(ps.lo, ps.hi)), params: p };
             let chains = mlt::Chains { p_large, ..mlt::Chains::KERNEL };
             let img = mlt::render_target(&tracer, p, chains, LARGE_STEP_FRAMES, false, |_| {})?.image.image();
-            k.insert(
-                format!("noise_r{r}"),
-                crate::repro::lin2017::convergence::rmse(&fig_9::scaled(&img, truth_y), &truth.mean),
-            );
+            let scaled = fig_9::scaled(&img, truth_y);
+            k.insert(format!("noise_r{r}"), crate::repro::lin2017::convergence::rmse(&scaled, &truth.mean));
+            if let Some(mask) = &region {
+                k.insert(format!("region_r{r}"), masked_rmse(&scaled, &truth.mean, mask));
+            }
         }
         out.push(Sample {
             group: LARGE_STEP_GROUP.into(),
@@ -251,60 +277,79 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
     Ok(out)
 }
 
-/// The RMS over runs of the brightness-removed error at large-step probability `p`.
-fn large_step_noise(r: &Results, scene: &str, p: f32) -> Option<f64> {
-    runs::rms((0..RUNS).map(|run| r.sum(LARGE_STEP_GROUP, scene, &format!("p{p}"), &format!("noise_r{run}"))))
+/// The RMS over runs of the brightness-removed error at large-step
+/// probability `p`: over the image, or (`region`) the pixels of the scene's
+/// intricate material.
+fn large_step_noise(r: &Results, scene: &str, p: f32, region: bool) -> Option<f64> {
+    let key = if region { "region" } else { "noise" };
+    runs::rms((0..RUNS).map(|run| r.sum(LARGE_STEP_GROUP, scene, &format!("p{p}"), &format!("{key}_r{run}"))))
 }
 
-/// The large-step probability of least noise on `scene`.
-pub fn best_large_step(r: &Results, scene: &str) -> Option<f32> {
+/// The large-step probability of least noise on `scene` (`region`: over its
+/// intricate material's pixels).
+pub fn best_large_step(r: &Results, scene: &str, region: bool) -> Option<f32> {
     LARGE_STEPS
         .iter()
-        .map(|&p| large_step_noise(r, scene, p).map(|e| (p, e)))
+        .map(|&p| large_step_noise(r, scene, p, region).map(|e| (p, e)))
         .collect::<Option<Vec<_>>>()?
         .into_iter()
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(p, _)| p)
 }
 
-/// The large-step table: a row per probability, a column per scene.
+/// The large-step table: a row per probability, a column per scene and per
+/// intricate region.
 pub fn render_large_step(e: &Entry, r: &Results) -> Vec<Table> {
-    let columns = LARGE_STEP_SCENES
-        .iter()
-        .map(|s| Column::ours_only(&format!("{s}: RMS error, brightness removed"), Unit::Number(4)))
-        .collect();
+    // (scene, region or not, column name)
+    let mut cols: Vec<(&str, bool, String)> = Vec::new();
+    for s in LARGE_STEP_SCENES {
+        cols.push((s, false, format!("{s}: RMS error, brightness removed")));
+        if let Some((_, _, what)) = INTRICATE.iter().find(|(x, _, _)| *x == s) {
+            cols.push((s, true, format!("{s}: the same over {what}")));
+        }
+    }
+    let columns = cols.iter().map(|(_, _, name)| Column::ours_only(name, Unit::Number(4))).collect();
     let rows = LARGE_STEPS
         .iter()
         .map(|&p| Row {
             label: format!("large steps {p}{}", if p == mlt::P_LARGE { " (the kernel's)" } else { "" }),
             kind: RowKind::Scene,
-            cells: LARGE_STEP_SCENES
+            cells: cols
                 .iter()
-                .map(|s| Cell { ours: large_step_noise(r, s, p), ..Cell::default() })
+                .map(|(s, region, _)| Cell { ours: large_step_noise(r, s, p, *region), ..Cell::default() })
                 .collect(),
         })
         .collect();
     let mut table =
         Table { address: e.address(), heading: e.heading(), columns, rows, checks: Vec::new(), notes: Vec::new() };
-    let [diffuse, glossy] = LARGE_STEP_SCENES.map(|s| best_large_step(r, s));
+    let diffuse = best_large_step(r, LARGE_STEP_SCENES[0], false);
     let show = |p: Option<f32>| p.map_or("–".into(), |p| p.to_string());
-    table.checks.push(Check {
-        claim: "a larger large-step rate suits diffuse scenes, a smaller one intricate effects (003:L324)".into(),
-        evidence: format!(
-            "measured over {RUNS} runs of {LARGE_STEP_FRAMES} frames: the least error at large steps {} on the \
-             diffuse box, {} on the box with the glossy back wall (holds if the diffuse box's is the larger)",
-            show(diffuse),
-            show(glossy)
-        ),
-        holds: diffuse.zip(glossy).is_some_and(|(d, g)| d > g),
-    });
+    for (scene, _, what) in INTRICATE {
+        for region in [false, true] {
+            let intricate = best_large_step(r, scene, region);
+            let over = if region { format!("over {what}") } else { "over the image".into() };
+            table.checks.push(Check {
+                claim: format!(
+                    "a larger large-step rate suits diffuse scenes, a smaller one intricate effects (003:L324): \
+                     {scene}, {over}"
+                ),
+                evidence: format!(
+                    "measured over {RUNS} runs of {LARGE_STEP_FRAMES} frames: the least error at large steps {} on \
+                     the diffuse box (over the image), {} on {scene} {over} (holds if the diffuse box's is the larger)",
+                    show(diffuse),
+                    show(intricate)
+                ),
+                holds: diffuse.zip(intricate).is_some_and(|(d, g)| d > g),
+            });
+        }
+    }
     table.notes.push(format!(
         "Ours: MLT over bdpt natively (mlt::render_target with mlt::Chains {{ p_large, start from the pool }}; the \
          kernel's probability is the constant 0.25), {} at {SIDE} x {SIDE}, {} bounces, {RUNS} runs (seeds {SEED0}-{}) of \
          {LARGE_STEP_FRAMES} frames (the thesis' 100 mutations a chain); the error: RMS over pixels and channels \
          against the Mitsuba reference with each image scaled to its mean luminance first (b's error removed: \
          lin:s4.8-bootstrap), the runs' mean square. Small steps: Kelemen's s1 = 1/1024, s2 = 1/64.",
-        LARGE_STEP_SCENES.iter().map(|s| format!("`scenes/{s}.toml`")).collect::<Vec<_>>().join(" and "),
+        LARGE_STEP_SCENES.iter().map(|s| format!("`scenes/{s}.toml`")).collect::<Vec<_>>().join(", "),
         fig_9::BOUNCES,
         SEED0 + RUNS - 1
     ));
