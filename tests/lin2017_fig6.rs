@@ -3,19 +3,17 @@
 //! lin:fig6`). The recorded errors and verdicts, and the checks following
 //! the evidence.
 
+mod lin2017_tables;
+use lin2017_tables::{checks_of, load, table_named};
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::repro::lin2017::fig_6::{self, MIS_BSDF, SCENE};
-use warplight::repro::protocol::Protocol;
-use warplight::repro::registry::{Workspace, resolve};
-use warplight::repro::results::{Results, Sample};
+use warplight::repro::registry::Workspace;
+use warplight::repro::results::Sample;
 use warplight::repro::table::Table;
 
 fn table_of(samples: &[Sample]) -> Table {
-    let mut r = Results::new("test", Protocol::quick(), vec!["lin:fig6".into()], vec![MIS_BSDF.into()]);
-    r.samples = samples.to_vec();
-    let e = resolve(&["lin:fig6".into()]).expect("registered").remove(0);
-    (e.table.render.expect("rendered"))(&e, &r).remove(0)
+    table_named("lin:fig6", MIS_BSDF, samples)
 }
 
 /// Per row (MIS at 10 frames, BSDF sampling at 100): RMS error on the back
@@ -24,13 +22,11 @@ const RECORDED: [[f64; 3]; 2] = [[0.0543, 0.1651, 0.1135], [0.1204, 0.0825, 0.08
 
 #[test]
 fn fig6_records_its_errors_and_checks() {
-    let scene = warplight::host::scene_file::load(&warplight::host::scene_file::resolve(SCENE)).expect("scene");
+    let scene = load(SCENE);
     let mut ws = Workspace::new(&scene, 0..1, 32);
     let mut samples = fig_6::measure(&mut ws, &mut |_| {}).expect("measure");
     let t = table_of(&samples);
-    for c in &t.checks {
-        eprintln!("{} {}: {}", if c.holds { "✓" } else { "✗" }, c.claim, c.evidence);
-    }
+    let holds = checks_of(&t);
     for (row, want) in t.rows.iter().zip(RECORDED) {
         let got: Vec<f64> = row.cells.iter().map(|c| c.ours.expect("measured")).collect();
         eprintln!("{}: {got:?}", row.label);
@@ -38,7 +34,7 @@ fn fig6_records_its_errors_and_checks() {
             assert!((g - w).abs() < 5e-5, "{}: {got:?} against {want:?}", row.label);
         }
     }
-    assert_eq!(t.checks.iter().map(|c| c.holds).collect::<Vec<_>>(), [true, true, true]);
+    assert_eq!(holds, [true, true, true]);
 
     // the two estimators' errors swapped: both claims fail
     for s in &mut samples {
@@ -55,7 +51,7 @@ fn fig6_records_its_errors_and_checks() {
 /// pixel's ray hits the rough mirror, and the regions are where the box is.
 #[test]
 fn regions_are_the_first_hits_materials() {
-    let scene = warplight::host::scene_file::load(&warplight::host::scene_file::resolve(SCENE)).expect("scene");
+    let scene = load(SCENE);
     let camera = Camera { resolution: [16, 16], ..scene.camera };
     let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
     let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));

@@ -3,19 +3,17 @@
 //! (`warplight tables lin:fig7`). The table's recorded values and verdicts,
 //! and its checks failing where the evidence says otherwise.
 
+mod lin2017_tables;
+use lin2017_tables::{checks_of, load, table_named};
 use std::collections::BTreeMap;
 
 use warplight::repro::lin2017::fig_7::{self, HEURISTICS, ROWS, SCENE, SEEDS};
-use warplight::repro::protocol::Protocol;
-use warplight::repro::registry::{Workspace, resolve};
-use warplight::repro::results::{Results, Sample};
+use warplight::repro::registry::Workspace;
+use warplight::repro::results::Sample;
 use warplight::repro::table::Table;
 
 fn table_of(samples: Vec<Sample>) -> Table {
-    let mut r = Results::new("test", Protocol::quick(), vec!["lin:fig7".into()], vec![HEURISTICS.into()]);
-    r.samples = samples;
-    let e = resolve(&["lin:fig7".into()]).expect("registered").remove(0);
-    (e.table.render.expect("rendered"))(&e, &r).remove(0)
+    table_named("lin:fig7", HEURISTICS, &samples)
 }
 
 /// The measured table: seed 0's correlations and errors (emulated) and the
@@ -23,22 +21,19 @@ fn table_of(samples: Vec<Sample>) -> Table {
 /// these: re-measure and update `docs/reproduction-lin2017.md`.
 #[test]
 fn fig7_records_its_values_and_checks() {
-    let scene = warplight::host::scene_file::load(&warplight::host::scene_file::resolve(SCENE)).expect("scene");
+    let scene = load(SCENE);
     let mut ws = Workspace::new(&scene, 0..1, 32);
     let samples = fig_7::measure(&mut ws, &mut |_| {}).expect("measure");
     let t = table_of(samples);
     let ours: Vec<Vec<Option<f64>>> = t.rows.iter().map(|r| r.cells.iter().map(|c| c.ours).collect()).collect();
     eprintln!("{ours:?}");
-    for c in &t.checks {
-        eprintln!("{} {}: {}", if c.holds { "✓" } else { "✗" }, c.claim, c.evidence);
-    }
+    let holds = checks_of(&t);
     for (row, want) in ours.iter().zip(RECORDED) {
         for (got, w) in row.iter().zip(want) {
             let got = got.expect("measured");
             assert!((got - w).abs() < 1e-6, "{ours:?}");
         }
     }
-    let holds: Vec<bool> = t.checks.iter().map(|c| c.holds).collect();
     assert_eq!(holds, CHECKS);
 }
 

@@ -3,23 +3,17 @@
 //! large-step probability (003:L318-324, `lin:s4.8-large-step`). The
 //! recorded errors and verdicts, and the checks following the evidence.
 
+mod lin2017_tables;
+use lin2017_tables::{checks_of, load, table_named};
 use warplight::host::path::mlt;
 use warplight::repro::lin2017::fig_9::SCENES;
 use warplight::repro::lin2017::sec_4_8::{self, BOOTSTRAP_GROUP, LARGE_STEP_GROUP, LARGE_STEP_SCENES};
-use warplight::repro::protocol::Protocol;
-use warplight::repro::registry::{Workspace, resolve};
-use warplight::repro::results::{Results, Sample};
+use warplight::repro::registry::Workspace;
+use warplight::repro::results::Sample;
 use warplight::repro::table::Table;
 
 fn table_of(samples: &[Sample]) -> Table {
     table_named("lin:s4.8-bootstrap", BOOTSTRAP_GROUP, samples)
-}
-
-fn table_named(address: &str, group: &str, samples: &[Sample]) -> Table {
-    let mut r = Results::new("test", Protocol::quick(), vec![address.into()], vec![group.into()]);
-    r.samples = samples.to_vec();
-    let e = resolve(&[address.into()]).expect("registered").remove(0);
-    (e.table.render.expect("rendered"))(&e, &r).remove(0)
 }
 
 /// b's RMS error over the runs (%) at 1, 4, 16, 64, 256, 1024 samples a
@@ -34,21 +28,18 @@ const CHECKS: [bool; 4] = [true, false, true, true];
 fn bootstrap_table_records_its_errors_and_checks() {
     let mut samples = Vec::new();
     for name in SCENES {
-        let scene = warplight::host::scene_file::load(&warplight::host::scene_file::resolve(name)).expect("scene");
+        let scene = load(name);
         let mut ws = Workspace::new(&scene, 0..1, 32);
         samples.extend(sec_4_8::measure(&mut ws, &mut |_| {}).expect("measure"));
     }
     let t = table_of(&samples);
-    for c in &t.checks {
-        eprintln!("{} {}: {}", if c.holds { "✓" } else { "✗" }, c.claim, c.evidence);
-    }
+    let holds = checks_of(&t);
     let got: Vec<f64> = t.rows.iter().map(|r| r.cells[1].ours.expect("measured")).collect();
     eprintln!("{got:?}");
     for (g, w) in got.iter().zip(RECORDED.iter().flatten()) {
         assert!((g - w).abs() <= 0.06, "{got:?} against {RECORDED:?}");
     }
     assert_eq!(got.len(), 12);
-    let holds: Vec<bool> = t.checks.iter().map(|c| c.holds).collect();
     assert_eq!(holds, CHECKS);
 
     // an image 1 % off its b, or a kernel b that is not the native one, fails the first check
@@ -78,14 +69,12 @@ const LARGE_STEP_RECORDED: [[f64; 5]; 5] = [
 fn large_step_table_records_its_errors_and_check() {
     let mut samples = Vec::new();
     for name in LARGE_STEP_SCENES {
-        let scene = warplight::host::scene_file::load(&warplight::host::scene_file::resolve(name)).expect("scene");
+        let scene = load(name);
         let mut ws = Workspace::new(&scene, 0..1, 32);
         samples.extend(sec_4_8::measure_large_step(&mut ws, &mut |_| {}).expect("measure"));
     }
     let t = table_named("lin:s4.8-large-step", LARGE_STEP_GROUP, &samples);
-    for c in &t.checks {
-        eprintln!("{} {}: {}", if c.holds { "✓" } else { "✗" }, c.claim, c.evidence);
-    }
+    let holds = checks_of(&t);
     for (row, want) in t.rows.iter().zip(LARGE_STEP_RECORDED) {
         let got: Vec<f64> = row.cells.iter().map(|c| c.ours.expect("measured")).collect();
         eprintln!("{}: {got:?}", row.label);
@@ -95,7 +84,7 @@ fn large_step_table_records_its_errors_and_check() {
     }
     // every box is best at the kernel's 0.25 over the image, the glossy wall
     // and the glass at 0.5: the thesis' advice is not seen
-    assert_eq!(t.checks.iter().map(|c| c.holds).collect::<Vec<_>>(), [false; 4]);
+    assert_eq!(holds, [false; 4]);
     // the glossy box best at 0.05 instead: its two checks hold
     for s in samples.iter_mut().filter(|s| s.scene == "cornell-rough" && s.variant == "p0.05") {
         for v in s.counters.values_mut() {
@@ -110,8 +99,7 @@ fn large_step_table_records_its_errors_and_check() {
 /// A large-step probability outside [0, 1] is refused, naming it.
 #[test]
 fn a_large_step_probability_outside_0_1_is_refused() {
-    let scene =
-        warplight::host::scene_file::load(&warplight::host::scene_file::resolve("cornell-lambert")).expect("scene");
+    let scene = load("cornell-lambert");
     let ps = warplight::repro::lin2017::runs::path_scene(&scene).expect("layout");
     let camera = warplight::host::camera::Camera { resolution: [4, 4], ..scene.camera };
     let p = warplight::host::path::FrameParams {

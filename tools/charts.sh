@@ -31,7 +31,7 @@ fi
 "$WARPLIGHT" chart scatter tests/fixtures/scatter.json -o docs/images/speed-accuracy-example.svg
 # Thesis 003's charts, redrawn from their committed data (no rendering; the
 # commands that measured the data are in docs/reproduction-lin2017.md, "Charts"):
-for s in cornell-lambert cornell-rough cornell-inverted; do
+for s in cornell-lambert cornell-rough cornell-inverted cornell-caustic; do
   "$WARPLIGHT" chart lin-convergence --from "docs/images/lin-convergence-$s-data.json" \
     -o "docs/images/lin-convergence-$s-{}.svg" > /dev/null
 done

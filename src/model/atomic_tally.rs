@@ -6,6 +6,11 @@
 //! counts both kinds of sharing over everything it observes (one launch, if
 //! attached to one): per address the lane updates and whether more than one
 //! warp made them. Its sums do not depend on the order CTAs run or retire in.
+//! Counted: `atom` and `red` whose lanes resolve to global memory (generic
+//! addresses included); not counted: surface reductions (`sured`, the
+//! texture path). Warps are keyed by CTA and warp, so attach it to one
+//! launch at a time (or one frame of launches where one alone makes
+//! atomics): the same warp of two launches counts as one.
 
 use std::any::Any;
 use std::collections::HashMap;
@@ -180,6 +185,35 @@ mod tests {
                 max_per_address: 3,
             }
         );
+    }
+
+    #[test]
+    fn three_warps_in_two_ctas_merge_in_any_order() {
+        // warps 0 and 1 of CTA 0 and warp 0 of CTA 1 each add once to address 8;
+        // warp 1 of CTA 0 alone to 16
+        let one = |a: u64| {
+            let mut x = [0u64; 32];
+            x[0] = a;
+            x
+        };
+        let (a8, a16) = (one(8), one(16));
+        let run = |order: [u32; 2]| {
+            let tally = AtomicTally::new();
+            for cta in order {
+                let mut o = tally.create(cta);
+                o.access(&event(MemOp::Reduction, MemSpace::Global, 1, &a8, cta, 0));
+                if cta == 0 {
+                    o.access(&event(MemOp::Reduction, MemSpace::Global, 1, &a8, 0, 1));
+                    o.access(&event(MemOp::Reduction, MemSpace::Global, 1, &a16, 0, 1));
+                }
+                tally.retire(o);
+            }
+            tally.sharing()
+        };
+        let s = run([0, 1]);
+        assert_eq!(s, run([1, 0]));
+        assert_eq!((s.lane_updates, s.addresses, s.shared_addresses, s.shared_lane_updates), (4, 2, 1, 3));
+        assert_eq!(s.max_per_address, 3);
     }
 
     #[test]

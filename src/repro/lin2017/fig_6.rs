@@ -22,7 +22,6 @@ use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
 use crate::host::path::layout::PathScene;
 use crate::host::path::{Integrator, render_native};
 use crate::host::scene::Scene;
@@ -81,16 +80,8 @@ pub fn regions(scene: &Scene, camera: &Camera, tree: &crate::host::kdtree::KdTre
 /// The RMS error of `img` against `truth` over pixels and channels, per region
 /// (the last: every pixel).
 fn region_rmse(img: &FrameBuffer, truth: &FrameBuffer, region: &[Option<usize>]) -> [f64; 3] {
-    let mut s = [0.0f64; 3];
-    let mut n = [0usize; 3];
-    for ((a, b), r) in img.pixels.iter().zip(&truth.pixels).zip(region) {
-        let e: f64 = (0..3).map(|c| (a[c] as f64 - b[c] as f64).powi(2)).sum();
-        for k in r.iter().copied().chain([REGIONS.len() - 1]) {
-            s[k] += e;
-            n[k] += 3;
-        }
-    }
-    std::array::from_fn(|k| (s[k] / n[k].max(1) as f64).sqrt())
+    let whole = REGIONS.len() - 1;
+    std::array::from_fn(|k| runs::masked_rmse(img, truth, |i| k == whole || region[i] == Some(k)))
 }
 
 /// Measurement group [`MIS_BSDF`]: per row and run `r`, `rmse{k}_r{r}` for
@@ -99,8 +90,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     let scene = ws.scene;
     let truth = runs::read_truth(TRUTH, SIDE)?;
     let camera = Camera { resolution: [SIDE, SIDE], ..scene.camera };
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
+    let tree = runs::sah_tree(scene);
     let ps = PathScene::new(scene, &tree)?;
     let region = regions(scene, &camera, &tree);
     let params = |integrator: Integrator, seed: u32| runs::square(SIDE, integrator, BOUNCES, seed);

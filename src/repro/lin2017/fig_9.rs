@@ -228,7 +228,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     k.insert("emulated_same".into(), same as u8 as f64);
     // who writes where: one frame of each at memory fidelity, its global atomics tallied by address
     for (prefix, integrator) in [("mlt", Integrator::Mlt), ("mc", Integrator::Bdpt)] {
-        let a = runs::atomic_sharing(&ps, &camera, params(integrator, SEED0), 1)?;
+        let a = runs::atomic_sharing(&ps, &camera, params(integrator, SEED0))?;
         for (name, v) in [
             ("instructions", a.instructions),
             ("lane_updates", a.lane_updates),
@@ -475,12 +475,12 @@ fn checks(table: &mut Table, r: &Results, scene: &str) {
     table.checks.push(Check {
         claim: format!(
             "{scene}: each thread runs an independent MLT task which can write color to all pixels on the screen \
-             (003:L332), so its writes are atomics that warps share (the thesis' cause of the slowdown; their time \
-             is not modelled)"
+             (003:L332), the thesis' cause of the slowdown; read as: an MLT frame's splats are atomics to \
+             addresses that more than one warp updates, a bdpt frame makes none (their time is not modelled)"
         ),
         evidence: format!(
             "counted in one emulated MLT frame (its start-up's kernels make no atomics): {} warp-level atomics ({} \
-             of the frame's warp instructions), {} lane updates of {} addresses (the image's 3 channels of {} pixels), {} of the updates to addresses \
+             of an MLT frame's warp instructions, its second's), {} lane updates of {} addresses (the image's 3 channels of {} pixels), {} of the updates to addresses \
              that more than one warp updates, at most {} on one address, {} repeats within one instruction; a bdpt \
              frame: {} atomic lane updates (each path writes its own pixel)",
             count(atomic("mlt", "instructions")),

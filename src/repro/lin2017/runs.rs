@@ -15,9 +15,7 @@ use crate::sim::{Device, Fidelity, SimError};
 
 /// `scene` laid out for the path tracer on the thesis' SAH kd-tree.
 pub fn path_scene(scene: &Scene) -> Result<PathScene, LayoutError> {
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    PathScene::new(scene, &tree)
+    PathScene::new(scene, &sah_tree(scene))
 }
 
 /// Per pixel of `camera`, the name of the material its centre's camera ray
@@ -82,23 +80,38 @@ pub fn emulate_twin(ps: &PathScene, camera: &Camera, params: FrameParams, frames
     Ok(Twin { emulated, same, seconds })
 }
 
-/// The global atomics of `frames` frames of `params` on the emulator at
-/// memory fidelity (the path kernel's simulator settings otherwise), tallied
-/// by address over every launch of the render ([`AtomicTally`]).
-pub fn atomic_sharing(
-    ps: &PathScene,
-    camera: &Camera,
-    params: FrameParams,
-    frames: u32,
-) -> Result<AtomicSharing, SimError> {
+/// The global atomics of one frame of `params` on the emulator at memory
+/// fidelity (the path kernel's simulator settings otherwise), tallied by
+/// address over the frame's launches ([`AtomicTally`]; MLT's start-up
+/// kernels make none). One frame only: the tally keys warps by CTA and warp,
+/// so the same warp in two launches would count as one, and warps of two
+/// launches, which never run at once, as sharing.
+pub fn atomic_sharing(ps: &PathScene, camera: &Camera, params: FrameParams) -> Result<AtomicSharing, SimError> {
     let mut cfg = kernel::sim_config(&params);
     cfg.fidelity = Fidelity::Memory;
     let mut dev = Device::with_config(cfg);
     let module = kernel::load(&mut dev)?;
     let tally = std::sync::Arc::new(AtomicTally::new());
     dev.set_observer(Some(tally.clone()));
-    kernel::render(&mut dev, &module, ps, camera, params, frames, false, |_| {})?;
+    kernel::render(&mut dev, &module, ps, camera, params, 1, false, |_| {})?;
     Ok(tally.sharing())
+}
+
+/// The SAH kd-tree of `scene` as the thesis builds it.
+pub fn sah_tree(scene: &Scene) -> KdTree {
+    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
+    build(&tris, BuildParams::thesis(Heuristic::Sah))
+}
+
+/// The RMS difference of `a` and `b` over the pixels where `mask` holds and
+/// their channels (0 over no pixel).
+pub fn masked_rmse(a: &FrameBuffer, b: &FrameBuffer, mask: impl Fn(usize) -> bool) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for (_, (x, y)) in a.pixels.iter().zip(&b.pixels).enumerate().filter(|(i, _)| mask(*i)) {
+        s += (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>();
+        n += 3;
+    }
+    (s / n.max(1) as f64).sqrt()
 }
 
 /// A committed ground truth (`rel`, relative to the checkout) of

@@ -32,8 +32,7 @@
 use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
-use crate::host::image::FrameBuffer;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
+use crate::host::path::layout::PathScene;
 use crate::host::path::native::Tracer;
 use crate::host::path::{Integrator, SAMPLES_PER_FRAME, eps_for, frame_of, kernel, mlt};
 use crate::repro::lin2017::convergence::{Reference, mean_luminance};
@@ -213,16 +212,6 @@ pub const LARGE_STEP_SCENES: [&str; 3] = ["cornell-lambert", "cornell-rough", "c
 pub const INTRICATE: [(&str, &str, &str); 2] =
     [("cornell-rough", "roughMirror", "the glossy back wall"), ("cornell-caustic", "clearGlass", "the glass box")];
 
-/// The RMS difference of `a` and `b` over the pixels of `mask` and their channels.
-fn masked_rmse(a: &FrameBuffer, b: &FrameBuffer, mask: &[bool]) -> f64 {
-    let (mut s, mut n) = (0.0, 0usize);
-    for ((x, y), _) in a.pixels.iter().zip(&b.pixels).zip(mask).filter(|(_, m)| **m) {
-        s += (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>();
-        n += 3;
-    }
-    (s / n.max(1) as f64).sqrt()
-}
-
 /// Frames a run: the thesis' 100 (of one mutation a chain; ours 4 a frame).
 pub const LARGE_STEP_FRAMES: u32 = 25;
 
@@ -230,7 +219,8 @@ pub const LARGE_STEP_FRAMES: u32 = 25;
 /// (variant `p0.25`) and run `r`, the image's RMS error against the truth
 /// after [`LARGE_STEP_FRAMES`] frames with its brightness (b) removed,
 /// `noise_r{r}`, and on the scenes of [`INTRICATE`] the same over the
-/// pixels that see their intricate material, `region_r{r}`. Native: the
+/// pixels that see their intricate material, `region_r{r}`, and their
+/// count, `region_pixels` (none is an error). Native: the
 /// kernel's probability is a constant.
 pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sample>, MeasureError> {
     let scene = ws.scene;
@@ -244,12 +234,21 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
         return Err(format!("{}: expected {n}x{n}", truth.prefix.display()).into());
     }
     let camera = Camera { resolution: [n, n], ..scene.camera };
-    let ps = runs::path_scene(scene)?;
-    let region: Option<Vec<bool>> = INTRICATE.iter().find(|(s, _, _)| *s == scene.name).map(|(_, material, _)| {
-        let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-        let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-        runs::first_hit_materials(scene, &camera, &tree).iter().map(|m| *m == Some(*material)).collect()
-    });
+    let tree = runs::sah_tree(scene);
+    let ps = PathScene::new(scene, &tree)?;
+    let region: Option<Vec<bool>> = INTRICATE
+        .iter()
+        .find(|(s, _, _)| *s == scene.name)
+        .map(|(_, material, _)| {
+            let mask: Vec<bool> =
+                runs::first_hit_materials(scene, &camera, &tree).iter().map(|m| *m == Some(*material)).collect();
+            if mask.contains(&true) {
+                Ok(mask)
+            } else {
+                Err(format!("{}: the camera sees no {material}, the study's region", scene.name))
+            }
+        })
+        .transpose()?;
     let mut out = Vec::new();
     for p_large in LARGE_STEPS {
         let variant = format!("p{p_large}");
@@ -263,8 +262,11 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
             let scaled = fig_9::scaled(&img, truth_y);
             k.insert(format!("noise_r{r}"), crate::repro::lin2017::convergence::rmse(&scaled, &truth.mean));
             if let Some(mask) = &region {
-                k.insert(format!("region_r{r}"), masked_rmse(&scaled, &truth.mean, mask));
+                k.insert(format!("region_r{r}"), runs::masked_rmse(&scaled, &truth.mean, |i| mask[i]));
             }
+        }
+        if let Some(mask) = &region {
+            k.insert("region_pixels".into(), mask.iter().filter(|&&m| m).count() as f64);
         }
         out.push(Sample {
             group: LARGE_STEP_GROUP.into(),
@@ -327,7 +329,10 @@ pub fn render_large_step(e: &Entry, r: &Results) -> Vec<Table> {
     for (scene, _, what) in INTRICATE {
         for region in [false, true] {
             let intricate = best_large_step(r, scene, region);
-            let over = if region { format!("over {what}") } else { "over the image".into() };
+            let pixels = r
+                .sum(LARGE_STEP_GROUP, scene, &format!("p{}", mlt::P_LARGE), "region_pixels")
+                .map_or("–".into(), |n| format!("{n:.0}"));
+            let over = if region { format!("over {what} ({pixels} pixels)") } else { "over the image".into() };
             table.checks.push(Check {
                 claim: format!(
                     "a larger large-step rate suits diffuse scenes, a smaller one intricate effects (003:L324): \
