@@ -4,7 +4,7 @@
 //! the evidence.
 
 mod lin2017_tables;
-use lin2017_tables::{checks_of, load, table_named};
+use lin2017_tables::{assert_recorded, checks_of, load, table_named};
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::repro::lin2017::fig_6::{self, MIS_BSDF, SCENE};
@@ -27,13 +27,7 @@ fn fig6_records_its_errors_and_checks() {
     let mut samples = fig_6::measure(&mut ws, &mut |_| {}).expect("measure");
     let t = table_of(&samples);
     let holds = checks_of(&t);
-    for (row, want) in t.rows.iter().zip(RECORDED) {
-        let got: Vec<f64> = row.cells.iter().map(|c| c.ours.expect("measured")).collect();
-        eprintln!("{}: {got:?}", row.label);
-        for (g, w) in got.iter().zip(want) {
-            assert!((g - w).abs() < 5e-5, "{}: {got:?} against {want:?}", row.label);
-        }
-    }
+    assert_recorded(&t, &RECORDED, |g, w| (g - w).abs() < 5e-5);
     assert_eq!(holds, [true, true, true]);
 
     // the two estimators' errors swapped: both claims fail

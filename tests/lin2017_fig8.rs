@@ -5,7 +5,7 @@
 //! another scene.
 
 mod lin2017_tables;
-use lin2017_tables::{checks_of, load, table_named};
+use lin2017_tables::{assert_recorded, checks_of, load, table_named};
 use warplight::repro::compare::Verdict;
 use warplight::repro::lin2017::fig_8::{self, BDPT_NEE, SCENE};
 use warplight::repro::registry::Workspace;
@@ -30,13 +30,7 @@ fn fig8_records_its_errors_rate_and_checks() {
     let mut samples = fig_8::measure(&mut ws, &mut |_| {}).expect("measure");
     let t = table_of(&samples);
     let holds = checks_of(&t);
-    for (row, want) in t.rows.iter().zip(RECORDED) {
-        let got: Vec<f64> = row.cells.iter().map(|c| c.ours.expect("measured")).collect();
-        eprintln!("{}: {got:?}", row.label);
-        for (g, w) in got.iter().zip(want) {
-            assert!((g - w).abs() < 5e-3 * w.abs().max(0.01), "{}: {got:?} against {want:?}", row.label);
-        }
-    }
+    assert_recorded(&t, &RECORDED, |g, w| (g - w).abs() < 5e-3 * w.abs().max(0.01));
     assert_eq!(t.rows[0].cells[2].verdict, Some(Verdict::Within), "bdpt's modelled frame rate is the thesis' 50%");
     assert_eq!(holds, CHECKS);
     // the runs behind the RMS: bdpt lower than nee in every run, halving it in 5 (radiance) and none (display)

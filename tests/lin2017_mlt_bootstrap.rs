@@ -4,7 +4,7 @@
 //! recorded errors and verdicts, and the checks following the evidence.
 
 mod lin2017_tables;
-use lin2017_tables::{checks_of, load, table_named};
+use lin2017_tables::{assert_recorded, checks_of, load, table_named};
 use warplight::host::path::mlt;
 use warplight::repro::lin2017::fig_9::SCENES;
 use warplight::repro::lin2017::sec_4_8::{self, BOOTSTRAP_GROUP, LARGE_STEP_GROUP, LARGE_STEP_SCENES};
@@ -75,13 +75,7 @@ fn large_step_table_records_its_errors_and_check() {
     }
     let t = table_named("lin:s4.8-large-step", LARGE_STEP_GROUP, &samples);
     let holds = checks_of(&t);
-    for (row, want) in t.rows.iter().zip(LARGE_STEP_RECORDED) {
-        let got: Vec<f64> = row.cells.iter().map(|c| c.ours.expect("measured")).collect();
-        eprintln!("{}: {got:?}", row.label);
-        for (g, w) in got.iter().zip(want) {
-            assert!((g - w).abs() < 5e-5, "{}: {got:?} against {want:?}", row.label);
-        }
-    }
+    assert_recorded(&t, &LARGE_STEP_RECORDED, |g, w| (g - w).abs() < 5e-5);
     // every box is best at the kernel's 0.25 over the image, the glossy wall
     // and the glass at 0.5: the thesis' advice is not seen
     assert_eq!(holds, [false; 4]);

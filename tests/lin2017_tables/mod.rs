@@ -1,6 +1,8 @@
 //! What the tests of thesis 003's registry tables share: a table rendered
 //! from measured samples as `warplight tables` renders it, a scene loaded by
-//! name, and the checks printed.
+//! name, the checks printed and the recorded values asserted. Each test
+//! file uses some of them.
+#![allow(dead_code)]
 
 use warplight::host::scene::Scene;
 use warplight::repro::protocol::Protocol;
@@ -27,4 +29,18 @@ pub fn checks_of(t: &Table) -> Vec<bool> {
         eprintln!("{} {}: {}", if c.holds { "✓" } else { "✗" }, c.claim, c.evidence);
     }
     t.checks.iter().map(|c| c.holds).collect()
+}
+
+/// Asserts that each of `t`'s rows holds its `recorded` values (every cell,
+/// in order), each within `close(got, recorded)`; prints the rows.
+pub fn assert_recorded<const N: usize>(t: &Table, recorded: &[[f64; N]], close: impl Fn(f64, f64) -> bool) {
+    assert_eq!(t.rows.len(), recorded.len(), "rows");
+    for (row, want) in t.rows.iter().zip(recorded) {
+        let got: Vec<f64> = row.cells.iter().map(|c| c.ours.expect("measured")).collect();
+        eprintln!("{}: {got:?}", row.label);
+        assert_eq!(got.len(), N, "{}: cells", row.label);
+        for (g, w) in got.iter().zip(want) {
+            assert!(close(*g, *w), "{}: {got:?} against {want:?}", row.label);
+        }
+    }
 }
