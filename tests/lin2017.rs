@@ -8,7 +8,7 @@ use warplight::host::path::layout::PathScene;
 use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
-use warplight::sim::{Device, Fidelity};
+use warplight::sim::Fidelity;
 
 fn cornell() -> (Scene, PathScene) {
     load("cornell-lambert")
@@ -80,10 +80,7 @@ fn mlt_traces_the_same_bits_emulated_and_native() {
             traversal: Traversal::ShortStack,
         };
         let native = mlt::render_native(&ps, &cam, p, 2, true, |_| {}).expect("settings");
-        let mut cfg = kernel::sim_config(&p);
-        cfg.fidelity = Fidelity::Functional;
-        let mut dev = Device::with_config(cfg);
-        let module = kernel::load(&mut dev).expect("load PTX");
+        let (mut dev, module) = kernel::device(&p, Fidelity::Functional).expect("load PTX");
         let emu = mlt::render_emulated(&mut dev, &module, &ps, &cam, p, 2, true, |_| {}).expect("launch");
         assert!(native.b > 0.0, "{name}: b = {}", native.b);
         assert_eq!(native.b.to_bits(), emu.b.to_bits(), "{name}: b");
@@ -149,10 +146,7 @@ fn same_frames((scene, ps): (Scene, PathScene), integrators: &[Integrator]) {
         let params =
             FrameParams { width: w, height: h, integrator, max_bounces: 16, seed: 3, traversal: Traversal::ShortStack };
         let native = render_native(&ps, &cam, params, 2, true, |_| {}).expect("render");
-        let mut cfg = kernel::sim_config(&params);
-        cfg.fidelity = Fidelity::Functional;
-        let mut dev = Device::with_config(cfg);
-        let module = kernel::load(&mut dev).expect("load PTX");
+        let (mut dev, module) = kernel::device(&params, Fidelity::Functional).expect("load PTX");
         let emu = kernel::render(&mut dev, &module, &ps, &cam, params, 2, true, |_| {}).expect("launch");
         let diff = native.accum.iter().zip(&emu.image.accum).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
         assert_eq!(diff, 0, "{integrator:?}: {diff} of {} accumulated values differ", native.accum.len());

@@ -62,6 +62,16 @@ pub fn load(dev: &mut Device) -> Result<Module, SimError> {
     dev.load_ptx(PTX, "kernels/lin2017/path.ptx")
 }
 
+/// A fresh device for frames of `params` ([`sim_config`]) at `fidelity`,
+/// with the kernel loaded.
+pub fn device(params: &FrameParams, fidelity: crate::sim::Fidelity) -> Result<(Device, Module), SimError> {
+    let mut cfg = sim_config(params);
+    cfg.fidelity = fidelity;
+    let mut dev = Device::with_config(cfg);
+    let m = load(&mut dev)?;
+    Ok((dev, m))
+}
+
 /// The simulator settings for frames of `params`: the default, with a
 /// watchdog that grows with the number of paths (under mlt, with the
 /// start-up's samples: [`super::mlt::BOOTSTRAP`] a pixel).

@@ -311,10 +311,7 @@ pub fn render(
 
 /// Loads both modules on a fresh device for `params` at `fidelity`.
 pub fn device(params: &FrameParams, fidelity: Fidelity) -> Result<(Device, Module, Module), SimError> {
-    let mut cfg = kernel::sim_config(params);
-    cfg.fidelity = fidelity;
-    let mut dev = Device::with_config(cfg);
-    let m = kernel::load(&mut dev)?;
+    let (mut dev, m) = kernel::device(params, fidelity)?;
     let c = load_compact(&mut dev)?;
     Ok((dev, m, c))
 }

@@ -33,7 +33,7 @@ use crate::chart::{Scatter, Series};
 use crate::host::camera::Camera;
 use crate::host::image::{FrameBuffer, ImageError};
 use crate::host::path::layout::LayoutError;
-use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, mlt, render_native, stats};
+use crate::host::path::{Integrator, SAMPLES_PER_FRAME, mlt, render_native, stats};
 use crate::host::scene::Scene;
 use crate::repro::lin2017::runs;
 
@@ -147,10 +147,7 @@ impl Reference {
 
 /// The RMS difference of `a` and `b` over pixels and channels.
 pub fn rmse(a: &FrameBuffer, b: &FrameBuffer) -> f64 {
-    let n = a.pixels.len().max(1) as f64 * 3.0;
-    let s: f64 =
-        a.pixels.iter().zip(&b.pixels).flat_map(|(x, y)| (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2))).sum();
-    (s / n).sqrt()
+    runs::masked_rmse(a, b, |_| true)
 }
 
 /// The mean luminance of an image.
@@ -309,14 +306,7 @@ pub fn measure(
     let mut curves = Vec::new();
     for &integrator in &o.integrators {
         ps.check_integrator(&scene.name, integrator)?;
-        let params = FrameParams {
-            width: size,
-            height: size,
-            integrator,
-            max_bounces: o.bounces,
-            seed: o.seed,
-            traversal: Traversal::ShortStack,
-        };
+        let params = runs::square(size, integrator, o.bounces, o.seed);
         params.check()?;
         if integrator == Integrator::Mlt {
             mlt::check(&params)?;

@@ -15,12 +15,11 @@
 use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
-use crate::host::path::layout::PathScene;
 use crate::host::path::wavefront::{self, Compactor, Level, PATH_ACTIVE, STATE_FLOATS, THREADS};
 use crate::host::path::{FrameParams, Integrator, Traversal, kernel};
 use crate::host::scene::Scene;
 use crate::repro::compare::Tolerance;
+use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
@@ -64,9 +63,7 @@ pub fn active(j: usize) -> bool {
 
 /// Runs the example on the Cornell box `scene`.
 pub fn measure_on(scene: &Scene) -> Result<Example, MeasureError> {
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(scene, &tree)?;
+    let ps = runs::path_scene(scene)?;
     // 8 x 4 pixels of 4 paths: 128 paths, 4 warps
     let params = FrameParams {
         width: 8,

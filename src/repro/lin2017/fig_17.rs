@@ -17,12 +17,11 @@
 use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
-use crate::host::path::layout::PathScene;
+use crate::host::path::Integrator;
 use crate::host::path::wavefront::{self, Mode, WavefrontRender};
-use crate::host::path::{FrameParams, Integrator, Traversal};
 use crate::host::scene::Scene;
 use crate::repro::compare::Tolerance;
+use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
@@ -74,17 +73,8 @@ fn deepest() -> u32 {
 /// table and the per-level chart (`warplight chart lin-compaction`).
 pub fn run(scene: &Scene, side: u32, depth: u32, mode: Mode) -> Result<WavefrontRender, MeasureError> {
     let camera = Camera { resolution: [side, side], ..scene.camera };
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(scene, &tree)?;
-    let params = FrameParams {
-        width: side,
-        height: side,
-        integrator: Integrator::Nee,
-        max_bounces: depth.saturating_sub(1),
-        seed: 0,
-        traversal: Traversal::ShortStack,
-    };
+    let ps = runs::path_scene(scene)?;
+    let params = runs::square(side, Integrator::Nee, depth.saturating_sub(1), 0);
     let (mut dev, m, c) = wavefront::device(&params, Fidelity::Instructions)?;
     Ok(wavefront::render(&mut dev, &m, &c, &ps, &camera, params, 1, mode, false, |_| {})?)
 }

@@ -187,13 +187,9 @@ fn run_error(r: &Results, variant: &str, m: Measure, run: u32) -> Option<f64> {
     r.sum(BDPT_NEE, SCENE, variant, &format!("{}_r{run}", m.key()))
 }
 
-/// Runs in which `a`'s error under `m` is at most `factor` times `b`'s
-/// (strictly below it at a factor of 1).
-fn runs_within(r: &Results, a: &str, b: &str, m: Measure, factor: f64) -> Option<u32> {
-    runs::count(RUNS, |run| {
-        let (x, y) = (run_error(r, a, m, run)?, run_error(r, b, m, run)?);
-        Some(if factor == 1.0 { x < y } else { x <= factor * y })
-    })
+/// Runs in which `a`'s error `x` and `b`'s `y` under `m` satisfy `holds(x, y)`.
+fn runs_where(r: &Results, a: &str, b: &str, m: Measure, holds: impl Fn(f64, f64) -> bool) -> Option<u32> {
+    runs::count(RUNS, |run| Some(holds(run_error(r, a, m, run)?, run_error(r, b, m, run)?)))
 }
 
 /// A row's frame rate relative to nee's, in percent, modelled by the
@@ -246,7 +242,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
             num(error(r, "bdpt", m)),
             num(error(r, other, m)),
             ratio("bdpt", other, m).map_or("–".into(), |q| format!("{q:.2}")),
-            of_runs(runs_within(r, "bdpt", other, m, 1.0))
+            of_runs(runs_where(r, "bdpt", other, m, |x, y| x < y))
         )
     };
     for m in [Measure::Radiance, Measure::Display] {
@@ -260,7 +256,7 @@ pub fn render(e: &Entry, r: &Results) -> Vec<Table> {
             evidence: format!(
                 "{}, at most {REMARKABLY} of it in {}",
                 evidence("nee", m),
-                of_runs(runs_within(r, "bdpt", "nee", m, REMARKABLY))
+                of_runs(runs_where(r, "bdpt", "nee", m, |x, y| x <= REMARKABLY * y))
             ),
             holds: ratio("bdpt", "nee", m).is_some_and(|q| q <= REMARKABLY),
         });

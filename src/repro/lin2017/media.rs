@@ -8,11 +8,11 @@
 //! pixels (`warplight chart media`).
 
 use crate::host::camera::Camera;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
-use crate::host::path::layout::{LayoutError, PathScene};
+use crate::host::path::layout::LayoutError;
 use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, render_native};
 use crate::host::scene::{Jitter, Scene};
 use crate::host::scene_file::MAX_MEDIUM_STEPS;
+use crate::repro::lin2017::runs;
 
 /// One measurement: a pattern at a step count.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -65,9 +65,7 @@ pub fn march_variance(
     if let Some(&n) = steps.iter().find(|&&n| n as f32 > MAX_MEDIUM_STEPS) {
         return Err(MediaError::Steps(n));
     }
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let mut ps = PathScene::new(scene, &tree)?;
+    let mut ps = runs::path_scene(scene)?;
     let Some(base) = ps.medium else { return Err(MediaError::NoMedium(scene.name.clone())) };
     let diag = (0..3).map(|k| (base[4 + k] - base[k]).powi(2)).sum::<f32>().sqrt();
     let cam = Camera { resolution: [size, size], ..scene.camera };

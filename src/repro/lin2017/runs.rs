@@ -11,7 +11,7 @@ use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel,
 use crate::host::raycast::{Caster, TraceStats};
 use crate::host::scene::Scene;
 use crate::model::atomic_tally::{AtomicSharing, AtomicTally};
-use crate::sim::{Device, Fidelity, SimError};
+use crate::sim::{Fidelity, SimError};
 
 /// `scene` laid out for the path tracer on the thesis' SAH kd-tree.
 pub fn path_scene(scene: &Scene) -> Result<PathScene, LayoutError> {
@@ -67,10 +67,7 @@ pub struct Twin {
 /// render, whether the two accumulation buffers are equal bit for bit, and
 /// the emulated render's host time.
 pub fn emulate_twin(ps: &PathScene, camera: &Camera, params: FrameParams, frames: u32) -> Result<Twin, TwinError> {
-    let mut cfg = kernel::sim_config(&params);
-    cfg.fidelity = Fidelity::Functional;
-    let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev)?;
+    let (mut dev, module) = kernel::device(&params, Fidelity::Functional)?;
     let t0 = std::time::Instant::now();
     let emulated = kernel::render(&mut dev, &module, ps, camera, params, frames, false, |_| {})?;
     let seconds = t0.elapsed().as_secs_f64();
@@ -87,10 +84,7 @@ pub fn emulate_twin(ps: &PathScene, camera: &Camera, params: FrameParams, frames
 /// so the same warp in two launches would count as one, and warps of two
 /// launches, which never run at once, as sharing.
 pub fn atomic_sharing(ps: &PathScene, camera: &Camera, params: FrameParams) -> Result<AtomicSharing, SimError> {
-    let mut cfg = kernel::sim_config(&params);
-    cfg.fidelity = Fidelity::Memory;
-    let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev)?;
+    let (mut dev, module) = kernel::device(&params, Fidelity::Memory)?;
     let tally = std::sync::Arc::new(AtomicTally::new());
     dev.set_observer(Some(tally.clone()));
     kernel::render(&mut dev, &module, ps, camera, params, 1, false, |_| {})?;
@@ -104,12 +98,17 @@ pub fn sah_tree(scene: &Scene) -> KdTree {
 }
 
 /// The RMS difference of `a` and `b` over the pixels where `mask` holds and
-/// their channels (0 over no pixel).
+/// their channels (0 over no pixel); the squares summed in pixel and
+/// channel order.
 pub fn masked_rmse(a: &FrameBuffer, b: &FrameBuffer, mask: impl Fn(usize) -> bool) -> f64 {
     let (mut s, mut n) = (0.0, 0usize);
-    for (_, (x, y)) in a.pixels.iter().zip(&b.pixels).enumerate().filter(|(i, _)| mask(*i)) {
-        s += (0..3).map(|c| (x[c] as f64 - y[c] as f64).powi(2)).sum::<f64>();
-        n += 3;
+    for (i, (x, y)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+        if mask(i) {
+            for c in 0..3 {
+                s += (x[c] as f64 - y[c] as f64).powi(2);
+            }
+            n += 3;
+        }
     }
     (s / n.max(1) as f64).sqrt()
 }

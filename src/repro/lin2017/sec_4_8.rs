@@ -26,8 +26,8 @@
 //! other hand, if the intricate optical effects are the emphasis of
 //! rendering, large mutation rate should be set much smaller." Ours: MLT's
 //! error after 100 mutations a chain at [`LARGE_STEPS`] on a diffuse box,
-//! one with a glossy back wall and one with a glass caustic, natively ([`mlt::Chains`]; the kernel's is
-//! the constant 0.25).
+//! one with a glossy back wall and one with a glass caustic, natively
+//! ([`mlt::Chains`]; the kernel's is the constant 0.25).
 
 use std::collections::BTreeMap;
 
@@ -40,7 +40,7 @@ use crate::repro::lin2017::{fig_9, runs};
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
-use crate::sim::{Device, Fidelity};
+use crate::sim::Fidelity;
 
 /// Measurement group.
 pub const BOOTSTRAP_GROUP: &str = "lin/mlt-bootstrap";
@@ -87,10 +87,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     }
     tick(Tick { frame: None, variant: "emulated" });
     let p = params(SEED0);
-    let mut cfg = kernel::sim_config(&p);
-    cfg.fidelity = Fidelity::Functional;
-    let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev)?;
+    let (mut dev, module) = kernel::device(&p, Fidelity::Functional)?;
     let e = mlt::render_emulated(&mut dev, &module, &ps, &camera, p, 1, false, |_| {})?;
     let b = e.b;
     let tracer = Tracer { scene: &ps, frame: frame_of(&camera, eps_for(ps.lo, ps.hi)), params: p };
@@ -249,6 +246,7 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
             }
         })
         .transpose()?;
+    let frame = frame_of(&camera, eps_for(ps.lo, ps.hi));
     let mut out = Vec::new();
     for p_large in LARGE_STEPS {
         let variant = format!("p{p_large}");
@@ -256,7 +254,7 @@ pub fn measure_large_step(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Res
         let mut k = BTreeMap::new();
         for r in 0..RUNS {
             let p = runs::square(n, Integrator::Mlt, fig_9::BOUNCES, SEED0 + r);
-            let tracer = Tracer { scene: &ps, frame: frame_of(&camera, eps_for(ps.lo, ps.hi)), params: p };
+            let tracer = Tracer { scene: &ps, frame, params: p };
             let chains = mlt::Chains { p_large, ..mlt::Chains::KERNEL };
             let img = mlt::render_target(&tracer, p, chains, LARGE_STEP_FRAMES, false, |_| {})?.image.image();
             let scaled = fig_9::scaled(&img, truth_y);

@@ -22,12 +22,11 @@
 use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
-use crate::host::kdtree::{BuildParams, Heuristic, build};
-use crate::host::path::layout::PathScene;
+use crate::host::path::Integrator;
 use crate::host::path::regroup::{self, Mode};
 use crate::host::path::wavefront;
-use crate::host::path::{FrameParams, Integrator, Traversal};
 use crate::repro::compare::Tolerance;
+use crate::repro::lin2017::runs;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
 use crate::repro::table::{Cell, Check, Column, Row, RowKind, Table, Unit};
@@ -51,17 +50,8 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     let scene = ws.scene;
     let n = ws.resolution.clamp(8, MAX_SIDE);
     let camera = Camera { resolution: [n, n], ..scene.camera };
-    let tris: Vec<[glam::Vec3; 3]> = scene.triangles.iter().map(|t| t.v).collect();
-    let tree = build(&tris, BuildParams::thesis(Heuristic::Sah));
-    let ps = PathScene::new(scene, &tree)?;
-    let params = FrameParams {
-        width: n,
-        height: n,
-        integrator: Integrator::Nee,
-        max_bounces: 16,
-        seed: 0,
-        traversal: Traversal::ShortStack,
-    };
+    let ps = runs::path_scene(scene)?;
+    let params = runs::square(n, Integrator::Nee, 16, 0);
     let mut out = Vec::new();
     let mut first: Option<Vec<f32>> = None;
     for mode in Mode::ALL {
