@@ -13,7 +13,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use warplight::host::camera::Camera;
 use warplight::host::path::build::{self, Construction};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
 
@@ -35,6 +35,7 @@ fn params() -> FrameParams {
         max_bounces: 16,
         seed: 0,
         traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
     }
 }
 

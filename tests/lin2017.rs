@@ -5,7 +5,7 @@
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::Fidelity;
@@ -78,6 +78,7 @@ fn mlt_traces_the_same_bits_emulated_and_native() {
             max_bounces,
             seed: 4,
             traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
         };
         let native = mlt::render_native(&ps, &cam, p, 2, true, |_| {}).expect("settings");
         let (mut dev, module) = kernel::device(&p, Fidelity::Functional).expect("load PTX");
@@ -104,14 +105,29 @@ fn bdpt_weights_a_direct_path_by_its_two_techniques() {
     let (w, h) = (12, 10);
     let cam = camera(&scene, w, h);
     let run = |integrator, max_bounces, seed| {
-        let p = FrameParams { width: w, height: h, integrator, max_bounces, seed, traversal: Traversal::ShortStack };
+        let p = FrameParams {
+            width: w,
+            height: h,
+            integrator,
+            max_bounces,
+            seed,
+            traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
+        };
         render_native(&ps, &cam, p, 1, false, |_| {}).expect("render").accum
     };
     assert_eq!(run(Integrator::Bdpt, 0, 5), run(Integrator::Pt, 0, 5), "0 bounces: the light seen directly");
     // 1 bounce, many frames: bdpt's mean equals nee's (both unbiased for direct light)
     let mean = |integrator| {
-        let p =
-            FrameParams { width: w, height: h, integrator, max_bounces: 1, seed: 9, traversal: Traversal::ShortStack };
+        let p = FrameParams {
+            width: w,
+            height: h,
+            integrator,
+            max_bounces: 1,
+            seed: 9,
+            traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
+        };
         let r = render_native(&ps, &cam, p, 64, false, |_| {}).expect("render");
         r.accum.iter().map(|&v| v as f64).sum::<f64>() / 64.0
     };
@@ -143,8 +159,15 @@ fn same_frames((scene, ps): (Scene, PathScene), integrators: &[Integrator]) {
     let (w, h) = (12, 10);
     let cam = camera(&scene, w, h);
     for &integrator in integrators {
-        let params =
-            FrameParams { width: w, height: h, integrator, max_bounces: 16, seed: 3, traversal: Traversal::ShortStack };
+        let params = FrameParams {
+            width: w,
+            height: h,
+            integrator,
+            max_bounces: 16,
+            seed: 3,
+            traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
+        };
         let native = render_native(&ps, &cam, params, 2, true, |_| {}).expect("render");
         let (mut dev, module) = kernel::device(&params, Fidelity::Functional).expect("load PTX");
         let emu = kernel::render(&mut dev, &module, &ps, &cam, params, 2, true, |_| {}).expect("launch");
@@ -180,7 +203,7 @@ fn render_takes_each_traversal_and_names_a_wrong_one() {
             render_path(&["--spp", "4", "--traversal", t, "-o", out.to_str().expect("utf-8 path")]);
         assert!(ok, "--traversal {t}: {stderr}");
         let name = if t == "stack" { "short-stack" } else { t };
-        assert!(stdout.contains(&format!("({name} traversal)")), "--traversal {t}: {stdout}");
+        assert!(stdout.contains(&format!("({name} traversal, roulette)")), "--traversal {t}: {stdout}");
         assert!(out.exists(), "--traversal {t}: no image");
     }
     let (ok, _, stderr) = render_path(&["--traversal", "bvh"]);
@@ -238,8 +261,15 @@ fn fig_8_bdpt_beats_nee_under_the_inverted_light() {
     let (w, h) = (16, 16);
     let cam = camera(&scene, w, h);
     let image = |integrator, seed| {
-        let p =
-            FrameParams { width: w, height: h, integrator, max_bounces: 16, seed, traversal: Traversal::ShortStack };
+        let p = FrameParams {
+            width: w,
+            height: h,
+            integrator,
+            max_bounces: 16,
+            seed,
+            traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
+        };
         render_native(&ps, &cam, p, 100, false, |_| {}).expect("render").image().pixels
     };
     let spread = |integrator| {

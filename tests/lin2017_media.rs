@@ -14,7 +14,7 @@ mod lin2017_mitsuba;
 use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, RenderError, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -29,8 +29,15 @@ fn load(name: &str) -> (Scene, PathScene) {
 fn same_frames((scene, ps): &(Scene, PathScene), integrator: Integrator, max_bounces: u32) {
     let (w, h) = (12, 10);
     let cam = Camera { resolution: [w, h], ..scene.camera };
-    let params =
-        FrameParams { width: w, height: h, integrator, max_bounces, seed: 3, traversal: Traversal::ShortStack };
+    let params = FrameParams {
+        width: w,
+        height: h,
+        integrator,
+        max_bounces,
+        seed: 3,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    };
     let native = render_native(ps, &cam, params, 2, true, |_| {}).expect("render");
     let mut cfg = kernel::sim_config(&params);
     cfg.fidelity = Fidelity::Functional;
@@ -123,6 +130,7 @@ fn bdpt_and_mlt_refuse_a_medium() {
             max_bounces: 4,
             seed: 1,
             traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
         };
         let e = render_native(&ps, &cam, p, 1, false, |_| {}).map(|_| ()).unwrap_err();
         assert!(matches!(e, RenderError::Medium(n) if n == i.name()), "{i:?}: {e:?}");
@@ -137,7 +145,15 @@ const SMOG: &str = "tests/fixtures/mitsuba/smog-room-32";
 
 /// Frames of `size` x `size` at one bounce (Mitsuba's max_depth 2).
 fn one_bounce(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
-    FrameParams { width: size, height: size, integrator, max_bounces: 1, seed, traversal: Traversal::ShortStack }
+    FrameParams {
+        width: size,
+        height: size,
+        integrator,
+        max_bounces: 1,
+        seed,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    }
 }
 
 /// The smog room at one bounce: nee and mis-power natively (96 frames) and

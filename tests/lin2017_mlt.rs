@@ -30,7 +30,7 @@ use warplight::host::camera::Camera;
 use warplight::host::image::FrameBuffer;
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::stats::{Estimate, Outcome, from_frames, welch_holm};
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, mlt, render_native};
+use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, mlt, render_native};
 use warplight::host::scene::MaterialKind;
 use warplight::sim::Device;
 
@@ -166,6 +166,7 @@ fn the_chains_keep_40_k_w_h_bytes() {
             max_bounces,
             seed: 1,
             traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
         };
         let mut dev = Device::with_config(kernel::sim_config(&p));
         let module = kernel::load(&mut dev).expect("load PTX");
@@ -243,6 +244,7 @@ fn strip_bias(start: mlt::Start, runs: u32) -> [(f64, f64); 2] {
             max_bounces: 16,
             seed,
             traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
         };
         let img = mlt::render_target(&Strip, p, mlt::Chains::starting(start), FRAMES, false, |_| {})
             .expect("render")

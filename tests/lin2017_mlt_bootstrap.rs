@@ -103,6 +103,7 @@ fn a_large_step_probability_outside_0_1_is_refused() {
         max_bounces: 4,
         seed: 0,
         traversal: warplight::host::path::Traversal::ShortStack,
+        termination: warplight::host::path::Termination::Roulette,
     };
     let tracer = warplight::host::path::native::Tracer {
         scene: &ps,

@@ -21,14 +21,22 @@ use lin2017_mitsuba::scene_of;
 use warplight::host::camera::Camera;
 use warplight::host::path::mlt::{self, MltError};
 use warplight::host::path::{
-    self, FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, RenderError, Traversal, kernel,
+    self, FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, RenderError, Termination, Traversal, kernel,
 };
 use warplight::ptx::ir::MemSpace;
 use warplight::sim::access_log::AccessLog;
 use warplight::sim::{Arg, Device, Fidelity, LaunchConfig};
 
 fn params(width: u32, height: u32, max_bounces: u32) -> FrameParams {
-    FrameParams { width, height, integrator: Integrator::Mlt, max_bounces, seed: 1, traversal: Traversal::ShortStack }
+    FrameParams {
+        width,
+        height,
+        integrator: Integrator::Mlt,
+        max_bounces,
+        seed: 1,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    }
 }
 
 #[test]

@@ -10,7 +10,7 @@ use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::regroup::{self, ANY, BRANCHES, Mode, STATE_FLOATS};
 use warplight::host::path::wavefront::{self, Compactor, PATH_ACTIVE};
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel};
+use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::repro::compare::Verdict;
@@ -95,8 +95,15 @@ fn regrouped_wavefront_traces_the_megakernels_paths() {
     let (w, h) = (8, 6);
     let cam = Camera { resolution: [w, h], ..scene.camera };
     for integrator in [Integrator::Nee, Integrator::MisPower, Integrator::Pt] {
-        let params =
-            FrameParams { width: w, height: h, integrator, max_bounces: 12, seed: 5, traversal: Traversal::ShortStack };
+        let params = FrameParams {
+            width: w,
+            height: h,
+            integrator,
+            max_bounces: 12,
+            seed: 5,
+            traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
+        };
         let mut cfg = kernel::sim_config(&params);
         cfg.fidelity = Fidelity::Functional;
         let mut dev = Device::with_config(cfg);

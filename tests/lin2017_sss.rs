@@ -17,7 +17,7 @@ mod lin2017_mitsuba;
 use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, native_outcome_without, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::{KIND_TRANSLUCENT, PathScene};
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -26,8 +26,15 @@ use warplight::sim::{Device, Fidelity};
 fn same_frames(scene: &Scene, ps: &PathScene, integrator: Integrator, max_bounces: u32, what: &str) {
     let (w, h) = (12, 10);
     let cam = Camera { resolution: [w, h], ..scene.camera };
-    let params =
-        FrameParams { width: w, height: h, integrator, max_bounces, seed: 7, traversal: Traversal::ShortStack };
+    let params = FrameParams {
+        width: w,
+        height: h,
+        integrator,
+        max_bounces,
+        seed: 7,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    };
     let native = render_native(ps, &cam, params, 2, true, |_| {}).unwrap();
     let mut cfg = kernel::sim_config(&params);
     cfg.fidelity = Fidelity::Functional;
@@ -167,7 +174,15 @@ const NEAR_HOLES: [(u32, u32); 8] = [(2, 5), (4, 6), (3, 6), (5, 6), (3, 5), (4,
 
 /// Frames of `size` x `size` at 3 bounces (Mitsuba's max_depth 4).
 fn three_bounces(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
-    FrameParams { width: size, height: size, integrator, max_bounces: 3, seed, traversal: Traversal::ShortStack }
+    FrameParams {
+        width: size,
+        height: size,
+        integrator,
+        max_bounces: 3,
+        seed,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    }
 }
 
 /// The translucent balls at 3 bounces: pt and nee natively (96 frames) and

@@ -14,7 +14,9 @@ mod lin2017_mitsuba;
 use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, params, reference_of, reference_samples, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::{KIND_CONDUCTOR, KIND_DIFFUSE, KIND_TEXTURED, PathScene, ROUGHNESS_LEVELS};
-use warplight::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Traversal, kernel, render_native};
+use warplight::host::path::{
+    FrameParams, Integrator, SAMPLES_PER_FRAME, Termination, Traversal, kernel, render_native,
+};
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
 
@@ -46,6 +48,7 @@ fn textured_frames_equal_native_frames_bit_for_bit() {
             max_bounces: 16,
             seed: 3,
             traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
         };
         let native = render_native(&ps, &cam, p, 2, true, |_| {}).unwrap();
         let mut cfg = kernel::sim_config(&p);
@@ -70,6 +73,7 @@ fn textured_frames_equal_native_frames_bit_for_bit() {
         max_bounces: 16,
         seed: 3,
         traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
     };
     let (a, b) = (
         render_native(&ps, &cam, p, 2, false, |_| {}).unwrap(),

@@ -10,7 +10,7 @@ use warplight::host::camera::Camera;
 use warplight::host::path::build::{self, Construction};
 use warplight::host::path::counts::{self, Counts};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Progressive, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Progressive, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -26,7 +26,15 @@ fn layout(scene: &Scene, c: Construction) -> PathScene {
 }
 
 fn params(w: u32, h: u32, traversal: Traversal) -> FrameParams {
-    FrameParams { width: w, height: h, integrator: Integrator::Nee, max_bounces: 16, seed: 5, traversal }
+    FrameParams {
+        width: w,
+        height: h,
+        integrator: Integrator::Nee,
+        max_bounces: 16,
+        seed: 5,
+        traversal,
+        termination: Termination::Roulette,
+    }
 }
 
 fn emulate(ps: &PathScene, cam: &Camera, p: FrameParams) -> (Progressive, Counts) {

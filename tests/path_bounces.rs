@@ -11,11 +11,21 @@ mod lin2017_mitsuba;
 use std::process::Command;
 
 use lin2017_mitsuba::scene_of;
-use warplight::host::path::{FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, Traversal, kernel, render_native};
+use warplight::host::path::{
+    FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, Termination, Traversal, kernel, render_native,
+};
 use warplight::sim::{Device, Fidelity};
 
 fn params(integrator: Integrator, max_bounces: u32) -> FrameParams {
-    FrameParams { width: 4, height: 4, integrator, max_bounces, seed: 1, traversal: Traversal::ShortStack }
+    FrameParams {
+        width: 4,
+        height: 4,
+        integrator,
+        max_bounces,
+        seed: 1,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    }
 }
 
 #[test]

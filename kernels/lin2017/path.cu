@@ -707,8 +707,13 @@ static __device__ __forceinline__ V3 light_point(const Scene &s, K key, unsigned
 
 // Russian roulette on the bounce's mask wgt = f cos / p (003:L267-271): continue
 // with q = its max RGB, then divide by q; false when the path ends.
+// Compiled with PATH_FIXED_DEPTH (path_fixed_depth.cu) there is no roulette:
+// every path goes on to max bounces, the alternative 003:L269 compares with.
 template <class K>
 static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, K key, unsigned dim) {
+#ifdef PATH_FIXED_DEPTH
+  beta = mul3(beta, wgt);
+#else
   float q = fmaxf(fmaxf(wgt.x, wgt.y), wgt.z);
   if (q < 1.0f) {
     if (!(rng(key, dim + 5) < q)) return false;
@@ -716,6 +721,7 @@ static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, K key, unsigne
   } else {
     beta = mul3(beta, wgt);
   }
+#endif
   return true;
 }
 

@@ -102,6 +102,11 @@ pub struct RenderArgs {
     /// Path tracer: the kd-tree traversal, stack (the 8-byte short stack), stack12 (12-byte entries), restart or backtrack.
     #[arg(long, default_value = "stack")]
     pub traversal: String,
+    /// Path tracer: how a path ends, roulette (the thesis' Russian roulette,
+    /// §4.5) or fixed-depth (no roulette: every path runs to --bounces; a
+    /// second build of the kernel, kernels/lin2017/path_fixed_depth.cu).
+    #[arg(long, default_value = "roulette")]
+    pub termination: String,
     /// Photon map (thesis 000 ch. 5): vkde, vkde-epanechnikov, knn (Table 5.1's k) or knn:K.
     #[arg(long, default_value = "vkde")]
     pub estimator: String,
@@ -223,6 +228,7 @@ fn check_applicable(a: &RenderArgs) -> Result<(), String> {
         ("--bounces", a.bounces != crate::host::path::DEFAULT_MAX_BOUNCES),
         ("--seed", a.seed != 0),
         ("--traversal", a.traversal != "stack"),
+        ("--termination", a.termination != "roulette"),
     ];
     if let Some((o, _)) = path_only.iter().find(|x| m != "path" && x.1) {
         return Err(format!("{o} applies to --method path only, not {m}"));
@@ -456,7 +462,7 @@ fn run_path(
     camera: &crate::host::camera::Camera,
     profile: Profile,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    use crate::host::path::{FrameParams, Integrator, Traversal};
+    use crate::host::path::{FrameParams, Integrator, Termination, Traversal};
     let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
         format!(
             "unknown integrator `{}`; expected pt, nee, mis (balance heuristic), mis-power, bdpt or mlt",
@@ -465,6 +471,8 @@ fn run_path(
     })?;
     let traversal = Traversal::parse(&a.traversal)
         .ok_or_else(|| format!("unknown traversal `{}`; expected stack, stack12, restart or backtrack", a.traversal))?;
+    let termination = Termination::parse(&a.termination)
+        .ok_or_else(|| format!("unknown termination `{}`; expected roulette or fixed-depth", a.termination))?;
     let frames = crate::repro::lin2017::render::frames_for(a.spp)?;
     // the emulated kernel runs on the command's profile, FMA contraction and fidelity
     let set = |c: &mut crate::sim::SimConfig| {
@@ -477,16 +485,18 @@ fn run_path(
         v => return Err(format!("--method path --variant {v}: expected native or emulated").into()),
     };
     let [width, height] = camera.resolution;
-    let params = FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal };
+    let params =
+        FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal, termination };
     let r = crate::repro::lin2017::render::render(scene, camera, params, frames, emulated)?;
     write_image(&r.image, &a.output, a.exposure)?;
     println!(
-        "{} ({}x{}), path tracer {} ({} traversal), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
+        "{} ({}x{}), path tracer {} ({} traversal, {}), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
         scene.name,
         width,
         height,
         integrator.name(),
         traversal.name(),
+        termination.name(),
         a.spp,
         frames,
         a.bounces,

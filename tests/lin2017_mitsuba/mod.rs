@@ -11,7 +11,7 @@ use warplight::host::path::layout::PathScene;
 use warplight::host::path::stats::{
     Estimate, Outcome, from_frames, from_reference, read_exr, welch_holm, welch_holm_floored,
 };
-use warplight::host::path::{FrameParams, Integrator, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -53,7 +53,15 @@ pub fn scene_of(name: &str, size: u32) -> (Scene, PathScene, Camera) {
 // each test crate that includes this module uses a part of it
 #[allow(dead_code)]
 pub fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
-    FrameParams { width: size, height: size, integrator, max_bounces: 16, seed, traversal: Traversal::ShortStack }
+    FrameParams {
+        width: size,
+        height: size,
+        integrator,
+        max_bounces: 16,
+        seed,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    }
 }
 
 /// A native render of `frames` frames against `reference`.
@@ -110,7 +118,7 @@ pub fn emulated_frames_outcome(
     let mut cfg = kernel::sim_config(&p);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev).expect("load PTX");
+    let module = kernel::load_for(&mut dev, p.termination).expect("load PTX");
     let r = kernel::render(&mut dev, &module, ps, cam, p, frames, true, |_| {}).expect("launch");
     let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
     welch_holm_floored(&ours, reference, ALPHA, floor).expect("same block grid")

@@ -14,6 +14,27 @@ use crate::sim::{Arg, Counters, Device, DevicePtr, Fidelity, LaunchConfig, Modul
 
 /// The kernel's PTX (clang-16), compiled in.
 pub const PTX: &str = include_str!("../../../kernels/lin2017/path.ptx");
+/// The same kernel without Russian roulette (`kernels/lin2017/path_fixed_depth.cu`).
+pub const FIXED_DEPTH_PTX: &str = include_str!("../../../kernels/lin2017/path_fixed_depth.ptx");
+/// The empty entry point that marks the fixed-depth build.
+pub const FIXED_DEPTH_MARK: &str = "path_fixed_depth_build";
+
+/// The PTX of the build that ends paths as `t` says, and its file name.
+pub fn ptx(t: super::Termination) -> (&'static str, &'static str) {
+    match t {
+        super::Termination::Roulette => (PTX, "kernels/lin2017/path.ptx"),
+        super::Termination::FixedDepth => (FIXED_DEPTH_PTX, "kernels/lin2017/path_fixed_depth.ptx"),
+    }
+}
+
+/// Which build `module` is: the fixed depth's carries [`FIXED_DEPTH_MARK`].
+pub fn termination_of(module: &Module) -> super::Termination {
+    if module.prog.functions.iter().any(|f| f.name == FIXED_DEPTH_MARK) {
+        super::Termination::FixedDepth
+    } else {
+        super::Termination::Roulette
+    }
+}
 /// The kernel's entry point (pt, nee, mis).
 pub const KERNEL: &str = "path_frame";
 /// The bidirectional path tracer's entry point.
@@ -57,9 +78,15 @@ pub const THREADS: u32 = 256;
 /// default 16 bounces needs well under a tenth of this).
 pub const WARP_INSTRUCTIONS_PER_PATH: u64 = 1 << 14;
 
-/// Loads the kernel on `dev`.
+/// Loads the thesis' kernel (Russian roulette) on `dev`.
 pub fn load(dev: &mut Device) -> Result<Module, SimError> {
-    dev.load_ptx(PTX, "kernels/lin2017/path.ptx")
+    load_for(dev, super::Termination::Roulette)
+}
+
+/// Loads on `dev` the build of the kernel that ends paths as `t` says ([`ptx`]).
+pub fn load_for(dev: &mut Device, t: super::Termination) -> Result<Module, SimError> {
+    let (text, name) = ptx(t);
+    dev.load_ptx(text, name)
 }
 
 /// A fresh device for frames of `params` ([`sim_config`]) at `fidelity`,
@@ -68,7 +95,7 @@ pub fn device(params: &FrameParams, fidelity: crate::sim::Fidelity) -> Result<(D
     let mut cfg = sim_config(params);
     cfg.fidelity = fidelity;
     let mut dev = Device::with_config(cfg);
-    let m = load(&mut dev)?;
+    let m = load_for(&mut dev, params.termination)?;
     Ok((dev, m))
 }
 
@@ -193,6 +220,14 @@ pub fn render(
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Result<KernelRender, SimError> {
+    let built = termination_of(module);
+    if built != params.termination {
+        return Err(SimError::BadLaunch(format!(
+            "the frames ask for {} termination, the loaded kernel is the {} build (load it with kernel::load_for)",
+            params.termination.name(),
+            built.name()
+        )));
+    }
     if scene.ignores_medium(params.integrator) {
         // volume_frame, sss_frame and texture_frame would run bdpt's integrator as a path tracer, mlt's kernels ignore them
         return Err(SimError::BadLaunch(super::RenderError::Medium(params.integrator.name()).to_string()));

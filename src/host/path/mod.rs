@@ -152,6 +152,40 @@ impl Traversal {
     }
 }
 
+/// How a path ends besides leaving the scene and reaching the longest path
+/// (§4.5, 003:L267-271). Each is its own build of the kernel: the thesis'
+/// roulette is `kernels/lin2017/path.cu`, the fixed depth
+/// `kernels/lin2017/path_fixed_depth.cu` (the same source compiled with
+/// `PATH_FIXED_DEPTH`), so the counted tables run the kernel as the thesis wrote it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Termination {
+    /// Russian roulette on the bounce's mask f cos / p: go on with q = its
+    /// largest RGB component, then divide by q (the thesis').
+    #[default]
+    Roulette,
+    /// No roulette: every path goes on to the longest path (the alternative
+    /// the thesis claims roulette beats, 003:L269).
+    FixedDepth,
+}
+
+impl Termination {
+    /// Both, the thesis' first.
+    pub const ALL: [Termination; 2] = [Termination::Roulette, Termination::FixedDepth];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Termination::Roulette => "roulette",
+            Termination::FixedDepth => "fixed-depth",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn parse(s: &str) -> Option<Termination> {
+        Termination::ALL.into_iter().find(|t| t.name() == s)
+    }
+}
+
 /// Samples per pixel in one frame (the 2 x 2 subpixels, §4.2).
 pub const SAMPLES_PER_FRAME: u32 = 4;
 
@@ -189,6 +223,9 @@ pub struct FrameParams {
     pub seed: u32,
     /// The kd-tree traversal.
     pub traversal: Traversal,
+    /// How a path ends: with the thesis' roulette or at the longest path (a
+    /// second build of the kernel, [`kernel::ptx`]).
+    pub termination: Termination,
 }
 
 impl FrameParams {

@@ -15,7 +15,7 @@ use super::layout::{
     LEAF_AXIS, PathScene,
 };
 use super::rng::{Sample, azimuth, path_key, tent};
-use super::{FrameParams, Integrator, Traversal};
+use super::{FrameParams, Integrator, Termination, Traversal};
 
 /// Random dimensions of the camera ray.
 pub const DIMS_CAMERA: u32 = 2;
@@ -383,7 +383,7 @@ impl Tracer<'_> {
             }
             let dim = DIMS_LIGHT + DIMS_PER_BOUNCE * lv.len() as u32;
             (d, _) = cosine_dir(ns, key.at(dim + 3), key.at(dim + 4));
-            if !roulette(&mut alpha, color, key, dim) {
+            if !roulette(self.params.termination, &mut alpha, color, key, dim) {
                 break;
             }
             o = hitp;
@@ -662,7 +662,7 @@ impl Tracer<'_> {
                     }
                     let wgt = v3(exp_neg(-mat[4] * dd), exp_neg(-mat[5] * dd), exp_neg(-mat[6] * dd));
                     let next = hg_dir(mat[10], *d, key.at(dim + 3), key.at(dim + 4));
-                    if !roulette(beta, wgt, key, dim) {
+                    if !roulette(self.params.termination, beta, wgt, key, dim) {
                         return false;
                     }
                     *scattered = true;
@@ -703,7 +703,7 @@ impl Tracer<'_> {
                 }
             }
         }
-        if !roulette(beta, wgt, key, dim) {
+        if !roulette(self.params.termination, beta, wgt, key, dim) {
             return false;
         }
         *o = o.add(d.scale(t));
@@ -932,7 +932,7 @@ impl Tracer<'_> {
         count_emission: &mut bool,
     ) -> bool {
         match self.scatter(mat, kind, ns, color, cos_d, cos_o, key, dim, d, bsdf_pdf, count_emission) {
-            Some(wgt) => roulette(beta, wgt, key, dim),
+            Some(wgt) => roulette(self.params.termination, beta, wgt, key, dim),
             None => false,
         }
     }
@@ -1050,8 +1050,13 @@ fn hg_dir(g: f32, d: V3, y1: f32, y2: f32) -> V3 {
 }
 
 /// Russian roulette on the bounce's mask `wgt` = f cos / p: the kernel's
-/// `roulette` (continue with q = its max RGB, then divide by q).
-fn roulette<S: Sample>(beta: &mut V3, wgt: V3, key: S, dim: u32) -> bool {
+/// `roulette` (continue with q = its max RGB, then divide by q); under
+/// [`Termination::FixedDepth`] the mask only (the kernel's `PATH_FIXED_DEPTH` build).
+fn roulette<S: Sample>(t: Termination, beta: &mut V3, wgt: V3, key: S, dim: u32) -> bool {
+    if t == Termination::FixedDepth {
+        *beta = beta.mul(wgt);
+        return true;
+    }
     let q = fmax(fmax(wgt.x, wgt.y), wgt.z);
     if q < 1.0 {
         if !(key.at(dim + 5) < q) {

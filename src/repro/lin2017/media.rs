@@ -9,7 +9,7 @@
 
 use crate::host::camera::Camera;
 use crate::host::path::layout::LayoutError;
-use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, render_native};
+use crate::host::path::{FrameParams, Integrator, RenderError, Termination, Traversal, render_native};
 use crate::host::scene::{Jitter, Scene};
 use crate::host::scene_file::MAX_MEDIUM_STEPS;
 use crate::repro::lin2017::runs;
@@ -76,6 +76,7 @@ pub fn march_variance(
         max_bounces,
         seed,
         traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
     };
     let mut out = Vec::new();
     for jitter in [Jitter::Stratified, Jitter::PerStep] {

@@ -7,7 +7,7 @@ use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, KdTree, build};
 use crate::host::path::layout::{LayoutError, PathScene};
-use crate::host::path::{FrameParams, Integrator, RenderError, Traversal, kernel, render_native};
+use crate::host::path::{FrameParams, Integrator, RenderError, Termination, Traversal, kernel, render_native};
 use crate::host::raycast::{Caster, TraceStats};
 use crate::host::scene::Scene;
 use crate::model::atomic_tally::{AtomicSharing, AtomicTally};
@@ -37,7 +37,15 @@ pub fn first_hit_materials<'s>(scene: &'s Scene, camera: &Camera, tree: &KdTree)
 /// A square image of `side` pixels traced with `integrator`, at most
 /// `bounces` bounces, `seed`, on the 8-byte short stack (the figures' settings).
 pub fn square(side: u32, integrator: Integrator, bounces: u32, seed: u32) -> FrameParams {
-    FrameParams { width: side, height: side, integrator, max_bounces: bounces, seed, traversal: Traversal::ShortStack }
+    FrameParams {
+        width: side,
+        height: side,
+        integrator,
+        max_bounces: bounces,
+        seed,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+    }
 }
 
 /// Why an emulated render could not be compared with its native twin.
