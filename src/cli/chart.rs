@@ -85,6 +85,8 @@ Example:
         after_help = "\
 Example:
   warplight chart lin-convergence --scene cornell-rough --frames 1024 -o docs/images/lin-convergence-cornell-rough-{}.svg
+  warplight chart lin-convergence --scene cornell-lambert --integrators pt,nee --termination roulette,fixed-depth \\
+      -o docs/images/lin-roulette-{}.svg     (Russian roulette against a fixed depth, 003:L269)
   warplight chart lin-convergence --from docs/images/lin-convergence-cornell-rough-data.json -o c-{}.png"
     )]
     LinConvergence(lin::ConvergenceArgs),

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use super::{parse_size, write};
 use crate::chart::Chart;
-use crate::host::path::Integrator;
+use crate::host::path::{Integrator, Termination};
 use crate::repro::lin2017::convergence::{self, Convergence, Options, Reference};
 use crate::repro::lin2017::lanes::{self, Compaction};
 
@@ -66,6 +66,11 @@ pub struct ConvergenceArgs {
     /// Integrators, comma-separated.
     #[arg(long, default_value = "pt,nee,mis,mis-power,bdpt,mlt", value_delimiter = ',')]
     pub integrators: Vec<String>,
+    /// How paths end, comma-separated: roulette (the thesis' Russian
+    /// roulette), fixed-depth (every path runs to --bounces; the kernel's
+    /// second build). A curve for each integrator and ending.
+    #[arg(long, default_value = "roulette", value_delimiter = ',')]
+    pub termination: Vec<String>,
     /// Native frames (4 samples a pixel each); points at 1, 2, 4, ... frames and the last.
     #[arg(long, default_value_t = 1024)]
     pub frames: u32,
@@ -143,10 +148,18 @@ pub fn lin_convergence(a: ConvergenceArgs) -> Result<(), Box<dyn std::error::Err
                     .ok_or_else(|| format!("--integrators: unknown `{s}` (pt, nee, mis, mis-power, bdpt, mlt)"))
             })
             .collect::<Result<Vec<_>, _>>()?;
+        let terminations = a
+            .termination
+            .iter()
+            .map(|s| {
+                Termination::parse(s).ok_or_else(|| format!("--termination: unknown `{s}` (roulette, fixed-depth)"))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
         let r = Reference::read(&reference_prefix(a.reference.as_deref(), &scene.name))?;
         let o = Options {
             integrators,
+            terminations,
             frames: a.frames,
             emulated_frames: a.emulated_frames.iter().copied().filter(|&f| f > 0).collect(),
             bounces: a.bounces,
@@ -162,7 +175,7 @@ fn report_convergence(data: &Convergence) {
         let last = c.native.last();
         println!(
             "{}: slope {} (from 16 spp, the reference's noise taken out); at {} spp RMSE {:.4e}, mean {:.2} %, {:.2} s; emulated = native: {}",
-            c.integrator,
+            c.label(),
             c.slope(16, data.reference_rmse).map_or("–".into(), |s| format!("{s:.3}")),
             last.map_or(0, |p| p.spp),
             last.map_or(f64::NAN, |p| p.rmse),
@@ -170,9 +183,15 @@ fn report_convergence(data: &Convergence) {
             last.map_or(f64::NAN, |p| p.seconds),
             c.emulated_equals_native
         );
-        for p in &c.emulated {
+        if let Some(v) = c.variance_seconds(data.reference_rmse) {
+            println!("  error variance x seconds {v:.4e} (the reference's noise taken out; lower is more efficient)");
+        }
+        if let (Some(v), Some(s)) = (c.frame_variance, c.frame_seconds) {
+            println!("  one frame: variance {v:.4e} (over the frames), {s:.4e} s; their product {:.4e}", v * s);
+        }
+        for (p, (_, vw)) in c.emulated.iter().zip(c.variance_instructions(data.reference_rmse)) {
             println!(
-                "  emulated {} spp: {} warp instructions, RMSE {:.4e}, {:.2} s",
+                "  emulated {} spp: {} warp instructions, RMSE {:.4e}, {:.2} s; variance x warp instructions {vw:.4e}",
                 p.spp,
                 p.warp_instructions.unwrap_or(0),
                 p.rmse,

@@ -33,7 +33,7 @@ use crate::chart::{Scatter, Series};
 use crate::host::camera::Camera;
 use crate::host::image::{FrameBuffer, ImageError};
 use crate::host::path::layout::LayoutError;
-use crate::host::path::{Integrator, SAMPLES_PER_FRAME, mlt, render_native, stats};
+use crate::host::path::{FrameParams, Integrator, SAMPLES_PER_FRAME, Termination, mlt, render_native, stats};
 use crate::host::scene::Scene;
 use crate::repro::lin2017::runs;
 
@@ -192,12 +192,24 @@ impl Point {
 pub struct Curve {
     /// The integrator (`warplight render --integrator` name).
     pub integrator: String,
+    /// How its paths end (the thesis' roulette, or the fixed-depth build).
+    #[serde(default)]
+    pub termination: Termination,
     /// Native renders' running images at 1, 2, 4, ... frames.
     pub native: Vec<Point>,
     /// Emulated renders of a few frames each.
     pub emulated: Vec<Point>,
     /// Whether every emulated render's accumulation equals the native render of as many frames, bit for bit.
     pub emulated_equals_native: bool,
+    /// The variance of one frame's pixel (4 samples), over the native
+    /// frames, averaged over pixels and channels: what the error's variance
+    /// is at 1 frame, with no reference in it. None for MLT, whose frames
+    /// are not independent.
+    #[serde(default)]
+    pub frame_variance: Option<f64>,
+    /// Native host seconds a frame took: the last point's over its frames.
+    #[serde(default)]
+    pub frame_seconds: Option<f64>,
 }
 
 impl Curve {
@@ -224,6 +236,39 @@ impl Curve {
     /// The native point at `spp`.
     pub fn at(&self, spp: u32) -> Option<&Point> {
         self.native.iter().find(|p| p.spp == spp)
+    }
+
+    /// The series' name: the integrator, and the ending when it is not the thesis' roulette.
+    pub fn label(&self) -> String {
+        match self.termination {
+            Termination::Roulette => self.integrator.clone(),
+            t => format!("{}, {}", self.integrator, t.name()),
+        }
+    }
+
+    /// The cost of an accuracy from the frames' own spread: one frame's
+    /// variance times its native seconds ([`Curve::frame_variance`]).
+    pub fn frame_variance_seconds(&self) -> Option<f64> {
+        Some(self.frame_variance? * self.frame_seconds?)
+    }
+
+    /// The cost of an accuracy at the last native point: the error's
+    /// variance (its mean square, the reference's `floor` taken out) times
+    /// the seconds it took. Constant for an unbiased estimator as it
+    /// converges; the lower, the more efficient (the inverse of Veach's
+    /// efficiency, 1 / (variance × time)).
+    pub fn variance_seconds(&self, floor: f64) -> Option<f64> {
+        let p = self.native.last()?;
+        Some((p.rmse * p.rmse - floor * floor).max(0.0) * p.seconds)
+    }
+
+    /// The same over the emulated points: the error's variance times the
+    /// warp instructions counted, one per emulated render.
+    pub fn variance_instructions(&self, floor: f64) -> Vec<(u32, f64)> {
+        self.emulated
+            .iter()
+            .filter_map(|p| Some((p.spp, (p.rmse * p.rmse - floor * floor).max(0.0) * p.warp_instructions? as f64)))
+            .collect()
     }
 }
 
@@ -259,6 +304,8 @@ pub struct Convergence {
 pub struct Options {
     /// The integrators.
     pub integrators: Vec<Integrator>,
+    /// The endings each integrator is measured with (a curve for each pair).
+    pub terminations: Vec<Termination>,
     /// Native frames (4 samples a pixel each); points at 1, 2, 4, ... and the last.
     pub frames: u32,
     /// Emulated renders, in frames each (may be empty).
@@ -294,9 +341,10 @@ pub fn measure(
             size,
         });
     }
-    if o.frames == 0 || o.integrators.is_empty() || o.emulated_frames.contains(&0) {
+    if o.frames == 0 || o.integrators.is_empty() || o.terminations.is_empty() || o.emulated_frames.contains(&0) {
         return Err(ConvergenceError::Settings(
-            "expected at least one integrator, a positive frame count and positive emulated frame counts".into(),
+            "expected at least one integrator and ending, a positive frame count and positive emulated frame counts"
+                .into(),
         ));
     }
     let ps = runs::path_scene(scene)?;
@@ -304,17 +352,25 @@ pub fn measure(
     let (ref_rmse, ref_rel) = r.noise();
     let marks = checkpoints(o.frames);
     let mut curves = Vec::new();
-    for &integrator in &o.integrators {
+    let runs: Vec<(Integrator, Termination)> =
+        o.integrators.iter().flat_map(|&i| o.terminations.iter().map(move |&t| (i, t))).collect();
+    for (integrator, termination) in runs {
         ps.check_integrator(&scene.name, integrator)?;
-        let params = runs::square(size, integrator, o.bounces, o.seed);
+        let params = FrameParams { termination, ..runs::square(size, integrator, o.bounces, o.seed) };
         params.check()?;
         if integrator == Integrator::Mlt {
             mlt::check(&params)?;
         }
-        progress(&format!("{}: {} native frames", integrator.name(), o.frames));
+        let name = match termination {
+            Termination::Roulette => integrator.name().to_string(),
+            t => format!("{} ({})", integrator.name(), t.name()),
+        };
+        progress(&format!("{name}: {} native frames", o.frames));
         let mut at = Vec::with_capacity(o.frames as usize);
         let t0 = Instant::now();
         let run = render_native(&ps, &camera, params, o.frames, true, |_| at.push(t0.elapsed().as_secs_f64()))?;
+        let frame_variance = (integrator != Integrator::Mlt).then(|| frame_variance(&run.frame_images)).flatten();
+        let frame_seconds = at.last().map(|&s| s / o.frames as f64);
         let native = runs::running_means(&run.frame_images, &marks)
             .into_iter()
             .map(|(frames, mean)| Point::of(&mean, r, frames * SAMPLES_PER_FRAME, at[frames as usize - 1]))
@@ -322,7 +378,7 @@ pub fn measure(
         let mut emulated = Vec::new();
         let mut equal = true;
         for &ef in &o.emulated_frames {
-            progress(&format!("{}: {ef} emulated frame(s)", integrator.name()));
+            progress(&format!("{name}: {ef} emulated frame(s)"));
             let runs::Twin { emulated: k, same, seconds } = runs::emulate_twin(&ps, &camera, params, ef)?;
             equal &= same;
             let mut p = Point::of(&k.image.image(), r, ef * SAMPLES_PER_FRAME, seconds);
@@ -330,7 +386,15 @@ pub fn measure(
             p.thread_instructions = Some(k.totals.thread_instructions);
             emulated.push(p);
         }
-        curves.push(Curve { integrator: integrator.name().into(), native, emulated_equals_native: equal, emulated });
+        curves.push(Curve {
+            integrator: integrator.name().into(),
+            termination,
+            native,
+            emulated_equals_native: equal,
+            emulated,
+            frame_variance,
+            frame_seconds,
+        });
     }
     Ok(Convergence {
         scene: scene.name.clone(),
@@ -345,6 +409,24 @@ pub fn measure(
         emulated_with: "functional fidelity, the path kernel's default simulator settings (kernel::sim_config)".into(),
         curves,
     })
+}
+
+/// The unbiased variance of a pixel's value over `frames`, averaged over
+/// pixels and channels (two passes in f64); None below two frames.
+pub fn frame_variance(frames: &[FrameBuffer]) -> Option<f64> {
+    let n = frames.len();
+    let first = frames.first()?;
+    if n < 2 {
+        return None;
+    }
+    let cells = first.pixels.len() * 3;
+    let at = |f: &FrameBuffer, k: usize| f.pixels[k / 3][k % 3] as f64;
+    let mut sum = 0.0;
+    for k in 0..cells {
+        let mean = frames.iter().map(|f| at(f, k)).sum::<f64>() / n as f64;
+        sum += frames.iter().map(|f| (at(f, k) - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+    }
+    Some(sum / cells.max(1) as f64)
 }
 
 /// The charts' names (`{}` in `warplight chart lin-convergence -o`).
@@ -363,7 +445,7 @@ impl Convergence {
         let series = |pick: &dyn Fn(&Curve) -> Vec<(f64, f64)>| -> Vec<Series> {
             self.curves
                 .iter()
-                .map(|c| Series { name: c.integrator.clone(), points: pick(c) })
+                .map(|c| Series { name: c.label(), points: pick(c) })
                 .filter(|s| !s.points.is_empty())
                 .collect()
         };
