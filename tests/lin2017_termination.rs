@@ -15,7 +15,7 @@ use lin2017_mitsuba::{native_outcome, params, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Termination, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Termination, kernel, regroup, render_native, wavefront};
 use warplight::repro::lin2017::runs;
 use warplight::sim::{Device, Fidelity};
 
@@ -38,6 +38,24 @@ fn the_fixed_depth_build_runs_as_its_native_twin() {
         assert_eq!(no_bounce(Termination::Roulette), no_bounce(Termination::FixedDepth), "{integrator:?}");
         let roulette = render_native(&ps, &cam, params(8, integrator, 5), 2, false, |_| {}).expect("render");
         assert_ne!(roulette.accum, t.emulated.image.accum, "{integrator:?}: the two builds made the same image");
+    }
+    // the other entry points: the march through a medium, the translucent
+    // walk, the textures (nee), and MLT's chains
+    for (scene, integrator) in [
+        ("fog-box", Integrator::Nee),
+        ("sss-balls", Integrator::Nee),
+        ("cornell-scratched", Integrator::Nee),
+        ("cornell-lambert", Integrator::Mlt),
+    ] {
+        let (_, ps, cam) = scene_of(scene, 4);
+        let p = fixed(params(4, integrator, 6));
+        let t = runs::emulate_twin(&ps, &cam, p, 2).expect("render");
+        assert!(t.same, "{scene} {integrator:?}: the fixed-depth build differs from its native twin");
+        let roulette = render_native(&ps, &cam, params(4, integrator, 6), 2, false, |_| {}).expect("render");
+        assert_ne!(
+            roulette.accum, t.emulated.image.accum,
+            "{scene} {integrator:?}: the two builds made the same image"
+        );
     }
 }
 
@@ -135,12 +153,22 @@ fn a_module_of_the_other_build_is_refused() {
         assert_eq!(kernel::termination_of(&module), loaded);
         let e = kernel::render(&mut dev, &module, &ps, &cam, p, 1, false, |_| {}).expect_err("refused");
         assert!(e.to_string().contains(asked.name()) && e.to_string().contains(loaded.name()), "{e}");
+        // the wavefront form and the regroup, which take the module as given
+        let (mut dev, _, compact) = wavefront::device(&p, Fidelity::Functional).expect("load PTX");
+        let other = kernel::load_for(&mut dev, loaded).expect("load PTX");
+        let e = wavefront::render(&mut dev, &other, &compact, &ps, &cam, p, 1, wavefront::Mode::Normal, false, |_| {})
+            .expect_err("refused");
+        assert!(e.to_string().contains(asked.name()), "{e}");
+        let e = regroup::render(&mut dev, &other, &compact, &ps, &cam, p, 1, regroup::Mode::Normal, false)
+            .expect_err("refused");
+        assert!(e.to_string().contains(asked.name()), "{e}");
     }
 }
 
 /// Both endings are unbiased: the fixed depth agrees with Mitsuba 3 (the
 /// per-block Welch test under Holm) as the roulette does
-/// (`tests/lin2017_reference.rs`), and a ten percent brighter light fails.
+/// (`tests/lin2017_reference.rs`, which also shows that a ten percent
+/// brighter light fails the same test).
 #[test]
 fn the_fixed_depth_agrees_with_mitsuba() {
     let (reference, size, _) = reference_of("tests/fixtures/mitsuba/cornell-lambert-32");
@@ -178,4 +206,26 @@ fn render_takes_a_termination_and_names_a_wrong_one() {
     let (ok, _, stderr) = warplight(&["render", "--scene", "cornell-lambert", "--termination", "fixed-depth", "-o", o]);
     assert!(!ok && stderr.contains("--termination applies to --method path only"), "{stderr}");
     assert!(!out.exists());
+}
+
+/// At a fixed depth every path runs to the longest path, so the emulator's
+/// watchdog grows with the bounces past the default 16 (a long fixed-depth
+/// render is not stopped as runaway); the roulette build's stays.
+#[test]
+fn the_watchdog_grows_with_a_fixed_depth() {
+    let budget = |t, max_bounces| {
+        // 512 x 512: a budget past the simulator's default one
+        let p = FrameParams { max_bounces, termination: t, ..params(512, Integrator::Nee, 1) };
+        kernel::sim_config(&p).schedule.max_warp_instructions
+    };
+    assert_eq!(budget(Termination::FixedDepth, 16), budget(Termination::Roulette, 16));
+    assert_eq!(budget(Termination::Roulette, 200), budget(Termination::Roulette, 16));
+    assert_eq!(budget(Termination::FixedDepth, 200), 12 * budget(Termination::Roulette, 200));
+    // and such a render runs: 100 bounces in the closed cube of mirrors
+    let dir = std::env::temp_dir().join(format!("warplight-termination-watchdog-{}", std::process::id()));
+    let (ps, cam) = mirror_cube(&dir, 1.0);
+    let p = FrameParams { max_bounces: 100, termination: Termination::FixedDepth, ..params(4, Integrator::Pt, 2) };
+    let t = runs::emulate_twin(&ps, &cam, p, 1).expect("not stopped by the watchdog");
+    assert!(t.same);
+    std::fs::remove_dir_all(&dir).ok();
 }

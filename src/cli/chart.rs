@@ -85,8 +85,9 @@ Example:
         after_help = "\
 Example:
   warplight chart lin-convergence --scene cornell-rough --frames 1024 -o docs/images/lin-convergence-cornell-rough-{}.svg
+  Russian roulette against a fixed depth (003:L269):
   warplight chart lin-convergence --scene cornell-lambert --integrators pt,nee --termination roulette,fixed-depth \\
-      -o docs/images/lin-roulette-{}.svg     (Russian roulette against a fixed depth, 003:L269)
+      --emulated-frames 1,2,4,8,16 -o docs/images/lin-roulette-cornell-lambert-{}.svg
   warplight chart lin-convergence --from docs/images/lin-convergence-cornell-rough-data.json -o c-{}.png"
     )]
     LinConvergence(lin::ConvergenceArgs),

@@ -69,7 +69,7 @@ pub struct ConvergenceArgs {
     /// How paths end, comma-separated: roulette (the thesis' Russian
     /// roulette), fixed-depth (every path runs to --bounces; the kernel's
     /// second build). A curve for each integrator and ending.
-    #[arg(long, default_value = "roulette", value_delimiter = ',')]
+    #[arg(long, alias = "terminations", default_value = "roulette", value_delimiter = ',')]
     pub termination: Vec<String>,
     /// Native frames (4 samples a pixel each); points at 1, 2, 4, ... frames and the last.
     #[arg(long, default_value_t = 1024)]

@@ -27,6 +27,20 @@ pub fn ptx(t: super::Termination) -> (&'static str, &'static str) {
     }
 }
 
+/// Refuses frames of `params` on `module` when it is the other build of the
+/// kernel (a path would end otherwise than `params.termination` says).
+pub fn check_build(module: &Module, params: &FrameParams) -> Result<(), SimError> {
+    let built = termination_of(module);
+    if built != params.termination {
+        return Err(SimError::BadLaunch(format!(
+            "the frames ask for {} termination, the loaded kernel is the {} build (load it with kernel::load_for)",
+            params.termination.name(),
+            built.name()
+        )));
+    }
+    Ok(())
+}
+
 /// Which build `module` is: the fixed depth's carries [`FIXED_DEPTH_MARK`].
 pub fn termination_of(module: &Module) -> super::Termination {
     if module.prog.functions.iter().any(|f| f.name == FIXED_DEPTH_MARK) {
@@ -101,14 +115,21 @@ pub fn device(params: &FrameParams, fidelity: crate::sim::Fidelity) -> Result<(D
 
 /// The simulator settings for frames of `params`: the default, with a
 /// watchdog that grows with the number of paths (under mlt, with the
-/// start-up's samples: [`super::mlt::BOOTSTRAP`] a pixel).
+/// start-up's samples: [`super::mlt::BOOTSTRAP`] a pixel) and, at a fixed
+/// depth, where every path runs to the longest path, with its bounces past
+/// the default 16.
 pub fn sim_config(params: &FrameParams) -> SimConfig {
     let mut c = SimConfig::default();
     let mut paths = params.paths() as u64;
     if params.integrator == super::Integrator::Mlt {
         paths = paths.max(params.width as u64 * params.height as u64 * super::mlt::BOOTSTRAP as u64);
     }
-    let budget = paths.saturating_mul(WARP_INSTRUCTIONS_PER_PATH);
+    let mut per_path = WARP_INSTRUCTIONS_PER_PATH;
+    if params.termination == super::Termination::FixedDepth {
+        let segments = u64::from(params.max_bounces) + 1;
+        per_path = per_path.saturating_mul(segments.div_ceil(u64::from(super::DEFAULT_MAX_BOUNCES) + 1));
+    }
+    let budget = paths.saturating_mul(per_path);
     c.schedule.max_warp_instructions = c.schedule.max_warp_instructions.max(budget);
     c
 }
@@ -220,14 +241,7 @@ pub fn render(
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Result<KernelRender, SimError> {
-    let built = termination_of(module);
-    if built != params.termination {
-        return Err(SimError::BadLaunch(format!(
-            "the frames ask for {} termination, the loaded kernel is the {} build (load it with kernel::load_for)",
-            params.termination.name(),
-            built.name()
-        )));
-    }
+    check_build(module, &params)?;
     if scene.ignores_medium(params.integrator) {
         // volume_frame, sss_frame and texture_frame would run bdpt's integrator as a path tracer, mlt's kernels ignore them
         return Err(SimError::BadLaunch(super::RenderError::Medium(params.integrator.name()).to_string()));

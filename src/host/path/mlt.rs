@@ -566,6 +566,7 @@ pub fn render_emulated(
     mut progress: impl FnMut(u32),
 ) -> Result<MltRender, MltError> {
     let state_len = check(&params)?;
+    kernel::check_build(module, &params)?;
     let bufs = kernel::upload_scene(dev, scene, camera, &params)?;
     let n = (params.width * params.height) as usize;
     let state = dev.alloc_bytes(state_len, STATE_BUFFER);

@@ -158,6 +158,7 @@ impl Traversal {
 /// `kernels/lin2017/path_fixed_depth.cu` (the same source compiled with
 /// `PATH_FIXED_DEPTH`), so the counted tables run the kernel as the thesis wrote it.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Termination {
     /// Russian roulette on the bounce's mask f cos / p: go on with q = its
     /// largest RGB component, then divide by q (the thesis').

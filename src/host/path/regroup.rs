@@ -103,6 +103,7 @@ pub fn render(
     mode: Mode,
     keep_frames: bool,
 ) -> Result<RegroupRender, SimError> {
+    super::kernel::check_build(module, &params)?;
     let bufs = upload_scene(dev, scene, camera, &params)?;
     let paths = params.paths();
     let n3 = paths * 3;

@@ -260,6 +260,7 @@ pub fn render(
     keep_frames: bool,
     mut progress: impl FnMut(u32),
 ) -> Result<WavefrontRender, SimError> {
+    super::kernel::check_build(module, &params)?;
     let live = live_tag();
     let bufs = upload_scene(dev, scene, camera, &params)?;
     let paths = params.paths();

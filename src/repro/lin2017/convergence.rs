@@ -295,7 +295,7 @@ pub struct Convergence {
     pub native_threads: usize,
     /// The emulator's fidelity and device for the emulated points.
     pub emulated_with: String,
-    /// Per integrator.
+    /// Per integrator and ending (the integrators' order, each with the endings in turn).
     pub curves: Vec<Curve>,
 }
 
