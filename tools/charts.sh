@@ -6,7 +6,7 @@
 #                                             tolerance bands, from docs/results/fabianowski-quick.json
 #   docs/images/speed-accuracy-example.svg    the generic speed-against-accuracy plot,
 #                                             from tests/fixtures/scatter.json
-#   docs/images/lin-convergence-*-{spp,seconds,instructions,mean}.svg, lin-roulette-cornell-lambert-{...}.svg,
+#   docs/images/lin-convergence-*-{spp,seconds,instructions,mean}.svg, lin-roulette-*-{...}.svg,
 #   lin-compaction-{lanes,paths}.svg
 #                                             thesis 003's charts, from their *-data.json beside them
 #
@@ -36,6 +36,8 @@ for s in cornell-lambert cornell-rough cornell-inverted cornell-caustic; do
   "$WARPLIGHT" chart lin-convergence --from "docs/images/lin-convergence-$s-data.json" \
     -o "docs/images/lin-convergence-$s-{}.svg" > /dev/null
 done
-"$WARPLIGHT" chart lin-convergence --from docs/images/lin-roulette-cornell-lambert-data.json \
-  -o "docs/images/lin-roulette-cornell-lambert-{}.svg" > /dev/null
+for s in cornell-lambert cornell-rough; do
+  "$WARPLIGHT" chart lin-convergence --from "docs/images/lin-roulette-$s-data.json" \
+    -o "docs/images/lin-roulette-$s-{}.svg" > /dev/null
+done
 "$WARPLIGHT" chart lin-compaction --from docs/images/lin-compaction-data.json -o "docs/images/lin-compaction-{}.svg" > /dev/null
