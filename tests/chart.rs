@@ -16,7 +16,8 @@ const OURS: &str = "#0072B2";
 const THESIS: &str = "#E69F00";
 const BAND: &str = "#999999";
 /// Okabe–Ito, in the order series take them.
-const PALETTE: [&str; 8] = ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#56B4E9", "#CC79A7", "#F0E442", "#000000"];
+const PALETTE: [&str; 9] =
+    ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#56B4E9", "#CC79A7", "#F0E442", "#000000", "#999999"];
 
 fn warplight(args: &[&str]) -> (bool, String, String) {
     let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
@@ -460,5 +461,32 @@ fn docs_charts_are_current() {
         assert!(ok, "{err}");
         let have = std::fs::read_to_string(root.join(doc)).unwrap_or_default();
         assert!(have == std::fs::read_to_string(&out).unwrap(), "{doc} is stale: run tools/charts.sh");
+    }
+}
+
+/// Nine series (eight methods and a reference line, as the rough box's
+/// roulette chart has) take nine colours: the ninth is the palette's grey,
+/// not the first series' blue again.
+#[test]
+fn nine_series_take_nine_colours() {
+    let dir = tempdir();
+    let series: Vec<serde_json::Value> = (0..9)
+        .map(|k| serde_json::json!({"name": format!("s{k}"), "points": [[1.0 + k as f64, 1.0 + k as f64]]}))
+        .collect();
+    let data = serde_json::json!({
+        "title": "nine", "x_label": "x", "y_label": "y", "log_x": false, "log_y": false, "connect": false,
+        "series": series
+    });
+    let input = dir.join("nine.json");
+    std::fs::write(&input, data.to_string()).unwrap();
+    let out = dir.join("nine.svg");
+    let (ok, _, err) = warplight(&["chart", "scatter", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let svg = std::fs::read_to_string(&out).unwrap();
+    let m = meta(&svg);
+    for (k, colour) in PALETTE.iter().enumerate() {
+        let got = circles(&svg, &m, colour);
+        assert_eq!(got.len(), 1, "series {k} ({colour}): {got:?}");
+        assert!((got[0].0 - m.x(1.0 + k as f64)).abs() <= 0.5 + 1e-9, "series {k}");
     }
 }
