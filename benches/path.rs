@@ -3,8 +3,11 @@
 //! the Lambertian Cornell box and of Fig. 3's bunny&ball at 32 x 32, the
 //! kernel `path_frame` at fidelity `functional` (and `instructions`, which
 //! the Fig. 3 table runs at) against the native mirror, both on all host
-//! threads. The ratios are measured in one run (the machines are shared and
-//! noisy) and printed before criterion's own timings.
+//! threads; and on the box, a frame of the fixed-depth build (no Russian
+//! roulette, `kernels/lin2017/path_fixed_depth.cu`) against the thesis'
+//! build, natively and emulated (the speed-up 003:L269 claims for roulette).
+//! The ratios are measured in one run (the machines are shared and noisy)
+//! and printed before criterion's own timings.
 
 use std::path::Path;
 use std::time::Instant;
@@ -15,7 +18,7 @@ use warplight::host::path::build::{self, Construction};
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
 use warplight::host::scene_file;
-use warplight::sim::{Device, Fidelity};
+use warplight::sim::Fidelity;
 
 const SIDE: u32 = 32;
 
@@ -28,6 +31,10 @@ fn setup(name: &str) -> (PathScene, Camera) {
 }
 
 fn params() -> FrameParams {
+    with(Termination::Roulette)
+}
+
+fn with(termination: Termination) -> FrameParams {
     FrameParams {
         width: SIDE,
         height: SIDE,
@@ -35,20 +42,25 @@ fn params() -> FrameParams {
         max_bounces: 16,
         seed: 0,
         traversal: Traversal::ShortStack,
-        termination: Termination::Roulette,
+        termination,
     }
 }
 
 fn native(ps: &PathScene, cam: &Camera) -> f32 {
-    render_native(ps, cam, params(), 1, false, |_| {}).expect("render").accum[0]
+    native_ending(ps, cam, Termination::Roulette)
+}
+
+fn native_ending(ps: &PathScene, cam: &Camera, t: Termination) -> f32 {
+    render_native(ps, cam, with(t), 1, false, |_| {}).expect("render").accum[0]
 }
 
 fn emulated(ps: &PathScene, cam: &Camera, level: Fidelity) -> f32 {
-    let p = params();
-    let mut cfg = kernel::sim_config(&p);
-    cfg.fidelity = level;
-    let mut dev = Device::with_config(cfg);
-    let module = kernel::load(&mut dev).expect("kernel");
+    emulated_ending(ps, cam, level, Termination::Roulette)
+}
+
+fn emulated_ending(ps: &PathScene, cam: &Camera, level: Fidelity, t: Termination) -> f32 {
+    let p = with(t);
+    let (mut dev, module) = kernel::device(&p, level).expect("kernel");
     kernel::render(&mut dev, &module, ps, cam, p, 1, false, |_| {}).expect("render").image.accum[0]
 }
 
@@ -74,6 +86,12 @@ fn report() {
         eprintln!("  native                  {:>10.0} paths/s", paths / tn);
         eprintln!("  emulated, functional    {:>10.0} paths/s   native / emulated {:>7.1} x", paths / tf, tf / tn);
         eprintln!("  emulated, instructions  {:>10.0} paths/s   native / emulated {:>7.1} x", paths / ti, ti / tn);
+        if name == "cornell-lambert" {
+            let fixed = Termination::FixedDepth;
+            let fnat = best(5, || native_ending(&ps, &cam, fixed));
+            let femu = best(2, || emulated_ending(&ps, &cam, Fidelity::Functional, fixed));
+            eprintln!("  fixed depth / roulette: native {:.2} x, emulated (functional) {:.2} x", fnat / tn, femu / tf);
+        }
     }
     eprintln!();
 }

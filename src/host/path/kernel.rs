@@ -2,7 +2,10 @@
 //! scene once, launches `path_frame` once per frame (one thread per path,
 //! 256-thread CTAs) and keeps the accumulation buffer on the device across
 //! launches; the counters of every launch are summed, and the traversal
-//! events of the `@count` lines read off each launch's profile.
+//! events of the `@count` lines read off each launch's profile. The kernel
+//! comes in two builds, the thesis' (Russian roulette, `path.ptx`) and the
+//! fixed depth (`path_fixed_depth.ptx`, [`super::Termination`]); every
+//! render refuses a module of the other build than its frames ask for.
 
 use super::counts::{self, Counts};
 use super::layout::PathScene;

@@ -18,6 +18,12 @@
 //!   ([`Curve::emulated_equals_native`]), so the native curve is the
 //!   emulated one at more samples.
 //!
+//! Each integrator may be charted with either ending of its paths
+//! ([`Termination`]: the thesis' Russian roulette, or the kernel's
+//! fixed-depth build), a curve for each pair, each with one frame's variance
+//! over its frames and the seconds a frame took: the cost of roulette's
+//! variance against the time it saves (003:L269).
+//!
 //! Path tracing, next-event estimation, MIS (balance and power) and bdpt
 //! frames are independent, so the running image after f frames is the mean
 //! of f frames' images. MLT's frames are not (the chains go on); its running
@@ -240,10 +246,7 @@ impl Curve {
 
     /// The series' name: the integrator, and the ending when it is not the thesis' roulette.
     pub fn label(&self) -> String {
-        match self.termination {
-            Termination::Roulette => self.integrator.clone(),
-            t => format!("{}, {}", self.integrator, t.name()),
-        }
+        label(&self.integrator, self.termination)
     }
 
     /// The cost of an accuracy from the frames' own spread: one frame's
@@ -361,10 +364,7 @@ pub fn measure(
         if integrator == Integrator::Mlt {
             mlt::check(&params)?;
         }
-        let name = match termination {
-            Termination::Roulette => integrator.name().to_string(),
-            t => format!("{} ({})", integrator.name(), t.name()),
-        };
+        let name = label(integrator.name(), termination);
         progress(&format!("{name}: {} native frames", o.frames));
         let mut at = Vec::with_capacity(o.frames as usize);
         let t0 = Instant::now();
@@ -409,6 +409,14 @@ pub fn measure(
         emulated_with: "functional fidelity, the path kernel's default simulator settings (kernel::sim_config)".into(),
         curves,
     })
+}
+
+/// A curve's name: `integrator`, and `termination` when it is not the thesis' roulette.
+fn label(integrator: &str, termination: Termination) -> String {
+    match termination {
+        Termination::Roulette => integrator.to_string(),
+        t => format!("{integrator}, {}", t.name()),
+    }
 }
 
 /// The unbiased variance of a pixel's value over `frames`, averaged over
