@@ -46,9 +46,9 @@ use plotters_backend::{BackendColor, BackendCoord, BackendStyle, BackendTextStyl
 use serde::{Deserialize, Serialize};
 
 /// The series' colours, in order (Okabe & Ito's palette: blue, orange, bluish
-/// green, vermillion, sky blue, reddish purple, yellow, black; then a mid
-/// grey, so that a chart of eight methods and a reference line shows nine
-/// colours); series past the ninth take them again.
+/// green, vermillion, sky blue, reddish purple, yellow, black; then a brown,
+/// so that a chart of eight methods and a reference line shows nine colours,
+/// none the tolerance band's grey); series past the ninth take them again.
 pub const PALETTE: [(u8, u8, u8); 9] = [
     (0x00, 0x72, 0xB2),
     (0xE6, 0x9F, 0x00),
@@ -58,7 +58,7 @@ pub const PALETTE: [(u8, u8, u8); 9] = [
     (0xCC, 0x79, 0xA7),
     (0xF0, 0xE4, 0x42),
     (0x00, 0x00, 0x00),
-    (0x99, 0x99, 0x99),
+    (0x8C, 0x56, 0x4B),
 ];
 
 /// The colour of tolerance bands (drawn at [`BAND_OPACITY`]).

@@ -17,7 +17,7 @@ const THESIS: &str = "#E69F00";
 const BAND: &str = "#999999";
 /// Okabe–Ito, in the order series take them.
 const PALETTE: [&str; 9] =
-    ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#56B4E9", "#CC79A7", "#F0E442", "#000000", "#999999"];
+    ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#56B4E9", "#CC79A7", "#F0E442", "#000000", "#8C564B"];
 
 fn warplight(args: &[&str]) -> (bool, String, String) {
     let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
@@ -465,10 +465,11 @@ fn docs_charts_are_current() {
 }
 
 /// Nine series (eight methods and a reference line, as the rough box's
-/// roulette chart has) take nine colours: the ninth is the palette's grey,
-/// not the first series' blue again.
+/// roulette chart has) take nine colours: the ninth is the palette's brown,
+/// neither the first series' blue again nor the tolerance band's grey.
 #[test]
 fn nine_series_take_nine_colours() {
+    assert!(!PALETTE.contains(&BAND), "a series drawn in the tolerance band's colour");
     let dir = tempdir();
     let series: Vec<serde_json::Value> = (0..9)
         .map(|k| serde_json::json!({"name": format!("s{k}"), "points": [[1.0 + k as f64, 1.0 + k as f64]]}))
