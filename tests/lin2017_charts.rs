@@ -181,14 +181,17 @@ fn roulette_and_fixed_depth_converge_alike_at_different_costs() {
 }
 
 /// One frame's variance over frames, by hand: a pixel whose channel is 1 and
-/// 3 in two frames has variance 2 (unbiased), a constant pixel 0; one frame has none.
+/// 3 in two frames has variance 2 (unbiased), a constant pixel 0; one frame
+/// has none. The mean of all cells: (2 + 0 + 0 + 15) / 6.
 #[test]
 fn the_frame_variance_is_the_unbiased_one_averaged_over_cells() {
     use warplight::host::image::FrameBuffer;
+    use warplight::repro::lin2017::runs::pixel_variance;
     let f = |v: f32| FrameBuffer { width: 2, height: 1, pixels: vec![[v, 0.0, 0.0], [5.0, 5.0, 5.0]] };
-    let v = convergence::frame_variance(&[f(1.0), f(3.0)]).expect("two frames");
+    let (v, mean) = pixel_variance(&[f(1.0), f(3.0)]).expect("two frames");
     assert!((v - 2.0 / 6.0).abs() < 1e-12, "{v}");
-    assert_eq!(convergence::frame_variance(&[f(1.0)]), None);
+    assert!((mean - 17.0 / 6.0).abs() < 1e-12, "{mean}");
+    assert_eq!(pixel_variance(&[f(1.0)]), None);
 }
 
 /// A reference that does not exist is a typed error naming the file.

@@ -186,16 +186,17 @@ fn report_convergence(data: &Convergence) {
         if let Some(v) = c.variance_seconds(data.reference_rmse) {
             println!("  error variance x seconds {v:.4e} (the reference's noise taken out; lower is more efficient)");
         }
-        if let (Some(v), Some(s)) = (c.frame_variance, c.frame_seconds) {
-            println!("  one frame: variance {v:.4e} (over the frames), {s:.4e} s; their product {:.4e}", v * s);
+        if let (Some(v), Some(s), Some(vs)) = (c.frame_variance, c.frame_seconds, c.frame_variance_seconds()) {
+            println!("  one frame: variance {v:.4e} (over the frames), {s:.4e} s; their product {vs:.4e}");
         }
-        for (p, (_, vw)) in c.emulated.iter().zip(c.variance_instructions(data.reference_rmse)) {
+        for p in &c.emulated {
+            let w = p.warp_instructions.unwrap_or(0);
             println!(
-                "  emulated {} spp: {} warp instructions, RMSE {:.4e}, {:.2} s; variance x warp instructions {vw:.4e}",
+                "  emulated {} spp: {w} warp instructions, RMSE {:.4e}, {:.2} s; variance x warp instructions {:.4e}",
                 p.spp,
-                p.warp_instructions.unwrap_or(0),
                 p.rmse,
-                p.seconds
+                p.seconds,
+                p.error_variance(data.reference_rmse) * w as f64
             );
         }
     }

@@ -180,6 +180,12 @@ pub struct Point {
 }
 
 impl Point {
+    /// The error's variance: its mean square with the reference's own noise
+    /// `floor` taken out (rmse² − floor², at least 0).
+    pub fn error_variance(&self, floor: f64) -> f64 {
+        (self.rmse * self.rmse - floor * floor).max(0.0)
+    }
+
     fn of(image: &FrameBuffer, r: &Reference, spp: u32, seconds: f64) -> Point {
         let want = mean_luminance(&r.mean);
         Point {
@@ -227,7 +233,7 @@ impl Curve {
             .native
             .iter()
             .filter(|p| p.spp >= from_spp && p.rmse > floor)
-            .map(|p| ((p.spp as f64).ln(), (p.rmse * p.rmse - floor * floor).sqrt().ln()))
+            .map(|p| ((p.spp as f64).ln(), p.error_variance(floor).sqrt().ln()))
             .collect();
         if pts.len() < 2 {
             return None;
@@ -262,16 +268,7 @@ impl Curve {
     /// efficiency, 1 / (variance × time)).
     pub fn variance_seconds(&self, floor: f64) -> Option<f64> {
         let p = self.native.last()?;
-        Some((p.rmse * p.rmse - floor * floor).max(0.0) * p.seconds)
-    }
-
-    /// The same over the emulated points: the error's variance times the
-    /// warp instructions counted, one per emulated render.
-    pub fn variance_instructions(&self, floor: f64) -> Vec<(u32, f64)> {
-        self.emulated
-            .iter()
-            .filter_map(|p| Some((p.spp, (p.rmse * p.rmse - floor * floor).max(0.0) * p.warp_instructions? as f64)))
-            .collect()
+        Some(p.error_variance(floor) * p.seconds)
     }
 }
 
@@ -369,7 +366,8 @@ pub fn measure(
         let mut at = Vec::with_capacity(o.frames as usize);
         let t0 = Instant::now();
         let run = render_native(&ps, &camera, params, o.frames, true, |_| at.push(t0.elapsed().as_secs_f64()))?;
-        let frame_variance = (integrator != Integrator::Mlt).then(|| frame_variance(&run.frame_images)).flatten();
+        let frame_variance =
+            (integrator != Integrator::Mlt).then(|| runs::pixel_variance(&run.frame_images)).flatten().map(|(v, _)| v);
         let frame_seconds = at.last().map(|&s| s / o.frames as f64);
         let native = runs::running_means(&run.frame_images, &marks)
             .into_iter()
@@ -417,24 +415,6 @@ fn label(integrator: &str, termination: Termination) -> String {
         Termination::Roulette => integrator.to_string(),
         t => format!("{integrator}, {}", t.name()),
     }
-}
-
-/// The unbiased variance of a pixel's value over `frames`, averaged over
-/// pixels and channels (two passes in f64); None below two frames.
-pub fn frame_variance(frames: &[FrameBuffer]) -> Option<f64> {
-    let n = frames.len();
-    let first = frames.first()?;
-    if n < 2 {
-        return None;
-    }
-    let cells = first.pixels.len() * 3;
-    let at = |f: &FrameBuffer, k: usize| f.pixels[k / 3][k % 3] as f64;
-    let mut sum = 0.0;
-    for k in 0..cells {
-        let mean = frames.iter().map(|f| at(f, k)).sum::<f64>() / n as f64;
-        sum += frames.iter().map(|f| (at(f, k) - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-    }
-    Some(sum / cells.max(1) as f64)
 }
 
 /// The charts' names (`{}` in `warplight chart lin-convergence -o`).

@@ -86,24 +86,9 @@ pub fn march_variance(
             m[11] = if jitter == Jitter::PerStep { 1.0 } else { 0.0 };
             ps.medium = Some(m);
             let r = render_native(&ps, &cam, p, frames, true, |_| {})?;
-            let (variance, mean) = pixel_variance(&r.frame_images);
+            let (variance, mean) = runs::pixel_variance(&r.frame_images).ok_or(MediaError::Frames(frames))?;
             out.push(MarchVariance { jitter, steps: n, variance, mean });
         }
     }
     Ok(out)
-}
-
-/// The variance of each pixel's channel over the frames (unbiased), averaged
-/// over pixels and channels, and the mean of all.
-pub fn pixel_variance(frames: &[crate::host::image::FrameBuffer]) -> (f64, f64) {
-    let n = frames.len() as f64;
-    let cells = frames[0].pixels.len() * 3;
-    let (mut var, mut all) = (0.0, 0.0);
-    for c in 0..cells {
-        let xs = frames.iter().map(|f| f.pixels[c / 3][c % 3] as f64);
-        let mean = xs.clone().sum::<f64>() / n;
-        var += xs.map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-        all += mean;
-    }
-    (var / cells as f64, all / cells as f64)
 }

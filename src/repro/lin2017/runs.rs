@@ -34,6 +34,25 @@ pub fn first_hit_materials<'s>(scene: &'s Scene, camera: &Camera, tree: &KdTree)
     out
 }
 
+/// The unbiased variance of each pixel's channel over `frames`, averaged
+/// over pixels and channels, and the mean of all (two passes in f64); None
+/// below two frames.
+pub fn pixel_variance(frames: &[FrameBuffer]) -> Option<(f64, f64)> {
+    let n = frames.len();
+    if n < 2 {
+        return None;
+    }
+    let cells = frames[0].pixels.len() * 3;
+    let (mut var, mut all) = (0.0, 0.0);
+    for c in 0..cells {
+        let xs = frames.iter().map(|f| f.pixels[c / 3][c % 3] as f64);
+        let mean = xs.clone().sum::<f64>() / n as f64;
+        var += xs.map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        all += mean;
+    }
+    Some((var / cells.max(1) as f64, all / cells.max(1) as f64))
+}
+
 /// A square image of `side` pixels traced with `integrator`, at most
 /// `bounces` bounces, `seed`, on the 8-byte short stack (the figures' settings).
 pub fn square(side: u32, integrator: Integrator, bounces: u32, seed: u32) -> FrameParams {
