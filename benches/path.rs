@@ -16,7 +16,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use warplight::host::camera::Camera;
 use warplight::host::path::build::{self, Construction};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, Termination, kernel, render_native};
 use warplight::host::scene_file;
 use warplight::sim::Fidelity;
 
@@ -35,15 +35,7 @@ fn params() -> FrameParams {
 }
 
 fn with(termination: Termination) -> FrameParams {
-    FrameParams {
-        width: SIDE,
-        height: SIDE,
-        integrator: Integrator::Nee,
-        max_bounces: 16,
-        seed: 0,
-        traversal: Traversal::ShortStack,
-        termination,
-    }
+    FrameParams { termination, ..FrameParams::new(SIDE, SIDE, Integrator::Nee, 16, 0) }
 }
 
 fn native(ps: &PathScene, cam: &Camera) -> f32 {

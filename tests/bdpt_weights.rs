@@ -16,7 +16,9 @@
 mod lin2017_mitsuba;
 
 use lin2017_mitsuba::scene_of;
-use warplight::host::path::{FrameParams, Integrator, Progressive, Termination, Traversal, render_native};
+use warplight::host::path::{
+    FrameParams, Integrator, PixelSampling, Progressive, Termination, Traversal, render_native,
+};
 
 const SIZE: u32 = 32;
 const FRAMES: u32 = 256;
@@ -32,6 +34,7 @@ fn frames(integrator: Integrator, max_bounces: u32, seed: u32) -> Progressive {
         seed,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     };
     render_native(&ps, &cam, p, FRAMES, true, |_| {}).expect("render")
 }

@@ -5,7 +5,7 @@
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::Fidelity;
@@ -79,6 +79,7 @@ fn mlt_traces_the_same_bits_emulated_and_native() {
             seed: 4,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let native = mlt::render_native(&ps, &cam, p, 2, true, |_| {}).expect("settings");
         let (mut dev, module) = kernel::device(&p, Fidelity::Functional).expect("load PTX");
@@ -113,6 +114,7 @@ fn bdpt_weights_a_direct_path_by_its_two_techniques() {
             seed,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         render_native(&ps, &cam, p, 1, false, |_| {}).expect("render").accum
     };
@@ -127,6 +129,7 @@ fn bdpt_weights_a_direct_path_by_its_two_techniques() {
             seed: 9,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let r = render_native(&ps, &cam, p, 64, false, |_| {}).expect("render");
         r.accum.iter().map(|&v| v as f64).sum::<f64>() / 64.0
@@ -167,6 +170,7 @@ fn same_frames((scene, ps): (Scene, PathScene), integrators: &[Integrator]) {
             seed: 3,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let native = render_native(&ps, &cam, params, 2, true, |_| {}).expect("render");
         let (mut dev, module) = kernel::device(&params, Fidelity::Functional).expect("load PTX");
@@ -269,6 +273,7 @@ fn fig_8_bdpt_beats_nee_under_the_inverted_light() {
             seed,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         render_native(&ps, &cam, p, 100, false, |_| {}).expect("render").image().pixels
     };

@@ -8,7 +8,7 @@ use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::wavefront::{self, Compactor, Mode, PATH_ACTIVE, STATE_FLOATS};
-use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel};
+use warplight::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::repro::lin2017::fig_16;
@@ -73,6 +73,7 @@ fn wavefront_with_and_without_compaction_traces_the_megakernels_paths() {
             seed: 7,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let mut cfg = kernel::sim_config(&params);
         cfg.fidelity = Fidelity::Functional;

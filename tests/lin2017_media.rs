@@ -14,7 +14,9 @@ mod lin2017_mitsuba;
 use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, RenderError, Termination, Traversal, kernel, render_native};
+use warplight::host::path::{
+    FrameParams, Integrator, PixelSampling, RenderError, Termination, Traversal, kernel, render_native,
+};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -37,6 +39,7 @@ fn same_frames((scene, ps): &(Scene, PathScene), integrator: Integrator, max_bou
         seed: 3,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     };
     let native = render_native(ps, &cam, params, 2, true, |_| {}).expect("render");
     let mut cfg = kernel::sim_config(&params);
@@ -131,6 +134,7 @@ fn bdpt_and_mlt_refuse_a_medium() {
             seed: 1,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let e = render_native(&ps, &cam, p, 1, false, |_| {}).map(|_| ()).unwrap_err();
         assert!(matches!(e, RenderError::Medium(n) if n == i.name()), "{i:?}: {e:?}");
@@ -153,6 +157,7 @@ fn one_bounce(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
         seed,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     }
 }
 

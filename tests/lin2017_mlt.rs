@@ -30,7 +30,9 @@ use warplight::host::camera::Camera;
 use warplight::host::image::FrameBuffer;
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::stats::{Estimate, Outcome, from_frames, welch_holm};
-use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, mlt, render_native};
+use warplight::host::path::{
+    FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel, mlt, render_native,
+};
 use warplight::host::scene::MaterialKind;
 use warplight::sim::Device;
 
@@ -167,6 +169,7 @@ fn the_chains_keep_40_k_w_h_bytes() {
             seed: 1,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let mut dev = Device::with_config(kernel::sim_config(&p));
         let module = kernel::load(&mut dev).expect("load PTX");
@@ -245,6 +248,7 @@ fn strip_bias(start: mlt::Start, runs: u32) -> [(f64, f64); 2] {
             seed,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let img = mlt::render_target(&Strip, p, mlt::Chains::starting(start), FRAMES, false, |_| {})
             .expect("render")

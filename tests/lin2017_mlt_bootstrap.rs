@@ -96,15 +96,7 @@ fn a_large_step_probability_outside_0_1_is_refused() {
     let scene = load("cornell-lambert");
     let ps = warplight::repro::lin2017::runs::path_scene(&scene).expect("layout");
     let camera = warplight::host::camera::Camera { resolution: [4, 4], ..scene.camera };
-    let p = warplight::host::path::FrameParams {
-        width: 4,
-        height: 4,
-        integrator: warplight::host::path::Integrator::Mlt,
-        max_bounces: 4,
-        seed: 0,
-        traversal: warplight::host::path::Traversal::ShortStack,
-        termination: warplight::host::path::Termination::Roulette,
-    };
+    let p = warplight::host::path::FrameParams::new(4, 4, warplight::host::path::Integrator::Mlt, 4, 0);
     let tracer = warplight::host::path::native::Tracer {
         scene: &ps,
         frame: warplight::host::path::frame_of(&camera, warplight::host::path::eps_for(ps.lo, ps.hi)),

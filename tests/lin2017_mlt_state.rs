@@ -21,7 +21,8 @@ use lin2017_mitsuba::scene_of;
 use warplight::host::camera::Camera;
 use warplight::host::path::mlt::{self, MltError};
 use warplight::host::path::{
-    self, FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, RenderError, Termination, Traversal, kernel,
+    self, FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, PixelSampling, RenderError, Termination, Traversal,
+    kernel,
 };
 use warplight::ptx::ir::MemSpace;
 use warplight::sim::access_log::AccessLog;
@@ -36,6 +37,7 @@ fn params(width: u32, height: u32, max_bounces: u32) -> FrameParams {
         seed: 1,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     }
 }
 

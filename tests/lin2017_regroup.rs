@@ -10,7 +10,7 @@ use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
 use warplight::host::path::regroup::{self, ANY, BRANCHES, Mode, STATE_FLOATS};
 use warplight::host::path::wavefront::{self, Compactor, PATH_ACTIVE};
-use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel};
+use warplight::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::repro::compare::Verdict;
@@ -103,6 +103,7 @@ fn regrouped_wavefront_traces_the_megakernels_paths() {
             seed: 5,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let mut cfg = kernel::sim_config(&params);
         cfg.fidelity = Fidelity::Functional;

@@ -17,7 +17,7 @@ mod lin2017_mitsuba;
 use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, native_outcome_without, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::{KIND_TRANSLUCENT, PathScene};
-use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -34,6 +34,7 @@ fn same_frames(scene: &Scene, ps: &PathScene, integrator: Integrator, max_bounce
         seed: 7,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     };
     let native = render_native(ps, &cam, params, 2, true, |_| {}).unwrap();
     let mut cfg = kernel::sim_config(&params);
@@ -182,6 +183,7 @@ fn three_bounces(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
         seed,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     }
 }
 

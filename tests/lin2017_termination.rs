@@ -14,8 +14,11 @@ use std::path::Path;
 use lin2017_mitsuba::{native_outcome, params, reference_of, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
+use warplight::host::path::kernel::KernelBuild;
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Termination, kernel, regroup, render_native, wavefront};
+use warplight::host::path::{
+    FrameParams, Integrator, PixelSampling, Termination, kernel, regroup, render_native, wavefront,
+};
 use warplight::repro::lin2017::runs;
 use warplight::sim::{Device, Fidelity};
 
@@ -141,27 +144,40 @@ fn in_a_closed_box_of_mirrors_every_fixed_depth_path_traces_max_bounces_plus_one
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Every build of the kernel refuses frames that need another (the thesis',
+/// the fixed depth, stratified pixels), in each entry point that takes the
+/// module as given: the megakernel, the wavefront form and the regroup.
 #[test]
-fn a_module_of_the_other_build_is_refused() {
+fn a_module_of_another_build_is_refused() {
     let (_, ps, cam) = scene_of("cornell-lambert", 4);
-    for (loaded, asked) in
-        [(Termination::Roulette, Termination::FixedDepth), (Termination::FixedDepth, Termination::Roulette)]
-    {
-        let p = FrameParams { termination: asked, ..params(4, Integrator::Nee, 1) };
-        let mut dev = Device::with_config(kernel::sim_config(&p));
-        let module = kernel::load_for(&mut dev, loaded).expect("load PTX");
-        assert_eq!(kernel::termination_of(&module), loaded);
-        let e = kernel::render(&mut dev, &module, &ps, &cam, p, 1, false, |_| {}).expect_err("refused");
-        assert!(e.to_string().contains(asked.name()) && e.to_string().contains(loaded.name()), "{e}");
-        // the wavefront form and the regroup, which take the module as given
-        let (mut dev, _, compact) = wavefront::device(&p, Fidelity::Functional).expect("load PTX");
-        let other = kernel::load_for(&mut dev, loaded).expect("load PTX");
-        let e = wavefront::render(&mut dev, &other, &compact, &ps, &cam, p, 1, wavefront::Mode::Normal, false, |_| {})
-            .expect_err("refused");
-        assert!(e.to_string().contains(asked.name()), "{e}");
-        let e = regroup::render(&mut dev, &other, &compact, &ps, &cam, p, 1, regroup::Mode::Normal, false)
-            .expect_err("refused");
-        assert!(e.to_string().contains(asked.name()), "{e}");
+    let params_for = |b: KernelBuild| {
+        let p = params(4, Integrator::Nee, 1);
+        match b {
+            KernelBuild::Thesis => p,
+            KernelBuild::FixedDepth => FrameParams { termination: Termination::FixedDepth, ..p },
+            KernelBuild::Stratified => FrameParams { pixels: PixelSampling::Stratified(2), ..p },
+        }
+    };
+    for loaded in KernelBuild::ALL {
+        for asked in KernelBuild::ALL.into_iter().filter(|&b| b != loaded) {
+            let p = params_for(asked);
+            assert_eq!(KernelBuild::of(&p), asked);
+            let mut dev = Device::with_config(kernel::sim_config(&p));
+            let module = kernel::load_for(&mut dev, loaded).expect("load PTX");
+            assert_eq!(KernelBuild::of_module(&module), loaded);
+            let e = kernel::render(&mut dev, &module, &ps, &cam, p, 1, false, |_| {}).expect_err("refused");
+            assert!(e.to_string().contains(asked.name()) && e.to_string().contains(loaded.name()), "{e}");
+            // the wavefront form and the regroup, which take the module as given
+            let (mut dev, _, compact) = wavefront::device(&p, Fidelity::Functional).expect("load PTX");
+            let other = kernel::load_for(&mut dev, loaded).expect("load PTX");
+            let e =
+                wavefront::render(&mut dev, &other, &compact, &ps, &cam, p, 1, wavefront::Mode::Normal, false, |_| {})
+                    .expect_err("refused");
+            assert!(e.to_string().contains(asked.name()), "{e}");
+            let e = regroup::render(&mut dev, &other, &compact, &ps, &cam, p, 1, regroup::Mode::Normal, false)
+                .expect_err("refused");
+            assert!(e.to_string().contains(asked.name()), "{e}");
+        }
     }
 }
 

@@ -15,7 +15,7 @@ use lin2017_mitsuba::{emulated_frames_outcome, native_outcome, params, reference
 use warplight::host::camera::Camera;
 use warplight::host::path::layout::{KIND_CONDUCTOR, KIND_DIFFUSE, KIND_TEXTURED, PathScene, ROUGHNESS_LEVELS};
 use warplight::host::path::{
-    FrameParams, Integrator, SAMPLES_PER_FRAME, Termination, Traversal, kernel, render_native,
+    FrameParams, Integrator, PixelSampling, SAMPLES_PER_FRAME, Termination, Traversal, kernel, render_native,
 };
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -49,6 +49,7 @@ fn textured_frames_equal_native_frames_bit_for_bit() {
             seed: 3,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let native = render_native(&ps, &cam, p, 2, true, |_| {}).unwrap();
         let mut cfg = kernel::sim_config(&p);
@@ -74,6 +75,7 @@ fn textured_frames_equal_native_frames_bit_for_bit() {
         seed: 3,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     };
     let (a, b) = (
         render_native(&ps, &cam, p, 2, false, |_| {}).unwrap(),

@@ -10,7 +10,9 @@ use warplight::host::camera::Camera;
 use warplight::host::path::build::{self, Construction};
 use warplight::host::path::counts::{self, Counts};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Progressive, Termination, Traversal, kernel, render_native};
+use warplight::host::path::{
+    FrameParams, Integrator, PixelSampling, Progressive, Termination, Traversal, kernel, render_native,
+};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -34,6 +36,7 @@ fn params(w: u32, h: u32, traversal: Traversal) -> FrameParams {
         seed: 5,
         traversal,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     }
 }
 

@@ -12,7 +12,8 @@ use std::process::Command;
 
 use lin2017_mitsuba::scene_of;
 use warplight::host::path::{
-    FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, Termination, Traversal, kernel, render_native,
+    FrameParams, FrameParamsError, Integrator, MAX_BOUNCES, PixelSampling, Termination, Traversal, kernel,
+    render_native,
 };
 use warplight::sim::{Device, Fidelity};
 
@@ -25,6 +26,7 @@ fn params(integrator: Integrator, max_bounces: u32) -> FrameParams {
         seed: 1,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     }
 }
 

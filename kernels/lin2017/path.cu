@@ -88,6 +88,7 @@ struct Params {
   int width, height, num_paths, frame, integrator, max_bounces, num_lights, seed, traversal;
   int env_w, env_h;   // the environment map's texels across and down (0: none)
   float mlt_b;        // mlt_frame: the bootstrap's mean luminance b (003:L330)
+  int strata;         // PATH_STRATIFIED's D: a subpixel's D x D strata (the other builds read none)
 };
 
 struct V3 { float x, y, z; };
@@ -570,13 +571,8 @@ struct Path {
   float bsdf_pdf;         // solid-angle pdf of the last diffuse bounce (mis)
 };
 
-// Path i's camera ray: tent-jittered in subpixel (sub & 1, sub >> 1) of the 2 x 2
-// grid by the tent filter's uniforms r0 (across) and r1 (down).
-static __device__ __forceinline__ Path camera_ray(const Params *p, int i, float r0, float r1) {
-  int pixel = i >> 2, sub = i & 3;
-  int x = pixel % p->width, y = pixel / p->width;
-  float px = (float)x + ((float)(sub & 1) + 0.5f + tent(r0)) * 0.5f;
-  float py = (float)y + ((float)(sub >> 1) + 0.5f + tent(r1)) * 0.5f;
+// The camera ray through the image point (px, py), in pixels from the top left.
+static __device__ __forceinline__ Path camera_through(const Params *p, float px, float py) {
   float cx = (px / (float)p->width * 2.0f - 1.0f) * p->tan_half * p->aspect;
   float cy = (1.0f - py / (float)p->height * 2.0f) * p->tan_half;
   V3 fwd = v3(p->cam_fwd[0], p->cam_fwd[1], p->cam_fwd[2]);
@@ -593,9 +589,40 @@ static __device__ __forceinline__ Path camera_ray(const Params *p, int i, float 
   return P;
 }
 
-// Path i's camera ray with the tent filter's uniforms from dimensions 0 and 1.
+// Path i's camera ray: tent-jittered in subpixel (sub & 1, sub >> 1) of the 2 x 2
+// grid by the tent filter's uniforms r0 (across) and r1 (down).
+static __device__ __forceinline__ Path camera_ray(const Params *p, int i, float r0, float r1) {
+  int pixel = i >> 2, sub = i & 3;
+  int x = pixel % p->width, y = pixel / p->width;
+  float px = (float)x + ((float)(sub & 1) + 0.5f + tent(r0)) * 0.5f;
+  float py = (float)y + ((float)(sub >> 1) + 0.5f + tent(r1)) * 0.5f;
+  return camera_through(p, px, py);
+}
+
+#if defined(PATH_STRATIFIED)
+// The stratified build's camera ray (§4.2's alternative, 003:L223): the
+// subpixel (sub & 1, sub >> 1) is cut into a D x D grid (D = p->strata) and
+// frame f takes stratum s = f mod D^2, row by row from the top left (s % D
+// across, s / D down), the same in every pixel; r0 and r1 place the ray
+// uniformly in it (a box filter). Only every D^2 frames cover the subpixel.
+static __device__ __forceinline__ Path camera_stratified(const Params *p, int i, float r0, float r1) {
+  int pixel = i >> 2, sub = i & 3;
+  int x = pixel % p->width, y = pixel / p->width;
+  int d = p->strata, s = p->frame % (d * d);
+  float px = (float)x + ((float)(sub & 1) + ((float)(s % d) + r0) / (float)d) * 0.5f;
+  float py = (float)y + ((float)(sub >> 1) + ((float)(s / d) + r1) / (float)d) * 0.5f;
+  return camera_through(p, px, py);
+}
+#endif
+
+// Path i's camera ray from dimensions 0 and 1: the tent filter's uniforms
+// (the stratified build: the place in the frame's stratum).
 static __device__ __forceinline__ Path camera_path(const Params *p, int i, unsigned key) {
+#if defined(PATH_STRATIFIED)
+  return camera_stratified(p, i, rng(key, 0), rng(key, 1));
+#else
   return camera_ray(p, i, rng(key, 0), rng(key, 1));
+#endif
 }
 
 // The next direction at a hit (d in, the sampled direction out) and the

@@ -25,6 +25,7 @@ Examples:
   warplight chart scatter tests/fixtures/scatter.json -o speed.svg   speed vs accuracy from JSON
   warplight chart lin-convergence --scene cornell-rough -o c-{}.svg  thesis 003: error vs spp and time
   warplight chart lin-compaction -o lanes-{}.svg                     thesis 003: Figs. 16/17 per level
+  warplight chart lin-pixel-sampling -o px-{}.svg                    thesis 003: stratified vs tent pixels
 
 The format follows the output's extension: .svg or .png.")]
 pub struct ChartArgs {
@@ -100,6 +101,27 @@ Example:
   warplight chart lin-compaction --size 32 --depth 30 -o docs/images/lin-compaction-{}.svg"
     )]
     LinCompaction(lin::CompactionArgs),
+    /// Thesis 003 §4.2: stratified pixels (D x D strata of each subpixel,
+    /// frame f in stratum f mod D²; the kernel's stratified build) against
+    /// the thesis' tent filter, RMS error vs spp and vs time, log-log.
+    ///
+    /// Each sampling is measured against its own long native render (other
+    /// random numbers, whole rounds of D² frames; its noise, from the spread
+    /// of its rounds, taken out), since the filters converge to different
+    /// images. Also charted: the points at exactly D² frames (one sample a
+    /// stratum, the regime of the O(1/n) claim, 003:L223). One frame of
+    /// each build is emulated (warp instructions, checked equal to the native twin).
+    #[command(
+        name = "lin-pixel-sampling",
+        after_help = "\
+Examples:
+  the pixel integral alone (0 bounces, lit by the environment map):
+  warplight chart lin-pixel-sampling --scene env-spheres --integrator pt --bounces 0 -o docs/images/lin-pixels-env-spheres-{}.svg
+  the Cornell box at 16 bounces, where the path's other dimensions dominate:
+  warplight chart lin-pixel-sampling --scene cornell-lambert -o docs/images/lin-pixels-cornell-lambert-{}.svg
+  warplight chart lin-pixel-sampling --from docs/images/lin-pixels-env-spheres-data.json -o p-{}.png"
+    )]
+    LinPixelSampling(lin::PixelSamplingArgs),
 }
 
 /// Options of `warplight chart media`.
@@ -215,6 +237,7 @@ pub fn run(a: ChartArgs) -> Result<(), Box<dyn std::error::Error>> {
         ChartCommand::Media(m) => media(m),
         ChartCommand::LinConvergence(c) => lin::lin_convergence(c),
         ChartCommand::LinCompaction(c) => lin::lin_compaction(c),
+        ChartCommand::LinPixelSampling(c) => lin::lin_pixel_sampling(c),
     }
 }
 

@@ -107,6 +107,13 @@ pub struct RenderArgs {
     /// second build of the kernel, kernels/lin2017/path_fixed_depth.cu).
     #[arg(long, default_value = "roulette")]
     pub termination: String,
+    /// Path tracer: where camera rays fall in their subpixels, tent (the
+    /// thesis' tent filter over uniform jitter, §4.2) or stratified:D (frame f
+    /// in stratum f mod D² of a D x D grid, a box filter; a third build of the
+    /// kernel, kernels/lin2017/path_stratified.cu; whole rounds need --spp a
+    /// multiple of 4·D²).
+    #[arg(long, default_value = "tent")]
+    pub pixels: String,
     /// Photon map (thesis 000 ch. 5): vkde, vkde-epanechnikov, knn (Table 5.1's k) or knn:K.
     #[arg(long, default_value = "vkde")]
     pub estimator: String,
@@ -229,6 +236,7 @@ fn check_applicable(a: &RenderArgs) -> Result<(), String> {
         ("--seed", a.seed != 0),
         ("--traversal", a.traversal != "stack"),
         ("--termination", a.termination != "roulette"),
+        ("--pixels", a.pixels != "tent"),
     ];
     if let Some((o, _)) = path_only.iter().find(|x| m != "path" && x.1) {
         return Err(format!("{o} applies to --method path only, not {m}"));
@@ -462,7 +470,7 @@ fn run_path(
     camera: &crate::host::camera::Camera,
     profile: Profile,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    use crate::host::path::{FrameParams, Integrator, Termination, Traversal};
+    use crate::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal};
     let integrator = Integrator::parse(&a.integrator).ok_or_else(|| {
         format!(
             "unknown integrator `{}`; expected pt, nee, mis (balance heuristic), mis-power, bdpt or mlt",
@@ -473,6 +481,7 @@ fn run_path(
         .ok_or_else(|| format!("unknown traversal `{}`; expected stack, stack12, restart or backtrack", a.traversal))?;
     let termination = Termination::parse(&a.termination)
         .ok_or_else(|| format!("unknown termination `{}`; expected roulette or fixed-depth", a.termination))?;
+    let pixels = PixelSampling::parse(&a.pixels)?;
     let frames = crate::repro::lin2017::render::frames_for(a.spp)?;
     // the emulated kernel runs on the command's profile, FMA contraction and fidelity
     let set = |c: &mut crate::sim::SimConfig| {
@@ -486,17 +495,18 @@ fn run_path(
     };
     let [width, height] = camera.resolution;
     let params =
-        FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal, termination };
+        FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal, termination, pixels };
     let r = crate::repro::lin2017::render::render(scene, camera, params, frames, emulated)?;
     write_image(&r.image, &a.output, a.exposure)?;
     println!(
-        "{} ({}x{}), path tracer {} ({} traversal, {}), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
+        "{} ({}x{}), path tracer {} ({} traversal, {}, {} pixels), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
         scene.name,
         width,
         height,
         integrator.name(),
         traversal.name(),
         termination.name(),
+        pixels.name(),
         a.spp,
         frames,
         a.bounces,
@@ -506,6 +516,14 @@ fn run_path(
     );
     if let Some((w, t)) = r.instructions {
         println!("  emulated {}: {w} warp instructions, {t} thread instructions", r.kernel);
+    }
+    if frames % pixels.round() != 0 {
+        println!(
+            "  note: {} pixels take {} frames a round; {} frames end inside a round, so the last round's strata cover only the top of each subpixel",
+            pixels.name(),
+            pixels.round(),
+            frames
+        );
     }
     println!("  wrote {}", a.output.display());
     Ok(())

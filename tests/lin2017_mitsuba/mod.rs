@@ -11,7 +11,7 @@ use warplight::host::path::layout::PathScene;
 use warplight::host::path::stats::{
     Estimate, Outcome, from_frames, from_reference, read_exr, welch_holm, welch_holm_floored,
 };
-use warplight::host::path::{FrameParams, Integrator, Termination, Traversal, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel, render_native};
 use warplight::host::scene::Scene;
 use warplight::host::scene_file;
 use warplight::sim::{Device, Fidelity};
@@ -61,6 +61,7 @@ pub fn params(size: u32, integrator: Integrator, seed: u32) -> FrameParams {
         seed,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     }
 }
 
@@ -118,7 +119,7 @@ pub fn emulated_frames_outcome(
     let mut cfg = kernel::sim_config(&p);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);
-    let module = kernel::load_for(&mut dev, p.termination).expect("load PTX");
+    let module = kernel::load_for(&mut dev, kernel::KernelBuild::of(&p)).expect("load PTX");
     let r = kernel::render(&mut dev, &module, ps, cam, p, frames, true, |_| {}).expect("launch");
     let ours = from_frames(&r.image.frame_images, BLOCK).expect("frames");
     welch_holm_floored(&ours, reference, ALPHA, floor).expect("same block grid")

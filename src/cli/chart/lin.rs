@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 
 use super::{parse_size, write};
 use crate::chart::Chart;
-use crate::host::path::{Integrator, Termination};
+use crate::host::path::{Integrator, PixelSampling, Termination};
 use crate::repro::lin2017::convergence::{self, Convergence, Options, Reference};
 use crate::repro::lin2017::lanes::{self, Compaction};
+use crate::repro::lin2017::pixel_sampling::{self, PixelSamplingData};
 
 /// Where the charts and their data go, or come from.
 #[derive(Debug, clap::Args)]
@@ -81,6 +82,42 @@ pub struct ConvergenceArgs {
     #[arg(long, default_value_t = 16)]
     pub bounces: u32,
     /// Seed of the random numbers.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u32,
+    /// The data and the charts.
+    #[command(flatten)]
+    pub out: Out,
+}
+
+/// Options of `warplight chart lin-pixel-sampling`.
+#[derive(Debug, clap::Args)]
+pub struct PixelSamplingArgs {
+    /// The scene (scenes/ name or path).
+    #[arg(long, default_value = "cornell-lambert")]
+    pub scene: String,
+    /// Pixel samplings, comma-separated: tent (the thesis') and stratified:D
+    /// (D x D strata of a subpixel; stratified:1 is the box filter unstratified).
+    #[arg(long, default_value = "tent,stratified:1,stratified:2,stratified:4,stratified:8", value_delimiter = ',')]
+    pub pixels: Vec<String>,
+    /// The integrator: pt, nee, mis, mis-power or bdpt.
+    #[arg(long, default_value = "nee")]
+    pub integrator: String,
+    /// The longest path in bounces (0: the camera ray alone, the pixel integral).
+    #[arg(long, default_value_t = 16)]
+    pub bounces: u32,
+    /// Image side in pixels.
+    #[arg(long, default_value_t = 32)]
+    pub size: u32,
+    /// Frames of the measured run (4 samples a pixel each); points at 1, 2, 4, ... and the last.
+    #[arg(long, default_value_t = 1024)]
+    pub frames: u32,
+    /// Frames of each sampling's reference, at least (rounded up to whole rounds of D²).
+    #[arg(long, default_value_t = 8192)]
+    pub reference_frames: u32,
+    /// Frames of each build to emulate for its warp instructions (0: none).
+    #[arg(long, default_value_t = 1)]
+    pub emulated_frames: u32,
+    /// Seed of the measured runs (the references': this plus a fixed offset).
     #[arg(long, default_value_t = 1)]
     pub seed: u32,
     /// The data and the charts.
@@ -227,4 +264,76 @@ pub fn lin_compaction(a: CompactionArgs) -> Result<(), Box<dyn std::error::Error
         }
     };
     chart_of(&a.out, &lanes::CHARTS, measure, report, Compaction::charts)
+}
+
+/// Runs `chart lin-pixel-sampling`.
+pub fn lin_pixel_sampling(a: PixelSamplingArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let measure = || -> Result<PixelSamplingData, Box<dyn std::error::Error>> {
+        let samplings = a
+            .pixels
+            .iter()
+            .map(|s| PixelSampling::parse(s).map_err(|e| format!("--pixels: {e}")))
+            .collect::<Result<Vec<_>, _>>()?;
+        let integrator = Integrator::parse(&a.integrator)
+            .ok_or_else(|| format!("--integrator: unknown `{}` (pt, nee, mis, mis-power, bdpt)", a.integrator))?;
+        let scene = crate::host::scene_file::load(&crate::host::scene_file::resolve(&a.scene))?;
+        let o = pixel_sampling::Options {
+            samplings,
+            integrator,
+            bounces: a.bounces,
+            size: a.size,
+            frames: a.frames,
+            reference_frames: a.reference_frames,
+            emulated_frames: a.emulated_frames,
+            seed: a.seed,
+        };
+        Ok(pixel_sampling::measure(&scene, &o, &mut |s| eprintln!("{s}"))?)
+    };
+    chart_of(&a.out, &pixel_sampling::CHARTS, measure, report_pixel_sampling, PixelSamplingData::charts)
+}
+
+fn report_pixel_sampling(data: &PixelSamplingData) {
+    let tent = data.curve(PixelSampling::Tent);
+    for c in &data.curves {
+        let last = c.native.last();
+        let ratio = match (tent, last) {
+            (Some(t), Some(p)) if c.pixels != PixelSampling::Tent => t
+                .at(p.frames)
+                .map(|q| format!(", {:.2} x the tent's error at as many samples", c.error(p) / t.error(q)))
+                .unwrap_or_default(),
+            _ => String::new(),
+        };
+        println!(
+            "{}: slope {} over whole rounds; at {} spp error {:.4e}{ratio}; reference {} frames, its noise {:.3e}; {:.3e} s a frame{}",
+            c.pixels.label(),
+            c.slope(1).map_or("–".into(), |s| format!("{s:.3}")),
+            last.map_or(0, |p| p.spp),
+            last.map_or(f64::NAN, |p| c.error(p)),
+            c.reference_frames,
+            c.reference_rmse,
+            c.frame_seconds,
+            match (c.warp_instructions_per_frame, c.emulated_equals_native) {
+                (Some(w), Some(same)) => format!("; emulated {w:.0} warp instructions a frame (= native: {same})"),
+                _ => String::new(),
+            }
+        );
+        let partial: Vec<String> = c
+            .native
+            .iter()
+            .filter(|p| !p.whole_rounds)
+            .map(|p| format!("{} frames {:.3e}", p.frames, c.error(p)))
+            .collect();
+        if !partial.is_empty() {
+            println!("  inside a round of {} frames: {}", c.pixels.round(), partial.join(", "));
+        }
+    }
+    let strata = data.one_per_stratum();
+    if strata.len() >= 2 {
+        let pts: Vec<String> = strata.iter().map(|(s, e)| format!("{s} spp {e:.3e}")).collect();
+        println!(
+            "one sample a stratum (D² frames): {}; slope {} (O(1/n) is -1, O(1/sqrt n) -0.5)",
+            pts.join(", "),
+            data.one_per_stratum_slope().map_or("–".into(), |s| format!("{s:.3}"))
+        );
+    }
 }

@@ -3,9 +3,11 @@
 //! 256-thread CTAs) and keeps the accumulation buffer on the device across
 //! launches; the counters of every launch are summed, and the traversal
 //! events of the `@count` lines read off each launch's profile. The kernel
-//! comes in two builds, the thesis' (Russian roulette, `path.ptx`) and the
-//! fixed depth (`path_fixed_depth.ptx`, [`super::Termination`]); every
-//! render refuses a module of the other build than its frames ask for.
+//! comes in three builds ([`KernelBuild`]): the thesis' (Russian roulette,
+//! the tent filter; `path.ptx`), the fixed depth (`path_fixed_depth.ptx`,
+//! [`super::Termination`]) and stratified pixels (`path_stratified.ptx`,
+//! [`super::PixelSampling`]); every render refuses a module of another build
+//! than its frames need.
 
 use super::counts::{self, Counts};
 use super::layout::PathScene;
@@ -21,37 +23,84 @@ pub const PTX: &str = include_str!("../../../kernels/lin2017/path.ptx");
 pub const FIXED_DEPTH_PTX: &str = include_str!("../../../kernels/lin2017/path_fixed_depth.ptx");
 /// The empty entry point that marks the fixed-depth build.
 pub const FIXED_DEPTH_MARK: &str = "path_fixed_depth_build";
+/// The same kernel with stratified pixels (`kernels/lin2017/path_stratified.cu`).
+pub const STRATIFIED_PTX: &str = include_str!("../../../kernels/lin2017/path_stratified.ptx");
+/// The empty entry point that marks the stratified build.
+pub const STRATIFIED_MARK: &str = "path_stratified_build";
 
-/// The PTX of the build that ends paths as `t` says, and its file name.
-pub fn ptx(t: super::Termination) -> (&'static str, &'static str) {
-    match t {
-        super::Termination::Roulette => (PTX, "kernels/lin2017/path.ptx"),
-        super::Termination::FixedDepth => (FIXED_DEPTH_PTX, "kernels/lin2017/path_fixed_depth.ptx"),
+/// The builds of `kernels/lin2017/path.cu`: one source, compiled as the
+/// thesis wrote it or with one of its alternatives switched in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum KernelBuild {
+    /// Russian roulette and the tent filter (`path.ptx`): every counted table's.
+    Thesis,
+    /// No roulette: paths run to the longest path (`path_fixed_depth.ptx`, [`super::Termination`]).
+    FixedDepth,
+    /// Stratified pixels (`path_stratified.ptx`, [`super::PixelSampling`]).
+    Stratified,
+}
+
+impl KernelBuild {
+    /// Every build, the thesis' first.
+    pub const ALL: [KernelBuild; 3] = [KernelBuild::Thesis, KernelBuild::FixedDepth, KernelBuild::Stratified];
+
+    /// The build that frames of `params` need (their settings checked by [`FrameParams::check`]).
+    pub fn of(params: &FrameParams) -> KernelBuild {
+        if params.termination == super::Termination::FixedDepth {
+            KernelBuild::FixedDepth
+        } else if params.pixels != super::PixelSampling::Tent {
+            KernelBuild::Stratified
+        } else {
+            KernelBuild::Thesis
+        }
+    }
+
+    /// Its PTX and file name.
+    pub fn ptx(self) -> (&'static str, &'static str) {
+        match self {
+            KernelBuild::Thesis => (PTX, "kernels/lin2017/path.ptx"),
+            KernelBuild::FixedDepth => (FIXED_DEPTH_PTX, "kernels/lin2017/path_fixed_depth.ptx"),
+            KernelBuild::Stratified => (STRATIFIED_PTX, "kernels/lin2017/path_stratified.ptx"),
+        }
+    }
+
+    /// Its name in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelBuild::Thesis => "thesis' (roulette, tent filter)",
+            KernelBuild::FixedDepth => "fixed-depth",
+            KernelBuild::Stratified => "stratified-pixel",
+        }
+    }
+
+    /// Which build `module` is: the others' carry their empty marker kernel.
+    pub fn of_module(module: &Module) -> KernelBuild {
+        let has = |mark: &str| module.prog.functions.iter().any(|f| f.name == mark);
+        if has(FIXED_DEPTH_MARK) {
+            KernelBuild::FixedDepth
+        } else if has(STRATIFIED_MARK) {
+            KernelBuild::Stratified
+        } else {
+            KernelBuild::Thesis
+        }
     }
 }
 
-/// Refuses frames of `params` on `module` when it is the other build of the
-/// kernel (a path would end otherwise than `params.termination` says).
+/// Refuses frames of `params` on `module` when it is another build of the
+/// kernel than theirs (a path would end, or a camera ray fall, otherwise
+/// than `params` say).
 pub fn check_build(module: &Module, params: &FrameParams) -> Result<(), SimError> {
-    let built = termination_of(module);
-    if built != params.termination {
+    let (built, want) = (KernelBuild::of_module(module), KernelBuild::of(params));
+    if built != want {
         return Err(SimError::BadLaunch(format!(
-            "the frames ask for {} termination, the loaded kernel is the {} build (load it with kernel::load_for)",
-            params.termination.name(),
+            "the frames need the {} build of the kernel, the loaded one is the {} build (load it with kernel::load_for)",
+            want.name(),
             built.name()
         )));
     }
     Ok(())
 }
 
-/// Which build `module` is: the fixed depth's carries [`FIXED_DEPTH_MARK`].
-pub fn termination_of(module: &Module) -> super::Termination {
-    if module.prog.functions.iter().any(|f| f.name == FIXED_DEPTH_MARK) {
-        super::Termination::FixedDepth
-    } else {
-        super::Termination::Roulette
-    }
-}
 /// The kernel's entry point (pt, nee, mis).
 pub const KERNEL: &str = "path_frame";
 /// The bidirectional path tracer's entry point.
@@ -95,14 +144,14 @@ pub const THREADS: u32 = 256;
 /// default 16 bounces needs well under a tenth of this).
 pub const WARP_INSTRUCTIONS_PER_PATH: u64 = 1 << 14;
 
-/// Loads the thesis' kernel (Russian roulette) on `dev`.
+/// Loads the thesis' kernel (Russian roulette, the tent filter) on `dev`.
 pub fn load(dev: &mut Device) -> Result<Module, SimError> {
-    load_for(dev, super::Termination::Roulette)
+    load_for(dev, KernelBuild::Thesis)
 }
 
-/// Loads on `dev` the build of the kernel that ends paths as `t` says ([`ptx`]).
-pub fn load_for(dev: &mut Device, t: super::Termination) -> Result<Module, SimError> {
-    let (text, name) = ptx(t);
+/// Loads `build` of the kernel on `dev` (for frames of `params`: [`KernelBuild::of`]).
+pub fn load_for(dev: &mut Device, build: KernelBuild) -> Result<Module, SimError> {
+    let (text, name) = build.ptx();
     dev.load_ptx(text, name)
 }
 
@@ -112,7 +161,7 @@ pub fn device(params: &FrameParams, fidelity: crate::sim::Fidelity) -> Result<(D
     let mut cfg = sim_config(params);
     cfg.fidelity = fidelity;
     let mut dev = Device::with_config(cfg);
-    let m = load_for(&mut dev, params.termination)?;
+    let m = load_for(&mut dev, KernelBuild::of(params))?;
     Ok((dev, m))
 }
 
@@ -168,6 +217,7 @@ pub fn params_bytes_mlt(scene: &PathScene, camera: &Camera, params: &FrameParams
         bytes.extend_from_slice(&v.to_le_bytes());
     }
     bytes.extend_from_slice(&b.to_le_bytes());
+    bytes.extend_from_slice(&params.pixels.strata().to_le_bytes());
     bytes
 }
 

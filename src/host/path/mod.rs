@@ -18,10 +18,13 @@ pub mod kernel;
 pub mod layout;
 pub mod mlt;
 pub mod native;
+pub mod pixels;
 pub mod regroup;
 pub mod rng;
 pub mod stats;
 pub mod wavefront;
+
+pub use pixels::{PixelSampling, PixelSamplingError};
 
 use super::camera::Camera;
 use super::image::FrameBuffer;
@@ -207,6 +210,17 @@ pub enum FrameParamsError {
         "a longest path of {0} bounces: at most {MAX_BOUNCES} (beyond, the eye and light subpaths would share random numbers)"
     )]
     TooManyBounces(u32),
+    /// A strata count out of range.
+    #[error(transparent)]
+    Pixels(#[from] PixelSamplingError),
+    /// An ending and a pixel sampling that no build of the kernel has together.
+    #[error(
+        "no build of the kernel has both {0} termination and {1} pixels (stratified pixels keep the thesis' roulette)"
+    )]
+    NoBuild(&'static str, String),
+    /// Stratified pixels under mlt.
+    #[error("{0} pixels under mlt: its camera sample is its chain's, so it takes the tent filter only")]
+    MltPixels(String),
 }
 
 /// The settings of a frame as the kernel reads them.
@@ -227,6 +241,9 @@ pub struct FrameParams {
     /// How a path ends: with the thesis' roulette or at the longest path (a
     /// second build of the kernel, [`kernel::ptx`]).
     pub termination: Termination,
+    /// Where camera rays fall in their subpixels: the thesis' tent filter,
+    /// or D x D strata (a third build of the kernel, [`kernel::KernelBuild`]).
+    pub pixels: PixelSampling,
 }
 
 impl FrameParams {
@@ -235,10 +252,37 @@ impl FrameParams {
         self.width as usize * self.height as usize * SAMPLES_PER_FRAME as usize
     }
 
-    /// Refuses settings the tracer does not take: more than [`MAX_BOUNCES`] bounces.
+    /// The thesis' settings for `width` x `height` pixels: the short stack,
+    /// Russian roulette and the tent filter.
+    pub fn new(width: u32, height: u32, integrator: Integrator, max_bounces: u32, seed: u32) -> FrameParams {
+        FrameParams {
+            width,
+            height,
+            integrator,
+            max_bounces,
+            seed,
+            traversal: Traversal::ShortStack,
+            termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
+        }
+    }
+
+    /// Refuses settings the tracer does not take: more than [`MAX_BOUNCES`]
+    /// bounces, a strata count out of range, and stratified pixels with a
+    /// fixed depth (no build has both) or under mlt (whose camera sample is
+    /// its chain's).
     pub fn check(&self) -> Result<(), FrameParamsError> {
         if self.max_bounces > MAX_BOUNCES {
             return Err(FrameParamsError::TooManyBounces(self.max_bounces));
+        }
+        self.pixels.check()?;
+        if self.pixels != PixelSampling::Tent {
+            if self.termination != Termination::Roulette {
+                return Err(FrameParamsError::NoBuild(self.termination.name(), self.pixels.name()));
+            }
+            if self.integrator == Integrator::Mlt {
+                return Err(FrameParamsError::MltPixels(self.pixels.name()));
+            }
         }
         Ok(())
     }

@@ -14,8 +14,8 @@ use super::layout::{
     KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TEXTURED, KIND_TRANSLUCENT,
     LEAF_AXIS, PathScene,
 };
-use super::rng::{Sample, azimuth, path_key, tent};
-use super::{FrameParams, Integrator, Termination, Traversal};
+use super::rng::{Sample, azimuth, path_key};
+use super::{FrameParams, Integrator, PixelSampling, Termination, Traversal};
 
 /// Random dimensions of the camera ray.
 pub const DIMS_CAMERA: u32 = 2;
@@ -319,12 +319,18 @@ impl Tracer<'_> {
     /// subpixel of the 2 x 2 grid by the tent filter's uniforms `r0` (across)
     /// and `r1` (down), the kernel's `camera_ray`.
     fn camera_ray(&self, i: u32, r0: f32, r1: f32) -> (V3, V3) {
+        self.camera_through(i, PixelSampling::Tent.offset(i & 3, 0, r0, r1))
+    }
+
+    /// Path `i`'s camera ray through its pixel at (`ox`, `oy`) half pixels
+    /// from the top left corner ([`PixelSampling::offset`]), the kernel's `camera_through`.
+    fn camera_through(&self, i: u32, (ox, oy): (f32, f32)) -> (V3, V3) {
         let cam = &self.frame;
         let (w, h) = (self.params.width, self.params.height);
-        let (pixel, sub) = (i >> 2, i & 3);
+        let pixel = i >> 2;
         let (x, y) = (pixel % w, pixel / w);
-        let px = x as f32 + ((sub & 1) as f32 + 0.5 + tent(r0)) * 0.5;
-        let py = y as f32 + ((sub >> 1) as f32 + 0.5 + tent(r1)) * 0.5;
+        let px = x as f32 + ox * 0.5;
+        let py = y as f32 + oy * 0.5;
         let cx = (px / w as f32 * 2.0 - 1.0) * cam.tan_half * cam.aspect;
         let cy = (1.0 - py / h as f32 * 2.0) * cam.tan_half;
         let (fwd, right, up) = (xyz(&cam.fwd, 0), xyz(&cam.right, 0), xyz(&cam.up, 0));
@@ -484,7 +490,8 @@ impl Tracer<'_> {
     /// Radiance of path `i` in frame `frame`, adding its traversal events to `c`.
     pub fn path_counted(&self, i: u32, frame: u32, counts: &mut Counts) -> [f32; 3] {
         let key = path_key(i, frame, self.params.seed);
-        self.radiance(self.camera_ray(i, key.at(0), key.at(1)), key, counts)
+        let offset = self.params.pixels.offset(i & 3, frame, key.at(0), key.at(1));
+        self.radiance(self.camera_through(i, offset), key, counts)
     }
 
     /// An MLT proposal (or bootstrap sample) drawn through `m`: its path

@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 
 use crate::host::camera::Camera;
 use crate::host::path::wavefront::{self, Compactor, Level, PATH_ACTIVE, STATE_FLOATS, THREADS};
-use crate::host::path::{FrameParams, Integrator, Termination, Traversal, kernel};
+use crate::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel};
 use crate::host::scene::Scene;
 use crate::repro::compare::Tolerance;
 use crate::repro::lin2017::runs;
@@ -73,6 +73,7 @@ pub fn measure_on(scene: &Scene) -> Result<Example, MeasureError> {
         seed: 0,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     };
     let camera = Camera { resolution: [8, 4], ..scene.camera };
     let n = params.paths();

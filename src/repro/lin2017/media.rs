@@ -9,7 +9,7 @@
 
 use crate::host::camera::Camera;
 use crate::host::path::layout::LayoutError;
-use crate::host::path::{FrameParams, Integrator, RenderError, Termination, Traversal, render_native};
+use crate::host::path::{FrameParams, Integrator, PixelSampling, RenderError, Termination, Traversal, render_native};
 use crate::host::scene::{Jitter, Scene};
 use crate::host::scene_file::MAX_MEDIUM_STEPS;
 use crate::repro::lin2017::runs;
@@ -77,6 +77,7 @@ pub fn march_variance(
         seed,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     };
     let mut out = Vec::new();
     for jitter in [Jitter::Stratified, Jitter::PerStep] {

@@ -35,6 +35,7 @@ pub mod fig_8;
 pub mod fig_9;
 pub mod lanes;
 pub mod media;
+pub mod pixel_sampling;
 pub mod render;
 pub mod runs;
 pub mod sec_4_8;

@@ -95,7 +95,7 @@ pub fn render(
             let mut cfg = kernel::sim_config(&params);
             set(&mut cfg);
             let mut dev = Device::with_config(cfg);
-            let module = kernel::load_for(&mut dev, params.termination)?;
+            let module = kernel::load_for(&mut dev, kernel::KernelBuild::of(&params))?;
             let k = kernel::render(&mut dev, &module, &ps, camera, params, frames, false, tick)?;
             (k.image.image(), Some((k.totals.warp_instructions, k.totals.thread_instructions)))
         }

@@ -7,7 +7,9 @@ use crate::host::camera::Camera;
 use crate::host::image::FrameBuffer;
 use crate::host::kdtree::{BuildParams, Heuristic, KdTree, build};
 use crate::host::path::layout::{LayoutError, PathScene};
-use crate::host::path::{FrameParams, Integrator, RenderError, Termination, Traversal, kernel, render_native};
+use crate::host::path::{
+    FrameParams, Integrator, PixelSampling, RenderError, Termination, Traversal, kernel, render_native,
+};
 use crate::host::raycast::{Caster, TraceStats};
 use crate::host::scene::Scene;
 use crate::model::atomic_tally::{AtomicSharing, AtomicTally};
@@ -64,6 +66,7 @@ pub fn square(side: u32, integrator: Integrator, bounces: u32, seed: u32) -> Fra
         seed,
         traversal: Traversal::ShortStack,
         termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
     }
 }
 

@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use crate::host::camera::Camera;
 use crate::host::path::build::{self, Construction};
 use crate::host::path::layout::PathScene;
-use crate::host::path::{FrameParams, Integrator, Termination, Traversal, kernel};
+use crate::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel};
 use crate::repro::compare::Tolerance;
 use crate::repro::registry::{Entry, MeasureError, Tick, Workspace};
 use crate::repro::results::{Results, Sample};
@@ -89,6 +89,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
             seed: 0,
             traversal: Traversal::ShortStack,
             termination: Termination::Roulette,
+            pixels: PixelSampling::Tent,
         };
         let mut cfg = kernel::sim_config(&params);
         cfg.fidelity = cfg.fidelity.max(Fidelity::Instructions);

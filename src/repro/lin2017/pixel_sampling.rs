@@ -1,0 +1,429 @@
+//! Stratified pixels against the tent filter (§4.2, 003:L221-230; extract
+//! A.10): `warplight chart lin-pixel-sampling`.
+//!
+//! The thesis claims that stratifying a pixel into D x D strata "reduces the
+//! error of estimation from O(1/√n) to O(1/n)" (003:L223), that smallpt's
+//! tent filter "produces same image quality given same sampling number as
+//! stratified sampling does" (003:L225), and that stratification cannot
+//! refine successively, needing D² samples as a unit (003:L223). Each
+//! sampling is rendered natively by its own build's twin (the tent filter:
+//! the thesis' `path.ptx`; strata: `path_stratified.ptx`, frame f in stratum
+//! f mod D²):
+//!
+//! - *Its own reference.* The filters converge to different images (the tent
+//!   spans two subpixels, a stratum's box one), so each curve is measured
+//!   against a long render of its own sampling with other random numbers
+//!   (`reference_seed`), in whole rounds of D² frames. The reference's own
+//!   noise (the RMS standard error of its mean, from the spread of its
+//!   rounds, each an independent estimate) is taken out of each error:
+//!   √(rmse² − floor²).
+//! - *Points* at 1, 2, 4, ... frames and the last; a point ends inside a
+//!   round when its frames are not a multiple of D² (then the strata seen so
+//!   far cover only the top of each subpixel: the successive-refinement
+//!   problem the thesis names).
+//! - *One sample a stratum*: the point of each D at exactly D² frames, the
+//!   regime of the O(1/n) claim (n = D² samples a subpixel, D growing).
+//! - *Cost*: native seconds a frame (measured), and the warp instructions of
+//!   an emulated frame of each build (counted), with the emulated image
+//!   checked to equal the native twin's bit for bit.
+//!
+//! Two scenes separate what stratifying two of a path's dimensions can do:
+//! at 0 bounces under an environment map (`env-spheres`) the estimate is the
+//! pixel integral alone; on the Cornell box at 16 bounces the path's other
+//! dimensions carry most of the variance.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::chart::{Scatter, Series};
+use crate::host::camera::Camera;
+use crate::host::path::layout::{LayoutError, PathScene};
+use crate::host::path::native::Tracer;
+use crate::host::path::{
+    FrameParams, FrameParamsError, Integrator, PixelSampling, Progressive, SAMPLES_PER_FRAME, eps_for, frame_of,
+};
+use crate::host::scene::Scene;
+use crate::repro::lin2017::convergence::checkpoints;
+use crate::repro::lin2017::runs;
+
+/// The seed of a curve's reference: the measured run's plus this (other random numbers).
+pub const REFERENCE_SEED_OFFSET: u32 = 0x9e37_79b9;
+
+/// The charts' names (`{}` in `warplight chart lin-pixel-sampling -o`).
+pub const CHARTS: [&str; 2] = ["spp", "seconds"];
+
+/// Why the comparison cannot be measured.
+#[derive(Debug, thiserror::Error)]
+pub enum PixelSamplingChartError {
+    /// Settings that give no curve.
+    #[error("{0}")]
+    Settings(String),
+    /// The scene's layout refused it.
+    #[error(transparent)]
+    Layout(#[from] LayoutError),
+    /// The path tracer refused the settings.
+    #[error(transparent)]
+    Params(#[from] FrameParamsError),
+    /// The emulated or the native render failed.
+    #[error(transparent)]
+    Twin(#[from] runs::TwinError),
+}
+
+/// What to measure.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The samplings, a curve each.
+    pub samplings: Vec<PixelSampling>,
+    /// The integrator (pt, nee, mis, mis-power or bdpt).
+    pub integrator: Integrator,
+    /// The longest path in bounces (0: the camera ray alone).
+    pub bounces: u32,
+    /// Image side in pixels.
+    pub size: u32,
+    /// The measured run's frames (4 samples a pixel each).
+    pub frames: u32,
+    /// Each reference's frames, at least; rounded up to whole rounds of D².
+    pub reference_frames: u32,
+    /// Frames of each build to emulate (0: none).
+    pub emulated_frames: u32,
+    /// Seed of the measured runs.
+    pub seed: u32,
+}
+
+/// One running image's error.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// Frames in it.
+    pub frames: u32,
+    /// Samples a pixel.
+    pub spp: u32,
+    /// RMS difference from the curve's reference, over pixels and channels.
+    pub rmse: f64,
+    /// Native seconds from the run's start to this frame's end (measured).
+    pub seconds: f64,
+    /// Whether its frames are whole rounds (a multiple of D²).
+    pub whole_rounds: bool,
+}
+
+/// One sampling's curve.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Curve {
+    /// The sampling.
+    pub pixels: PixelSampling,
+    /// Its reference's frames (whole rounds).
+    pub reference_frames: u32,
+    /// Its reference's own noise: the RMS over pixels and channels of the
+    /// standard error of its mean, from the spread of its rounds.
+    pub reference_rmse: f64,
+    /// The measured run's points.
+    pub native: Vec<Point>,
+    /// Native seconds a frame (the measured run's).
+    pub frame_seconds: f64,
+    /// Warp instructions an emulated frame of its build took (counted; None: not emulated).
+    pub warp_instructions_per_frame: Option<f64>,
+    /// Whether the emulated frames equal the native twin's bit for bit (None: not emulated).
+    pub emulated_equals_native: Option<bool>,
+}
+
+impl Curve {
+    /// A point's error with the reference's noise taken out: √(rmse² − floor²), at least 0.
+    pub fn error(&self, p: &Point) -> f64 {
+        (p.rmse * p.rmse - self.reference_rmse * self.reference_rmse).max(0.0).sqrt()
+    }
+
+    /// The least-squares slope of log error against log spp over the points
+    /// of whole rounds (frames ≥ D²) from `from_frames` on; −1/2 for
+    /// independent samples.
+    pub fn slope(&self, from_frames: u32) -> Option<f64> {
+        let pts: Vec<(f64, f64)> = self
+            .native
+            .iter()
+            .filter(|p| p.whole_rounds && p.frames >= from_frames.max(self.pixels.round()) && self.error(p) > 0.0)
+            .map(|p| ((p.spp as f64).ln(), self.error(p).ln()))
+            .collect();
+        fit_slope(&pts)
+    }
+
+    /// The point at `frames`.
+    pub fn at(&self, frames: u32) -> Option<&Point> {
+        self.native.iter().find(|p| p.frames == frames)
+    }
+}
+
+/// The least-squares slope of `pts` (x, y); None below two points.
+pub fn fit_slope(pts: &[(f64, f64)]) -> Option<f64> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+/// The chart data (`docs/images/lin-pixels-*-data.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PixelSamplingData {
+    /// The scene's name.
+    pub scene: String,
+    /// Image side in pixels.
+    pub size: u32,
+    /// The integrator.
+    pub integrator: String,
+    /// The longest path in bounces.
+    pub bounces: u32,
+    /// Seed of the measured runs.
+    pub seed: u32,
+    /// Seed of the references.
+    pub reference_seed: u32,
+    /// Threads the native renders ran on (rayon).
+    pub native_threads: usize,
+    /// A curve per sampling.
+    pub curves: Vec<Curve>,
+}
+
+impl PixelSamplingData {
+    /// The curve of `pixels`.
+    pub fn curve(&self, pixels: PixelSampling) -> Option<&Curve> {
+        self.curves.iter().find(|c| c.pixels == pixels)
+    }
+
+    /// One sample a stratum: (spp, error) of each stratified curve at
+    /// exactly D² frames, D ascending.
+    pub fn one_per_stratum(&self) -> Vec<(f64, f64)> {
+        let mut v: Vec<(u32, f64, f64)> = self
+            .curves
+            .iter()
+            .filter_map(|c| match c.pixels {
+                PixelSampling::Stratified(d) => c.at(d * d).map(|p| (d, p.spp as f64, c.error(p))),
+                PixelSampling::Tent => None,
+            })
+            .filter(|p| p.2 > 0.0)
+            .collect();
+        v.sort_by_key(|p| p.0);
+        v.into_iter().map(|(_, s, e)| (s, e)).collect()
+    }
+
+    /// The slope of [`PixelSamplingData::one_per_stratum`] in log-log: −1 if the error is O(1/n).
+    pub fn one_per_stratum_slope(&self) -> Option<f64> {
+        let pts: Vec<(f64, f64)> = self.one_per_stratum().into_iter().map(|(s, e)| (s.ln(), e.ln())).collect();
+        fit_slope(&pts)
+    }
+
+    /// The charts, in [`CHARTS`]' order: the error (the reference's noise
+    /// taken out) against samples a pixel, with the one-sample-a-stratum
+    /// points as their own series, and against native seconds.
+    pub fn charts(&self) -> Vec<Scatter> {
+        let head =
+            format!("{} ({}x{}, {}, {} bounces)", self.scene, self.size, self.size, self.integrator, self.bounces);
+        let series = |x: &dyn Fn(&Point) -> f64| -> Vec<Series> {
+            self.curves
+                .iter()
+                .map(|c| Series {
+                    name: c.pixels.label(),
+                    points: c.native.iter().map(|p| (x(p), c.error(p))).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect(),
+                })
+                .filter(|s| !s.points.is_empty())
+                .collect()
+        };
+        let mut spp = series(&|p| p.spp as f64);
+        let strata = self.one_per_stratum();
+        if strata.len() >= 2 {
+            spp.push(Series { name: "one sample a stratum (D² frames)".into(), points: strata });
+        }
+        let secs = series(&|p| p.seconds);
+        let scatter = |title: String, x_label: &str, series| Scatter {
+            title,
+            x_label: x_label.into(),
+            y_label: "RMS error, its reference's noise taken out".into(),
+            log_x: true,
+            log_y: true,
+            connect: true,
+            series,
+        };
+        vec![
+            scatter(
+                format!("{head}: stratified pixels vs the tent filter, error vs samples (native; measured)"),
+                "samples per pixel",
+                spp,
+            ),
+            scatter(
+                format!("{head}: stratified pixels vs the tent filter, error vs time (native host seconds; measured)"),
+                "seconds (native, this machine)",
+                secs,
+            ),
+        ]
+    }
+}
+
+/// Frames of `tracer` from 0 to `frames`, streamed: the running mean at
+/// each of `marks` (per pixel and channel) with the seconds it took, and
+/// the variance of the mean from the spread of whole rounds of `round`
+/// frames (None below two rounds).
+struct Stream {
+    means: Vec<(u32, Vec<f64>, f64)>,
+    var_of_mean: Option<Vec<f64>>,
+}
+
+fn stream(tracer: &Tracer, frames: u32, marks: &[u32], round: u32) -> Stream {
+    let (w, h) = (tracer.params.width, tracer.params.height);
+    let mut out = Progressive::new(w, h);
+    let mut last = vec![0.0f32; out.accum.len()];
+    let cells = (w * h * 3) as usize;
+    let (mut sum, mut in_round) = (vec![0.0f64; cells], vec![0.0f64; cells]);
+    let (mut rounds_sum, mut rounds_sq) = (vec![0.0f64; cells], vec![0.0f64; cells]);
+    let mut means = Vec::new();
+    let t0 = Instant::now();
+    for f in 0..frames {
+        tracer.frame(f, &mut out.accum, &mut last);
+        let img = Progressive::pixels_of(w, h, &last);
+        for (c, v) in img.pixels.iter().flatten().enumerate() {
+            sum[c] += *v as f64;
+            in_round[c] += *v as f64;
+        }
+        let n = f + 1;
+        if n % round == 0 {
+            for c in 0..cells {
+                let m = in_round[c] / round as f64;
+                rounds_sum[c] += m;
+                rounds_sq[c] += m * m;
+                in_round[c] = 0.0;
+            }
+        }
+        if marks.contains(&n) {
+            means.push((n, sum.iter().map(|s| s / n as f64).collect(), t0.elapsed().as_secs_f64()));
+        }
+    }
+    let rounds = (frames / round) as f64;
+    let var_of_mean = (rounds >= 2.0).then(|| {
+        rounds_sum
+            .iter()
+            .zip(&rounds_sq)
+            .map(|(s, q)| ((q - s * s / rounds) / (rounds - 1.0)).max(0.0) / rounds)
+            .collect()
+    });
+    Stream { means, var_of_mean }
+}
+
+/// Renders `scene` with each sampling of `o` and measures its curve
+/// against its own reference; `progress` hears each step.
+pub fn measure(
+    scene: &Scene,
+    o: &Options,
+    progress: &mut dyn FnMut(&str),
+) -> Result<PixelSamplingData, PixelSamplingChartError> {
+    if o.samplings.is_empty() || o.frames == 0 || o.size == 0 || o.reference_frames == 0 {
+        return Err(PixelSamplingChartError::Settings(
+            "expected at least one sampling, a positive image size, frame count and reference frame count".into(),
+        ));
+    }
+    if o.integrator == Integrator::Mlt {
+        return Err(PixelSamplingChartError::Settings(
+            "mlt takes its camera sample from its chain, never a stratum: chart pt, nee, mis, mis-power or bdpt".into(),
+        ));
+    }
+    let ps: PathScene = runs::path_scene(scene)?;
+    ps.check_integrator(&scene.name, o.integrator)?;
+    let camera = Camera { resolution: [o.size, o.size], ..scene.camera };
+    let frame = frame_of(&camera, eps_for(ps.lo, ps.hi));
+    let marks = checkpoints(o.frames);
+    let reference_seed = o.seed.wrapping_add(REFERENCE_SEED_OFFSET);
+    let mut curves = Vec::new();
+    for &pixels in &o.samplings {
+        let params = FrameParams { pixels, ..FrameParams::new(o.size, o.size, o.integrator, o.bounces, o.seed) };
+        params.check()?;
+        let round = pixels.round();
+        let reference_frames = o.reference_frames.div_ceil(round).max(2) * round;
+        progress(&format!("{}: reference, {reference_frames} native frames", pixels.label()));
+        let ref_params = FrameParams { seed: reference_seed, ..params };
+        let r = stream(&Tracer { scene: &ps, frame, params: ref_params }, reference_frames, &[reference_frames], round);
+        let ref_mean = &r.means[0].1;
+        let var = r.var_of_mean.unwrap_or_default();
+        let reference_rmse = (var.iter().sum::<f64>() / var.len().max(1) as f64).sqrt();
+        progress(&format!("{}: {} native frames", pixels.label(), o.frames));
+        let run = stream(&Tracer { scene: &ps, frame, params }, o.frames, &marks, round);
+        let native: Vec<Point> = run
+            .means
+            .iter()
+            .map(|(n, mean, seconds)| {
+                let mse = mean.iter().zip(ref_mean).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / mean.len() as f64;
+                Point {
+                    frames: *n,
+                    spp: n * SAMPLES_PER_FRAME,
+                    rmse: mse.sqrt(),
+                    seconds: *seconds,
+                    whole_rounds: n % round == 0,
+                }
+            })
+            .collect();
+        let frame_seconds = native.last().map_or(0.0, |p| p.seconds / p.frames as f64);
+        let (mut warp, mut same) = (None, None);
+        if o.emulated_frames > 0 {
+            progress(&format!("{}: {} emulated frame(s)", pixels.label(), o.emulated_frames));
+            let t = runs::emulate_twin(&ps, &camera, params, o.emulated_frames)?;
+            warp = Some(t.emulated.totals.warp_instructions as f64 / o.emulated_frames as f64);
+            same = Some(t.same);
+        }
+        curves.push(Curve {
+            pixels,
+            reference_frames,
+            reference_rmse,
+            native,
+            frame_seconds,
+            warp_instructions_per_frame: warp,
+            emulated_equals_native: same,
+        });
+    }
+    Ok(PixelSamplingData {
+        scene: scene.name.clone(),
+        size: o.size,
+        integrator: o.integrator.name().into(),
+        bounces: o.bounces,
+        seed: o.seed,
+        reference_seed,
+        native_threads: rayon::current_num_threads(),
+        curves,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slopes_of_power_laws() {
+        let pts: Vec<(f64, f64)> = (0..5).map(|k| ((4u32 << k) as f64, 3.0 * (4u32 << k) as f64)).collect();
+        let logs: Vec<(f64, f64)> = pts.iter().map(|p| (p.0.ln(), p.1.powf(-0.75).ln())).collect();
+        assert!((fit_slope(&logs).unwrap() + 0.75).abs() < 1e-12);
+        assert_eq!(fit_slope(&logs[..1]), None);
+        assert_eq!(fit_slope(&[(1.0, 1.0), (1.0, 2.0)]), None, "no spread in x");
+    }
+
+    /// The reference's noise comes out of the error; the slope reads only
+    /// whole rounds from D² frames on.
+    #[test]
+    fn a_curves_error_and_slope() {
+        let point = |frames: u32, rmse: f64| Point {
+            frames,
+            spp: 4 * frames,
+            rmse,
+            seconds: 1.0,
+            whole_rounds: frames % 4 == 0,
+        };
+        let c = Curve {
+            pixels: PixelSampling::Stratified(2),
+            reference_frames: 64,
+            reference_rmse: 3.0,
+            // errors 4 (rmse 5), 2, 1 at 4, 16, 64 frames: slope -1/2; frames 2 ends inside a round
+            native: vec![point(2, 100.0), point(4, 5.0), point(16, 13f64.sqrt()), point(64, 10f64.sqrt())],
+            frame_seconds: 0.1,
+            warp_instructions_per_frame: None,
+            emulated_equals_native: None,
+        };
+        assert_eq!(c.error(&c.native[1]), 4.0);
+        assert_eq!(c.error(&point(1, 1.0)), 0.0, "below the floor");
+        assert!((c.slope(1).unwrap() + 0.5).abs() < 1e-12, "{:?}", c.slope(1));
+    }
+}
