@@ -86,10 +86,11 @@ impl KernelBuild {
     }
 }
 
-/// Refuses frames of `params` on `module` when it is another build of the
-/// kernel than theirs (a path would end, or a camera ray fall, otherwise
-/// than `params` say).
+/// Refuses frames of `params` that no build has ([`FrameParams::check_build`])
+/// or on `module` when it is another build of the kernel than theirs (a path
+/// would end, or a camera ray fall, otherwise than `params` say).
 pub fn check_build(module: &Module, params: &FrameParams) -> Result<(), SimError> {
+    params.check_build().map_err(|e| SimError::BadLaunch(e.to_string()))?;
     let (built, want) = (KernelBuild::of_module(module), KernelBuild::of(params));
     if built != want {
         return Err(SimError::BadLaunch(format!(

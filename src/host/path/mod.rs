@@ -268,13 +268,18 @@ impl FrameParams {
     }
 
     /// Refuses settings the tracer does not take: more than [`MAX_BOUNCES`]
-    /// bounces, a strata count out of range, and stratified pixels with a
-    /// fixed depth (no build has both) or under mlt (whose camera sample is
-    /// its chain's).
+    /// bounces, and what [`FrameParams::check_build`] refuses.
     pub fn check(&self) -> Result<(), FrameParamsError> {
         if self.max_bounces > MAX_BOUNCES {
             return Err(FrameParamsError::TooManyBounces(self.max_bounces));
         }
+        self.check_build()
+    }
+
+    /// Refuses settings no build of the kernel has (every render, native or
+    /// emulated, checks them): a strata count out of range, and stratified
+    /// pixels with a fixed depth or under mlt (whose camera sample is its chain's).
+    pub fn check_build(&self) -> Result<(), FrameParamsError> {
         self.pixels.check()?;
         if self.pixels != PixelSampling::Tent {
             if self.termination != Termination::Roulette {
@@ -387,6 +392,9 @@ pub enum RenderError {
         "the scene has a participating medium, translucent materials or texture maps, which only pt, nee, mis and mis-power render (volume_frame, sss_frame, texture_frame); not {0}"
     )]
     Medium(&'static str),
+    /// Settings no build of the kernel has ([`FrameParams::check_build`]).
+    #[error(transparent)]
+    Params(#[from] FrameParamsError),
 }
 
 /// Renders `frames` frames natively; `keep_frames` keeps each frame's image
@@ -406,6 +414,7 @@ pub fn render_native(
     if scene.ignores_medium(params.integrator) {
         return Err(RenderError::Medium(params.integrator.name()));
     }
+    params.check_build()?;
     if params.integrator == Integrator::Mlt {
         return Ok(mlt::render_native(scene, camera, params, frames, keep_frames, progress)?.image);
     }

@@ -1,0 +1,241 @@
+//! Stratified pixels (§4.2, 003:L221-230): the kernel's third build
+//! (`kernels/lin2017/path_stratified.cu`, frame f in stratum f mod D² of a
+//! D x D grid over each subpixel) runs bit for bit as its native twin in
+//! every entry point that takes a camera ray from a frame, is refused where
+//! no build has it, and the chart that sets it against the thesis' tent
+//! filter shows what stratification does to the pixel integral.
+
+#[allow(dead_code)]
+mod lin2017_mitsuba;
+
+use std::path::Path;
+
+use lin2017_mitsuba::{params, scene_of};
+use warplight::host::path::kernel::KernelBuild;
+use warplight::host::path::{FrameParams, FrameParamsError, Integrator, PixelSampling, Termination, render_native};
+use warplight::host::scene_file;
+use warplight::repro::lin2017::pixel_sampling::{self, Options, PixelSamplingData};
+use warplight::repro::lin2017::runs;
+
+fn stratified(p: FrameParams, d: u32) -> FrameParams {
+    FrameParams { pixels: PixelSampling::Stratified(d), ..p }
+}
+
+#[test]
+fn the_stratified_build_runs_as_its_native_twin() {
+    let (_, ps, cam) = scene_of("cornell-lambert", 8);
+    // three frames: three strata of the 2 x 2 grid
+    for integrator in [Integrator::Pt, Integrator::Nee, Integrator::MisPower, Integrator::Bdpt] {
+        let p = stratified(params(8, integrator, 5), 2);
+        assert_eq!(KernelBuild::of(&p), KernelBuild::Stratified);
+        let t = runs::emulate_twin(&ps, &cam, p, 3).expect("render");
+        assert!(t.same, "{integrator:?}: the stratified build differs from its native twin");
+        let tent = render_native(&ps, &cam, params(8, integrator, 5), 3, false, |_| {}).expect("render");
+        assert_ne!(tent.accum, t.emulated.image.accum, "{integrator:?}: the two samplings made the same image");
+    }
+    // the other entry points: the march through a medium, the translucent
+    // walk, the textures, and the environment map seen directly
+    for scene in ["fog-box", "sss-balls", "cornell-scratched", "env-spheres"] {
+        let (_, ps, cam) = scene_of(scene, 4);
+        let t = runs::emulate_twin(&ps, &cam, stratified(params(4, Integrator::Nee, 6), 3), 2).expect("render");
+        assert!(t.same, "{scene}: the stratified build differs from its native twin");
+    }
+}
+
+/// Whole rounds of D x D strata estimate the same box-filtered image as one
+/// stratum (stratified:1, a uniform place in the subpixel), and the tent a
+/// different one; the frames of a round's top row of strata alone (f mod 16
+/// below 4) see only the top of each subpixel. The pixel integral alone: 0
+/// bounces under the environment map, 1,024 frames each.
+#[test]
+fn whole_rounds_estimate_the_box_filtered_image() {
+    let (_, ps, cam) = scene_of("env-spheres", 16);
+    let frames = |pixels| {
+        let p = FrameParams { max_bounces: 0, pixels, ..params(16, Integrator::Pt, 2) };
+        render_native(&ps, &cam, p, 1024, true, |_| {}).expect("render").frame_images
+    };
+    let mean = |fs: &[&warplight::host::image::FrameBuffer]| -> Vec<f64> {
+        let mut m = vec![0.0; fs[0].pixels.len() * 3];
+        for f in fs {
+            for (a, &v) in m.iter_mut().zip(f.pixels.iter().flatten()) {
+                *a += v as f64 / fs.len() as f64;
+            }
+        }
+        m
+    };
+    let all = |fs: &[warplight::host::image::FrameBuffer]| mean(&fs.iter().collect::<Vec<_>>());
+    let rms =
+        |a: &[f64], b: &[f64]| (a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64).sqrt();
+    let (s1, s4) = (frames(PixelSampling::Stratified(1)), frames(PixelSampling::Stratified(4)));
+    let tent = all(&frames(PixelSampling::Tent));
+    let (box1, box4) = (all(&s1), all(&s4));
+    let top: Vec<_> = s4.iter().enumerate().filter(|(f, _)| f % 16 < 4).map(|(_, i)| i).collect();
+    let top = mean(&top);
+    let same = rms(&box4, &box1);
+    assert!(3.0 * same < rms(&tent, &box1), "strata {same} vs tent {}", rms(&tent, &box1));
+    assert!(3.0 * same < rms(&top, &box1), "strata {same} vs the top row {}", rms(&top, &box1));
+}
+
+#[test]
+fn settings_no_build_has_are_refused() {
+    let p = stratified(params(4, Integrator::Nee, 1), 2);
+    assert_eq!(p.check(), Ok(()));
+    let e = FrameParams { termination: Termination::FixedDepth, ..p }.check().unwrap_err();
+    assert!(matches!(e, FrameParamsError::NoBuild(..)), "{e}");
+    assert!(e.to_string().contains("fixed-depth") && e.to_string().contains("stratified:2"), "{e}");
+    let e = FrameParams { integrator: Integrator::Mlt, ..p }.check().unwrap_err();
+    assert!(e.to_string().contains("under mlt"), "{e}");
+    assert!(stratified(p, 0).check().is_err() && stratified(p, 65).check().is_err());
+    // the render refuses them before a frame runs
+    let (_, ps, cam) = scene_of("cornell-lambert", 4);
+    let bad = FrameParams { termination: Termination::FixedDepth, ..p };
+    assert!(runs::emulate_twin(&ps, &cam, bad, 1).is_err());
+    let e = render_native(&ps, &cam, bad, 1, false, |_| {}).err().expect("refused natively too");
+    assert!(e.to_string().contains("no build of the kernel has both"), "{e}");
+}
+
+fn scene(name: &str) -> warplight::host::scene::Scene {
+    scene_file::load(&scene_file::resolve(name)).expect("the scene loads")
+}
+
+/// The pixel integral alone (0 bounces under the environment map): 8 x 8
+/// strata at whole rounds beat the same box filter unstratified (stratified:1)
+/// by more than a quarter at 64 frames, and its one-sample-a-stratum point;
+/// inside a round (8 of 64 frames) the strata seen cover only the top of each
+/// subpixel and the error is more than 1.5 x the tent's (the successive
+/// refinement the thesis says stratification lacks); independent samples
+/// fall as spp^-1/2. Each curve's reference noise is below its error.
+#[test]
+fn strata_lower_the_pixel_integrals_error_only_in_whole_rounds() {
+    let o = Options {
+        samplings: vec![PixelSampling::Tent, PixelSampling::Stratified(1), PixelSampling::Stratified(8)],
+        integrator: Integrator::Pt,
+        bounces: 0,
+        size: 32,
+        frames: 64,
+        reference_frames: 1024,
+        emulated_frames: 0,
+        seed: 3,
+    };
+    let d = pixel_sampling::measure(&scene("env-spheres"), &o, &mut |_| {}).expect("measure");
+    let c = |p| d.curve(p).expect("a curve");
+    let (tent, box1, s8) = (c(PixelSampling::Tent), c(PixelSampling::Stratified(1)), c(PixelSampling::Stratified(8)));
+    let err = |c: &pixel_sampling::Curve, f| c.error(c.at(f).expect("a point"));
+    assert!(err(s8, 64) < 0.75 * err(box1, 64), "whole round: {} vs {}", err(s8, 64), err(box1, 64));
+    assert!(err(s8, 8) > 1.5 * err(tent, 8), "inside a round: {} vs {}", err(s8, 8), err(tent, 8));
+    assert!(!s8.at(8).unwrap().whole_rounds && s8.at(64).unwrap().whole_rounds);
+    assert_eq!(s8.reference_frames, 1024);
+    for c in [tent, box1] {
+        let s = c.slope(1).expect("a slope");
+        assert!((-0.7..=-0.3).contains(&s), "{:?}: slope {s}", c.pixels);
+    }
+    for c in &d.curves {
+        assert!(c.reference_rmse > 0.0 && c.reference_rmse < err(c, 64), "{:?}", c.pixels);
+        assert_eq!(c.emulated_equals_native, None);
+    }
+    // one sample a stratum: stratified:1 at 1 frame and stratified:8 at 64
+    let one = d.one_per_stratum();
+    assert_eq!(one.iter().map(|p| p.0).collect::<Vec<_>>(), vec![4.0, 256.0]);
+    assert_eq!(d.charts().len(), pixel_sampling::CHARTS.len());
+    let text = serde_json::to_string(&d).unwrap();
+    let back: PixelSamplingData = serde_json::from_str(&text).expect("the data read back");
+    assert_eq!(back.curves.len(), d.curves.len());
+    assert_eq!(back.curves[2].pixels, PixelSampling::Stratified(8));
+}
+
+/// The committed charts' data hold what the docs say of them
+/// (`docs/reproduction-lin2017.md`, "Stratified pixels against the tent filter").
+#[test]
+fn the_committed_pixel_sampling_data_hold_the_documented_verdicts() {
+    let read = |name: &str| -> PixelSamplingData {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("docs/images/lin-pixels-{name}-data.json"));
+        serde_json::from_str(&std::fs::read_to_string(&p).expect("committed data")).expect("the data")
+    };
+    let env = read("env-spheres");
+    let cornell = read("cornell-lambert");
+    for d in [&env, &cornell] {
+        assert!(d.curves.iter().all(|c| c.emulated_equals_native == Some(true)), "{}", d.scene);
+        // the builds cost alike: every frame within 5 % of the tent's warp instructions
+        let tent = d.curve(PixelSampling::Tent).and_then(|c| c.warp_instructions_per_frame).expect("tent");
+        for c in &d.curves {
+            let w = c.warp_instructions_per_frame.expect("emulated");
+            assert!((w / tent - 1.0).abs() < 0.05, "{} {:?}: {w} vs {tent}", d.scene, c.pixels);
+        }
+    }
+    let last = |d: &PixelSamplingData, p| {
+        let c = d.curve(p).expect("a curve");
+        c.error(c.native.last().expect("a point"))
+    };
+    // the pixel integral: 8 x 8 strata at 1024 frames well under the tent's error
+    assert!(last(&env, PixelSampling::Stratified(8)) < 0.5 * last(&env, PixelSampling::Tent));
+    // one sample a stratum falls faster than spp^-1/2 but slower than 1/n
+    let s = env.one_per_stratum_slope().expect("a slope");
+    assert!((-0.95..=-0.6).contains(&s), "one sample a stratum: {s}");
+    // 16 bounces: strata change the box's error by less than 10 %
+    let (s8, box1) = (last(&cornell, PixelSampling::Stratified(8)), last(&cornell, PixelSampling::Stratified(1)));
+    assert!((s8 / box1 - 1.0).abs() < 0.1, "cornell: {s8} vs {box1}");
+}
+
+fn warplight(args: &[&str]) -> (bool, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
+
+#[test]
+fn render_takes_stratified_pixels_and_names_a_wrong_one() {
+    let out = std::env::temp_dir().join(format!("warplight-pixels-{}.exr", std::process::id()));
+    let o = out.to_str().expect("utf-8 path");
+    let base = ["render", "--method", "path", "--scene", "cornell-lambert", "--resolution", "8x6", "--spp", "8"];
+    for variant in ["native", "emulated"] {
+        let mut args = base.to_vec();
+        args.extend(["--pixels", "stratified:2", "--variant", variant, "-o", o]);
+        let (ok, stdout, stderr) = warplight(&args);
+        assert!(ok, "{variant}: {stderr}");
+        assert!(stdout.contains("stratified:2 pixels"), "{variant}: {stdout}");
+        // 2 frames of a 4-frame round
+        assert!(stdout.contains("note: stratified:2 pixels take 4 frames a round"), "{variant}: {stdout}");
+        assert!(out.exists(), "{variant}: no image");
+        std::fs::remove_file(&out).ok();
+    }
+    for (bad, says) in [
+        (vec!["--pixels", "jitter"], "unknown pixel sampling `jitter`"),
+        (vec!["--pixels", "stratified:2", "--termination", "fixed-depth"], "no build of the kernel has both"),
+        (vec!["--pixels", "stratified:2", "--integrator", "mlt"], "under mlt"),
+    ] {
+        let mut args = base.to_vec();
+        args.extend(bad);
+        args.extend(["-o", o]);
+        let (ok, _, stderr) = warplight(&args);
+        assert!(!ok && stderr.contains(says), "{stderr}");
+    }
+    let (ok, _, stderr) = warplight(&["render", "--scene", "cornell-lambert", "--pixels", "stratified:2", "-o", o]);
+    assert!(!ok && stderr.contains("--pixels applies to --method path only"), "{stderr}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn the_chart_redraws_from_its_data_and_refuses_mlt() {
+    let dir = std::env::temp_dir().join(format!("warplight-pixels-chart-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/images/lin-pixels-env-spheres-data.json");
+    let out = dir.join("p-{}.svg");
+    let (ok, stdout, stderr) =
+        warplight(&["chart", "lin-pixel-sampling", "--from", data.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("stratified 8x8: slope") && stdout.contains("one sample a stratum"), "{stdout}");
+    for name in pixel_sampling::CHARTS {
+        assert!(dir.join(format!("p-{name}.svg")).exists(), "{name}");
+    }
+    let (ok, _, stderr) = warplight(&[
+        "chart",
+        "lin-pixel-sampling",
+        "--integrator",
+        "mlt",
+        "--frames",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!ok && stderr.contains("mlt takes its camera sample from its chain"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}
