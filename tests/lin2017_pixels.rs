@@ -155,11 +155,11 @@ fn the_committed_pixel_sampling_data_hold_the_documented_verdicts() {
     let cornell = read("cornell-lambert");
     for d in [&env, &cornell] {
         assert!(d.curves.iter().all(|c| c.emulated_equals_native == Some(true)), "{}", d.scene);
-        // the builds cost alike: every frame within 5 % of the tent's warp instructions
+        // the builds cost alike: every frame within 10 % of the tent's warp instructions
         let tent = d.curve(PixelSampling::Tent).and_then(|c| c.warp_instructions_per_frame).expect("tent");
         for c in &d.curves {
             let w = c.warp_instructions_per_frame.expect("emulated");
-            assert!((w / tent - 1.0).abs() < 0.05, "{} {:?}: {w} vs {tent}", d.scene, c.pixels);
+            assert!((w / tent - 1.0).abs() < 0.1, "{} {:?}: {w} vs {tent}", d.scene, c.pixels);
         }
     }
     let last = |d: &PixelSamplingData, p| {
@@ -171,9 +171,34 @@ fn the_committed_pixel_sampling_data_hold_the_documented_verdicts() {
     // one sample a stratum falls faster than spp^-1/2 but slower than 1/n
     let s = env.one_per_stratum_slope().expect("a slope");
     assert!((-0.95..=-0.6).contains(&s), "one sample a stratum: {s}");
-    // 16 bounces: strata change the box's error by less than 10 %
-    let (s8, box1) = (last(&cornell, PixelSampling::Stratified(8)), last(&cornell, PixelSampling::Stratified(1)));
-    assert!((s8 / box1 - 1.0).abs() < 0.1, "cornell: {s8} vs {box1}");
+    // 16 bounces: over the whole image, whose error the light's silhouette
+    // dominates, 8 x 8 strata cut the tent's error by more than half; away
+    // from it they change the unstratified box's error by less than 10 %
+    assert!(last(&cornell, PixelSampling::Stratified(8)) < 0.5 * last(&cornell, PixelSampling::Tent));
+    let away = |p| {
+        let c = cornell.curve(p).expect("a curve");
+        c.error_away(c.native.last().expect("a point"))
+    };
+    let (s8, box1) = (away(PixelSampling::Stratified(8)), away(PixelSampling::Stratified(1)));
+    assert!((s8 / box1 - 1.0).abs() < 0.1, "cornell, away from the light: {s8} vs {box1}");
+    assert!(cornell.away_pixels > 900 && cornell.away_pixels < 1024, "{}", cornell.away_pixels);
+    assert_eq!(env.away_pixels, 64 * 64, "no light is seen in env-spheres");
+}
+
+/// The pixels away from the lights' silhouettes: the Cornell box's ceiling
+/// light, seen at the top of the image, and its 3 x 3 neighbourhood are out.
+#[test]
+fn the_lights_silhouette_is_masked() {
+    let s = scene("cornell-lambert");
+    let cam = warplight::host::camera::Camera { resolution: [16, 16], ..s.camera };
+    let away = pixel_sampling::away_from_lights(&s, &cam);
+    let near: Vec<usize> = (0..256).filter(|&i| !away[i]).collect();
+    assert!(!near.is_empty() && near.len() < 40, "{near:?}");
+    assert!(near.iter().all(|&i| i / 16 < 4), "the light is at the top: {near:?}");
+    // no emitter in view: every pixel is away
+    let e = scene("env-spheres");
+    let cam = warplight::host::camera::Camera { resolution: [8, 8], ..e.camera };
+    assert!(pixel_sampling::away_from_lights(&e, &cam).iter().all(|&a| a));
 }
 
 fn warplight(args: &[&str]) -> (bool, String, String) {
@@ -223,6 +248,7 @@ fn the_chart_redraws_from_its_data_and_refuses_mlt() {
         warplight(&["chart", "lin-pixel-sampling", "--from", data.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("stratified 8x8: slope") && stdout.contains("one sample a stratum"), "{stdout}");
+    assert!(stdout.contains("away from the lights' silhouettes"), "{stdout}");
     for name in pixel_sampling::CHARTS {
         assert!(dir.join(format!("p-{name}.svg")).exists(), "{name}");
     }

@@ -7,7 +7,7 @@
 #   docs/images/speed-accuracy-example.svg    the generic speed-against-accuracy plot,
 #                                             from tests/fixtures/scatter.json
 #   docs/images/lin-convergence-*-{spp,seconds,instructions,mean}.svg, lin-roulette-*-{...}.svg,
-#   lin-compaction-{lanes,paths}.svg
+#   lin-pixels-*-{spp,seconds}.svg, lin-compaction-{lanes,paths}.svg
 #                                             thesis 003's charts, from their *-data.json beside them
 #
 # Drawing needs no emulation: the table comes from the committed raw measurements.
@@ -39,5 +39,9 @@ done
 for s in cornell-lambert cornell-rough; do
   "$WARPLIGHT" chart lin-convergence --from "docs/images/lin-roulette-$s-data.json" \
     -o "docs/images/lin-roulette-$s-{}.svg" > /dev/null
+done
+for s in env-spheres cornell-lambert; do
+  "$WARPLIGHT" chart lin-pixel-sampling --from "docs/images/lin-pixels-$s-data.json" \
+    -o "docs/images/lin-pixels-$s-{}.svg" > /dev/null
 done
 "$WARPLIGHT" chart lin-compaction --from docs/images/lin-compaction-data.json -o "docs/images/lin-compaction-{}.svg" > /dev/null

@@ -317,6 +317,20 @@ fn report_pixel_sampling(data: &PixelSamplingData) {
                 _ => String::new(),
             }
         );
+        if let Some(p) = last {
+            let ratio = tent
+                .filter(|_| c.pixels != PixelSampling::Tent)
+                .and_then(|t| {
+                    t.at(p.frames).map(|q| format!(", {:.2} x the tent's", c.error_away(p) / t.error_away(q)))
+                })
+                .unwrap_or_default();
+            println!(
+                "  over the {} pixels away from the lights' silhouettes: error {:.4e}{ratio}; reference noise {:.3e}",
+                data.away_pixels,
+                c.error_away(p),
+                c.reference_rmse_away
+            );
+        }
         let partial: Vec<String> = c
             .native
             .iter()

@@ -51,7 +51,7 @@ use crate::repro::lin2017::runs;
 pub const REFERENCE_SEED_OFFSET: u32 = 0x9e37_79b9;
 
 /// The charts' names (`{}` in `warplight chart lin-pixel-sampling -o`).
-pub const CHARTS: [&str; 2] = ["spp", "seconds"];
+pub const CHARTS: [&str; 3] = ["spp", "seconds", "away"];
 
 /// Why the comparison cannot be measured.
 #[derive(Debug, thiserror::Error)]
@@ -100,6 +100,10 @@ pub struct Point {
     pub spp: u32,
     /// RMS difference from the curve's reference, over pixels and channels.
     pub rmse: f64,
+    /// The same over the pixels away from the lights' silhouettes
+    /// ([`PixelSamplingData::away_pixels`]; every pixel when no light is seen).
+    #[serde(default)]
+    pub rmse_away: f64,
     /// Native seconds from the run's start to this frame's end (measured).
     pub seconds: f64,
     /// Whether its frames are whole rounds (a multiple of D²).
@@ -116,6 +120,9 @@ pub struct Curve {
     /// Its reference's own noise: the RMS over pixels and channels of the
     /// standard error of its mean, from the spread of its rounds.
     pub reference_rmse: f64,
+    /// The same over the pixels away from the lights' silhouettes.
+    #[serde(default)]
+    pub reference_rmse_away: f64,
     /// The measured run's points.
     pub native: Vec<Point>,
     /// Native seconds a frame (the measured run's).
@@ -130,6 +137,11 @@ impl Curve {
     /// A point's error with the reference's noise taken out: √(rmse² − floor²), at least 0.
     pub fn error(&self, p: &Point) -> f64 {
         (p.rmse * p.rmse - self.reference_rmse * self.reference_rmse).max(0.0).sqrt()
+    }
+
+    /// The same away from the lights' silhouettes.
+    pub fn error_away(&self, p: &Point) -> f64 {
+        (p.rmse_away * p.rmse_away - self.reference_rmse_away * self.reference_rmse_away).max(0.0).sqrt()
     }
 
     /// The least-squares slope of log error against log spp over the points
@@ -180,6 +192,10 @@ pub struct PixelSamplingData {
     pub reference_seed: u32,
     /// Threads the native renders ran on (rayon).
     pub native_threads: usize,
+    /// Pixels away from the lights' silhouettes: none of the 3 x 3 pixels
+    /// around them has its centre's camera ray hit an emitter first.
+    #[serde(default)]
+    pub away_pixels: usize,
     /// A curve per sampling.
     pub curves: Vec<Curve>,
 }
@@ -218,22 +234,23 @@ impl PixelSamplingData {
     pub fn charts(&self) -> Vec<Scatter> {
         let head =
             format!("{} ({}x{}, {}, {} bounces)", self.scene, self.size, self.size, self.integrator, self.bounces);
-        let series = |x: &dyn Fn(&Point) -> f64| -> Vec<Series> {
+        let series = |x: &dyn Fn(&Point) -> f64, y: &dyn Fn(&Curve, &Point) -> f64| -> Vec<Series> {
             self.curves
                 .iter()
                 .map(|c| Series {
                     name: c.pixels.label(),
-                    points: c.native.iter().map(|p| (x(p), c.error(p))).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect(),
+                    points: c.native.iter().map(|p| (x(p), y(c, p))).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect(),
                 })
                 .filter(|s| !s.points.is_empty())
                 .collect()
         };
-        let mut spp = series(&|p| p.spp as f64);
+        let mut spp = series(&|p| p.spp as f64, &Curve::error);
         let strata = self.one_per_stratum();
         if strata.len() >= 2 {
             spp.push(Series { name: "one sample a stratum (D² frames)".into(), points: strata });
         }
-        let secs = series(&|p| p.seconds);
+        let secs = series(&|p| p.seconds, &Curve::error);
+        let away = series(&|p| p.spp as f64, &Curve::error_away);
         let scatter = |title: String, x_label: &str, series| Scatter {
             title,
             x_label: x_label.into(),
@@ -253,6 +270,14 @@ impl PixelSamplingData {
                 format!("{head}: stratified pixels vs the tent filter, error vs time (native host seconds; measured)"),
                 "seconds (native, this machine)",
                 secs,
+            ),
+            scatter(
+                format!(
+                    "{head}: error vs samples over the {} pixels away from the lights' silhouettes (native; measured)",
+                    self.away_pixels
+                ),
+                "samples per pixel",
+                away,
             ),
         ]
     }
@@ -328,6 +353,8 @@ pub fn measure(
     ps.check_integrator(&scene.name, o.integrator)?;
     let camera = Camera { resolution: [o.size, o.size], ..scene.camera };
     let frame = frame_of(&camera, eps_for(ps.lo, ps.hi));
+    let away = away_from_lights(scene, &camera);
+    let cells_away: Vec<bool> = away.iter().flat_map(|&a| [a; 3]).collect();
     let marks = checkpoints(o.frames);
     let reference_seed = o.seed.wrapping_add(REFERENCE_SEED_OFFSET);
     let mut curves = Vec::new();
@@ -341,18 +368,20 @@ pub fn measure(
         let r = stream(&Tracer { scene: &ps, frame, params: ref_params }, reference_frames, &[reference_frames], round);
         let ref_mean = &r.means[0].1;
         let var = r.var_of_mean.unwrap_or_default();
-        let reference_rmse = (var.iter().sum::<f64>() / var.len().max(1) as f64).sqrt();
+        let reference_rmse = masked_mean(&var, &cells_away, false).sqrt();
+        let reference_rmse_away = masked_mean(&var, &cells_away, true).sqrt();
         progress(&format!("{}: {} native frames", pixels.label(), o.frames));
         let run = stream(&Tracer { scene: &ps, frame, params }, o.frames, &marks, round);
         let native: Vec<Point> = run
             .means
             .iter()
             .map(|(n, mean, seconds)| {
-                let mse = mean.iter().zip(ref_mean).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / mean.len() as f64;
+                let sq: Vec<f64> = mean.iter().zip(ref_mean).map(|(a, b)| (a - b).powi(2)).collect();
                 Point {
                     frames: *n,
                     spp: n * SAMPLES_PER_FRAME,
-                    rmse: mse.sqrt(),
+                    rmse: masked_mean(&sq, &cells_away, false).sqrt(),
+                    rmse_away: masked_mean(&sq, &cells_away, true).sqrt(),
                     seconds: *seconds,
                     whole_rounds: n % round == 0,
                 }
@@ -370,6 +399,7 @@ pub fn measure(
             pixels,
             reference_frames,
             reference_rmse,
+            reference_rmse_away,
             native,
             frame_seconds,
             warp_instructions_per_frame: warp,
@@ -384,8 +414,39 @@ pub fn measure(
         seed: o.seed,
         reference_seed,
         native_threads: rayon::current_num_threads(),
+        away_pixels: away.iter().filter(|&&a| a).count(),
         curves,
     })
+}
+
+/// The mean of `v` over every cell (`only` false) or over the cells where `mask` holds (0 over none).
+fn masked_mean(v: &[f64], mask: &[bool], only: bool) -> f64 {
+    let (s, n) = v.iter().zip(mask).filter(|(_, m)| **m || !only).fold((0.0, 0usize), |(s, n), (x, _)| (s + x, n + 1));
+    if n == 0 { 0.0 } else { s / n as f64 }
+}
+
+/// Per pixel of `camera`: whether none of the 3 x 3 pixels around it (itself
+/// included) has its centre's camera ray hit an emitting material first, so
+/// that its footprint holds no light's silhouette.
+pub fn away_from_lights(scene: &Scene, camera: &Camera) -> Vec<bool> {
+    let hits = runs::first_hit_materials(scene, camera, &runs::sah_tree(scene));
+    let emits = |name: Option<&str>| {
+        name.and_then(|n| scene.materials.iter().find(|m| m.name == n))
+            .is_some_and(|m| m.emission.iter().any(|&e| e > 0.0))
+    };
+    let lit: Vec<bool> = hits.into_iter().map(emits).collect();
+    let [w, h] = camera.resolution.map(|v| v as i64);
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            !(-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    let (u, v) = (x + dx, y + dy);
+                    (0..w).contains(&u) && (0..h).contains(&v) && lit[(v * w + u) as usize]
+                })
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -416,6 +477,7 @@ mod tests {
             pixels: PixelSampling::Stratified(2),
             reference_frames: 64,
             reference_rmse: 3.0,
+            reference_rmse_away: 3.0,
             // errors 4 (rmse 5), 2, 1 at 4, 16, 64 frames: slope -1/2; frames 2 ends inside a round
             native: vec![point(2, 100.0), point(4, 5.0), point(16, 13f64.sqrt()), point(64, 10f64.sqrt())],
             frame_seconds: 0.1,
