@@ -470,6 +470,7 @@ mod tests {
             frames,
             spp: 4 * frames,
             rmse,
+            rmse_away: rmse,
             seconds: 1.0,
             whole_rounds: frames % 4 == 0,
         };
@@ -477,6 +478,7 @@ mod tests {
             pixels: PixelSampling::Stratified(2),
             reference_frames: 64,
             reference_rmse: 3.0,
+            reference_rmse_away: 3.0,
             reference_rmse_away: 3.0,
             // errors 4 (rmse 5), 2, 1 at 4, 16, 64 frames: slope -1/2; frames 2 ends inside a round
             native: vec![point(2, 100.0), point(4, 5.0), point(16, 13f64.sqrt()), point(64, 10f64.sqrt())],
