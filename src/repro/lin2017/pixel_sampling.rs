@@ -479,7 +479,6 @@ mod tests {
             reference_frames: 64,
             reference_rmse: 3.0,
             reference_rmse_away: 3.0,
-            reference_rmse_away: 3.0,
             // errors 4 (rmse 5), 2, 1 at 4, 16, 64 frames: slope -1/2; frames 2 ends inside a round
             native: vec![point(2, 100.0), point(4, 5.0), point(16, 13f64.sqrt()), point(64, 10f64.sqrt())],
             frame_seconds: 0.1,
