@@ -5,7 +5,10 @@
 //! the Fig. 3 table runs at) against the native mirror, both on all host
 //! threads; and on the box, a frame of the fixed-depth build (no Russian
 //! roulette, `kernels/lin2017/path_fixed_depth.cu`) against the thesis'
-//! build, natively and emulated (the speed-up 003:L269 claims for roulette).
+//! build, natively and emulated (the speed-up 003:L269 claims for roulette),
+//! and a frame of the stratified-pixel build (`path_stratified.cu`, 4 x 4
+//! strata) against the thesis' tent filter (003:L225 compares them at equal
+//! samples; the two should cost alike).
 //! The ratios are measured in one run (the machines are shared and noisy)
 //! and printed before criterion's own timings.
 
@@ -16,7 +19,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use warplight::host::camera::Camera;
 use warplight::host::path::build::{self, Construction};
 use warplight::host::path::layout::PathScene;
-use warplight::host::path::{FrameParams, Integrator, Termination, kernel, render_native};
+use warplight::host::path::{FrameParams, Integrator, PixelSampling, Termination, kernel, render_native};
 use warplight::host::scene_file;
 use warplight::sim::Fidelity;
 
@@ -31,27 +34,23 @@ fn setup(name: &str) -> (PathScene, Camera) {
 }
 
 fn params() -> FrameParams {
-    with(Termination::Roulette)
-}
-
-fn with(termination: Termination) -> FrameParams {
-    FrameParams { termination, ..FrameParams::new(SIDE, SIDE, Integrator::Nee, 16, 0) }
+    FrameParams::new(SIDE, SIDE, Integrator::Nee, 16, 0)
 }
 
 fn native(ps: &PathScene, cam: &Camera) -> f32 {
-    native_ending(ps, cam, Termination::Roulette)
+    native_with(ps, cam, params())
 }
 
-fn native_ending(ps: &PathScene, cam: &Camera, t: Termination) -> f32 {
-    render_native(ps, cam, with(t), 1, false, |_| {}).expect("render").accum[0]
+fn native_with(ps: &PathScene, cam: &Camera, p: FrameParams) -> f32 {
+    render_native(ps, cam, p, 1, false, |_| {}).expect("render").accum[0]
 }
 
 fn emulated(ps: &PathScene, cam: &Camera, level: Fidelity) -> f32 {
-    emulated_ending(ps, cam, level, Termination::Roulette)
+    emulated_with(ps, cam, level, params())
 }
 
-fn emulated_ending(ps: &PathScene, cam: &Camera, level: Fidelity, t: Termination) -> f32 {
-    let p = with(t);
+/// One emulated frame of `p` on the build it needs.
+fn emulated_with(ps: &PathScene, cam: &Camera, level: Fidelity, p: FrameParams) -> f32 {
     let (mut dev, module) = kernel::device(&p, level).expect("kernel");
     kernel::render(&mut dev, &module, ps, cam, p, 1, false, |_| {}).expect("render").image.accum[0]
 }
@@ -79,10 +78,13 @@ fn report() {
         eprintln!("  emulated, functional    {:>10.0} paths/s   native / emulated {:>7.1} x", paths / tf, tf / tn);
         eprintln!("  emulated, instructions  {:>10.0} paths/s   native / emulated {:>7.1} x", paths / ti, ti / tn);
         if name == "cornell-lambert" {
-            let fixed = Termination::FixedDepth;
-            let fnat = best(5, || native_ending(&ps, &cam, fixed));
-            let femu = best(2, || emulated_ending(&ps, &cam, Fidelity::Functional, fixed));
-            eprintln!("  fixed depth / roulette: native {:.2} x, emulated (functional) {:.2} x", fnat / tn, femu / tf);
+            let fixed = FrameParams { termination: Termination::FixedDepth, ..params() };
+            let stratified = FrameParams { pixels: PixelSampling::Stratified(4), ..params() };
+            for (what, p) in [("fixed depth / roulette", fixed), ("stratified 4x4 / tent", stratified)] {
+                let n = best(5, || native_with(&ps, &cam, p));
+                let e = best(2, || emulated_with(&ps, &cam, Fidelity::Functional, p));
+                eprintln!("  {what}: native {:.2} x, emulated (functional) {:.2} x", n / tn, e / tf);
+            }
         }
     }
     eprintln!();
