@@ -90,7 +90,7 @@ fn settings_no_build_has_are_refused() {
     let (_, ps, cam) = scene_of("cornell-lambert", 4);
     let bad = FrameParams { termination: Termination::FixedDepth, ..p };
     assert!(runs::emulate_twin(&ps, &cam, bad, 1).is_err());
-    let e = render_native(&ps, &cam, bad, 1, false, |_| {}).err().expect("refused natively too");
+    let e = render_native(&ps, &cam, bad, 1, false, |_| {}).map(|_| ()).expect_err("refused natively too");
     assert!(e.to_string().contains("no build of the kernel has both"), "{e}");
 }
 

@@ -472,7 +472,7 @@ mod tests {
             rmse,
             rmse_away: rmse,
             seconds: 1.0,
-            whole_rounds: frames % 4 == 0,
+            whole_rounds: frames.is_multiple_of(4),
         };
         let c = Curve {
             pixels: PixelSampling::Stratified(2),
