@@ -12,10 +12,13 @@ use std::path::Path;
 
 use lin2017_mitsuba::{params, scene_of};
 use warplight::host::path::kernel::KernelBuild;
-use warplight::host::path::{FrameParams, FrameParamsError, Integrator, PixelSampling, Termination, render_native};
+use warplight::host::path::{
+    FrameParams, FrameParamsError, Integrator, PixelSampling, Termination, regroup, render_native, wavefront,
+};
 use warplight::host::scene_file;
 use warplight::repro::lin2017::pixel_sampling::{self, Options, PixelSamplingData};
 use warplight::repro::lin2017::runs;
+use warplight::sim::Fidelity;
 
 fn stratified(p: FrameParams, d: u32) -> FrameParams {
     FrameParams { pixels: PixelSampling::Stratified(d), ..p }
@@ -33,6 +36,20 @@ fn the_stratified_build_runs_as_its_native_twin() {
         let tent = render_native(&ps, &cam, params(8, integrator, 5), 3, false, |_| {}).expect("render");
         assert_ne!(tent.accum, t.emulated.image.accum, "{integrator:?}: the two samplings made the same image");
     }
+    // the wavefront form and the regroup (path_init / regroup_init take the
+    // same camera_path), compacted: the native twin's image bit for bit (here
+    // every path once ended at a level's trace, and the regroup launched an
+    // empty grid to shade none)
+    let p = stratified(params(8, Integrator::Nee, 5), 2);
+    let native = render_native(&ps, &cam, p, 3, false, |_| {}).expect("render").accum;
+    let same = |a: &[f32]| a.len() == native.len() && a.iter().zip(&native).all(|(x, y)| x.to_bits() == y.to_bits());
+    let (mut dev, m, c) = wavefront::device(&p, Fidelity::Functional).expect("load PTX");
+    let w = wavefront::render(&mut dev, &m, &c, &ps, &cam, p, 3, wavefront::Mode::Compacted, false, |_| {})
+        .expect("wavefront");
+    assert!(same(&w.image.accum), "the wavefront form differs from the native twin");
+    let (mut dev, m, c) = wavefront::device(&p, Fidelity::Functional).expect("load PTX");
+    let r = regroup::render(&mut dev, &m, &c, &ps, &cam, p, 3, regroup::Mode::Regrouped, false).expect("regroup");
+    assert!(same(&r.image.accum), "the regroup differs from the native twin");
     // the other entry points: the march through a medium, the translucent
     // walk, the textures, and the environment map seen directly
     for scene in ["fog-box", "sss-balls", "cornell-scratched", "env-spheres"] {
@@ -89,7 +106,8 @@ fn settings_no_build_has_are_refused() {
     // the render refuses them before a frame runs
     let (_, ps, cam) = scene_of("cornell-lambert", 4);
     let bad = FrameParams { termination: Termination::FixedDepth, ..p };
-    assert!(runs::emulate_twin(&ps, &cam, bad, 1).is_err());
+    let e = runs::emulate_twin(&ps, &cam, bad, 1).map(|_| ()).expect_err("refused on the emulator");
+    assert!(e.to_string().contains("no build of the kernel has both"), "{e}");
     let e = render_native(&ps, &cam, bad, 1, false, |_| {}).map(|_| ()).expect_err("refused natively too");
     assert!(e.to_string().contains("no build of the kernel has both"), "{e}");
 }
@@ -124,14 +142,12 @@ fn strata_lower_the_pixel_integrals_error_only_in_whole_rounds() {
     assert!(err(s8, 64) < 0.75 * err(box1, 64), "whole round: {} vs {}", err(s8, 64), err(box1, 64));
     assert!(err(s8, 8) > 1.5 * err(tent, 8), "inside a round: {} vs {}", err(s8, 8), err(tent, 8));
     assert!(!s8.at(8).unwrap().whole_rounds && s8.at(64).unwrap().whole_rounds);
-    assert_eq!(s8.reference_frames, 1024);
     for c in [tent, box1] {
         let s = c.slope(1).expect("a slope");
         assert!((-0.7..=-0.3).contains(&s), "{:?}: slope {s}", c.pixels);
     }
     for c in &d.curves {
         assert!(c.reference_rmse > 0.0 && c.reference_rmse < err(c, 64), "{:?}", c.pixels);
-        assert_eq!(c.emulated_equals_native, None);
     }
     // one sample a stratum: stratified:1 at 1 frame and stratified:8 at 64
     let one = d.one_per_stratum();

@@ -239,7 +239,7 @@ pub struct FrameParams {
     /// The kd-tree traversal.
     pub traversal: Traversal,
     /// How a path ends: with the thesis' roulette or at the longest path (a
-    /// second build of the kernel, [`kernel::ptx`]).
+    /// second build of the kernel, [`kernel::KernelBuild`]).
     pub termination: Termination,
     /// Where camera rays fall in their subpixels: the thesis' tent filter,
     /// or D x D strata (a third build of the kernel, [`kernel::KernelBuild`]).

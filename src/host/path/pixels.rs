@@ -92,10 +92,11 @@ impl PixelSampling {
         }
     }
 
-    /// Where in its subpixel frame `frame` puts a ray from the uniforms `r0`
-    /// (across) and `r1` (down): offsets from the subpixel's top left corner
-    /// in subpixel widths ([-0.5, 1.5) under the tent, [0, 1) stratified), as
-    /// the kernel's `camera_ray` and `camera_stratified` compute them.
+    /// Where frame `frame` puts subpixel `sub`'s ray from the uniforms `r0`
+    /// (across) and `r1` (down): offsets from the pixel's top left corner in
+    /// subpixel widths (half pixels), the subpixel's own corner at (sub & 1,
+    /// sub >> 1) plus [-0.5, 1.5) under the tent or [0, 1) stratified, as the
+    /// kernel's `camera_ray` and `camera_stratified` compute them.
     pub fn offset(self, sub: u32, frame: u32, r0: f32, r1: f32) -> (f32, f32) {
         let (sx, sy) = ((sub & 1) as f32, (sub >> 1) as f32);
         match self {

@@ -156,11 +156,15 @@ pub fn render(
                 states.swap(0, 1);
                 n = placed;
             }
-            let mut args = scene_args.clone();
-            args.extend([Arg::Ptr(states[0]), Arg::U32(n), Arg::Ptr(accum), Arg::Ptr(last)]);
-            let s = dev.launch(module, "regroup_shade", grid(n), &args)?.totals;
-            r.shade.merge(&s);
-            r.totals.merge(&s);
+            // every path may have ended at this level's trace: nothing to shade
+            // (an empty grid is no launch)
+            if n > 0 {
+                let mut args = scene_args.clone();
+                args.extend([Arg::Ptr(states[0]), Arg::U32(n), Arg::Ptr(accum), Arg::Ptr(last)]);
+                let s = dev.launch(module, "regroup_shade", grid(n), &args)?.totals;
+                r.shade.merge(&s);
+                r.totals.merge(&s);
+            }
             if r.shade_threads.len() <= l {
                 r.shade_threads.push(0);
             }
