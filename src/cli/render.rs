@@ -499,14 +499,14 @@ fn run_path(
     let r = crate::repro::lin2017::render::render(scene, camera, params, frames, emulated)?;
     write_image(&r.image, &a.output, a.exposure)?;
     println!(
-        "{} ({}x{}), path tracer {} ({} traversal, {}, {} pixels), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
+        "{} ({}x{}), path tracer {} ({} traversal, {}{}), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
         scene.name,
         width,
         height,
         integrator.name(),
         traversal.name(),
         termination.name(),
-        pixels.name(),
+        if pixels == PixelSampling::Tent { String::new() } else { format!(", {} pixels", pixels.name()) },
         a.spp,
         frames,
         a.bounces,
