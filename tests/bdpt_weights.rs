@@ -16,9 +16,7 @@
 mod lin2017_mitsuba;
 
 use lin2017_mitsuba::scene_of;
-use warplight::host::path::{
-    FrameParams, Integrator, PixelSampling, Progressive, Termination, Traversal, render_native,
-};
+use warplight::host::path::{FrameParams, Integrator, Progressive, render_native};
 
 const SIZE: u32 = 32;
 const FRAMES: u32 = 256;
@@ -26,16 +24,7 @@ const FRAMES: u32 = 256;
 /// The frames' images of `integrator` at `max_bounces` (`SIZE` x `SIZE` = 32 x 32 pixels).
 fn frames(integrator: Integrator, max_bounces: u32, seed: u32) -> Progressive {
     let (_, ps, cam) = scene_of("cornell-lambert", SIZE);
-    let p = FrameParams {
-        width: SIZE,
-        height: SIZE,
-        integrator,
-        max_bounces,
-        seed,
-        traversal: Traversal::ShortStack,
-        termination: Termination::Roulette,
-        pixels: PixelSampling::Tent,
-    };
+    let p = FrameParams::new(SIZE, SIZE, integrator, max_bounces, seed);
     render_native(&ps, &cam, p, FRAMES, true, |_| {}).expect("render")
 }
 

@@ -106,16 +106,7 @@ fn bdpt_weights_a_direct_path_by_its_two_techniques() {
     let (w, h) = (12, 10);
     let cam = camera(&scene, w, h);
     let run = |integrator, max_bounces, seed| {
-        let p = FrameParams {
-            width: w,
-            height: h,
-            integrator,
-            max_bounces,
-            seed,
-            traversal: Traversal::ShortStack,
-            termination: Termination::Roulette,
-            pixels: PixelSampling::Tent,
-        };
+        let p = FrameParams::new(w, h, integrator, max_bounces, seed);
         render_native(&ps, &cam, p, 1, false, |_| {}).expect("render").accum
     };
     assert_eq!(run(Integrator::Bdpt, 0, 5), run(Integrator::Pt, 0, 5), "0 bounces: the light seen directly");

@@ -235,14 +235,7 @@ impl Curve {
             .filter(|p| p.spp >= from_spp && p.rmse > floor)
             .map(|p| ((p.spp as f64).ln(), p.error_variance(floor).sqrt().ln()))
             .collect();
-        if pts.len() < 2 {
-            return None;
-        }
-        let n = pts.len() as f64;
-        let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
-        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-        let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-        Some(sxy / sxx)
+        runs::fit_slope(&pts)
     }
 
     /// The native point at `spp`.

@@ -154,25 +154,13 @@ impl Curve {
             .filter(|p| p.whole_rounds && p.frames >= from_frames.max(self.pixels.round()) && self.error(p) > 0.0)
             .map(|p| ((p.spp as f64).ln(), self.error(p).ln()))
             .collect();
-        fit_slope(&pts)
+        runs::fit_slope(&pts)
     }
 
     /// The point at `frames`.
     pub fn at(&self, frames: u32) -> Option<&Point> {
         self.native.iter().find(|p| p.frames == frames)
     }
-}
-
-/// The least-squares slope of `pts` (x, y); None below two points.
-pub fn fit_slope(pts: &[(f64, f64)]) -> Option<f64> {
-    if pts.len() < 2 {
-        return None;
-    }
-    let n = pts.len() as f64;
-    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
 }
 
 /// The chart data (`docs/images/lin-pixels-*-data.json`).
@@ -225,7 +213,7 @@ impl PixelSamplingData {
     /// The slope of [`PixelSamplingData::one_per_stratum`] in log-log: −1 if the error is O(1/n).
     pub fn one_per_stratum_slope(&self) -> Option<f64> {
         let pts: Vec<(f64, f64)> = self.one_per_stratum().into_iter().map(|(s, e)| (s.ln(), e.ln())).collect();
-        fit_slope(&pts)
+        runs::fit_slope(&pts)
     }
 
     /// The charts, in [`CHARTS`]' order: the error (the reference's noise
@@ -452,15 +440,6 @@ pub fn away_from_lights(scene: &Scene, camera: &Camera) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn slopes_of_power_laws() {
-        let pts: Vec<(f64, f64)> = (0..5).map(|k| ((4u32 << k) as f64, 3.0 * (4u32 << k) as f64)).collect();
-        let logs: Vec<(f64, f64)> = pts.iter().map(|p| (p.0.ln(), p.1.powf(-0.75).ln())).collect();
-        assert!((fit_slope(&logs).unwrap() + 0.75).abs() < 1e-12);
-        assert_eq!(fit_slope(&logs[..1]), None);
-        assert_eq!(fit_slope(&[(1.0, 1.0), (1.0, 2.0)]), None, "no spread in x");
-    }
 
     /// The reference's noise comes out of the error; the slope reads only
     /// whole rounds from D² frames on.

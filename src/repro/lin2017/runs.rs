@@ -245,3 +245,30 @@ mod tests {
         assert!(above_floor(f64::NAN, 1.0).is_nan());
     }
 }
+
+/// The least-squares slope of `pts` (x, y), as of log error on log samples;
+/// None below two points or with no spread in x.
+pub fn fit_slope(pts: &[(f64, f64)]) -> Option<f64> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
+#[cfg(test)]
+mod slope_tests {
+    use super::fit_slope;
+
+    #[test]
+    fn slopes_of_power_laws() {
+        let logs: Vec<(f64, f64)> =
+            (0..5).map(|k| (4u32 << k) as f64).map(|x| (x.ln(), (3.0 * x).powf(-0.75).ln())).collect();
+        assert!((fit_slope(&logs).unwrap() + 0.75).abs() < 1e-12);
+        assert_eq!(fit_slope(&logs[..1]), None);
+        assert_eq!(fit_slope(&[(1.0, 1.0), (1.0, 2.0)]), None, "no spread in x");
+    }
+}
