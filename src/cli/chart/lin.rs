@@ -18,7 +18,8 @@ pub struct Out {
     #[arg(long)]
     pub from: Option<PathBuf>,
     /// Output .svg or .png with `{}` for each chart's name (lin-convergence:
-    /// spp, seconds, instructions, mean; lin-compaction: lanes, paths); the
+    /// spp, seconds, instructions, mean; lin-pixel-sampling: spp, seconds,
+    /// away; lin-compaction: lanes, paths); the
     /// data goes beside them as `{}` = data, .json.
     #[arg(short, long)]
     pub output: PathBuf,
