@@ -295,15 +295,16 @@ pub fn lin_pixel_sampling(a: PixelSamplingArgs) -> Result<(), Box<dyn std::error
 
 fn report_pixel_sampling(data: &PixelSamplingData) {
     let tent = data.curve(PixelSampling::Tent);
+    // c's error at p over the tent's at as many frames, by `error` (the whole image, or away from the lights)
+    let vs_tent = |c: &pixel_sampling::Curve, p: &pixel_sampling::Point, error: fn(&_, &_) -> f64| {
+        let t = tent.filter(|_| c.pixels != PixelSampling::Tent)?;
+        t.at(p.frames).map(|q| error(c, p) / error(t, q))
+    };
     for c in &data.curves {
         let last = c.native.last();
-        let ratio = match (tent, last) {
-            (Some(t), Some(p)) if c.pixels != PixelSampling::Tent => t
-                .at(p.frames)
-                .map(|q| format!(", {:.2} x the tent's error at as many samples", c.error(p) / t.error(q)))
-                .unwrap_or_default(),
-            _ => String::new(),
-        };
+        let ratio = last
+            .and_then(|p| vs_tent(c, p, pixel_sampling::Curve::error))
+            .map_or(String::new(), |r| format!(", {r:.2} x the tent's error at as many samples"));
         println!(
             "{}: slope {} over whole rounds; at {} spp error {:.4e}{ratio}; reference {} frames, its noise {:.3e}; {:.3e} s a frame{}",
             c.pixels.label(),
@@ -319,12 +320,8 @@ fn report_pixel_sampling(data: &PixelSamplingData) {
             }
         );
         if let Some(p) = last {
-            let ratio = tent
-                .filter(|_| c.pixels != PixelSampling::Tent)
-                .and_then(|t| {
-                    t.at(p.frames).map(|q| format!(", {:.2} x the tent's", c.error_away(p) / t.error_away(q)))
-                })
-                .unwrap_or_default();
+            let ratio = vs_tent(c, p, pixel_sampling::Curve::error_away)
+                .map_or(String::new(), |r| format!(", {r:.2} x the tent's"));
             println!(
                 "  over the {} pixels away from the lights' silhouettes: error {:.4e}{ratio}; reference noise {:.3e}",
                 data.away_pixels,

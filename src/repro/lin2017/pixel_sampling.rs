@@ -134,14 +134,15 @@ pub struct Curve {
 }
 
 impl Curve {
-    /// A point's error with the reference's noise taken out: √(rmse² − floor²), at least 0.
+    /// A point's error with the reference's noise taken out: √(rmse² − floor²), at least 0
+    /// ([`runs::above_floor`]).
     pub fn error(&self, p: &Point) -> f64 {
-        (p.rmse * p.rmse - self.reference_rmse * self.reference_rmse).max(0.0).sqrt()
+        runs::above_floor(p.rmse, self.reference_rmse)
     }
 
     /// The same away from the lights' silhouettes.
     pub fn error_away(&self, p: &Point) -> f64 {
-        (p.rmse_away * p.rmse_away - self.reference_rmse_away * self.reference_rmse_away).max(0.0).sqrt()
+        runs::above_floor(p.rmse_away, self.reference_rmse_away)
     }
 
     /// The least-squares slope of log error against log spp over the points
@@ -282,15 +283,15 @@ struct Stream {
 
 fn stream(tracer: &Tracer, frames: u32, marks: &[u32], round: u32) -> Stream {
     let (w, h) = (tracer.params.width, tracer.params.height);
-    let mut out = Progressive::new(w, h);
-    let mut last = vec![0.0f32; out.accum.len()];
+    let mut accum = vec![0.0f32; tracer.params.paths() * 3];
+    let mut last = accum.clone();
     let cells = (w * h * 3) as usize;
     let (mut sum, mut in_round) = (vec![0.0f64; cells], vec![0.0f64; cells]);
     let (mut rounds_sum, mut rounds_sq) = (vec![0.0f64; cells], vec![0.0f64; cells]);
     let mut means = Vec::new();
     let t0 = Instant::now();
     for f in 0..frames {
-        tracer.frame(f, &mut out.accum, &mut last);
+        tracer.frame(f, &mut accum, &mut last);
         let img = Progressive::pixels_of(w, h, &last);
         for (c, v) in img.pixels.iter().flatten().enumerate() {
             sum[c] += *v as f64;

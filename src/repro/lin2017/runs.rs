@@ -186,6 +186,19 @@ pub fn above_floor(rms: f64, floor: f64) -> f64 {
     if v.is_nan() { f64::NAN } else { v.max(0.0).sqrt() }
 }
 
+/// The least-squares slope of `pts` (x, y), as of log error on log samples;
+/// None below two points or with no spread in x.
+pub fn fit_slope(pts: &[(f64, f64)]) -> Option<f64> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0).then(|| sxy / sxx)
+}
+
 /// The running means of `frames` (frame images of one run, in order) after
 /// each count of frames in `marks`, as `(frames, mean image)`; sums in f64.
 pub fn running_means(frames: &[FrameBuffer], marks: &[u32]) -> Vec<(u32, FrameBuffer)> {
@@ -244,24 +257,6 @@ mod tests {
         assert_eq!(above_floor(3.0, 5.0), 0.0);
         assert!(above_floor(f64::NAN, 1.0).is_nan());
     }
-}
-
-/// The least-squares slope of `pts` (x, y), as of log error on log samples;
-/// None below two points or with no spread in x.
-pub fn fit_slope(pts: &[(f64, f64)]) -> Option<f64> {
-    if pts.len() < 2 {
-        return None;
-    }
-    let n = pts.len() as f64;
-    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    (sxx > 0.0).then(|| sxy / sxx)
-}
-
-#[cfg(test)]
-mod slope_tests {
-    use super::fit_slope;
 
     #[test]
     fn slopes_of_power_laws() {
