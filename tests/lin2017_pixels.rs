@@ -10,7 +10,7 @@ mod lin2017_mitsuba;
 
 use std::path::Path;
 
-use lin2017_mitsuba::{params, scene_of};
+use lin2017_mitsuba::{params, scene_of, warplight};
 use warplight::host::path::kernel::KernelBuild;
 use warplight::host::path::{
     FrameParams, FrameParamsError, Integrator, PixelSampling, Termination, regroup, render_native, wavefront,
@@ -215,11 +215,6 @@ fn the_lights_silhouette_is_masked() {
     let e = scene("env-spheres");
     let cam = warplight::host::camera::Camera { resolution: [8, 8], ..e.camera };
     assert!(pixel_sampling::away_from_lights(&e, &cam).iter().all(|&a| a));
-}
-
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
 }
 
 #[test]

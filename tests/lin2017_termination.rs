@@ -11,7 +11,7 @@ mod lin2017_mitsuba;
 
 use std::path::Path;
 
-use lin2017_mitsuba::{native_outcome, params, reference_of, scene_of};
+use lin2017_mitsuba::{native_outcome, params, reference_of, scene_of, warplight};
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::kernel::KernelBuild;
@@ -194,11 +194,6 @@ fn the_fixed_depth_agrees_with_mitsuba() {
         eprintln!("{integrator:?} fixed depth: {o:?}");
         assert!(o.passed(), "{integrator:?} at a fixed depth disagrees with Mitsuba: {o:?}");
     }
-}
-
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
 }
 
 #[test]

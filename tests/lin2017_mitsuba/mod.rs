@@ -159,3 +159,10 @@ pub fn native_outcome_without(
         welch_holm(&without_blocks(&ours, blocks), &without_blocks(reference, blocks), ALPHA).expect("same block grid");
     (all, rest)
 }
+
+/// Runs the `warplight` binary with `args`: (success, stdout, stderr).
+#[allow(dead_code)]
+pub fn warplight(args: &[&str]) -> (bool, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
