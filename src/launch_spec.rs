@@ -743,7 +743,7 @@ pub fn prepare(spec: &Spec, dev: &mut Device) -> Result<Prepared, SpecError> {
     };
     let prog = crate::ptx::load(&src, &spec.ptx.display().to_string()).map_err(SimError::from)?;
     check_resources(spec, &prog, dev.config())?;
-    let mut module = dev.load(prog);
+    let mut module = dev.load_parsed(prog, &src);
     for (i, c) in spec.constants.iter().enumerate() {
         let bytes = spec.initial_bytes(c)?;
         module.write_constant(&c.name, &bytes).map_err(|msg| SpecError::Key {

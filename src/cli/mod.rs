@@ -5,6 +5,7 @@ pub mod compile;
 pub use crate::files::{interrupt, write_atomically};
 pub mod launch;
 pub mod ptx_info;
+pub mod record;
 pub mod render;
 pub mod run;
 pub mod scene_info;
@@ -48,6 +49,14 @@ pub struct Cli {
     /// with an unused result as atomics, not reductions (maxwell, hopper). See docs/devices.md.
     #[arg(long = "no-ptxas-vectorize", global = true)]
     pub no_ptxas_vectorize: bool,
+    /// Record what the command does with its emulated devices (allocations,
+    /// host writes, launches, host reads with the emulator's bytes) into the
+    /// folder DIR, made if missing: recording.json, data.bin and the modules'
+    /// PTX. `tools/device/replay.py DIR` replays it on an NVIDIA GPU, compares
+    /// every read with the emulator's bytes and times each launch
+    /// (docs/gpu-replay.md). The recording is held in memory until the command ends.
+    #[arg(long, global = true, value_name = "DIR")]
+    pub record: Option<std::path::PathBuf>,
 }
 
 /// Subcommands.
@@ -139,6 +148,13 @@ pub fn main() -> i32 {
     if cli.no_ptxas_vectorize {
         crate::model::vectorize::set_default(false);
     }
+    if let Some(dir) = &cli.record {
+        if let Err(e) = record::check(dir) {
+            eprintln!("error: {e}");
+            return 1;
+        }
+        crate::sim::recording::start();
+    }
     let r = match cli.command {
         Command::Launch(a) => launch::run(a),
         Command::Kernels { ptx } => ptx_info::kernels(&ptx),
@@ -152,6 +168,10 @@ pub fn main() -> i32 {
         Command::Render(a) => render::run(a),
         Command::Step(a) => step::run(a),
         Command::Trace(a) => trace::run(a),
+    };
+    let r = match &cli.record {
+        Some(dir) => r.and_then(|()| record::write(dir)),
+        None => r,
     };
     match r {
         Ok(()) => 0,

@@ -147,6 +147,14 @@ pub fn from_bytes<T: Element>(b: &[u8]) -> Vec<T> {
     b.chunks_exact(T::SIZE).map(T::from_bytes).collect()
 }
 
+/// The current bytes of `prog`'s `__constant__` variables, by name.
+fn constants_of(prog: &Program) -> Vec<(String, Vec<u8>)> {
+    prog.const_vars
+        .iter()
+        .map(|(name, off, size)| (name.clone(), prog.const_bank[*off as usize..(*off + *size) as usize].to_vec()))
+        .collect()
+}
+
 /// A kernel argument.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Arg {
@@ -302,6 +310,9 @@ pub struct Module {
     /// What `code` was decoded with.
     opts: FloatOptions,
     globals: Vec<u64>,
+    /// Its place in a recording ([`super::recording`]): the log's address and
+    /// the module's index there, when loaded from PTX text while one ran.
+    recorded: Option<(usize, usize)>,
 }
 
 impl Module {
@@ -354,6 +365,8 @@ pub struct Device {
     textures: Vec<super::texture::Object>,
     /// The observer of launches made without one ([`Device::set_observer`]).
     observer: Option<std::sync::Arc<dyn ObserverFactory + Send>>,
+    /// What the host does with the device, while a recording runs ([`super::recording`]).
+    log: Option<super::recording::SharedLog>,
 }
 
 impl Default for Device {
@@ -381,6 +394,7 @@ impl Device {
             progress: DEFAULT_PROGRESS.read().ok().and_then(|h| h.clone()),
             textures: Vec::new(),
             observer: None,
+            log: super::recording::attach(),
         }
     }
 
@@ -411,9 +425,24 @@ impl Device {
 
     /// Allocates `bytes` zeroed bytes.
     pub fn alloc_bytes(&mut self, bytes: u64, name: &str) -> DevicePtr {
+        let p = self.alloc_unlogged(bytes, name);
+        self.log(|l| l.alloc(p.0, bytes, name));
+        p
+    }
+
+    /// Allocates without logging it (a module's `.global` variables, which
+    /// a replay's module brings itself).
+    fn alloc_unlogged(&mut self, bytes: u64, name: &str) -> DevicePtr {
         let p = self.mem.alloc(bytes, name);
         self.sizes.insert(p, bytes);
         DevicePtr(p)
+    }
+
+    /// Tells the recording's log, if one runs.
+    fn log(&self, f: impl FnOnce(&mut super::recording::DeviceLog)) {
+        if let Some(l) = &self.log {
+            f(&mut l.lock().unwrap_or_else(|e| e.into_inner()));
+        }
     }
 
     /// Allocates `n` zeroed elements.
@@ -436,6 +465,7 @@ impl Device {
             .find(p.0, bytes.len() as u64)
             .ok_or_else(|| SimError::BadPointer(format!("{} bytes at {:#x}", bytes.len(), p.0)))?;
         al.write_bytes(off, &bytes);
+        self.log(|l| l.write(p.0, &bytes));
         Ok(())
     }
 
@@ -451,6 +481,7 @@ impl Device {
             self.mem.find(p.0, len).ok_or_else(|| SimError::BadPointer(format!("{len} bytes at {:#x}", p.0)))?;
         let mut b = vec![0u8; len as usize];
         al.read_bytes(off, &mut b);
+        self.log(|l| l.read(p.0, &b));
         Ok(from_bytes(&b))
     }
 
@@ -461,6 +492,7 @@ impl Device {
     pub fn create_texture(&mut self, desc: super::texture::TextureDesc) -> Result<u64, SimError> {
         desc.validate(|a, n| self.mem.find(a, n).is_some())
             .map_err(|msg| SimError::BadObject { what: "texture", msg })?;
+        self.log(|l| l.refuse("a texture object (its handle is the emulator's)"));
         self.textures.push(super::texture::Object::Texture(desc));
         Ok(super::texture::handle_of(self.textures.len() - 1))
     }
@@ -471,6 +503,7 @@ impl Device {
     pub fn create_surface(&mut self, desc: super::texture::SurfaceDesc) -> Result<u64, SimError> {
         desc.validate(|a, n| self.mem.find(a, n).is_some())
             .map_err(|msg| SimError::BadObject { what: "surface", msg })?;
+        self.log(|l| l.refuse("a surface object (its handle is the emulator's)"));
         self.textures.push(super::texture::Object::Surface(desc));
         Ok(super::texture::handle_of(self.textures.len() - 1))
     }
@@ -491,7 +524,19 @@ impl Device {
     /// Parses, validates and loads PTX text, allocating its `.global` variables.
     pub fn load_ptx(&mut self, src: &str, name: &str) -> Result<Module, SimError> {
         let prog = ptx::load(src, name)?;
-        Ok(self.load(prog))
+        Ok(self.load_parsed(prog, src))
+    }
+
+    /// Loads `prog`, parsed from the PTX text `src` (which a recording keeps,
+    /// [`super::recording`]; [`Device::load`] has no text to keep).
+    pub fn load_parsed(&mut self, prog: Program, src: &str) -> Module {
+        let mut m = self.load(prog);
+        if let Some(l) = &self.log {
+            let name = m.prog.source_name.clone();
+            let index = l.lock().unwrap_or_else(|e| e.into_inner()).module(&name, src, constants_of(&m.prog));
+            m.recorded = Some((std::sync::Arc::as_ptr(l) as usize, index));
+        }
+        m
     }
 
     /// Loads a validated program.
@@ -499,7 +544,7 @@ impl Device {
         let cfgs = prog.functions.iter().map(Cfg::build).collect();
         let mut globals = Vec::new();
         for g in &prog.globals {
-            let p = self.alloc_bytes(g.size.max(1), &g.name);
+            let p = self.alloc_unlogged(g.size.max(1), &g.name);
             if let Some((al, off)) = self.mem.find(p.0, g.init.len() as u64) {
                 al.write_bytes(off, &g.init);
             }
@@ -507,7 +552,7 @@ impl Device {
         }
         let opts = FloatOptions { fmad: self.config.fmad, sfu: self.config.sfu };
         let code = Code::decode(&prog, opts);
-        Module { prog, cfgs, code, stepping: std::sync::OnceLock::new(), opts, globals }
+        Module { prog, cfgs, code, stepping: std::sync::OnceLock::new(), opts, globals, recorded: None }
     }
 
     fn prepare(
@@ -633,6 +678,13 @@ impl Device {
         observers: Option<&dyn ObserverFactory>,
     ) -> Result<LaunchStats, SimError> {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
+        if let Some(l) = &self.log {
+            // a module of this device's log, or of none (loaded from a program, or on another device)
+            let me = std::sync::Arc::as_ptr(l) as usize;
+            let index = m.recorded.filter(|r| r.0 == me).map(|r| r.1);
+            let constants = constants_of(&m.prog);
+            l.lock().unwrap_or_else(|e| e.into_inner()).launch(index, constants, kernel, &cfg, args);
+        }
         // Below `memory` nobody listens; the listener learns whether to simulate caches.
         let fidelity = self.config.fidelity;
         let observers = observers.filter(|_| fidelity >= Fidelity::Memory);
@@ -656,6 +708,7 @@ impl Device {
         observers: Option<&'a dyn ObserverFactory>,
     ) -> Result<GridRun<'a>, SimError> {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
+        self.log(|l| l.refuse("a stepped launch (the teaching views run warps outside Device::launch)"));
         let ctx = self.ctx(m, m.stepping_code(), kp, &cfg, observers);
         Ok(GridRun::new(ctx, k, shared, self.config.schedule.clone()))
     }

@@ -23,6 +23,7 @@ pub mod half;
 pub mod memory;
 pub mod observer;
 pub mod printf;
+pub mod recording;
 pub mod regalloc;
 pub mod sfu;
 pub mod simt_stack;

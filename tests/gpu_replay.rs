@@ -1,0 +1,210 @@
+//! `--record`: recordings of emulated runs, and the emulator against an
+//! NVIDIA H200 that replayed them (tests/fixtures/gpu_replay.json, made by
+//! tools/device/replay_cases.sh, replay_run.sh and replay_fixture.py;
+//! docs/gpu-replay.md).
+
+use std::path::{Path, PathBuf};
+
+fn warplight(args: &[&str]) -> (bool, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
+
+fn tempdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("warplight-replay-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// FNV-1a (64-bit), as the fixture names bytes.
+fn fnv1a64(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+/// A recording's manifest and data.
+fn load(dir: &Path) -> (serde_json::Value, Vec<u8>) {
+    let json = std::fs::read(dir.join("recording.json")).expect("recording.json");
+    (serde_json::from_slice(&json).unwrap(), std::fs::read(dir.join("data.bin")).expect("data.bin"))
+}
+
+/// The hashes of every read of each device, in order.
+fn read_hashes(manifest: &serde_json::Value, data: &[u8]) -> Vec<Vec<String>> {
+    let devices = manifest["devices"].as_array().unwrap();
+    devices
+        .iter()
+        .map(|d| {
+            d["ops"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|o| o["op"] == "read")
+                .map(|o| {
+                    let (off, len) = (o["data"]["offset"].as_u64().unwrap(), o["data"]["len"].as_u64().unwrap());
+                    fnv1a64(&data[off as usize..(off + len) as usize])
+                })
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn a_launch_spec_is_recorded_op_by_op() {
+    let dir = tempdir("spec");
+    let d = dir.to_str().unwrap();
+    let (ok, out, err) = warplight(&["--record", d, "launch", "examples/reduce.toml", "--dump", "sums=/dev/null"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("recorded 1 device(s), 1 launches"), "{out}");
+    let (m, data) = load(&dir);
+    assert_eq!(m["format"], 1);
+    assert!(m["what"].as_str().unwrap().contains("launch examples/reduce.toml"));
+    let dev = &m["devices"][0];
+    assert!(dev["unreplayable"].is_null());
+    let ops: Vec<&str> = dev["ops"].as_array().unwrap().iter().map(|o| o["op"].as_str().unwrap()).collect();
+    // reduce.toml: two buffers (the input filled by iota), one launch, the dump's read
+    let launch = ops.iter().position(|&o| o == "launch").expect("a launch");
+    assert!(ops[..launch].iter().filter(|&&o| o == "alloc").count() >= 2, "{ops:?}");
+    assert_eq!(ops.last(), Some(&"read"), "{ops:?}");
+    let l = &dev["ops"][launch];
+    assert_eq!(l["kernel"].as_str().unwrap(), "reduce_sum");
+    // every pointer argument lies in an allocation recorded before the launch
+    let allocs: Vec<(u64, u64)> = dev["ops"].as_array().unwrap()[..launch]
+        .iter()
+        .filter(|o| o["op"] == "alloc")
+        .map(|o| (o["addr"].as_u64().unwrap(), o["bytes"].as_u64().unwrap()))
+        .collect();
+    for a in l["args"].as_array().unwrap() {
+        if let Some(p) = a["ptr"].as_u64() {
+            assert!(allocs.iter().any(|&(b, n)| b <= p && p <= b + n), "{p:#x} in none of {allocs:?}");
+        }
+    }
+    // the module's PTX is the spec's, and the data holds the written and read bytes
+    let ptx = std::fs::read_to_string(dir.join(dev["modules"][0]["file"].as_str().unwrap())).unwrap();
+    assert!(ptx.contains(".entry reduce_sum") || ptx.contains("reduce_sum"), "module text");
+    let last = &dev["ops"][ops.len() - 1]["data"];
+    assert_eq!(last["offset"].as_u64().unwrap() + last["len"].as_u64().unwrap(), data.len() as u64);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_command_that_emulates_nothing_records_nothing() {
+    let dir = tempdir("native");
+    let img = dir.with_extension("png");
+    let (ok, _, err) = warplight(&[
+        "--record",
+        dir.to_str().unwrap(),
+        "render",
+        "--method",
+        "path",
+        "--resolution",
+        "8x8",
+        "--spp",
+        "4",
+        "-o",
+        img.to_str().unwrap(),
+    ]);
+    assert!(!ok);
+    assert!(err.contains("ran no emulated kernel"), "{err}");
+    assert!(!dir.exists(), "no folder is made for nothing");
+    let _ = std::fs::remove_file(&img);
+    // a file where the folder should go is refused before anything runs
+    std::fs::write(&img, b"x").unwrap();
+    let (ok, _, err) = warplight(&["--record", img.to_str().unwrap(), "launch", "examples/reduce.toml"]);
+    assert!(!ok);
+    assert!(err.contains("not a folder"), "{err}");
+    std::fs::remove_file(&img).unwrap();
+}
+
+/// Re-records the fixture's case `name` and asserts that every read of every
+/// device hashes to what the H200 read when it replayed the case (where the
+/// GPU had read other bytes, to what the emulator read then).
+fn check_case(name: &str) {
+    let text = std::fs::read_to_string("tests/fixtures/gpu_replay.json").expect("fixture");
+    let fx: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let case = &fx["cases"][name];
+    assert!(case.is_object(), "{name}: not in the fixture");
+    let args: Vec<&str> = case["args"].as_array().unwrap().iter().map(|a| a.as_str().unwrap()).collect();
+    let dir = tempdir(name);
+    // the outputs go beside the recording's folder, named as the recorded run named them
+    let out_dir = dir.with_extension("out");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let out = out_dir.join(case["output"].as_str().unwrap());
+    let mut all = vec!["--record", dir.to_str().unwrap()];
+    all.extend(&args);
+    all.extend(["-o", out.to_str().unwrap()]);
+    let (ok, _, err) = warplight(&all);
+    assert!(ok, "{name}: {err}");
+    let (m, data) = load(&dir);
+    let ours = read_hashes(&m, &data);
+    let devices = case["devices"].as_array().unwrap();
+    assert_eq!(ours.len(), devices.len(), "{name}: devices");
+    let mut reads = 0;
+    for (d, (hashes, gpu)) in ours.iter().zip(devices).enumerate() {
+        let gpu_reads = gpu["reads"].as_array().unwrap();
+        assert_eq!(hashes.len(), gpu_reads.len(), "{name} device {d}: reads");
+        for (i, (h, r)) in hashes.iter().zip(gpu_reads).enumerate() {
+            let want = if r["equal"] == true { &r["hash"] } else { &r["emulator_hash"] };
+            assert_eq!(h, want.as_str().unwrap(), "{name} device {d} read {i}: the emulator reads other bytes");
+            reads += 1;
+        }
+    }
+    assert!(reads > 0, "{name}: no read to compare");
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&out_dir);
+}
+
+// The fixture's small cases, a few a test so that they run side by side (the
+// 256 x 256 timing cases, the bunny's and the photon map's take minutes on 2 cores).
+
+#[test]
+fn the_h200_reads_what_the_emulator_read_path_integrators() {
+    for name in ["lambert-pt", "lambert-mis-power", "lambert-bdpt", "lambert-mlt"] {
+        check_case(name);
+    }
+}
+
+#[test]
+fn the_h200_reads_what_the_emulator_read_path_builds_and_traversals() {
+    for name in ["lambert-nee-fixed", "lambert-nee-stratified", "lambert-nee-backtrack", "lambert-nee-stack12"] {
+        check_case(name);
+    }
+}
+
+#[test]
+fn the_h200_reads_what_the_emulator_read_path_kernels() {
+    for name in ["fog-nee", "scratched-nee", "env-glass-mis", "caustic-nee"] {
+        check_case(name);
+    }
+}
+
+#[test]
+fn the_h200_reads_what_the_emulator_read_wavefront_and_thesis_000() {
+    for name in ["compaction", "raycast-short-stack"] {
+        check_case(name);
+    }
+}
+
+#[test]
+fn every_replayed_read_was_equal() {
+    // the fixture's verdict itself: every read of every case equal on the H200
+    let fx: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("tests/fixtures/gpu_replay.json").unwrap()).unwrap();
+    let mut reads = 0;
+    for (name, case) in fx["cases"].as_object().unwrap() {
+        for d in case["devices"].as_array().unwrap() {
+            assert!(d.get("skipped").is_none(), "{name}: skipped");
+            for r in d["reads"].as_array().unwrap() {
+                assert_eq!(r["equal"], true, "{name}: a read differed");
+                reads += 1;
+            }
+            for l in d["launches"].as_array().unwrap() {
+                assert!(l.get("error").is_none(), "{name}: {}", l["error"]);
+            }
+        }
+    }
+    assert!(reads >= 45, "{reads} reads");
+}

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Records the GPU-replay cases (docs/gpu-replay.md) on this machine, with the
+# emulator (no GPU needed): each case is one warplight command run with
+# `--record`, into $REC/<case>/, and its output into $REC/<case>/emulator.txt.
+# Then tools/device/replay_run.sh replays them on the GPU.
+#   bash tools/device/replay_cases.sh [small|timing|all]   (default all)
+# Environment: REC (default /tmp/replay-cases), WARPLIGHT (default target/release/warplight).
+# small: 32 x 32 pixels, 2 frames (8 spp), every kernel and integrator of the
+#        path tracer, thesis 003's compaction chart, thesis 000's ray caster
+#        and photon map, seed 004's photon map: the bit-for-bit checks.
+# timing: 256 x 256 pixels (262,144 paths, about one wave of an H200), one
+#        frame, Russian roulette against a fixed depth for pt, nee and bdpt.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+REC=${REC:-/tmp/replay-cases}
+W=${WARPLIGHT:-target/release/warplight}
+which=${1:-all}
+mkdir -p "$REC"
+
+# case name, then the warplight arguments
+record() {
+  local name=$1
+  shift
+  rm -rf "${REC:?}/$name"
+  mkdir -p "$REC/$name"
+  echo "== $name: warplight $*" >&2
+  "$W" "$@" --record "$REC/$name" -o "$REC/$name/image.exr" > "$REC/$name/emulator.txt"
+  rm -f "$REC/$name/image.exr"
+}
+
+path="render --method path --variant emulated --device hopper --fidelity instructions"
+if [ "$which" = small ] || [ "$which" = all ]; then
+  s="--resolution 32x32 --spp 8"
+  for i in pt nee mis mis-power bdpt mlt; do
+    record "lambert-$i" $path $s --scene cornell-lambert --integrator $i
+  done
+  record lambert-nee-fixed $path $s --scene cornell-lambert --integrator nee --termination fixed-depth
+  record lambert-bdpt-fixed $path $s --scene cornell-lambert --integrator bdpt --termination fixed-depth
+  record lambert-nee-stratified $path $s --scene cornell-lambert --integrator nee --pixels stratified:2
+  for t in stack12 restart backtrack; do
+    record "lambert-nee-$t" $path $s --scene cornell-lambert --integrator nee --traversal $t
+  done
+  record rough-mis-power $path $s --scene cornell-rough --integrator mis-power
+  record caustic-nee $path $s --scene cornell-caustic --integrator nee
+  record inverted-bdpt $path $s --scene cornell-inverted --integrator bdpt
+  record fog-nee $path $s --scene fog-box --integrator nee
+  record jade-nee $path $s --scene bunny-jade --integrator nee
+  record scratched-nee $path $s --scene cornell-scratched --integrator nee
+  record env-spheres-nee $path $s --scene env-spheres --integrator nee
+  record env-glass-mis $path $s --scene env-glass --integrator mis
+  # the megakernel, thread compaction and the Fresnel regroup, level by level (host reads between launches)
+  rm -rf "$REC/compaction" && mkdir -p "$REC/compaction"
+  echo "== compaction" >&2
+  "$W" chart lin-compaction --size 32 --depth 30 --record "$REC/compaction" \
+    -o "$REC/compaction/chart-{}.svg" > "$REC/compaction/emulator.txt"
+  rm -f "$REC"/compaction/chart-*
+  record raycast-short-stack render --method raycast --variant short-stack --device hopper --scene cornell-box --resolution 64x64
+  record photon-map render --method photon-map --variant emulated --device hopper --scene cornell-box --resolution 32x32
+fi
+if [ "$which" = timing ] || [ "$which" = all ]; then
+  for i in pt nee bdpt; do
+    for e in roulette fixed-depth; do
+      record "time-$i-$e" $path --resolution 256x256 --spp 4 --scene cornell-lambert --integrator $i --termination $e
+    done
+  done
+fi
+du -sh "$REC"

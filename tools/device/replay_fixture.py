@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""Makes the GPU-replay fixture (docs/gpu-replay.md) from what
+tools/device/replay_run.sh brought back and the recordings it replayed.
+
+  replay_fixture.py RESULTS.tar.gz REC FILE
+
+RESULTS.tar.gz: replay_run.sh's results; REC: the folder of recordings
+(tools/device/replay_cases.sh), for each case's command and the emulator's
+printed counts; FILE: the fixture (JSON). Per case: the command, the
+emulator's output lines, every read (bytes, equal to the emulator's, the
+GPU's FNV-1a hash and, when they differ, the emulator's and how), every
+launch (kernel, grid, block, the first run's and the timed runs' GPU
+milliseconds) and, where ncu profiled the case, its metrics per launch.
+"""
+import csv
+import io
+import json
+import os
+import sys
+import tarfile
+
+
+def ncu_rows(text):
+    """ncu --csv's rows: per launch ID, {metric: value}; kernels in order."""
+    lines = text.splitlines()
+    start = next((i for i, l in enumerate(lines) if l.startswith('"ID"')), None)
+    if start is None:
+        return []
+    rows = list(csv.DictReader(io.StringIO("\n".join(lines[start:]))))
+    launches = {}
+    for r in rows:
+        i = int(r["ID"])
+        e = launches.setdefault(i, {"kernel": r["Kernel Name"].split("(")[0]})
+        v = r["Metric Value"].replace(",", "")
+        try:
+            v = float(v)
+        except ValueError:
+            pass
+        e[r["Metric Name"]] = v
+    return [launches[i] for i in sorted(launches)]
+
+
+def main():
+    if len(sys.argv) != 4:
+        print(__doc__, file=sys.stderr)
+        return 2
+    results, rec, path = sys.argv[1:]
+    files = {}
+    with tarfile.open(results) as t:
+        for m in t.getmembers():
+            if m.isfile():
+                files[os.path.basename(m.name)] = t.extractfile(m).read().decode()
+    fixture = {
+        "what": "GPU replays of emulated runs (tools/device/replay_cases.sh, replay_run.sh, replay_fixture.py); docs/gpu-replay.md",
+        "env": files.get("env.txt", "").strip().splitlines(),
+        "cases": {},
+    }
+    for name in sorted(n[:-5] for n in files if n.endswith(".json")):
+        r = json.loads(files[name + ".json"])
+        emulator = open(os.path.join(rec, name, "emulator.txt")).read().strip().splitlines()
+        words = r["what"].split()[1:]
+        args, output = [], None
+        while words:
+            w = words.pop(0)
+            if w == "--record":
+                words.pop(0)
+            elif w in ("-o", "--output"):
+                output = os.path.basename(words.pop(0))
+            else:
+                args.append(w)
+        case = {"args": args, "output": output, "emulator": emulator, "devices": []}
+        for d in r["devices"]:
+            dev = {"reads": d["reads"], "launches": []}
+            if "skipped" in d:
+                dev["skipped"] = d["skipped"]
+            for l in d["launches"]:
+                dev["launches"].append({k: (round(v, 4) if isinstance(v, float) else v) for k, v in l.items()})
+            case["devices"].append(dev)
+        if name + ".ncu.csv" in files:
+            case["ncu"] = ncu_rows(files[name + ".ncu.csv"])
+        fixture["cases"][name] = case
+    with open(path, "w") as f:
+        json.dump(fixture, f, indent=1)
+        f.write("\n")
+    print(f"{path}: {len(fixture['cases'])} cases")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
