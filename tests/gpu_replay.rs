@@ -71,6 +71,8 @@ fn a_launch_spec_is_recorded_op_by_op() {
     assert_eq!(ops.last(), Some(&"read"), "{ops:?}");
     let l = &dev["ops"][launch];
     assert_eq!(l["kernel"].as_str().unwrap(), "reduce_sum");
+    // the emulator's count of the launch (the spec runs at the full fidelity)
+    assert!(l["warp_instructions"].as_u64().unwrap() > 0, "{l}");
     // every pointer argument lies in an allocation recorded before the launch
     let allocs: Vec<(u64, u64)> = dev["ops"].as_array().unwrap()[..launch]
         .iter()

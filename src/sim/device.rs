@@ -693,7 +693,11 @@ impl Device {
         }
         let ctx = self.ctx(m, &m.code, kp, &cfg, observers);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
-        run.run_with_progress(self.pool.as_ref(), self.progress.as_ref()).map_err(SimError::Fault)
+        let st = run.run_with_progress(self.pool.as_ref(), self.progress.as_ref()).map_err(SimError::Fault)?;
+        if fidelity >= Fidelity::Instructions {
+            self.log(|l| l.launched(st.totals.warp_instructions));
+        }
+        Ok(st)
     }
 
     /// Checks a launch and makes its runner (for [`super::stepper`], which

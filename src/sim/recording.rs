@@ -107,6 +107,10 @@ pub enum Op {
         shared: u32,
         /// The arguments.
         args: Vec<RecordedArg>,
+        /// The warp instructions the emulator issued for it (when its
+        /// fidelity counts them: `instructions` or above).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        warp_instructions: Option<u64>,
     },
     /// A host read at `addr`, with what the emulator returned.
     Read {
@@ -219,7 +223,15 @@ impl DeviceLog {
             block: cfg.block,
             shared: cfg.dynamic_shared,
             args: recorded,
+            warp_instructions: None,
         });
+    }
+
+    /// The last launch issued `warp` warp instructions on the emulator.
+    pub fn launched(&mut self, warp: u64) {
+        if let Some(Op::Launch { warp_instructions, .. }) = self.ops.last_mut() {
+            *warp_instructions = Some(warp);
+        }
     }
 
     /// The operations so far.

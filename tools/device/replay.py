@@ -13,9 +13,15 @@ same on the GPU through CuPy (the driver's JIT loads the recorded PTX):
     FNV-1a (64-bit) hash of the GPU's bytes, and for differing reads the
     number of differing 4-byte words and the largest difference as f32;
   * with --time N, after the replay each launch is run N more times in
-    order (state moves on, as frames accumulate) and timed with CUDA events.
+    order (state moves on, as frames accumulate) and timed with CUDA events;
+    right for independent launches (a path tracer's frames), not for a
+    sequence whose launches consume each other's state (a wavefront's
+    levels: after the replay every path has ended);
+  * with --passes K, the whole replay runs K times, each from fresh buffers,
+    and each launch's first-run time is kept per pass (ms_passes, and their
+    median ms_pass_median): the times of such sequences.
 
-  replay.py DIR [--out FILE] [--time N]
+  replay.py DIR [--out FILE] [--time N] [--passes K]
 
 FILE (default DIR/replay.json): {"gpu", "cupy", "recordings": [...]}, one
 entry per device with "reads" and "launches". Exits 1 when a read differs or
@@ -149,6 +155,7 @@ def main():
     ap.add_argument("dir", help="the recording's folder")
     ap.add_argument("--out", help="result JSON (default DIR/replay.json)")
     ap.add_argument("--time", type=int, default=0, metavar="N", help="time each launch N more times")
+    ap.add_argument("--passes", type=int, default=1, metavar="K", help="replay K times from fresh buffers")
     a = ap.parse_args()
     import numpy as np
     import cupy as cp
@@ -167,7 +174,18 @@ def main():
     result = {"what": rec["what"], "gpu": props["name"].decode(), "cupy": cp.__version__,
               "driver": cp.cuda.runtime.driverGetVersion(), "devices": []}
     for dev in rec["devices"]:
-        result["devices"].append(replay_device(np, cp, a.dir, data, dev, a.time))
+        out = replay_device(np, cp, a.dir, data, dev, a.time)
+        if a.passes > 1 and "skipped" not in out:
+            times = [[l.get("ms_first")] for l in out["launches"]]
+            for _ in range(a.passes - 1):
+                again = replay_device(np, cp, a.dir, data, dev, 0)
+                out["reads"] += [r for r in again["reads"] if not r["equal"]]
+                for t, l in zip(times, again["launches"]):
+                    t.append(l.get("ms_first"))
+            for l, t in zip(out["launches"], times):
+                l["ms_passes"] = t
+                l["ms_pass_median"] = statistics.median(x for x in t if x is not None)
+        result["devices"].append(out)
     out = a.out or os.path.join(a.dir, "replay.json")
     with open(out, "w") as f:
         json.dump(result, f, indent=1)

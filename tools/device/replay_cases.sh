@@ -9,7 +9,9 @@
 #        path tracer, thesis 003's compaction chart, thesis 000's ray caster
 #        and photon map, seed 004's photon map: the bit-for-bit checks.
 # timing: 256 x 256 pixels (262,144 paths, about one wave of an H200), one
-#        frame, Russian roulette against a fixed depth for pt, nee and bdpt.
+#        frame, Russian roulette against a fixed depth for pt, nee and bdpt;
+#        thesis 003's compaction chart at Fig. 17's 1,048,576 paths; Fig. 3's
+#        traversals on its SAH tree at 256 x 256.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REC=${REC:-/tmp/replay-cases}
@@ -53,11 +55,22 @@ if [ "$which" = small ] || [ "$which" = all ]; then
   echo "== compaction" >&2
   "$W" chart lin-compaction --size 32 --depth 30 --record "$REC/compaction" \
     -o "$REC/compaction/chart-{}.svg" > "$REC/compaction/emulator.txt"
-  rm -f "$REC"/compaction/chart-*
+  # the chart's data (per level: active paths, warp instructions) stays for the report
+  rm -f "$REC"/compaction/chart-*.svg
   record raycast-short-stack render --method raycast --variant short-stack --device hopper --scene cornell-box --resolution 64x64
   record photon-map render --method photon-map --variant emulated --device hopper --scene cornell-box --resolution 32x32
 fi
 if [ "$which" = timing ] || [ "$which" = all ]; then
+  # Fig. 17's 1,048,576 paths: the normal and the compacted wavefront, 30 levels
+  rm -rf "$REC/compaction-512" && mkdir -p "$REC/compaction-512"
+  echo "== compaction-512" >&2
+  "$W" chart lin-compaction --size 512 --depth 30 --record "$REC/compaction-512" \
+    -o "$REC/compaction-512/chart-{}.svg" > "$REC/compaction-512/emulator.txt"
+  rm -f "$REC"/compaction-512/chart-*.svg
+  # Fig. 3's three traversals on bunny-ball's SAH tree, 262,144 paths a frame
+  for t in stack restart backtrack; do
+    record "fig3-$t" $path --resolution 256x256 --spp 4 --scene bunny-ball --integrator nee --traversal $t
+  done
   for i in pt nee bdpt; do
     for e in roulette fixed-depth; do
       record "time-$i-$e" $path --resolution 256x256 --spp 4 --scene cornell-lambert --integrator $i --termination $e

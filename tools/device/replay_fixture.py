@@ -10,7 +10,7 @@ printed counts; FILE: the fixture (JSON). Per case: the command, the
 emulator's output lines, every read (bytes, equal to the emulator's, the
 GPU's FNV-1a hash and, when they differ, the emulator's and how), every
 launch (kernel, grid, block, the first run's and the timed runs' GPU
-milliseconds) and, where ncu profiled the case, its metrics per launch.
+milliseconds, the emulator's warp instructions where the recording has them) and, where ncu profiled the case, its metrics per launch.
 """
 import csv
 import io
@@ -69,13 +69,24 @@ def main():
             else:
                 args.append(w)
         case = {"args": args, "output": output, "emulator": emulator, "devices": []}
-        for d in r["devices"]:
+        recorded = json.load(open(os.path.join(rec, name, "recording.json")))
+        for d, rd in zip(r["devices"], recorded["devices"]):
             dev = {"reads": d["reads"], "launches": []}
+            # the emulator's warp instructions of each launch, where the recording has them
+            emulated = [o.get("warp_instructions") for o in rd["ops"] if o["op"] == "launch"]
             if "skipped" in d:
                 dev["skipped"] = d["skipped"]
-            for l in d["launches"]:
-                dev["launches"].append({k: (round(v, 4) if isinstance(v, float) else v) for k, v in l.items()})
+            for l, w in zip(d["launches"], emulated):
+                entry = {k: (round(v, 4) if isinstance(v, float) else v) for k, v in l.items()}
+                if "ms_passes" in entry:
+                    entry["ms_passes"] = [round(x, 4) for x in entry["ms_passes"]]
+                if w is not None:
+                    entry["emulated_warp_instructions"] = w
+                dev["launches"].append(entry)
             case["devices"].append(dev)
+        levels = os.path.join(rec, name, "chart-data.json")
+        if os.path.exists(levels):
+            case["levels"] = json.load(open(levels))
         if name + ".ncu.csv" in files:
             case["ncu"] = ncu_rows(files[name + ".ncu.csv"])
         fixture["cases"][name] = case
