@@ -210,3 +210,83 @@ fn every_replayed_read_was_equal() {
     }
     assert!(reads >= 45, "{reads} reads");
 }
+
+/// The fixture as JSON.
+fn fixture() -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string("tests/fixtures/gpu_replay.json").unwrap()).unwrap()
+}
+
+/// The emulator's warp instructions, the H200's SASS warp instructions and
+/// its median milliseconds of a one-launch timing case.
+fn timed(fx: &serde_json::Value, name: &str) -> (f64, f64, f64) {
+    let c = &fx["cases"][name];
+    let line =
+        c["emulator"].as_array().unwrap().iter().filter_map(|l| l.as_str()).find(|l| l.contains("warp instructions"));
+    let emulated: f64 =
+        line.and_then(|l| l.split(": ").nth(1)).and_then(|l| l.split(' ').next()).unwrap().parse().unwrap();
+    let sass = c["ncu"][0]["smsp__inst_executed.sum"].as_f64().unwrap();
+    let ms = c["devices"][0]["launches"][0]["ms_median"].as_f64().unwrap();
+    (emulated, sass, ms)
+}
+
+#[test]
+fn the_documented_h200_findings_hold_in_the_fixture() {
+    // docs/gpu-replay.md's statements, from the committed measurements
+    let fx = fixture();
+    for (i, model, gpu) in [("pt", 2.73, 2.15), ("nee", 2.72, 2.11), ("bdpt", 3.81, 3.08)] {
+        let (er, sr, tr) = timed(&fx, &format!("time-{i}-roulette"));
+        let (ef, sf, tf) = timed(&fx, &format!("time-{i}-fixed-depth"));
+        for (e, s) in [(er, sr), (ef, sf)] {
+            assert!((1.235..1.27).contains(&(s / e)), "{i}: SASS / PTX {}", s / e);
+        }
+        assert!((ef / er - model).abs() < 0.005, "{i}: modelled speedup {}", ef / er);
+        assert!((tf / tr - gpu).abs() < 0.005, "{i}: the H200's speedup {}", tf / tr);
+        // the instruction model overstates roulette's speedup by 24-29 %
+        assert!((1.235..1.295).contains(&((ef / er) / (tf / tr))), "{i}");
+    }
+    // Fig. 3: the H200 keeps the thesis' order, the instruction model swaps the last two
+    let [s, r, b] = ["stack", "restart", "backtrack"].map(|t| timed(&fx, &format!("fig3-{t}")));
+    assert!(s.2 < r.2 && r.2 < b.2, "H200 ms {s:?} {r:?} {b:?}");
+    assert!(b.0 < r.0, "the model: backtrack issues fewer warp instructions than restart");
+    // Fig. 17 at 1,048,576 paths: by kernel durations compaction overtakes at depth 3, the model at 2
+    let c = &fx["cases"]["compaction-512"];
+    let n0 = c["devices"][0]["launches"].as_array().unwrap().len();
+    let ncu: Vec<(&str, f64)> = c["ncu"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| (x["kernel"].as_str().unwrap(), x["gpu__time_duration.sum"].as_f64().unwrap()))
+        .collect();
+    let emulated = |d: usize| -> Vec<(&str, f64)> {
+        c["devices"][d]["launches"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| (l["kernel"].as_str().unwrap(), l["emulated_warp_instructions"].as_f64().unwrap()))
+            .collect()
+    };
+    // a frame up to max depth D: the camera rays, D levels, the compactions between them
+    let frame = |launches: &[(&str, f64)], depth: usize| -> f64 {
+        let mut levels = 0;
+        let mut sum = launches[0].1;
+        for &(k, v) in &launches[1..] {
+            if k == "path_level" {
+                levels += 1;
+                if levels > depth {
+                    break;
+                }
+                sum += v;
+            } else if levels < depth {
+                sum += v;
+            }
+        }
+        sum
+    };
+    let (normal, compact) = ncu.split_at(n0);
+    let gpu = |d| frame(compact, d) / frame(normal, d);
+    let (en, ec) = (emulated(0), emulated(1));
+    let model = |d| frame(&ec, d) / frame(&en, d);
+    assert!(gpu(2) > 1.0 && gpu(3) < 0.9, "the H200: {} at 2, {} at 3", gpu(2), gpu(3));
+    assert!(model(2) < 0.9, "the model overtakes at depth 2: {}", model(2));
+    assert!((gpu(30) - 0.605).abs() < 0.005 && (model(30) - 0.423).abs() < 0.005, "{} {}", gpu(30), model(30));
+}
