@@ -60,6 +60,12 @@ fn addresses_and_their_errors() {
     assert!(ok && out.contains("protocol thesis: 50 frame(s) of each flight at 512x512"), "{err}");
     assert!(out.contains("estimated time: ") && out.contains(" h on "), "{out}");
     assert!(out.contains("unavailable: scenes/fairy.toml"), "{out}");
+    // a group that caps the image side says so when the protocol asks for more
+    let (ok, out, err) = warplight(&["tables", "lin:fig3", "--resolution", "256", "--plan"]);
+    assert!(ok && out.contains("lin/traversals:"), "{err}");
+    assert!(out.contains("(at most 64x64 pixels: the protocol's 256x256 is capped)"), "{out}");
+    let (ok, out, _) = warplight(&["tables", "lin:fig3", "--resolution", "48", "--plan"]);
+    assert!(ok && out.contains("lin/traversals:") && !out.contains("capped"), "{out}");
     let (ok, _, err) = warplight(&["tables", "4.5", "--protocol", "slow"]);
     assert!(!ok && err.contains("expected quick or thesis"), "{err}");
 }

@@ -160,6 +160,9 @@ pub struct Group {
     pub seconds_per_side: f64,
     /// Estimated core-seconds per triangle of its own work once per scene (timed builds).
     pub seconds_per_triangle: f64,
+    /// The largest image side it emulates, when it caps the protocol's
+    /// resolution (the plan says so when the protocol asks for more).
+    pub max_side: Option<u32>,
     /// The kd-trees it runs on (built once per scene for all groups).
     pub trees: &'static [Heuristic],
     /// The measurement.

@@ -99,10 +99,11 @@ impl Plan {
 
     /// Estimated seconds on `threads` threads: frames run in parallel, tree builds do not.
     pub fn seconds(&self, scenes: &[Scene], threads: usize) -> f64 {
-        let side = self.protocol.resolution as f64;
         let frames = self.work(scenes, |g, _, frames| {
             let runs = if g.per_frame { frames as f64 } else { 1.0 } * g.variants as f64;
-            runs * side * g.seconds_per_side
+            // a group that caps the side runs at most its own
+            let side = g.max_side.map_or(self.protocol.resolution, |m| self.protocol.resolution.min(m));
+            runs * side as f64 * g.seconds_per_side
         });
         let own = self.work(scenes, |g, s, _| s.triangles.len() as f64 * g.seconds_per_triangle);
         let mut trees = 0.0;
@@ -152,7 +153,12 @@ impl Plan {
             } else {
                 " (not in this shard: the shard starting at frame 0 takes it)".into()
             };
-            s.push_str(&format!("  {}: {} on {}{when}\n", g.name, g.what, run.join(", ")));
+            let side = self.protocol.resolution;
+            let cap = match g.max_side {
+                Some(m) if side > m => format!(" (at most {m}x{m} pixels: the protocol's {side}x{side} is capped)"),
+                _ => String::new(),
+            };
+            s.push_str(&format!("  {}: {} on {}{when}{cap}\n", g.name, g.what, run.join(", ")));
         }
         for u in unavailable {
             s.push_str(&format!("  unavailable: {}\n", u.why));
