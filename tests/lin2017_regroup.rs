@@ -175,3 +175,61 @@ const RECORDED: [[u64; 3]; 3] = [[2982802, 0, 14003], [1597705, 100445, 11142], 
 const VERDICT: Verdict = Verdict::Outside;
 /// Fewer divergent branches in shading: holds; a speedup: does not; the same image: holds.
 const CHECKS: [bool; 3] = [true, false, true];
+
+/// `warplight ARGS`: (success, stdout, stderr).
+fn warplight(args: &[&str]) -> (bool, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
+    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
+}
+
+#[test]
+fn render_form_launches_every_form_to_the_same_image() {
+    let dir = std::env::temp_dir().join(format!("warplight-forms-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut images = Vec::new();
+    for form in ["megakernel", "wavefront", "compacted", "split", "split-compacted", "regrouped"] {
+        let out = dir.join(format!("{form}.exr"));
+        let (ok, stdout, err) = warplight(&[
+            "render",
+            "--method",
+            "path",
+            "--variant",
+            "emulated",
+            "--fidelity",
+            "functional",
+            "--scene",
+            "cornell-glossy",
+            "--resolution",
+            "8x8",
+            "--spp",
+            "8",
+            "--integrator",
+            "mis",
+            "--form",
+            form,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(ok, "{form}: {err}");
+        assert_eq!(stdout.contains(&format!("{form} form")), form != "megakernel", "{stdout}");
+        images.push(std::fs::read(&out).unwrap());
+    }
+    assert!(images.iter().all(|i| *i == images[0]), "every form writes the megakernel's image");
+    // refused: natively, bdpt and mlt, a scene with a medium, an unknown form, another method
+    let o = dir.join("x.exr");
+    let o = o.to_str().unwrap();
+    for (args, want) in [
+        (vec!["--form", "compacted"], "--variant emulated"),
+        (vec!["--variant", "emulated", "--integrator", "bdpt", "--form", "split"], "not bdpt"),
+        (vec!["--variant", "emulated", "--scene", "fog-box", "--form", "regrouped"], "volume_frame"),
+        (vec!["--variant", "emulated", "--form", "levels"], "expected megakernel, wavefront"),
+    ] {
+        let mut all = vec!["render", "--method", "path", "--resolution", "8x8", "-o", o];
+        all.extend(&args);
+        let (ok, _, err) = warplight(&all);
+        assert!(!ok && err.contains(want), "{args:?}: {err}");
+    }
+    let (ok, _, err) = warplight(&["render", "--method", "raycast", "--form", "compacted", "-o", o]);
+    assert!(!ok && err.contains("--form applies to --method path only"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

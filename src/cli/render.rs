@@ -114,6 +114,15 @@ pub struct RenderArgs {
     /// multiple of 4·D²).
     #[arg(long, default_value = "tent")]
     pub pixels: String,
+    /// Path tracer, emulated: how the frames are launched. megakernel (one launch
+    /// a frame); wavefront (a launch a level: path_init, then path_level per
+    /// bounce), compacted (the same with thread compaction between levels, §6.3);
+    /// split (trace and shade of each level apart), split-compacted (the active
+    /// states compacted between them) or regrouped (compacted by next Fresnel
+    /// branch, the 3-way regroup of §6.3). The same image bit for bit; pt, nee,
+    /// mis and mis-power on scenes without media, translucent materials or textures.
+    #[arg(long, default_value = "megakernel")]
+    pub form: String,
     /// Photon map (thesis 000 ch. 5): vkde, vkde-epanechnikov, knn (Table 5.1's k) or knn:K.
     #[arg(long, default_value = "vkde")]
     pub estimator: String,
@@ -237,6 +246,7 @@ fn check_applicable(a: &RenderArgs) -> Result<(), String> {
         ("--traversal", a.traversal != "stack"),
         ("--termination", a.termination != "roulette"),
         ("--pixels", a.pixels != "tent"),
+        ("--form", a.form != "megakernel"),
     ];
     if let Some((o, _)) = path_only.iter().find(|x| m != "path" && x.1) {
         return Err(format!("{o} applies to --method path only, not {m}"));
@@ -496,7 +506,8 @@ fn run_path(
     let [width, height] = camera.resolution;
     let params =
         FrameParams { width, height, integrator, max_bounces: a.bounces, seed: a.seed, traversal, termination, pixels };
-    let r = crate::repro::lin2017::render::render(scene, camera, params, frames, emulated)?;
+    let form = crate::repro::lin2017::render::Form::parse(&a.form)?;
+    let r = crate::repro::lin2017::render::render_form(scene, camera, params, frames, emulated, form)?;
     write_image(&r.image, &a.output, a.exposure)?;
     println!(
         "{} ({}x{}), path tracer {} ({} traversal, {}{}), {} spp ({} frames of 4 subpixels), at most {} bounces: {:.3} s, {:.3} M paths/s{}",
@@ -506,7 +517,12 @@ fn run_path(
         integrator.name(),
         traversal.name(),
         termination.name(),
-        if pixels == PixelSampling::Tent { String::new() } else { format!(", {} pixels", pixels.name()) },
+        if pixels == PixelSampling::Tent { String::new() } else { format!(", {} pixels", pixels.name()) }
+            + &if form == crate::repro::lin2017::render::Form::Megakernel {
+                String::new()
+            } else {
+                format!(", {} form", form.name())
+            },
         a.spp,
         frames,
         a.bounces,

@@ -28,6 +28,48 @@ pub struct PathRender {
     pub kernel: &'static str,
 }
 
+/// How the emulated frames are launched: the megakernel (one launch a
+/// frame, the default) or one of the wavefront forms of §6.3 (a launch per
+/// level, with or without thread compaction; or trace and shade apart, the
+/// states compacted or regrouped by Fresnel branch between them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Form {
+    /// `path_frame` (and the other entry points): one launch a frame.
+    Megakernel,
+    /// `path_init`, then `path_level` per level (`host::path::wavefront`), in that mode.
+    Levels(crate::host::path::wavefront::Mode),
+    /// `regroup_init`, then `regroup_trace` and `regroup_shade` per level (`host::path::regroup`), in that mode.
+    Split(crate::host::path::regroup::Mode),
+}
+
+impl Form {
+    /// Every form with its name, as `--form` takes it.
+    pub const ALL: [(&'static str, Form); 6] = {
+        use crate::host::path::{regroup, wavefront};
+        [
+            ("megakernel", Form::Megakernel),
+            ("wavefront", Form::Levels(wavefront::Mode::Normal)),
+            ("compacted", Form::Levels(wavefront::Mode::Compacted)),
+            ("split", Form::Split(regroup::Mode::Normal)),
+            ("split-compacted", Form::Split(regroup::Mode::Compacted)),
+            ("regrouped", Form::Split(regroup::Mode::Regrouped)),
+        ]
+    };
+
+    /// The form named `s`, or an error listing them.
+    pub fn parse(s: &str) -> Result<Form, String> {
+        Form::ALL.iter().find(|f| f.0 == s).map(|f| f.1).ok_or_else(|| {
+            let names: Vec<&str> = Form::ALL.iter().map(|f| f.0).collect();
+            format!("unknown form `{s}`; expected {}", names.join(", "))
+        })
+    }
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        Form::ALL.iter().find(|f| f.1 == self).map_or("megakernel", |f| f.0)
+    }
+}
+
 /// Frames for `spp` samples per pixel: `spp` must be a positive multiple of 4.
 pub fn frames_for(spp: u32) -> Result<u32, String> {
     if spp == 0 || !spp.is_multiple_of(SAMPLES_PER_FRAME) {
@@ -60,7 +102,38 @@ pub fn render(
     frames: u32,
     emulated: Option<&dyn Fn(&mut crate::sim::SimConfig)>,
 ) -> Result<PathRender, Box<dyn std::error::Error>> {
+    render_form(scene, camera, params, frames, emulated, Form::Megakernel)
+}
+
+/// As [`render`], the emulated frames launched in `form`. The wavefront
+/// forms trace pt, nee, mis and mis-power on scenes without a medium,
+/// translucent materials or texture maps (their kernels run `step()`, the
+/// plain path tracer's bounce), on the emulator only; anything else is refused.
+pub fn render_form(
+    scene: &crate::host::scene::Scene,
+    camera: &Camera,
+    params: FrameParams,
+    frames: u32,
+    emulated: Option<&dyn Fn(&mut crate::sim::SimConfig)>,
+    form: Form,
+) -> Result<PathRender, Box<dyn std::error::Error>> {
     params.check()?;
+    if form != Form::Megakernel {
+        use crate::host::path::Integrator;
+        if emulated.is_none() {
+            return Err(
+                format!("--form {}: the wavefront forms are launches, so --variant emulated", form.name()).into()
+            );
+        }
+        if matches!(params.integrator, Integrator::Bdpt | Integrator::Mlt) {
+            return Err(format!(
+                "--form {}: the wavefront forms trace pt, nee, mis and mis-power, not {}",
+                form.name(),
+                params.integrator.name()
+            )
+            .into());
+        }
+    }
     if params.integrator == crate::host::path::Integrator::Mlt {
         // the chains' state (40 k W H bytes) within its bound, before anything is built
         crate::host::path::mlt::check(&params)?;
@@ -75,6 +148,15 @@ pub fn render(
     };
     let ps = PathScene::new(scene, &tree)?;
     ps.check_integrator(&scene.name, params.integrator)?;
+    if form != Form::Megakernel && kernel::entry_for(&ps, params.integrator) != kernel::KERNEL {
+        return Err(format!(
+            "--form {}: scene `{}` needs the {} kernel (a medium, translucent materials or texture maps); the wavefront forms run the plain path tracer",
+            form.name(),
+            scene.name,
+            kernel::entry_for(&ps, params.integrator)
+        )
+        .into());
+    }
     let what = format!(
         "{} {} {}x{}",
         if emulated.is_some() { "emulating" } else { "tracing" },
@@ -96,13 +178,39 @@ pub fn render(
             set(&mut cfg);
             let mut dev = Device::with_config(cfg);
             let module = kernel::load_for(&mut dev, kernel::KernelBuild::of(&params))?;
-            let k = kernel::render(&mut dev, &module, &ps, camera, params, frames, false, tick)?;
-            (k.image.image(), Some((k.totals.warp_instructions, k.totals.thread_instructions)))
+            let (image, totals) = match form {
+                Form::Megakernel => {
+                    let k = kernel::render(&mut dev, &module, &ps, camera, params, frames, false, tick)?;
+                    (k.image, k.totals)
+                }
+                Form::Levels(mode) => {
+                    let compact = crate::host::path::wavefront::load_compact(&mut dev)?;
+                    let r = crate::host::path::wavefront::render(
+                        &mut dev, &module, &compact, &ps, camera, params, frames, mode, false, tick,
+                    )?;
+                    (r.image, r.totals)
+                }
+                Form::Split(mode) => {
+                    let compact = crate::host::path::wavefront::load_compact(&mut dev)?;
+                    let r = crate::host::path::regroup::render(
+                        &mut dev, &module, &compact, &ps, camera, params, frames, mode, false,
+                    )?;
+                    tick(frames);
+                    (r.image, r.totals)
+                }
+            };
+            (image.image(), Some((totals.warp_instructions, totals.thread_instructions)))
         }
     };
     if let Some(pb) = pb {
         pb.finish_and_clear();
     }
-    let kernel = kernel::entry_for(&ps, params.integrator);
+    let kernel = match form {
+        Form::Megakernel => kernel::entry_for(&ps, params.integrator),
+        Form::Levels(crate::host::path::wavefront::Mode::Normal) => "path_init and path_level",
+        Form::Levels(_) => "path_init, path_level and the compaction kernels",
+        Form::Split(crate::host::path::regroup::Mode::Normal) => "regroup_init, regroup_trace and regroup_shade",
+        Form::Split(_) => "regroup_init, regroup_trace, regroup_shade and the compaction kernels",
+    };
     Ok(PathRender { image, frames, seconds: t0.elapsed().as_secs_f64(), instructions, kernel })
 }
