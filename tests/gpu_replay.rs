@@ -16,15 +16,7 @@ fn tempdir(name: &str) -> PathBuf {
     d
 }
 
-/// FNV-1a (64-bit), as the fixture names bytes.
-fn fnv1a64(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    format!("{h:016x}")
-}
+use warplight::sim::recording::fnv1a64;
 
 /// A recording's manifest and data.
 fn load(dir: &Path) -> (serde_json::Value, Vec<u8>) {

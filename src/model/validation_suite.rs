@@ -132,14 +132,8 @@ pub fn hash32(mut x: u32) -> u32 {
 
 /// FNV-1a, 64 bits, of little-endian words.
 fn fnv1a64(words: &[u32]) -> String {
-    let mut h: u64 = 0xCBF2_9CE4_8422_2325;
-    for w in words {
-        for b in w.to_le_bytes() {
-            h ^= b as u64;
-            h = h.wrapping_mul(0x100_0000_01B3);
-        }
-    }
-    format!("{h:016x}")
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    crate::sim::recording::fnv1a64(&bytes)
 }
 
 /// The words of a buffer of `n` elements made by `init` (as `validation.py`'s `init_words`).

@@ -10,7 +10,8 @@
 #        and photon map, seed 004's photon map: the bit-for-bit checks.
 # timing: 256 x 256 pixels (262,144 paths, about one wave of an H200), one
 #        frame, Russian roulette against a fixed depth for pt, nee and bdpt;
-#        thesis 003's compaction chart at Fig. 17's 1,048,576 paths; Fig. 3's
+#        thesis 003's compaction chart at Fig. 17's 1,048,576 paths; the
+#        Fresnel regroup's three forms at the same size; Fig. 3's
 #        traversals on its SAH tree at 256 x 256.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -67,6 +68,10 @@ if [ "$which" = timing ] || [ "$which" = all ]; then
   "$W" chart lin-compaction --size 512 --depth 30 --record "$REC/compaction-512" \
     -o "$REC/compaction-512/chart-{}.svg" > "$REC/compaction-512/emulator.txt"
   rm -f "$REC"/compaction-512/chart-*.svg
+  # §6.3's regroup: trace and shade apart, compacted or regrouped by Fresnel branch, 1,048,576 paths
+  for f in split split-compacted regrouped; do
+    record "regroup-$f" $path --resolution 512x512 --spp 4 --scene cornell-glossy --integrator nee --form $f
+  done
   # Fig. 3's three traversals on bunny-ball's SAH tree, 262,144 paths a frame
   for t in stack restart backtrack; do
     record "fig3-$t" $path --resolution 256x256 --spp 4 --scene bunny-ball --integrator nee --traversal $t

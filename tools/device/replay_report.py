@@ -134,6 +134,39 @@ def traversal_table(fx):
               f"{r['local'] / 1e6:.2f} M | {r['occ']:.1f} % |")
 
 
+def regroup_table(fx):
+    forms = {}
+    for f in ("split", "split-compacted", "regrouped"):
+        c = fx["cases"].get(f"regroup-{f}")
+        if not c or "ncu" not in c:
+            return
+        launches = c["devices"][0]["launches"]
+        key = "ms_pass_median" if "ms_pass_median" in launches[0] else "ms_first"
+        shade = [i for i, l in enumerate(launches) if l["kernel"] == "regroup_shade"]
+        forms[f] = {
+            "emu": sum(l["emulated_warp_instructions"] for l in launches),
+            "ms": sum(l[key] for l in launches),
+            "ncu": sum(n["gpu__time_duration.sum"] for n in c["ncu"]) / 1e6,
+            "shade_ncu": sum(c["ncu"][i]["gpu__time_duration.sum"] for i in shade) / 1e6,
+            "shade_sass": sum(c["ncu"][i]["smsp__inst_executed.sum"] for i in shade),
+            "shade_emu": sum(launches[i]["emulated_warp_instructions"] for i in shade),
+            "launches": len(launches),
+        }
+    paths = fx["cases"]["regroup-regrouped"]["devices"][0]["launches"][0]["grid"][0] * 256
+    print(f"`cornell-glossy`, NEE, one frame of {paths:,} paths, 16 bounces; milliseconds: the median of 5 whole replays (events) and ncu's kernel durations.")
+    print()
+    print("| form | launches | emulated warp instructions, frame | H200 ms (events) | H200 ms (kernels, ncu) | shade: emulated warp instructions | shade: SASS warp instructions | shade: ms (ncu) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for f, r in forms.items():
+        print(f"| {f} | {r['launches']} | {r['emu'] / 1e6:.1f} M | {r['ms']:.3f} | {r['ncu']:.3f} | {r['shade_emu'] / 1e6:.1f} M | {r['shade_sass'] / 1e6:.1f} M | {r['shade_ncu']:.3f} |")
+    c, g = forms["split-compacted"], forms["regrouped"]
+    print()
+    print("| regrouped against compacted (speedup) | modelled (warp instructions) | H200 (events) | H200 (kernels) |")
+    print("|---|---|---|---|")
+    print(f"| whole frame | {c['emu'] / g['emu'] - 1:+.1%} | {c['ms'] / g['ms'] - 1:+.1%} | {c['ncu'] / g['ncu'] - 1:+.1%} |")
+    print(f"| shade launches only | {c['shade_emu'] / g['shade_emu'] - 1:+.1%} | - | {c['shade_ncu'] / g['shade_ncu'] - 1:+.1%} |")
+
+
 def main():
     fx = json.load(open(sys.argv[1] if len(sys.argv) > 1 else "tests/fixtures/gpu_replay.json"))
     print("GPU:", "; ".join(fx["env"][2:3]))
@@ -143,6 +176,8 @@ def main():
     timing_table(fx)
     print()
     traversal_table(fx)
+    print()
+    regroup_table(fx)
     for name in fx["cases"]:
         if name.startswith("compaction"):
             print()

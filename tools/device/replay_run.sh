@@ -6,7 +6,7 @@
 #   summary.txt          one line per case (reads equal, launches, times)
 #   results.tar.gz       env.txt, <case>.json (replay.py's result, with
 #                        --time 20 for the time-* and fig3-* cases, --passes 5
-#                        for the compaction cases, --time 3 for the others),
+#                        for the compaction and regroup cases, --time 3 for the others),
 #                        <case>.ncu.csv (ncu's metrics of each launch), logs
 # Then, here: python3 tools/device/replay_fixture.py results.tar.gz REC FILE.
 # Environment: REC (a folder or a .tar.gz), OUT (default /tmp/replay-out).
@@ -37,14 +37,14 @@ for d in "$REC"/*/; do
   # independent launches (frames) are timed by repeating each; a sequence of
   # launches that consume each other's state (the wavefront) by whole passes
   opts="--time 3"
-  case $name in time-*|fig3-*) opts="--time 20" ;; compaction*) opts="--passes 5" ;; esac
+  case $name in time-*|fig3-*) opts="--time 20" ;; compaction*|regroup-*) opts="--passes 5" ;; esac
   timeout 300 python3 tools/device/replay.py "$d" --out "$R/$name.json" $opts > "$R/$name.log" 2>&1
   echo "$name rc=$? $(tail -1 "$R/$name.log")" >> "$S"
   # what is done so far comes back even if a later step runs past the call's limit
   tar -czf "$OUT/results.tar.gz" -C "$R" .
 done
 # ncu: the timing cases, and the small ones of each kernel family
-for d in "$REC"/time-* "$REC"/lambert-nee "$REC"/lambert-bdpt "$REC"/lambert-mlt "$REC"/compaction* "$REC"/fig3*; do
+for d in "$REC"/time-* "$REC"/lambert-nee "$REC"/lambert-bdpt "$REC"/lambert-mlt "$REC"/compaction* "$REC"/fig3* "$REC"/regroup-*; do
   [ -d "$d" ] || continue
   name=$(basename "$d")
   timeout 400 ncu --csv --metrics "$METRICS" --log-file "$R/$name.ncu.csv" \
