@@ -281,4 +281,23 @@ fn the_documented_h200_findings_hold_in_the_fixture() {
     assert!(gpu(2) > 1.0 && gpu(3) < 0.9, "the H200: {} at 2, {} at 3", gpu(2), gpu(3));
     assert!(model(2) < 0.9, "the model overtakes at depth 2: {}", model(2));
     assert!((gpu(30) - 0.605).abs() < 0.005 && (model(30) - 0.423).abs() < 0.005, "{} {}", gpu(30), model(30));
+
+    // §6.3's regroup at 1,048,576 paths: the shade gains, the frame loses
+    let form = |f: &str| {
+        let c = &fx["cases"][&format!("regroup-{f}")];
+        let ncu = c["ncu"].as_array().unwrap();
+        let kernel = |x: &serde_json::Value| x["kernel"].as_str().unwrap() == "regroup_shade";
+        let ms =
+            |v: &[&serde_json::Value]| v.iter().map(|x| x["gpu__time_duration.sum"].as_f64().unwrap()).sum::<f64>();
+        let all: Vec<&serde_json::Value> = ncu.iter().collect();
+        let shade: Vec<&serde_json::Value> = ncu.iter().filter(|x| kernel(x)).collect();
+        let launches = c["devices"][0]["launches"].as_array().unwrap();
+        let emulated: f64 = launches.iter().map(|l| l["emulated_warp_instructions"].as_f64().unwrap()).sum();
+        assert_eq!(ncu.len(), launches.len(), "{f}: ncu profiled every launch");
+        (ms(&all), ms(&shade), emulated)
+    };
+    let (c, g) = (form("split-compacted"), form("regrouped"));
+    assert!((c.1 / g.1 - 1.174).abs() < 0.005, "shade speedup {}", c.1 / g.1);
+    assert!((c.0 / g.0 - 0.728).abs() < 0.005, "frame {}", c.0 / g.0);
+    assert!((c.2 / g.2 - 0.952).abs() < 0.005, "modelled frame {}", c.2 / g.2);
 }
