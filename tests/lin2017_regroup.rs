@@ -186,7 +186,7 @@ fn warplight(args: &[&str]) -> (bool, String, String) {
 fn render_form_launches_every_form_to_the_same_image() {
     let dir = std::env::temp_dir().join(format!("warplight-forms-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let mut images = Vec::new();
+    let (mut images, mut counts) = (Vec::new(), Vec::new());
     for form in ["megakernel", "wavefront", "compacted", "split", "split-compacted", "regrouped"] {
         let out = dir.join(format!("{form}.exr"));
         let (ok, stdout, err) = warplight(&[
@@ -213,8 +213,18 @@ fn render_form_launches_every_form_to_the_same_image() {
         assert!(ok, "{form}: {err}");
         assert_eq!(stdout.contains(&format!("{form} form")), form != "megakernel", "{stdout}");
         images.push(std::fs::read(&out).unwrap());
+        // each form launches its own kernels: its line names them with the frame's warp instructions
+        let line = stdout.lines().find(|l| l.contains("warp instructions")).expect("the count line").to_string();
+        counts.push(line);
     }
     assert!(images.iter().all(|i| *i == images[0]), "every form writes the megakernel's image");
+    assert!(
+        counts[0].contains("path_frame") && counts[1].contains("path_level") && counts[5].contains("regroup_shade")
+    );
+    let mut distinct = counts.clone();
+    distinct.sort();
+    distinct.dedup();
+    assert_eq!(distinct.len(), 6, "six forms, six different launch sequences: {counts:?}");
     // refused: natively, bdpt and mlt, a scene with a medium, an unknown form, another method
     let o = dir.join("x.exr");
     let o = o.to_str().unwrap();

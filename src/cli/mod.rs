@@ -52,7 +52,7 @@ pub struct Cli {
     /// Record what the command does with its emulated devices (allocations,
     /// host writes, launches, host reads with the emulator's bytes) into the
     /// folder DIR, made if missing: recording.json, data.bin and the modules'
-    /// PTX. `tools/device/replay.py DIR` replays it on an NVIDIA GPU, compares
+    /// PTX. `python3 tools/device/replay.py DIR` replays it on an NVIDIA GPU, compares
     /// every read with the emulator's bytes and times each launch
     /// (docs/gpu-replay.md). The recording is held in memory until the command ends.
     #[arg(long, global = true, value_name = "DIR")]

@@ -17,7 +17,7 @@ pub fn check(dir: &Path) -> Result<(), String> {
 /// all or none). An error when the command emulated nothing.
 pub fn write(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let rec = recording::finish().unwrap_or_default();
-    if rec.devices.is_empty() {
+    if rec.launches() == 0 {
         return Err(format!(
             "--record {}: the command ran no emulated kernel, so there is nothing to record (a native variant?)",
             dir.display()
@@ -29,8 +29,9 @@ pub fn write(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let files: Vec<(PathBuf, Vec<u8>)> = rec.files(&what).into_iter().map(|(n, b)| (dir.join(n), b)).collect();
     super::launch::dump::write_all(&files)?;
     let bytes: usize = files.iter().map(|f| f.1.len()).sum();
-    println!(
-        "recorded {} device(s), {} launches, {:.1} MB into {} (replay: tools/device/replay.py {})",
+    // on stderr: stdout stays the command's own (`launch --json | jq`)
+    eprintln!(
+        "recorded {} device(s), {} launches, {:.1} MB into {} (replay: python3 tools/device/replay.py {})",
         rec.devices.len(),
         rec.launches(),
         bytes as f64 / 1e6,
@@ -39,7 +40,7 @@ pub fn write(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     );
     for (i, d) in rec.devices.iter().enumerate() {
         if let Some(why) = d.unreplayable() {
-            println!("note: device {i} cannot be replayed: {why}");
+            eprintln!("note: device {i} cannot be replayed: {why}");
         }
     }
     Ok(())

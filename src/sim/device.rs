@@ -310,9 +310,9 @@ pub struct Module {
     /// What `code` was decoded with.
     opts: FloatOptions,
     globals: Vec<u64>,
-    /// Its place in a recording ([`super::recording`]): the log's address and
-    /// the module's index there, when loaded from PTX text while one ran.
-    recorded: Option<(usize, usize)>,
+    /// Its place in a recording ([`super::recording`]): the log's id and the
+    /// module's index there, when loaded from PTX text while one ran.
+    recorded: Option<(u64, usize)>,
 }
 
 impl Module {
@@ -533,8 +533,9 @@ impl Device {
         let mut m = self.load(prog);
         if let Some(l) = &self.log {
             let name = m.prog.source_name.clone();
-            let index = l.lock().unwrap_or_else(|e| e.into_inner()).module(&name, src, constants_of(&m.prog));
-            m.recorded = Some((std::sync::Arc::as_ptr(l) as usize, index));
+            let mut log = l.lock().unwrap_or_else(|e| e.into_inner());
+            let index = log.module(&name, src, constants_of(&m.prog));
+            m.recorded = Some((log.id(), index));
         }
         m
     }
@@ -680,10 +681,9 @@ impl Device {
         let (k, kp, shared) = self.prepare(m, kernel, &cfg, args)?;
         if let Some(l) = &self.log {
             // a module of this device's log, or of none (loaded from a program, or on another device)
-            let me = std::sync::Arc::as_ptr(l) as usize;
-            let index = m.recorded.filter(|r| r.0 == me).map(|r| r.1);
-            let constants = constants_of(&m.prog);
-            l.lock().unwrap_or_else(|e| e.into_inner()).launch(index, constants, kernel, &cfg, args);
+            let mut log = l.lock().unwrap_or_else(|e| e.into_inner());
+            let index = m.recorded.filter(|r| r.0 == log.id()).map(|r| r.1);
+            log.launch(index, constants_of(&m.prog), kernel, &cfg, args);
         }
         // Below `memory` nobody listens; the listener learns whether to simulate caches.
         let fidelity = self.config.fidelity;

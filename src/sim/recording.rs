@@ -44,7 +44,7 @@ pub struct Blob {
 
 /// A kernel argument as recorded: pointers apart, since the replay moves
 /// them to its own allocations; floats as their bits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RecordedArg {
     /// A device address (8 bytes), inside an allocation or one past its end.
@@ -61,6 +61,9 @@ pub enum RecordedArg {
     F32(u32),
     /// An f64's bits.
     F64(u64),
+    /// A scalar of 1, 2, 4 or 8 bytes given as bytes (a launch spec's
+    /// numbers take the parameter's width), little-endian, passed as is.
+    Bytes(Vec<u8>),
 }
 
 /// One thing the host did with a device.
@@ -132,6 +135,8 @@ struct RecordedModule {
 /// One device's log.
 #[derive(Debug, Default)]
 pub struct DeviceLog {
+    /// Unique among the logs of the process (a module knows its log by it).
+    id: u64,
     modules: Vec<RecordedModule>,
     ops: Vec<Op>,
     data: Vec<u8>,
@@ -143,6 +148,11 @@ impl DeviceLog {
         let b = Blob { offset: self.data.len() as u64, len: bytes.len() as u64 };
         self.data.extend_from_slice(bytes);
         b
+    }
+
+    /// The log's identity, unique in the process.
+    pub fn id(&self) -> u64 {
+        self.id
     }
 
     /// Marks the log as not replayable (the first reason stays).
@@ -198,6 +208,7 @@ impl DeviceLog {
                 Arg::I64(v) => RecordedArg::I64(*v),
                 Arg::F32(v) => RecordedArg::F32(v.to_bits()),
                 Arg::F64(v) => RecordedArg::F64(v.to_bits()),
+                Arg::Bytes(b) if matches!(b.len(), 1 | 2 | 4 | 8) => RecordedArg::Bytes(b.clone()),
                 Arg::Bytes(_) => {
                     self.refuse("a structure passed by value (it may hold device pointers)");
                     return;
@@ -266,9 +277,11 @@ pub fn start() {
 
 /// A new device's log, when a recording runs.
 pub(crate) fn attach() -> Option<SharedLog> {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
     let mut r = RECORDING.lock().ok()?;
     let logs = r.as_mut()?;
-    let log = SharedLog::default();
+    let id = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let log = SharedLog::new(Mutex::new(DeviceLog { id, ..DeviceLog::default() }));
     logs.push(log.clone());
     Some(log)
 }
@@ -285,6 +298,7 @@ pub fn finish() -> Option<Recording> {
             Err(shared) => {
                 let g = shared.lock().unwrap_or_else(|e| e.into_inner());
                 DeviceLog {
+                    id: g.id,
                     modules: g.modules.clone(),
                     ops: g.ops.clone(),
                     data: g.data.clone(),
@@ -416,7 +430,11 @@ mod tests {
         let Op::Launch { ref args, .. } = log.ops()[2] else { unreachable!() };
         assert_eq!(args, &[RecordedArg::F32(1.5f32.to_bits())]);
         assert!(log.unreplayable().is_none());
-        log.launch(Some(m), vec![], "k", &cfg, &[Arg::Bytes(vec![0; 8])]);
+        log.launch(Some(m), vec![], "k", &cfg, &[Arg::Bytes(vec![7, 0, 0, 0])]);
+        let Op::Launch { ref args, .. } = log.ops()[4] else { unreachable!() };
+        assert_eq!(args, &[RecordedArg::Bytes(vec![7, 0, 0, 0])], "a scalar given as bytes");
+        assert!(log.unreplayable().is_none());
+        log.launch(Some(m), vec![], "k", &cfg, &[Arg::Bytes(vec![0; 12])]);
         log.launch(None, vec![], "k", &cfg, &[]);
         assert_eq!(log.unreplayable(), Some("a structure passed by value (it may hold device pointers)"));
     }

@@ -23,9 +23,19 @@ same on the GPU through CuPy (the driver's JIT loads the recorded PTX):
 
   replay.py DIR [--out FILE] [--time N] [--passes K]
 
-FILE (default DIR/replay.json): {"gpu", "cupy", "recordings": [...]}, one
-entry per device with "reads" and "launches". Exits 1 when a read differs or
-a launch fails (the JSON is written first), 2 on a bad recording.
+FILE (default DIR/replay.json): {"what", "gpu", "cupy", "driver",
+"devices": [...]}, one entry per device with "reads" (the first pass's, in
+the recording's order), "launches" and, if anything went wrong, "error" (a
+pointer or read outside every recorded allocation, a fault on the GPU: the
+replay of that device, and of every later one after a GPU fault, stops
+there) and "later_pass_differences". The JSON is always written. Exits 1
+when a read differs or a launch fails, 2 when the recording cannot be read
+or replayed.
+
+Arguments: pointers are moved to the replay's buffers; other scalars
+(including U64 ones and a launch spec's numbers given as bytes) are passed
+as recorded. Addresses stored inside buffers are not moved: a recording of
+a kernel that follows pointers written by the host would need them.
 """
 import argparse
 import json
@@ -52,22 +62,31 @@ class Memory:
     def alloc(self, addr, n):
         self.allocs.append((addr, n, self.cp.zeros(max(n, 1), dtype=self.cp.uint8)))
 
-    def find(self, addr, n, one_past=False):
+    def find(self, addr, n):
         for base, size, arr in self.allocs:
-            end = base + size + (1 if one_past else 0)
-            if base <= addr and addr + n <= end:
+            if base <= addr and addr + n <= base + size:
                 return arr, addr - base
-        raise ValueError(f"{n} bytes at {addr:#x} lie in no recorded allocation")
+        raise BadRecording(f"{n} bytes at {addr:#x} lie in no recorded allocation")
 
     def pointer(self, addr):
-        arr, off = self.find(addr, 0, one_past=True)
+        # a pointer may point one past its allocation's end (n = 0 allows it)
+        arr, off = self.find(addr, 0)
         return arr.data.ptr + off
+
+
+class BadRecording(Exception):
+    """The recording asks for something the replay cannot do."""
+
+
+SCALARS = {1: "<u1", 2: "<u2", 4: "<u4", 8: "<u8"}
 
 
 def argument(np, mem, a):
     (kind, v), = a.items()
     if kind == "ptr":
         return np.uint64(mem.pointer(v))
+    if kind == "bytes":
+        return np.frombuffer(bytes(v), dtype=SCALARS[len(v)])[0]
     return {"u32": np.uint32, "i32": np.int32, "u64": np.uint64, "i64": np.int64,
             "f32": np.uint32, "f64": np.uint64}[kind](v)
 
@@ -81,12 +100,15 @@ def compare(np, want, got):
         g = np.frombuffer(got[:4 * n], dtype="<u4")
         diff = w != g
         r["differing_words"] = int(diff.sum())
+        r["differing_trailing_bytes"] = sum(1 for x, y in zip(want[4 * n:], got[4 * n:]) if x != y)
         if diff.any():
             r["first_differing_word"] = int(np.argmax(diff))
-            wf, gf = w.view("<f4").astype(np.float64), g.view("<f4").astype(np.float64)
-            with np.errstate(invalid="ignore"):
+            with np.errstate(invalid="ignore", over="ignore"):
+                wf, gf = w.view("<f4").astype(np.float64), g.view("<f4").astype(np.float64)
                 d = np.abs(wf - gf)[diff]
-            r["max_abs_difference_f32"] = float(np.nanmax(d)) if np.isfinite(d).any() else None
+            d = d[np.isfinite(d)]
+            # as f32 the words' largest finite difference (JSON has no infinity)
+            r["max_abs_difference_f32"] = float(d.max()) if d.size else None
     return r
 
 
@@ -95,6 +117,29 @@ def replay_device(np, cp, folder, data, dev, timing):
     if dev.get("unreplayable"):
         out["skipped"] = dev["unreplayable"]
         return out
+    try:
+        replay_ops(np, cp, folder, data, dev, timing, out)
+    except BadRecording as e:
+        out["error"] = f"bad recording: {e}"
+    except GpuFault as e:
+        out["error"] = f"a launch faulted: {e}"
+        out["fault"] = True
+    return out
+
+
+def launch(cp, f, op, args):
+    """Runs one recorded launch and returns its milliseconds."""
+    if op["shared"] > 48 * 1024:
+        f.max_dynamic_shared_size_bytes = op["shared"]
+    start, end = cp.cuda.Event(), cp.cuda.Event()
+    start.record()
+    f(tuple(op["grid"]), tuple(op["block"]), args, shared_mem=op["shared"])
+    end.record()
+    end.synchronize()
+    return cp.cuda.get_elapsed_time(start, end)
+
+
+def replay_ops(np, cp, folder, data, dev, timing, out):
     mods = [cp.RawModule(path=os.path.join(folder, m["file"])) for m in dev["modules"]]
     mem = Memory(cp)
     launches = []
@@ -115,39 +160,29 @@ def replay_device(np, cp, folder, data, dev, timing):
             args = tuple(argument(np, mem, a) for a in op["args"])
             launches.append((op, f, args))
             entry = {"kernel": op["kernel"], "grid": op["grid"], "block": op["block"]}
-            start, end = cp.cuda.Event(), cp.cuda.Event()
-            try:
-                start.record()
-                f(tuple(op["grid"]), tuple(op["block"]), args, shared_mem=op["shared"])
-                end.record()
-                end.synchronize()
-                entry["ms_first"] = cp.cuda.get_elapsed_time(start, end)
-            except Exception as e:  # a fault on the GPU ends this device's replay
-                entry["error"] = str(e)
-                out["launches"].append(entry)
-                return out
             out["launches"].append(entry)
+            try:
+                entry["ms_first"] = launch(cp, f, op, args)
+            except Exception as e:  # a fault on the GPU: its context is lost, the replay ends
+                entry["error"] = str(e)
+                raise GpuFault(str(e))
         elif kind == "read":
             o, n = op["data"]["offset"], op["data"]["len"]
             arr, off = mem.find(op["addr"], n)
             got = cp.asnumpy(arr[off:off + n]).tobytes()
             out["reads"].append(compare(np, data[o:o + n].tobytes(), got))
         else:
-            raise ValueError(f"unknown operation {kind}")
+            raise BadRecording(f"unknown operation {kind}")
     for i, (op, f, args) in enumerate(launches):
-        times = []
-        for _ in range(timing):
-            start, end = cp.cuda.Event(), cp.cuda.Event()
-            start.record()
-            f(tuple(op["grid"]), tuple(op["block"]), args, shared_mem=op["shared"])
-            end.record()
-            end.synchronize()
-            times.append(cp.cuda.get_elapsed_time(start, end))
+        times = [launch(cp, f, op, args) for _ in range(timing)]
         if times:
             out["launches"][i]["ms_median"] = statistics.median(times)
             out["launches"][i]["ms_min"] = min(times)
             out["launches"][i]["timed"] = len(times)
-    return out
+
+
+class GpuFault(Exception):
+    """A launch faulted: the CUDA context is unusable from here on."""
 
 
 def main():
@@ -173,28 +208,48 @@ def main():
     props = cp.cuda.runtime.getDeviceProperties(0)
     result = {"what": rec["what"], "gpu": props["name"].decode(), "cupy": cp.__version__,
               "driver": cp.cuda.runtime.driverGetVersion(), "devices": []}
+    faulted = False
     for dev in rec["devices"]:
+        if faulted:
+            result["devices"].append({"error": "not replayed: an earlier launch faulted", "reads": [], "launches": []})
+            continue
         out = replay_device(np, cp, a.dir, data, dev, a.time)
-        if a.passes > 1 and "skipped" not in out:
+        if a.passes > 1 and "skipped" not in out and "error" not in out:
             times = [[l.get("ms_first")] for l in out["launches"]]
-            for _ in range(a.passes - 1):
+            for p in range(1, a.passes):
                 again = replay_device(np, cp, a.dir, data, dev, 0)
-                out["reads"] += [r for r in again["reads"] if not r["equal"]]
+                if "error" in again:
+                    out["error"] = f"pass {p + 1}: {again['error']}"
+                    out["fault"] = again.get("fault", False)
+                    break
+                diffs = [r for r in again["reads"] if not r["equal"]]
+                if diffs:
+                    out.setdefault("later_pass_differences", []).extend(diffs)
                 for t, l in zip(times, again["launches"]):
                     t.append(l.get("ms_first"))
             for l, t in zip(out["launches"], times):
+                done = [x for x in t if x is not None]
                 l["ms_passes"] = t
-                l["ms_pass_median"] = statistics.median(x for x in t if x is not None)
+                if done:
+                    l["ms_pass_median"] = statistics.median(done)
+        faulted = out.pop("fault", False)
         result["devices"].append(out)
     out = a.out or os.path.join(a.dir, "replay.json")
     with open(out, "w") as f:
         json.dump(result, f, indent=1)
-    bad = [r for d in result["devices"] for r in d["reads"] if not r["equal"]]
-    failed = [l for d in result["devices"] for l in d["launches"] if "error" in l]
-    reads = sum(len(d["reads"]) for d in result["devices"])
-    print(f"{a.dir}: {reads - len(bad)}/{reads} reads equal the emulator's, "
-          f"{sum(len(d['launches']) for d in result['devices'])} launches, {len(failed)} failed")
-    return 1 if bad or failed else 0
+    devices = result["devices"]
+    bad = [r for d in devices for r in d["reads"] if not r["equal"]]
+    later = sum(len(d.get("later_pass_differences", [])) for d in devices)
+    failed = [l for d in devices for l in d["launches"] if "error" in l]
+    errors = [d["error"] for d in devices if "error" in d]
+    reads = sum(len(d["reads"]) for d in devices)
+    print(f"{a.dir}: {reads - len(bad)}/{reads} reads equal the emulator's"
+          + (f" ({later} differ in later passes)" if later else "")
+          + f", {sum(len(d['launches']) for d in devices)} launches, {len(failed)} failed"
+          + "".join(f"; {e}" for e in errors))
+    if any(e.startswith("bad recording") for e in errors):
+        return 2
+    return 1 if bad or later or failed or errors else 0
 
 
 if __name__ == "__main__":

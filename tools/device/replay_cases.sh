@@ -8,7 +8,7 @@
 # small: 32 x 32 pixels, 2 frames (8 spp), every kernel and integrator of the
 #        path tracer, thesis 003's compaction chart, thesis 000's ray caster
 #        and photon map, seed 004's photon map: the bit-for-bit checks.
-# timing: 256 x 256 pixels (262,144 paths, about one wave of an H200), one
+# timing: 256 x 256 pixels (262,144 paths, about four waves of an H200), one
 #        frame, Russian roulette against a fixed depth for pt, nee and bdpt;
 #        thesis 003's compaction chart at Fig. 17's 1,048,576 paths; the
 #        Fresnel regroup's three forms at the same size; Fig. 3's

@@ -9,8 +9,10 @@
 #                        for the compaction and regroup cases, --time 3 for the others),
 #                        <case>.ncu.csv (ncu's metrics of each launch), logs
 # Then, here: python3 tools/device/replay_fixture.py results.tar.gz REC FILE.
-# Environment: REC (a folder or a .tar.gz), OUT (default /tmp/replay-out).
+# Environment: REC (a folder or a .tar.gz: `tar -czf recordings.tar.gz -C
+# /tmp/replay-cases .` here), OUT (default /tmp/replay-out).
 set -uo pipefail
+cd "$(dirname "$0")/../.."
 export PATH=/usr/local/cuda/bin:$PATH
 if ! command -v ncu >/dev/null; then
   for d in /usr/local/cuda/nsight-compute* /opt/nvidia/nsight-compute/*; do [ -x "$d/ncu" ] && PATH=$PATH:$d; done

@@ -60,7 +60,7 @@ impl Form {
     pub fn parse(s: &str) -> Result<Form, String> {
         Form::ALL.iter().find(|f| f.0 == s).map(|f| f.1).ok_or_else(|| {
             let names: Vec<&str> = Form::ALL.iter().map(|f| f.0).collect();
-            format!("unknown form `{s}`; expected {}", names.join(", "))
+            format!("--form {s}: unknown form; expected {}", names.join(", "))
         })
     }
 
