@@ -48,7 +48,9 @@ fn read_hashes(manifest: &serde_json::Value, data: &[u8]) -> Vec<Vec<String>> {
 fn a_launch_spec_is_recorded_op_by_op() {
     let dir = tempdir("spec");
     let d = dir.to_str().unwrap();
-    let (ok, out, err) = warplight(&["--record", d, "launch", "examples/reduce.toml", "--dump", "sums=/dev/null"]);
+    let sums = dir.with_extension("bin");
+    let dump = format!("sums={}", sums.display());
+    let (ok, out, err) = warplight(&["--record", d, "launch", "examples/reduce.toml", "--dump", &dump]);
     assert!(ok, "{err}");
     assert!(err.contains("recorded 1 device(s), 1 launches"), "{err}");
     // stdout is the command's own: the counters, and not the recording's line
@@ -83,7 +85,11 @@ fn a_launch_spec_is_recorded_op_by_op() {
     assert!(ptx.contains("reduce_sum"), "module text");
     let last = &dev["ops"][ops.len() - 1]["data"];
     assert_eq!(last["offset"].as_u64().unwrap() + last["len"].as_u64().unwrap(), data.len() as u64);
+    // the last read is the dump's: the recorded bytes are the file's
+    let (off, len) = (last["offset"].as_u64().unwrap() as usize, last["len"].as_u64().unwrap() as usize);
+    assert_eq!(&data[off..off + len], std::fs::read(&sums).unwrap().as_slice());
     std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_file(&sums).unwrap();
 }
 
 #[test]

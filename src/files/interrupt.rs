@@ -95,6 +95,13 @@ impl Temporary {
     /// one a killed run left; it is made new (never opened through an
     /// existing link or FIFO).
     pub fn create(output: &Path) -> std::io::Result<Temporary> {
+        // the rename would replace a device, FIFO or socket (`-o /dev/null` run as root) with a plain file
+        if std::fs::symlink_metadata(output).is_ok_and(|m| !m.file_type().is_file() && !m.file_type().is_symlink()) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file: the output is written beside it and renamed over it, which would replace it",
+            ));
+        }
         let path = temporary_name(output);
         let mut held = pending();
         if let Err(e) = std::fs::remove_file(&path)
@@ -172,6 +179,17 @@ mod tests {
         let d = std::env::temp_dir().join(format!("warplight-interrupt-{tag}-{}", std::process::id()));
         std::fs::create_dir_all(&d).unwrap();
         d
+    }
+
+    #[test]
+    fn a_device_is_never_an_output() {
+        // `-o /dev/null` run as root would otherwise rename a plain file over the device
+        let Err(e) = Temporary::create(Path::new("/dev/null")) else { panic!("a temporary for /dev/null") };
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput);
+        assert!(e.to_string().contains("not a regular file"), "{e}");
+        assert!(crate::files::write_atomically(Path::new("/dev/null"), b"x").is_err());
+        use std::os::unix::fs::FileTypeExt;
+        assert!(std::fs::metadata("/dev/null").unwrap().file_type().is_char_device());
     }
 
     #[test]

@@ -13,6 +13,14 @@ pub fn check_paths<'a>(files: impl IntoIterator<Item = &'a Path>) -> Result<(), 
         if f.file_name().is_none() || f.is_dir() {
             return Err(format!("--dump {}: expected a file name", f.display()));
         }
+        // the dump is written beside the file and renamed over it: that would
+        // replace a device or a pipe (/dev/null) with a plain file
+        if std::fs::symlink_metadata(f).is_ok_and(|m| !m.file_type().is_file()) {
+            return Err(format!(
+                "--dump {}: not a regular file (the dump replaces the file it names; give a path to a file)",
+                f.display()
+            ));
+        }
         let parent = f.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
         if !parent.is_dir() {
             return Err(format!("--dump {}: the folder {} does not exist", f.display(), parent.display()));
@@ -57,6 +65,8 @@ mod tests {
         assert!(check_paths([d.join("x/y.bin").as_path()]).unwrap_err().contains("does not exist"));
         assert!(check_paths([d.join("dir.bin").as_path()]).unwrap_err().contains("expected a file name"));
         assert!(check_paths([a.as_path()]).is_ok());
+        // a device is never replaced by a plain file
+        assert!(check_paths([Path::new("/dev/null")]).unwrap_err().contains("not a regular file"));
         std::fs::remove_dir_all(&d).unwrap();
     }
 }
