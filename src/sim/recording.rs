@@ -294,16 +294,12 @@ pub fn finish() -> Option<Recording> {
         .into_iter()
         .map(|l| match Arc::try_unwrap(l) {
             Ok(m) => m.into_inner().unwrap_or_else(|e| e.into_inner()),
-            // a device still alive keeps its handle: copy what it logged
+            // a device still alive keeps its handle: take what it logged (the
+            // recording is over), leaving it an empty log of the same id
             Err(shared) => {
-                let g = shared.lock().unwrap_or_else(|e| e.into_inner());
-                DeviceLog {
-                    id: g.id,
-                    modules: g.modules.clone(),
-                    ops: g.ops.clone(),
-                    data: g.data.clone(),
-                    unreplayable: g.unreplayable.clone(),
-                }
+                let mut g = shared.lock().unwrap_or_else(|e| e.into_inner());
+                let id = g.id;
+                std::mem::replace(&mut *g, DeviceLog { id, ..DeviceLog::default() })
             }
         })
         .collect();
@@ -437,6 +433,25 @@ mod tests {
         log.launch(Some(m), vec![], "k", &cfg, &[Arg::Bytes(vec![0; 12])]);
         log.launch(None, vec![], "k", &cfg, &[]);
         assert_eq!(log.unreplayable(), Some("a structure passed by value (it may hold device pointers)"));
+    }
+
+    #[test]
+    fn finish_takes_the_log_of_a_device_still_alive() {
+        // (devices that other tests make meanwhile log too; this one is found by its allocation's name)
+        start();
+        let mut dev = crate::sim::Device::new();
+        let p = dev.alloc_bytes(8, "finish-takes-this-log");
+        dev.write(p, &[1u32, 2]).unwrap();
+        let rec = finish().expect("a recording ran");
+        let mine = rec
+            .devices
+            .iter()
+            .find(|d| d.ops().iter().any(|o| matches!(o, Op::Alloc { name, .. } if name == "finish-takes-this-log")))
+            .expect("the live device's log");
+        assert!(matches!(mine.ops()[1], Op::Write { data, .. } if mine.bytes(data) == [1, 0, 0, 0, 2, 0, 0, 0]));
+        // the device goes on after the recording
+        assert_eq!(dev.read::<u32>(p, 2), [1, 2]);
+        assert!(finish().is_none(), "no recording runs any more");
     }
 
     #[test]

@@ -148,12 +148,12 @@ pub fn render_form(
     };
     let ps = PathScene::new(scene, &tree)?;
     ps.check_integrator(&scene.name, params.integrator)?;
-    if form != Form::Megakernel && kernel::entry_for(&ps, params.integrator) != kernel::KERNEL {
+    let entry = kernel::entry_for(&ps, params.integrator);
+    if form != Form::Megakernel && entry != kernel::KERNEL {
         return Err(format!(
-            "--form {}: scene `{}` needs the {} kernel (a medium, translucent materials or texture maps); the wavefront forms run the plain path tracer",
+            "--form {}: scene `{}` needs the {entry} kernel (a medium, translucent materials or texture maps); the wavefront forms run the plain path tracer",
             form.name(),
             scene.name,
-            kernel::entry_for(&ps, params.integrator)
         )
         .into());
     }
@@ -206,7 +206,7 @@ pub fn render_form(
         pb.finish_and_clear();
     }
     let kernel = match form {
-        Form::Megakernel => kernel::entry_for(&ps, params.integrator),
+        Form::Megakernel => entry,
         Form::Levels(crate::host::path::wavefront::Mode::Normal) => "path_init and path_level",
         Form::Levels(_) => "path_init, path_level and the compaction kernels",
         Form::Split(crate::host::path::regroup::Mode::Normal) => "regroup_init, regroup_trace and regroup_shade",
