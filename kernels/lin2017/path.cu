@@ -88,7 +88,7 @@ struct Params {
   int width, height, num_paths, frame, integrator, max_bounces, num_lights, seed, traversal;
   int env_w, env_h;   // the environment map's texels across and down (0: none)
   float mlt_b;        // mlt_frame: the bootstrap's mean luminance b (003:L330)
-  int strata;         // PATH_STRATIFIED's D: a subpixel's D x D strata (the other builds read none)
+  int strata;         // PATH_STRATIFIED's D x D strata of a subpixel: D row by row, -D progressive (the other builds read none)
 };
 
 struct V3 { float x, y, z; };
@@ -600,17 +600,51 @@ static __device__ __forceinline__ Path camera_ray(const Params *p, int i, float 
 }
 
 #if defined(PATH_STRATIFIED)
+// The progressive order of the strata (Params::strata = -D, D a power of two):
+// frame f's stratum of the D x D grid is read from k = f mod D^2 two bits at a
+// time, the lowest pair choosing the quadrant of the subpixel, the next the
+// quadrant of that, and so on; each pair is XORed with two bits hashed from
+// the subpixel's key and the quadrants chosen so far (Owen's nested
+// scrambling). So every 4^j aligned frames put one ray in each cell of a
+// 2^j x 2^j grid, and, the scramble being uniform, each frame's ray is
+// uniform over the subpixel: every frame count is a fair image (successive
+// refinement) and every 4^j frames a stratified one. (sx, sy): the stratum.
+static __device__ __forceinline__ void progressive_stratum(unsigned k, int d, unsigned key, int *sx, int *sy) {
+  unsigned x = 0u, y = 0u, node = 1u;
+  for (int b = 1; b < d; b <<= 1, k >>= 2) {
+    unsigned q = (k & 3u) ^ (mix(key ^ node * 0x85ebca6bu) & 3u);
+    x = x * 2u + (q & 1u);
+    y = y * 2u + (q >> 1);
+    node = node * 4u + q;
+  }
+  *sx = (int)x;
+  *sy = (int)y;
+}
+// The key of subpixel path i's scramble under seed: the same in every frame.
+static __device__ __forceinline__ unsigned scramble_key(unsigned i, unsigned seed) {
+  return mix(i * 0x9e3779b9u ^ mix(seed + 0x68e31da4u));
+}
+
 // The stratified build's camera ray (§4.2's alternative, 003:L223): the
-// subpixel (sub & 1, sub >> 1) is cut into a D x D grid (D = p->strata) and
+// subpixel (sub & 1, sub >> 1) is cut into a D x D grid (D = |p->strata|) and
 // frame f takes stratum s = f mod D^2, row by row from the top left (s % D
-// across, s / D down), the same in every pixel; r0 and r1 place the ray
-// uniformly in it (a box filter). Only every D^2 frames cover the subpixel.
+// across, s / D down), the same in every pixel (strata = D), or in the
+// progressive order above (strata = -D); r0 and r1 place the ray uniformly
+// in it (a box filter). Row by row, only every D^2 frames cover the subpixel.
 static __device__ __forceinline__ Path camera_stratified(const Params *p, int i, float r0, float r1) {
   int pixel = i >> 2, sub = i & 3;
   int x = pixel % p->width, y = pixel / p->width;
-  int d = p->strata, s = p->frame % (d * d);
-  float px = (float)x + ((float)(sub & 1) + ((float)(s % d) + r0) / (float)d) * 0.5f;
-  float py = (float)y + ((float)(sub >> 1) + ((float)(s / d) + r1) / (float)d) * 0.5f;
+  int d = p->strata, sx, sy;
+  if (d < 0) {
+    d = -d;
+    progressive_stratum((unsigned)(p->frame % (d * d)), d, scramble_key((unsigned)i, (unsigned)p->seed), &sx, &sy);
+  } else {
+    int s = p->frame % (d * d);
+    sx = s % d;
+    sy = s / d;
+  }
+  float px = (float)x + ((float)(sub & 1) + ((float)sx + r0) / (float)d) * 0.5f;
+  float py = (float)y + ((float)(sub >> 1) + ((float)sy + r1) / (float)d) * 0.5f;
   return camera_through(p, px, py);
 }
 #endif

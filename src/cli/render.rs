@@ -111,7 +111,9 @@ pub struct RenderArgs {
     /// thesis' tent filter over uniform jitter, §4.2) or stratified:D (frame f
     /// in stratum f mod D² of a D x D grid, a box filter; a third build of the
     /// kernel, kernels/lin2017/path_stratified.cu; whole rounds need --spp a
-    /// multiple of 4·D²).
+    /// multiple of 4·D²) or progressive:D (D a power of two: the same strata in
+    /// a scrambled order, every 4^j frames one ray in each cell of a 2^j x 2^j
+    /// grid and every frame count a fair image).
     #[arg(long, default_value = "tent")]
     pub pixels: String,
     /// Path tracer, emulated: how the frames are launched. megakernel (one launch
@@ -533,7 +535,7 @@ fn run_path(
     if let Some((w, t)) = r.instructions {
         println!("  emulated {}: {w} warp instructions, {t} thread instructions", r.kernel);
     }
-    if frames % pixels.round() != 0 {
+    if !pixels.fair(frames) {
         println!(
             "  note: {} pixels take {} frames a round; {} frames end inside a round, so the last round's strata cover only the top of each subpixel",
             pixels.name(),

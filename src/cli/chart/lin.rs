@@ -96,9 +96,15 @@ pub struct PixelSamplingArgs {
     /// The scene (scenes/ name or path).
     #[arg(long, default_value = "cornell-lambert")]
     pub scene: String,
-    /// Pixel samplings, comma-separated: tent (the thesis') and stratified:D
-    /// (D x D strata of a subpixel; stratified:1 is the box filter unstratified).
-    #[arg(long, default_value = "tent,stratified:1,stratified:2,stratified:4,stratified:8", value_delimiter = ',')]
+    /// Pixel samplings, comma-separated: tent (the thesis'), stratified:D
+    /// (D x D strata of a subpixel, row by row; stratified:1 is the box filter
+    /// unstratified) and progressive:D (D a power of two: the strata in a
+    /// scrambled order whose every 4^j frames stratify a 2^j x 2^j grid).
+    #[arg(
+        long,
+        default_value = "tent,stratified:1,stratified:2,stratified:4,stratified:8,progressive:8",
+        value_delimiter = ','
+    )]
     pub pixels: Vec<String>,
     /// The integrator: pt, nee, mis, mis-power or bdpt.
     #[arg(long, default_value = "nee")]
@@ -336,7 +342,12 @@ fn report_pixel_sampling(data: &PixelSamplingData) {
             .map(|p| format!("{} frames {:.3e}", p.frames, c.error(p)))
             .collect();
         if !partial.is_empty() {
-            println!("  inside a round of {} frames: {}", c.pixels.round(), partial.join(", "));
+            let fair = if c.pixels.fair(1) {
+                " (fair images: the progressive order)"
+            } else {
+                " (biased: the strata seen cover the top of each subpixel)"
+            };
+            println!("  inside a round of {} frames{fair}: {}", c.pixels.round(), partial.join(", "));
         }
     }
     let strata = data.one_per_stratum();
@@ -347,5 +358,12 @@ fn report_pixel_sampling(data: &PixelSamplingData) {
             pts.join(", "),
             data.one_per_stratum_slope().map_or("–".into(), |s| format!("{s:.3}"))
         );
+    }
+    for (pixels, g, e) in data.progressive_levels() {
+        let rowwise = data
+            .curve(PixelSampling::Stratified(g))
+            .and_then(|c| c.at(g * g).map(|p| c.error(p)))
+            .map_or(String::new(), |r| format!(", {:.2} x stratified {g}x{g}'s at as many frames", e / r));
+        println!("{} at {} frames (one ray a cell of {g}x{g}): error {e:.3e}{rowwise}", pixels.label(), g * g);
     }
 }

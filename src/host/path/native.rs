@@ -319,7 +319,7 @@ impl Tracer<'_> {
     /// subpixel of the 2 x 2 grid by the tent filter's uniforms `r0` (across)
     /// and `r1` (down), the kernel's `camera_ray`.
     fn camera_ray(&self, i: u32, r0: f32, r1: f32) -> (V3, V3) {
-        self.camera_through(i, PixelSampling::Tent.offset(i & 3, 0, r0, r1))
+        self.camera_through(i, PixelSampling::Tent.offset(i, 0, 0, r0, r1))
     }
 
     /// Path `i`'s camera ray through its pixel at (`ox`, `oy`) half pixels
@@ -490,7 +490,7 @@ impl Tracer<'_> {
     /// Radiance of path `i` in frame `frame`, adding its traversal events to `c`.
     pub fn path_counted(&self, i: u32, frame: u32, counts: &mut Counts) -> [f32; 3] {
         let key = path_key(i, frame, self.params.seed);
-        let offset = self.params.pixels.offset(i & 3, frame, key.at(0), key.at(1));
+        let offset = self.params.pixels.offset(i, frame, self.params.seed, key.at(0), key.at(1));
         self.radiance(self.camera_through(i, offset), key, counts)
     }
 

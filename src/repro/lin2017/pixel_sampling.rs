@@ -203,12 +203,32 @@ impl PixelSamplingData {
             .iter()
             .filter_map(|c| match c.pixels {
                 PixelSampling::Stratified(d) => c.at(d * d).map(|p| (d, p.spp as f64, c.error(p))),
-                PixelSampling::Tent => None,
+                PixelSampling::Tent | PixelSampling::Progressive(_) => None,
             })
             .filter(|p| p.2 > 0.0)
             .collect();
         v.sort_by_key(|p| p.0);
         v.into_iter().map(|(_, s, e)| (s, e)).collect()
+    }
+
+    /// The progressive curves' points at 4^j frames, j = 0, 1, ... up to
+    /// D² (the frames that stratify a 2^j x 2^j grid): (curve, d = 2^j,
+    /// error), to set beside [`PixelSamplingData::one_per_stratum`]'s
+    /// stratified:d at d² frames.
+    pub fn progressive_levels(&self) -> Vec<(PixelSampling, u32, f64)> {
+        let mut v = Vec::new();
+        for c in &self.curves {
+            if let PixelSampling::Progressive(d) = c.pixels {
+                let mut g = 1;
+                while g <= d {
+                    if let Some(p) = c.at(g * g) {
+                        v.push((c.pixels, g, c.error(p)));
+                    }
+                    g *= 2;
+                }
+            }
+        }
+        v
     }
 
     /// The slope of [`PixelSamplingData::one_per_stratum`] in log-log: −1 if the error is O(1/n).
