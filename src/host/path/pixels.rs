@@ -124,7 +124,7 @@ impl PixelSampling {
     /// row by row.
     pub fn fair(self, frames: u32) -> bool {
         match self {
-            PixelSampling::Stratified(_) => frames % self.round() == 0,
+            PixelSampling::Stratified(_) => frames.is_multiple_of(self.round()),
             PixelSampling::Tent | PixelSampling::Progressive(_) => true,
         }
     }
