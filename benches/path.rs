@@ -80,7 +80,12 @@ fn report() {
         if name == "cornell-lambert" {
             let fixed = FrameParams { termination: Termination::FixedDepth, ..params() };
             let stratified = FrameParams { pixels: PixelSampling::Stratified(4), ..params() };
-            for (what, p) in [("fixed depth / roulette", fixed), ("stratified 4x4 / tent", stratified)] {
+            let progressive = FrameParams { pixels: PixelSampling::Progressive(4), ..params() };
+            for (what, p) in [
+                ("fixed depth / roulette", fixed),
+                ("stratified 4x4 / tent", stratified),
+                ("progressive 4x4 / tent", progressive),
+            ] {
                 let n = best(5, || native_with(&ps, &cam, p));
                 let e = best(2, || emulated_with(&ps, &cam, Fidelity::Functional, p));
                 eprintln!("  {what}: native {:.2} x, emulated (functional) {:.2} x", n / tn, e / tf);

@@ -186,7 +186,13 @@ fn the_h200_reads_what_the_emulator_read_path_integrators() {
 
 #[test]
 fn the_h200_reads_what_the_emulator_read_path_builds_and_traversals() {
-    for name in ["lambert-nee-fixed", "lambert-nee-stratified", "lambert-nee-backtrack", "lambert-nee-stack12"] {
+    for name in [
+        "lambert-nee-fixed",
+        "lambert-nee-stratified",
+        "lambert-nee-progressive",
+        "lambert-nee-backtrack",
+        "lambert-nee-stack12",
+    ] {
         check_case(name);
     }
 }
@@ -223,7 +229,7 @@ fn every_replayed_read_was_equal() {
             }
         }
     }
-    assert_eq!(reads, 155, "the fixture's reads");
+    assert_eq!(reads, 156, "the fixture's reads");
 }
 
 /// The fixture as JSON.

@@ -40,6 +40,7 @@ if [ "$which" = small ] || [ "$which" = all ]; then
   record lambert-nee-fixed $path $s --scene cornell-lambert --integrator nee --termination fixed-depth
   record lambert-bdpt-fixed $path $s --scene cornell-lambert --integrator bdpt --termination fixed-depth
   record lambert-nee-stratified $path $s --scene cornell-lambert --integrator nee --pixels stratified:2
+  record lambert-nee-progressive $path $s --scene cornell-lambert --integrator nee --pixels progressive:2
   for t in stack12 restart backtrack; do
     record "lambert-nee-$t" $path $s --scene cornell-lambert --integrator nee --traversal $t
   done

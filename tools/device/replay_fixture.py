@@ -2,7 +2,11 @@
 """Makes the GPU-replay fixture (docs/gpu-replay.md) from what
 tools/device/replay_run.sh brought back and the recordings it replayed.
 
-  replay_fixture.py RESULTS.tar.gz REC FILE
+  replay_fixture.py [--merge] RESULTS.tar.gz REC FILE
+
+--merge: FILE exists; the cases in RESULTS replace or join its cases and
+the others stay. A merged case whose machine line differs from FILE's keeps
+its own (its "env").
 
 RESULTS.tar.gz: replay_run.sh's results; REC: the folder of recordings
 (tools/device/replay_cases.sh), for each case's command and the emulator's
@@ -41,20 +45,28 @@ def ncu_rows(text):
 
 
 def main():
-    if len(sys.argv) != 4:
+    argv = sys.argv[1:]
+    merge = bool(argv) and argv[0] == "--merge"
+    if merge:
+        argv = argv[1:]
+    if len(argv) != 3:
         print(__doc__, file=sys.stderr)
         return 2
-    results, rec, path = sys.argv[1:]
+    results, rec, path = argv
     files = {}
     with tarfile.open(results) as t:
         for m in t.getmembers():
             if m.isfile():
                 files[os.path.basename(m.name)] = t.extractfile(m).read().decode()
+    env = files.get("env.txt", "").strip().splitlines()
     fixture = {
         "what": "GPU replays of emulated runs (tools/device/replay_cases.sh, replay_run.sh, replay_fixture.py); docs/gpu-replay.md",
-        "env": files.get("env.txt", "").strip().splitlines(),
+        "env": env,
         "cases": {},
     }
+    if merge:
+        with open(path) as f:
+            fixture = json.load(f)
     for name in sorted(n[:-5] for n in files if n.endswith(".json")):
         r = json.loads(files[name + ".json"])
         emulator = open(os.path.join(rec, name, "emulator.txt")).read().strip().splitlines()
@@ -69,6 +81,9 @@ def main():
             else:
                 args.append(w)
         case = {"args": args, "output": output, "emulator": emulator, "devices": []}
+        # the machine line (GPU, driver, clock) of a merged case run elsewhere
+        if merge and env[2:3] != fixture["env"][2:3]:
+            case["env"] = env
         recorded = json.load(open(os.path.join(rec, name, "recording.json")))
         for d, rd in zip(r["devices"], recorded["devices"]):
             dev = {"reads": d["reads"], "launches": []}
