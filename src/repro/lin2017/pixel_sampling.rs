@@ -8,7 +8,8 @@
 //! refine successively, needing D² samples as a unit (003:L223). Each
 //! sampling is rendered natively by its own build's twin (the tent filter:
 //! the thesis' `path.ptx`; strata: `path_stratified.ptx`, frame f in stratum
-//! f mod D²):
+//! f mod D² row by row, or in the progressive order that answers the
+//! successive-refinement objection, [`PixelSampling::Progressive`]):
 //!
 //! - *Its own reference.* The filters converge to different images (the tent
 //!   spans two subpixels, a stratum's box one), so each curve is measured
@@ -19,8 +20,10 @@
 //!   √(rmse² − floor²).
 //! - *Points* at 1, 2, 4, ... frames and the last; a point ends inside a
 //!   round when its frames are not a multiple of D² (then the strata seen so
-//!   far cover only the top of each subpixel: the successive-refinement
-//!   problem the thesis names).
+//!   far cover only the top of each subpixel under the row order: the
+//!   successive-refinement problem the thesis names; the progressive order's
+//!   are fair, and [`PixelSamplingData::progressive_levels`] sets its points
+//!   at 4^j frames beside the row order's one sample a stratum).
 //! - *One sample a stratum*: the point of each D at exactly D² frames, the
 //!   regime of the O(1/n) claim (n = D² samples a subpixel, D growing).
 //! - *Cost*: native seconds a frame (measured), and the warp instructions of
