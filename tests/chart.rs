@@ -3,9 +3,11 @@
 //! table's and the JSON's to within half a pixel; PNGs are valid images of the
 //! size asked for; names other than .svg/.png fail and write nothing.
 
+mod support;
+use support::warplight;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use warplight::repro::compare::Tolerance;
@@ -18,11 +20,6 @@ const BAND: &str = "#999999";
 /// Okabe–Ito, in the order series take them.
 const PALETTE: [&str; 9] =
     ["#0072B2", "#E69F00", "#009E73", "#D55E00", "#56B4E9", "#CC79A7", "#F0E442", "#000000", "#8C564B"];
-
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
-}
 
 fn tempdir() -> PathBuf {
     use std::sync::atomic::{AtomicU64, Ordering};

@@ -1,12 +1,10 @@
 //! The `warplight` binary: launch specs end to end, output formats, and errors
 //! that leave no partial output.
 
-use std::process::Command;
+mod support;
+use support::warplight;
 
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
-}
+use std::process::Command;
 
 #[test]
 fn launch_prints_counters_and_dumps_buffers() {

@@ -3,12 +3,10 @@
 //! tools/device/replay_cases.sh, replay_run.sh and replay_fixture.py;
 //! docs/gpu-replay.md).
 
-use std::path::{Path, PathBuf};
+mod support;
+use support::warplight;
 
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
-}
+use std::path::{Path, PathBuf};
 
 fn tempdir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("warplight-replay-{name}-{}", std::process::id()));

@@ -3,8 +3,10 @@
 //! give a clear error or documented behaviour: never a panic, an abort or an
 //! endless run.
 
+mod support;
+use support::warplight_code;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use warplight::ptx::ir::Kind;
 use warplight::ptx::{PtxErrorKind, parser::MAX_NESTING};
@@ -335,11 +337,6 @@ fn host_threads_are_capped() {
 // ---------------------------------------------------------------------------
 // The binary: launch, step and trace.
 
-fn warplight(args: &[&str]) -> (Option<i32>, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
-    (o.status.code(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
-}
-
 fn tempdir() -> PathBuf {
     use std::sync::atomic::{AtomicU64, Ordering};
     static N: AtomicU64 = AtomicU64::new(0);
@@ -372,14 +369,14 @@ fn launch_step_and_trace_run_kernels_that_fall_off_their_end() {
         let dir = tempdir();
         let s = spec(&dir, &module(body), "k", 40, true, "");
         let html = dir.join("t.html").display().to_string();
-        let (code, _, err) = warplight(&["check", &dir.join("k.ptx").display().to_string()]);
+        let (code, _, err) = warplight_code(&["check", &dir.join("k.ptx").display().to_string()]);
         assert_eq!(code, Some(0), "{name}: check: {err}");
         for args in [
             vec!["launch", s.as_str()],
             vec!["step", s.as_str(), "--log"],
             vec!["trace", s.as_str(), "-o", html.as_str()],
         ] {
-            let (code, out, err) = warplight(&args);
+            let (code, out, err) = warplight_code(&args);
             assert_eq!(code, Some(0), "{name}: {args:?}: {out}{err}");
             assert!(!err.contains("panicked"), "{name}: {args:?}: {err}");
         }
@@ -398,7 +395,7 @@ fn max_instructions_flag_and_spec_key_stop_a_runaway() {
         vec!["step", s.as_str(), "--log", "--max-steps", "10000000", "--max-instructions", "50000"],
         vec!["trace", s.as_str(), "-o", html.as_str(), "--cta", "7", "--max-instructions", "50000"],
     ] {
-        let (code, out, err) = warplight(&args);
+        let (code, out, err) = warplight_code(&args);
         assert_eq!(code, Some(1), "{args:?}: {out}{err}");
         let all = format!("{out}{err}");
         assert!(all.contains("runaway kernel: more than 50000 warp instructions"), "{args:?}: {all}");
@@ -407,18 +404,18 @@ fn max_instructions_flag_and_spec_key_stop_a_runaway() {
     assert!(!Path::new(&html).exists(), "no page for a failed recording");
     // The spec key; the flag wins over it.
     let s = spec(&dir, &module(ALU_SPIN), "k", 32, false, "max_instructions = 40000");
-    let (code, _, err) = warplight(&["launch", &s]);
+    let (code, _, err) = warplight_code(&["launch", &s]);
     assert_eq!(code, Some(1));
     assert!(err.contains("more than 40000 warp instructions"), "{err}");
-    let (code, _, err) = warplight(&["launch", &s, "--max-instructions", "30000"]);
+    let (code, _, err) = warplight_code(&["launch", &s, "--max-instructions", "30000"]);
     assert_eq!(code, Some(1));
     assert!(err.contains("more than 30000 warp instructions"), "{err}");
     // Nonsense values.
-    let (code, _, err) = warplight(&["launch", &s, "--max-instructions", "0"]);
+    let (code, _, err) = warplight_code(&["launch", &s, "--max-instructions", "0"]);
     assert_eq!(code, Some(2), "{err}");
     for bad in ["max_instructions = 0", "max_instructions = -5", "max_instructions = \"lots\"", "max_call_depth = 0"] {
         let s = spec(&dir, &module(ALU_SPIN), "k", 32, false, bad);
-        let (code, _, err) = warplight(&["launch", &s]);
+        let (code, _, err) = warplight_code(&["launch", &s]);
         assert_eq!(code, Some(1), "{bad}: {err}");
         let key = bad.split(' ').next().unwrap();
         assert!(err.contains(&format!("`{key}`: expected an integer from 1 to")), "{bad}: {err}");
@@ -430,7 +427,7 @@ fn max_instructions_flag_and_spec_key_stop_a_runaway() {
 fn max_call_depth_spec_key_bounds_recursion() {
     let dir = tempdir();
     let s = spec(&dir, &recursion(1_000_000), "k", 32, false, "max_call_depth = 16\nargs = [\"buf\", 3]");
-    let (code, _, err) = warplight(&["launch", &s]);
+    let (code, _, err) = warplight_code(&["launch", &s]);
     assert_eq!(code, Some(1), "{err}");
     assert!(err.contains("more than 16 device-function calls") && err.contains("call chain: k → down ×16"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
@@ -440,13 +437,13 @@ fn max_call_depth_spec_key_bounds_recursion() {
 fn too_many_host_threads_are_capped_with_a_warning() {
     let dir = tempdir();
     let s = spec(&dir, &module(FALLS_OFF_THE_END[1].1), "k", 32, true, "");
-    let (code, _, err) = warplight(&["launch", &s, "--threads", "100000"]);
+    let (code, _, err) = warplight_code(&["launch", &s, "--threads", "100000"]);
     assert_eq!(code, Some(0), "{err}");
     assert!(
         err.contains("warning: --threads 100000: using") && err.contains("host threads instead of 100000"),
         "{err}"
     );
-    let (code, _, err) = warplight(&["launch", &s, "--threads", "2"]);
+    let (code, _, err) = warplight_code(&["launch", &s, "--threads", "2"]);
     assert_eq!(code, Some(0));
     assert!(!err.contains("warning"), "{err}");
     std::fs::remove_dir_all(&dir).ok();

@@ -3,8 +3,10 @@
 //! `launch --csv` keeps the occupancy notice of a kernel with more registers
 //! than a thread may have.
 
+mod support;
+use support::warplight_code;
+
 use std::path::PathBuf;
-use std::process::Command;
 
 const HEAD: &str = ".version 7.8\n.target sm_90\n.address_size 64\n";
 
@@ -12,11 +14,6 @@ fn tempdir(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("warplight-hostile-cli-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-fn warplight(args: &[&str]) -> (Option<i32>, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
-    (o.status.code(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
 }
 
 #[test]
@@ -35,7 +32,7 @@ fn check_refuses_constant_barrier_ids_and_counts_naming_the_line() {
             ".visible .entry k()\n{{\n .reg .b32 %r<2>;\n .reg .pred %p<2>;\n setp.eq.u32 %p1, 0, 0;\n {line}\n ret;\n}}\n"
         );
         std::fs::write(&ptx, format!("{HEAD}{body}")).unwrap();
-        let (code, out, err) = warplight(&["check", &ptx.display().to_string()]);
+        let (code, out, err) = warplight_code(&["check", &ptx.display().to_string()]);
         assert_eq!(code, Some(1), "{line}: {out}{err}");
         assert!(err.contains("k.ptx:9:") && err.contains(want), "{line}: {err}");
     }
@@ -44,7 +41,7 @@ fn check_refuses_constant_barrier_ids_and_counts_naming_the_line() {
               bar.sync %r1, %r2;\n bar.sync 15, 1024;\n bar.sync 0, 32;\n ret;\n}\n";
     let ptx = d.join("ok.ptx");
     std::fs::write(&ptx, format!("{HEAD}{ok}")).unwrap();
-    let (code, out, err) = warplight(&["check", &ptx.display().to_string()]);
+    let (code, out, err) = warplight_code(&["check", &ptx.display().to_string()]);
     assert_eq!(code, Some(0), "{out}{err}");
     std::fs::remove_dir_all(&d).unwrap();
 }
@@ -57,7 +54,7 @@ fn the_occupancy_notice_of_a_clamped_register_count_reaches_csv() {
     std::fs::write(d.join("k.ptx"), ptx).unwrap();
     std::fs::write(d.join("k.toml"), "ptx = \"k.ptx\"\nkernel = \"k\"\ngrid = 1\nblock = 32\n").unwrap();
     let spec = d.join("k.toml").display().to_string();
-    let (code, out, err) = warplight(&["launch", &spec, "--csv", "--device", "hopper"]);
+    let (code, out, err) = warplight_code(&["launch", &spec, "--csv", "--device", "hopper"]);
     assert_eq!(code, Some(0), "{out}{err}");
     assert!(out.contains("0,k,occupancy.registers_per_thread,255\n"), "{out}");
     assert!(out.contains("0,k,occupancy.registers_declared,300\n"), "{out}");
@@ -67,11 +64,11 @@ fn the_occupancy_notice_of_a_clamped_register_count_reaches_csv() {
     }
     assert!(err.contains("note: launch 0 (k): ") && err.contains("declares 300 registers per thread"), "{err}");
     // the terminal report says it too; a kernel within the limit has no note
-    let (_, out, _) = warplight(&["launch", &spec, "--device", "hopper"]);
+    let (_, out, _) = warplight_code(&["launch", &spec, "--device", "hopper"]);
     assert!(out.contains("note: ") && out.contains("declares 300 registers per thread"), "{out}");
     let ptx = format!("{HEAD}.visible .entry k()\n{{\n .reg .b32 %r<30>;\n ret;\n}}\n");
     std::fs::write(d.join("k.ptx"), ptx).unwrap();
-    let (code, out, err) = warplight(&["launch", &spec, "--csv", "--device", "hopper"]);
+    let (code, out, err) = warplight_code(&["launch", &spec, "--csv", "--device", "hopper"]);
     assert_eq!(code, Some(0), "{out}{err}");
     assert!(!out.contains("registers_declared") && !err.contains("note:"), "{out}{err}");
     std::fs::remove_dir_all(&d).unwrap();

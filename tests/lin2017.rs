@@ -2,6 +2,9 @@
 //! and the native mirror (`src/host/path/`) trace the same paths bit for bit;
 //! the layout, traversal and estimators behave as derived by hand.
 
+mod support;
+use support::warplight;
+
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
@@ -174,11 +177,6 @@ fn same_frames((scene, ps): (Scene, PathScene), integrators: &[Integrator]) {
         let bad = native.accum.iter().filter(|v| !v.is_finite() || **v < 0.0).count();
         assert_eq!(bad, 0, "{integrator:?}: {bad} values NaN, infinite or negative");
     }
-}
-
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
 }
 
 /// `warplight render --method path --scene cornell-lambert --resolution 8x6` and `extra`.

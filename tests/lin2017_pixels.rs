@@ -73,6 +73,9 @@ fn the_progressive_order_runs_as_its_native_twin() {
         let rows = render_native(&ps, &cam, stratified(params(8, integrator, 5), 4), 3, false, |_| {}).expect("render");
         assert_ne!(rows.accum, t.emulated.image.accum, "{integrator:?}: the two orders made the same image");
     }
+    // past a round (6 frames of progressive:2's 4) and two levels deep (D = 8)
+    let p = FrameParams { pixels: PixelSampling::Progressive(2), ..params(8, Integrator::Nee, 5) };
+    assert!(runs::emulate_twin(&ps, &cam, p, 6).expect("render").same, "6 frames of progressive:2");
     let (_, ps, cam) = scene_of("env-spheres", 4);
     let p = FrameParams { pixels: PixelSampling::Progressive(8), ..params(4, Integrator::Pt, 6) };
     assert!(runs::emulate_twin(&ps, &cam, p, 2).expect("render").same, "env-spheres");

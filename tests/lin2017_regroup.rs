@@ -5,6 +5,9 @@
 //! image bit for bit; the table `lin:s6.3-regroup` records its counts and
 //! verdicts.
 
+mod support;
+use support::warplight;
+
 use warplight::host::camera::Camera;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::PathScene;
@@ -175,12 +178,6 @@ const RECORDED: [[u64; 3]; 3] = [[2982802, 0, 14003], [1597705, 100445, 11142], 
 const VERDICT: Verdict = Verdict::Outside;
 /// Fewer divergent branches in shading: holds; a speedup: does not; the same image: holds.
 const CHECKS: [bool; 3] = [true, false, true];
-
-/// `warplight ARGS`: (success, stdout, stderr).
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
-}
 
 #[test]
 fn render_form_launches_every_form_to_the_same_image() {

@@ -2,14 +2,12 @@
 //! tables with verdicts and scores, shards that merge into exactly what one
 //! run prints, the cluster scripts, and the committed baseline of verdicts.
 
+mod support;
+use support::warplight;
+
 mod common;
 
 use std::process::Command;
-
-fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().unwrap();
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
-}
 
 fn tempdir(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("warplight-repro-{name}-{}", std::process::id()));

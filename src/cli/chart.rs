@@ -25,7 +25,7 @@ Examples:
   warplight chart scatter tests/fixtures/scatter.json -o speed.svg   speed vs accuracy from JSON
   warplight chart lin-convergence --scene cornell-rough -o c-{}.svg  thesis 003: error vs spp and time
   warplight chart lin-compaction -o lanes-{}.svg                     thesis 003: Figs. 16/17 per level
-  warplight chart lin-pixel-sampling -o px-{}.svg                    thesis 003: stratified vs tent pixels
+  warplight chart lin-pixel-sampling -o px-{}.svg                    thesis 003: strata (rows, progressive) vs tent
 
 The format follows the output's extension: .svg or .png.")]
 pub struct ChartArgs {
@@ -102,8 +102,10 @@ Example:
     )]
     LinCompaction(lin::CompactionArgs),
     /// Thesis 003 §4.2: stratified pixels (D x D strata of each subpixel,
-    /// frame f in stratum f mod D²; the kernel's stratified build) against
-    /// the thesis' tent filter, RMS error vs spp and vs time, log-log.
+    /// frame f in stratum f mod D² row by row, or in the progressive order
+    /// whose every 4^j frames stratify a 2^j x 2^j grid; the kernel's
+    /// stratified build) against the thesis' tent filter, RMS error vs spp
+    /// and vs time, log-log.
     ///
     /// Each sampling is measured against its own long native render (other
     /// random numbers, whole rounds of D² frames; its noise, from the spread

@@ -160,9 +160,8 @@ pub fn native_outcome_without(
     (all, rest)
 }
 
+#[path = "../support/mod.rs"]
+mod support;
 /// Runs the `warplight` binary with `args`: (success, stdout, stderr).
-#[allow(dead_code)]
-pub fn warplight(args: &[&str]) -> (bool, String, String) {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_warplight")).args(args).output().expect("run warplight");
-    (o.status.success(), String::from_utf8_lossy(&o.stdout).into(), String::from_utf8_lossy(&o.stderr).into())
-}
+#[allow(unused_imports)]
+pub use support::warplight;

@@ -40,7 +40,8 @@ if [ "$which" = small ] || [ "$which" = all ]; then
   record lambert-nee-fixed $path $s --scene cornell-lambert --integrator nee --termination fixed-depth
   record lambert-bdpt-fixed $path $s --scene cornell-lambert --integrator bdpt --termination fixed-depth
   record lambert-nee-stratified $path $s --scene cornell-lambert --integrator nee --pixels stratified:2
-  record lambert-nee-progressive $path $s --scene cornell-lambert --integrator nee --pixels progressive:2
+  # 20 frames: past a round of 4 x 4 strata, two levels of the scramble
+  record lambert-nee-progressive $path --resolution 32x32 --spp 80 --scene cornell-lambert --integrator nee --pixels progressive:4
   for t in stack12 restart backtrack; do
     record "lambert-nee-$t" $path $s --scene cornell-lambert --integrator nee --traversal $t
   done

@@ -5,8 +5,8 @@ tools/device/replay_run.sh brought back and the recordings it replayed.
   replay_fixture.py [--merge] RESULTS.tar.gz REC FILE
 
 --merge: FILE exists; the cases in RESULTS replace or join its cases and
-the others stay. A merged case whose machine line differs from FILE's keeps
-its own (its "env").
+the others stay. A merged case keeps its own run's environment lines (its
+"env": date, GPU, driver, tools).
 
 RESULTS.tar.gz: replay_run.sh's results; REC: the folder of recordings
 (tools/device/replay_cases.sh), for each case's command and the emulator's
@@ -81,8 +81,8 @@ def main():
             else:
                 args.append(w)
         case = {"args": args, "output": output, "emulator": emulator, "devices": []}
-        # the machine line (GPU, driver, clock) of a merged case run elsewhere
-        if merge and env[2:3] != fixture["env"][2:3]:
+        # a merged case ran in another call: its own date, GPU, driver and tools
+        if merge:
             case["env"] = env
         recorded = json.load(open(os.path.join(rec, name, "recording.json")))
         for d, rd in zip(r["devices"], recorded["devices"]):

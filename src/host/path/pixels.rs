@@ -37,7 +37,7 @@ pub enum PixelSampling {
 /// A pixel sampling the kernel's builds cannot take.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum PixelSamplingError {
-    /// Not `tent` or `stratified:D`.
+    /// Not `tent`, `stratified:D` or `progressive:D`.
     #[error(
         "unknown pixel sampling `{0}`; expected tent, stratified:D or progressive:D (D strata across a subpixel, 1 to {MAX_STRATA})"
     )]
@@ -250,11 +250,19 @@ mod tests {
                 }
             }
         }
-        // a round visits every stratum once
-        let mut all: Vec<(i32, i32)> = (0..64).map(|k| progressive_stratum(k, 8, 99)).collect();
-        all.sort();
-        all.dedup();
-        assert_eq!(all.len(), 64);
+        // frames past a round wrap: frame 64 + f takes frame f's stratum, and a round's frames
+        // take 64 different ones
+        let p = PixelSampling::Progressive(8);
+        let mut round: Vec<(u32, u32)> = (0..64)
+            .map(|f| {
+                assert_eq!(p.offset(9, f + 64, 2, 0.5, 0.5), p.offset(9, f, 2, 0.5, 0.5), "frame {f}");
+                let (x, y) = p.offset(9, f, 2, 0.5, 0.5);
+                ((x * 8.0) as u32, (y * 8.0) as u32)
+            })
+            .collect();
+        round.sort();
+        round.dedup();
+        assert_eq!(round.len(), 64);
         // one stratum: nothing to choose
         assert_eq!(progressive_stratum(0, 1, 5), (0, 0));
     }
@@ -275,9 +283,9 @@ mod tests {
                 assert!((810..=1190).contains(c), "frame {frame}: stratum {s} drew {c} of 64,000");
             }
         }
-        // the offsets: a path whose frame 0 scrambles to the bottom right stratum of progressive:2
-        // puts r = 0.5 at three quarters of its subpixel
-        let i = (0..).find(|&i| progressive_stratum(0, 2, scramble_key(i, 0)) == (1, 1)).unwrap();
-        assert_eq!(PixelSampling::Progressive(2).offset(i, 0, 0, 0.5, 0.5).0 % 1.0, 0.75);
+        // the offsets: a path of subpixel 0 whose frame 0 scrambles to the top right stratum of
+        // progressive:2 puts r = 0.5 at (3/4, 1/4) of its subpixel
+        let i = (0..).step_by(4).find(|&i| progressive_stratum(0, 2, scramble_key(i, 0)) == (1, 0)).unwrap();
+        assert_eq!(PixelSampling::Progressive(2).offset(i, 0, 0, 0.5, 0.5), (0.75, 0.25));
     }
 }
