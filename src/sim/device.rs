@@ -694,9 +694,8 @@ impl Device {
         let ctx = self.ctx(m, &m.code, kp, &cfg, observers);
         let run = GridRun::new(ctx, k, shared, self.config.schedule.clone());
         let st = run.run_with_progress(self.pool.as_ref(), self.progress.as_ref()).map_err(SimError::Fault)?;
-        if fidelity >= Fidelity::Instructions {
-            self.log(|l| l.launched(st.totals.warp_instructions));
-        }
+        // the launch totals are counted at every fidelity
+        self.log(|l| l.launched(st.totals.warp_instructions));
         Ok(st)
     }
 

@@ -110,8 +110,8 @@ pub enum Op {
         shared: u32,
         /// The arguments.
         args: Vec<RecordedArg>,
-        /// The warp instructions the emulator issued for it (when its
-        /// fidelity counts them: `instructions` or above).
+        /// The warp instructions the emulator issued for it (counted at
+        /// every fidelity; None until the launch has run, or when it failed).
         #[serde(skip_serializing_if = "Option::is_none")]
         warp_instructions: Option<u64>,
     },

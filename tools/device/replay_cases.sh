@@ -12,7 +12,8 @@
 #        frame, Russian roulette against a fixed depth for pt, nee and bdpt;
 #        thesis 003's compaction chart at Fig. 17's 1,048,576 paths; the
 #        Fresnel regroup's three forms at the same size; Fig. 3's
-#        traversals on its SAH tree at 256 x 256.
+#        traversals on its SAH tree at 256 x 256; Fig. 9's MLT and bdpt
+#        frames at 256 x 256 on its two scenes (about 9 minutes here).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REC=${REC:-/tmp/replay-cases}
@@ -73,6 +74,15 @@ if [ "$which" = timing ] || [ "$which" = all ]; then
   # §6.3's regroup: trace and shade apart, compacted or regrouped by Fresnel branch, 1,048,576 paths
   for f in split split-compacted regrouped; do
     record "regroup-$f" $path --resolution 512x512 --spp 4 --scene cornell-glossy --integrator nee --form $f
+  done
+  # Fig. 9: an MLT frame against a bdpt frame (003:L332 "only slightly
+  # slower"), 256 x 256, 2 frames, on both of its scenes; functional fidelity
+  # (the same bytes; MLT's bootstrap takes minutes at instructions)
+  fpath="render --method path --variant emulated --device hopper --fidelity functional"
+  for scene in cornell-lambert cornell-inverted; do
+    for i in bdpt mlt; do
+      record "fig9-$i-${scene#cornell-}" $fpath --resolution 256x256 --spp 8 --scene $scene --integrator $i
+    done
   done
   # Fig. 3's three traversals on bunny-ball's SAH tree, 262,144 paths a frame
   for t in stack restart backtrack; do

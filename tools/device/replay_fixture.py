@@ -104,6 +104,8 @@ def main():
             case["levels"] = json.load(open(levels))
         if name + ".ncu.csv" in files:
             case["ncu"] = ncu_rows(files[name + ".ncu.csv"])
+        if name + ".ncu-atomics.csv" in files:
+            case["ncu_atomics"] = ncu_rows(files[name + ".ncu-atomics.csv"])
         fixture["cases"][name] = case
     with open(path, "w") as f:
         json.dump(fixture, f, indent=1)
