@@ -48,7 +48,8 @@ fn the_stratified_build_runs_as_its_native_twin() {
         .expect("wavefront");
     assert!(same(&w.image.accum), "the wavefront form differs from the native twin");
     let (mut dev, m, c) = wavefront::device(&p, Fidelity::Functional).expect("load PTX");
-    let r = regroup::render(&mut dev, &m, &c, &ps, &cam, p, 3, regroup::Mode::Regrouped, false).expect("regroup");
+    let r =
+        regroup::render(&mut dev, &m, &c, &ps, &cam, p, 3, regroup::Mode::Regrouped, false, |_| {}).expect("regroup");
     assert!(same(&r.image.accum), "the regroup differs from the native twin");
     // the other entry points: the march through a medium, the translucent
     // walk, the textures, and the environment map seen directly

@@ -116,7 +116,10 @@ fn regrouped_wavefront_traces_the_megakernels_paths() {
         let mut branches = Vec::new();
         for mode in Mode::ALL {
             let (mut dev, m, c) = wavefront::device(&params, Fidelity::Instructions).expect("device");
-            let r = regroup::render(&mut dev, &m, &c, &ps, &cam, params, 2, mode, true).expect("regroup");
+            let mut heard = Vec::new();
+            let r = regroup::render(&mut dev, &m, &c, &ps, &cam, params, 2, mode, true, |f| heard.push(f))
+                .expect("regroup");
+            assert_eq!(heard, [1, 2], "{mode:?}: progress hears each frame");
             let diff = r.image.accum.iter().zip(&mega.image.accum).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
             assert_eq!(diff, 0, "{integrator:?} {mode:?}: {diff} values differ from the megakernel's");
             assert_eq!(r.image.frame_images, mega.image.frame_images, "{integrator:?} {mode:?}");

@@ -174,7 +174,7 @@ fn a_module_of_another_build_is_refused() {
                 wavefront::render(&mut dev, &other, &compact, &ps, &cam, p, 1, wavefront::Mode::Normal, false, |_| {})
                     .expect_err("refused");
             assert!(e.to_string().contains(asked.name()), "{e}");
-            let e = regroup::render(&mut dev, &other, &compact, &ps, &cam, p, 1, regroup::Mode::Normal, false)
+            let e = regroup::render(&mut dev, &other, &compact, &ps, &cam, p, 1, regroup::Mode::Normal, false, |_| {})
                 .expect_err("refused");
             assert!(e.to_string().contains(asked.name()), "{e}");
         }

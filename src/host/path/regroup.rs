@@ -90,7 +90,7 @@ impl RegroupRender {
 
 /// Renders `frames` frames in the regroup's wavefront form on `dev` (`module`
 /// loaded by `kernel::load`, `compact` by `wavefront::load_compact`; both by
-/// `wavefront::device`).
+/// `wavefront::device`); `progress` hears each frame done.
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     dev: &mut Device,
@@ -102,6 +102,7 @@ pub fn render(
     frames: u32,
     mode: Mode,
     keep_frames: bool,
+    mut progress: impl FnMut(u32),
 ) -> Result<RegroupRender, SimError> {
     super::kernel::check_build(module, &params)?;
     let bufs = upload_scene(dev, scene, camera, &params)?;
@@ -174,6 +175,7 @@ pub fn render(
         if keep_frames {
             r.image.frame_images.push(Progressive::pixels_of(params.width, params.height, &dev.read::<f32>(last, n3)));
         }
+        progress(f + 1);
     }
     r.image.accum = dev.read::<f32>(accum, n3);
     Ok(r)

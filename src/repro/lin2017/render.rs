@@ -193,9 +193,8 @@ pub fn render_form(
                 Form::Split(mode) => {
                     let compact = crate::host::path::wavefront::load_compact(&mut dev)?;
                     let r = crate::host::path::regroup::render(
-                        &mut dev, &module, &compact, &ps, camera, params, frames, mode, false,
+                        &mut dev, &module, &compact, &ps, camera, params, frames, mode, false, tick,
                     )?;
-                    tick(frames);
                     (r.image, r.totals)
                 }
             };

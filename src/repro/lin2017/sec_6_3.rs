@@ -57,7 +57,7 @@ pub fn measure(ws: &mut Workspace, tick: &mut dyn FnMut(Tick)) -> Result<Vec<Sam
     for mode in Mode::ALL {
         tick(Tick { frame: None, variant: mode.name() });
         let (mut dev, m, c) = wavefront::device(&params, Fidelity::Instructions)?;
-        let r = regroup::render(&mut dev, &m, &c, &ps, &camera, params, 1, mode, false)?;
+        let r = regroup::render(&mut dev, &m, &c, &ps, &camera, params, 1, mode, false, |_| {})?;
         let same = match &first {
             None => {
                 first = Some(r.image.accum.clone());
