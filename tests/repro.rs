@@ -64,6 +64,12 @@ fn addresses_and_their_errors() {
     assert!(out.contains("(at most 64x64 pixels: the protocol's 256x256 is capped)"), "{out}");
     let (ok, out, _) = warplight(&["tables", "lin:fig3", "--resolution", "48", "--plan"]);
     assert!(ok && out.contains("lin/traversals:") && !out.contains("capped"), "{out}");
+    // a group with its own side says the protocol's does not apply, unless they agree
+    let (ok, out, err) = warplight(&["tables", "lin:fig8", "--resolution", "256", "--plan"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("(at 32x32 pixels, its Mitsuba reference's: the protocol's 256x256 does not apply)"), "{out}");
+    let (ok, out, _) = warplight(&["tables", "lin:fig8", "--resolution", "32", "--plan"]);
+    assert!(ok && !out.contains("does not apply"), "{out}");
     let (ok, _, err) = warplight(&["tables", "4.5", "--protocol", "slow"]);
     assert!(!ok && err.contains("expected quick or thesis"), "{err}");
 }

@@ -160,13 +160,48 @@ pub struct Group {
     pub seconds_per_side: f64,
     /// Estimated core-seconds per triangle of its own work once per scene (timed builds).
     pub seconds_per_triangle: f64,
-    /// The largest image side it emulates, when it caps the protocol's
-    /// resolution (the plan says so when the protocol asks for more).
-    pub max_side: Option<u32>,
+    /// The image side it runs at: the protocol's, capped, or its own (the
+    /// plan says so where the protocol's is not what runs).
+    pub side: Side,
     /// The kd-trees it runs on (built once per scene for all groups).
     pub trees: &'static [Heuristic],
     /// The measurement.
     pub measure: Measure,
+}
+
+/// The image side a group runs at.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// The protocol's resolution.
+    Protocol,
+    /// The protocol's, at most this many pixels.
+    AtMost(u32),
+    /// Its own, whatever the protocol's: the pixels, and what fixes them.
+    Fixed(u32, &'static str),
+}
+
+impl Side {
+    /// The side it runs at under a protocol of `protocol` pixels.
+    pub fn of(self, protocol: u32) -> u32 {
+        match self {
+            Side::Protocol => protocol,
+            Side::AtMost(m) => protocol.min(m),
+            Side::Fixed(n, _) => n,
+        }
+    }
+
+    /// What the plan says of it under a protocol of `protocol` pixels (empty when it runs the protocol's).
+    pub fn note(self, protocol: u32) -> String {
+        match self {
+            Side::AtMost(m) if protocol > m => {
+                format!(" (at most {m}x{m} pixels: the protocol's {protocol}x{protocol} is capped)")
+            }
+            Side::Fixed(n, why) if n != protocol => {
+                format!(" (at {n}x{n} pixels, {why}: the protocol's {protocol}x{protocol} does not apply)")
+            }
+            _ => String::new(),
+        }
+    }
 }
 
 /// Estimated seconds per triangle to build a tree by `h`, single-threaded

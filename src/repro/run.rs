@@ -102,7 +102,7 @@ impl Plan {
         let frames = self.work(scenes, |g, _, frames| {
             let runs = if g.per_frame { frames as f64 } else { 1.0 } * g.variants as f64;
             // a group that caps the side runs at most its own
-            let side = g.max_side.map_or(self.protocol.resolution, |m| self.protocol.resolution.min(m));
+            let side = g.side.of(self.protocol.resolution);
             runs * side as f64 * g.seconds_per_side
         });
         let own = self.work(scenes, |g, s, _| s.triangles.len() as f64 * g.seconds_per_triangle);
@@ -153,11 +153,7 @@ impl Plan {
             } else {
                 " (not in this shard: the shard starting at frame 0 takes it)".into()
             };
-            let side = self.protocol.resolution;
-            let cap = match g.max_side {
-                Some(m) if side > m => format!(" (at most {m}x{m} pixels: the protocol's {side}x{side} is capped)"),
-                _ => String::new(),
-            };
+            let cap = g.side.note(self.protocol.resolution);
             s.push_str(&format!("  {}: {} on {}{when}{cap}\n", g.name, g.what, run.join(", ")));
         }
         for u in unavailable {

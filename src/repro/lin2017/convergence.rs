@@ -96,6 +96,9 @@ pub enum ConvergenceError {
     Render(#[from] crate::host::path::RenderError),
 }
 
+/// The side of the committed Mitsuba references (`tests/fixtures/mitsuba/SCENE-32*`).
+pub const REFERENCE_SIDE: u32 = 32;
+
 /// A committed Mitsuba reference: its mean image, its variance of the mean, and its sample count.
 #[derive(Debug, Clone)]
 pub struct Reference {
@@ -112,7 +115,7 @@ pub struct Reference {
 impl Reference {
     /// The committed reference of `scene`: `tests/fixtures/mitsuba/SCENE-32` of the checkout.
     pub fn default_prefix(scene: &str) -> PathBuf {
-        let rel = format!("tests/fixtures/mitsuba/{scene}-32");
+        let rel = format!("tests/fixtures/mitsuba/{scene}-{REFERENCE_SIDE}");
         let exr = crate::host::scene_file::data_file(Path::new(&format!("{rel}.exr")));
         PathBuf::from(exr.display().to_string().trim_end_matches(".exr"))
     }

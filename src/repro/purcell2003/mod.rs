@@ -32,7 +32,7 @@ pub mod stencil;
 pub mod table_1;
 pub mod table_2;
 
-use crate::repro::registry::{Group, Status, TableDef, Thesis};
+use crate::repro::registry::{Group, Side, Status, TableDef, Thesis};
 
 /// The seed and its tables.
 pub static THESIS: Thesis = Thesis {
@@ -57,7 +57,7 @@ static GROUPS: [Group; 2] = [
         variants: 2,
         seconds_per_side: PIPELINE_SECONDS_PER_SIDE,
         seconds_per_triangle: 0.0,
-        max_side: None,
+        side: Side::Protocol,
         trees: &[],
         measure: pipeline::measure,
     },
@@ -68,7 +68,7 @@ static GROUPS: [Group; 2] = [
         variants: 2,
         seconds_per_side: PIPELINE_SECONDS_PER_SIDE,
         seconds_per_triangle: 0.0,
-        max_side: None,
+        side: Side::Protocol,
         trees: &[],
         measure: table_2::measure,
     },
