@@ -178,6 +178,9 @@ pub enum Side {
     AtMost(u32),
     /// Its own, whatever the protocol's: the pixels, and what fixes them.
     Fixed(u32, &'static str),
+    /// An image of its own that no square side describes (what it is); its
+    /// estimate takes no side.
+    Own(&'static str),
 }
 
 impl Side {
@@ -187,6 +190,7 @@ impl Side {
             Side::Protocol => protocol,
             Side::AtMost(m) => protocol.min(m),
             Side::Fixed(n, _) => n,
+            Side::Own(_) => 0,
         }
     }
 
@@ -199,6 +203,7 @@ impl Side {
             Side::Fixed(n, why) if n != protocol => {
                 format!(" (at {n}x{n} pixels, {why}: the protocol's {protocol}x{protocol} does not apply)")
             }
+            Side::Own(what) => format!(" ({what}: the protocol's {protocol}x{protocol} does not apply)"),
             _ => String::new(),
         }
     }
@@ -366,6 +371,22 @@ pub fn resolve_in(theses: &[&'static Thesis], addresses: &[String]) -> Result<Ve
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The side a group runs at, and what the plan says of it.
+    #[test]
+    fn sides_run_and_say_what_they_are() {
+        assert_eq!((Side::Protocol.of(96), Side::Protocol.note(96)), (96, String::new()));
+        assert_eq!(Side::AtMost(32).of(96), 32);
+        assert_eq!(Side::AtMost(32).of(16), 16);
+        assert!(Side::AtMost(32).note(96).contains("at most 32x32 pixels: the protocol's 96x96 is capped"));
+        assert_eq!(Side::AtMost(32).note(16), "");
+        let f = Side::Fixed(64, "its truth's");
+        assert_eq!((f.of(96), f.of(512)), (64, 64));
+        assert!(f.note(96).contains("at 64x64 pixels, its truth's: the protocol's 96x96 does not apply"));
+        assert_eq!(f.note(64), "");
+        assert_eq!(Side::Own("an 8x4 image").of(96), 0);
+        assert!(Side::Own("an 8x4 image").note(96).contains("an 8x4 image: the protocol's 96x96 does not apply"));
+    }
 
     #[test]
     fn addresses_resolve() {

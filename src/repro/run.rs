@@ -101,7 +101,7 @@ impl Plan {
     pub fn seconds(&self, scenes: &[Scene], threads: usize) -> f64 {
         let frames = self.work(scenes, |g, _, frames| {
             let runs = if g.per_frame { frames as f64 } else { 1.0 } * g.variants as f64;
-            // a group that caps the side runs at most its own
+            // the side it runs at: the protocol's, capped, or its own
             let side = g.side.of(self.protocol.resolution);
             runs * side as f64 * g.seconds_per_side
         });

@@ -78,7 +78,7 @@ static GROUPS: [Group; 13] = [
         variants: 1,
         seconds_per_side: 0.0,
         seconds_per_triangle: 1e-3,
-        side: Side::Protocol,
+        side: Side::Own("an 8x4 image, 128 paths"),
         trees: &[] as &[Heuristic],
         measure: fig_16::measure_group,
     },

@@ -55,7 +55,7 @@ pub const RUNS: u32 = 8;
 pub const SEED0: u32 = 900;
 
 /// The image side.
-pub const SIDE: u32 = 32;
+pub const SIDE: u32 = crate::repro::lin2017::convergence::REFERENCE_SIDE;
 
 /// How far an MLT image's mean luminance may lie from its b (the fixed-point
 /// splats truncate; the image's pixels are rounded to f32).
