@@ -175,6 +175,33 @@ def regroup_table(fx):
     print(f"| shade launches only | {c['shade_emu'] / g['shade_emu'] - 1:+.1%} | - | {c['shade_ncu'] / g['shade_ncu'] - 1:+.1%} |")
 
 
+def fig9_table(fx):
+    """Fig. 9: the second MLT frame against the second bdpt frame per scene."""
+    rows = []
+    for scene in ("lambert", "inverted"):
+        m, b = fx["cases"].get(f"fig9-mlt-{scene}"), fx["cases"].get(f"fig9-bdpt-{scene}")
+        if not m or not b or "ncu_atomics" not in m:
+            return
+        lm, lb = m["devices"][0]["launches"][3], b["devices"][0]["launches"][1]
+        nm, nb = m["ncu"][3], b["ncu"][1]
+        am, ab = m["ncu_atomics"][3], b["ncu_atomics"][1]
+        em, eb = lm["emulated_warp_instructions"], lb["emulated_warp_instructions"]
+        sm, sb = nm["smsp__inst_executed.sum"], nb["smsp__inst_executed.sum"]
+        tm, tb = lm["ms_pass_median"], lb["ms_median"]
+        occ = "sm__warps_active.avg.pct_of_peak_sustained_active"
+        red, req = "smsp__inst_executed_op_global_red.sum", "lts__t_requests_op_red.sum"
+        rows.append(f"| cornell-{scene} | {em / 1e6:.1f} M / {eb / 1e6:.1f} M = {em / eb:.3f} | "
+                    f"{sm / 1e6:.1f} M / {sb / 1e6:.1f} M = {sm / sb:.3f} | {tm:.3f} / {tb:.3f} | **{tm / tb:.3f}** | "
+                    f"{nm['gpu__time_duration.sum'] / nb['gpu__time_duration.sum']:.3f} | "
+                    f"{nm['launch__registers_per_thread']:.0f} / {nb['launch__registers_per_thread']:.0f} | "
+                    f"{nm[occ]:.1f} % / {nb[occ]:.1f} % | {nm['dram__bytes.sum'] / 1e6:.1f} / {nb['dram__bytes.sum'] / 1e6:.1f} | "
+                    f"{am[red]:,.0f} / {ab[red]:,.0f} | {am[req] / 1e6:.2f} M / {ab[req]:,.0f} |")
+    print("| scene | emulated warp instructions, mlt / bdpt (PTX) | SASS, mlt / bdpt | H200 ms, mlt / bdpt | H200 mlt / bdpt (events) | (ncu's durations) | registers | achieved occupancy | DRAM MB | global reductions (warp) | their L2 requests |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(r)
+
+
 def main():
     fx = json.load(open(sys.argv[1] if len(sys.argv) > 1 else "tests/fixtures/gpu_replay.json"))
     print("GPU:", "; ".join(fx["env"][2:3]))
@@ -186,6 +213,8 @@ def main():
     traversal_table(fx)
     print()
     regroup_table(fx)
+    print()
+    fig9_table(fx)
     for name in fx["cases"]:
         if name.startswith("compaction"):
             print()
