@@ -51,6 +51,20 @@ fn every_material_kind_traces_the_same_bits_emulated_and_native() {
     same_frames((scene, ps), &[Integrator::Pt, Integrator::Nee, Integrator::MisPower]);
 }
 
+/// The anisotropic mirror (§5.1, the thesis' "Ward" lobe, path.cu's Aniso):
+/// its sampling, D_aniso, the projected-roughness G and the light sample at
+/// it trace the same bits emulated and native, under every integrator that
+/// samples it (mlt's chains mutate its two random numbers too).
+#[test]
+fn the_anisotropic_mirror_traces_the_same_bits_emulated_and_native() {
+    use warplight::host::path::layout::KIND_CONDUCTOR;
+    let (scene, ps) = load("cornell-anisotropic");
+    let lobes: Vec<[f32; 2]> =
+        ps.mats.iter().filter(|m| m[3].to_bits() == KIND_CONDUCTOR).map(|m| [m[8], m[10]]).collect();
+    assert_eq!(lobes, [[0.05, 0.4]], "the back wall's alpha_x and alpha_y");
+    same_frames((scene, ps), &[Integrator::Pt, Integrator::Nee, Integrator::MisPower, Integrator::Mlt]);
+}
+
 /// Bidirectional path tracing (`bdpt_frame`): the light subpath, the
 /// connections and the uniform weights trace the same bits emulated and
 /// native, on the Lambertian box and on the glossy one, whose mirror, glass

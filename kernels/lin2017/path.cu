@@ -110,7 +110,7 @@ struct Scene {
   const unsigned *refs;    // the concatenated leaf triangle lists
   const float4 *tris;      // 3 float4 per triangle: the affine rows (§6.4)
   const float4 *tri_data;  // per triangle: unit geometric normal, material index (int bits)
-  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior], [alpha, exact Fresnel (1) or Schlick's (0), 0, 0]
+  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior], [alpha, exact Fresnel (1) or Schlick's (0), an anisotropic mirror's alpha_y (0: isotropic), 0]
   const float4 *lights;    // per emitting triangle: [v0, cdf], [e1, triangle (int bits)], [e2, 0]
   const float4 *boxes;     // per node (kd-backtrack): [box lo, parent (int bits)], [box hi, 0]
   const float4 *env;       // the environment map (§5.4): env_w x env_h texels [r g b 0], row 0 the zenith
@@ -524,6 +524,58 @@ static __device__ __forceinline__ void basis(V3 n, V3 *b1, V3 *b2) {
   *b2 = v3(b, sign + n.y * n.y * a, -n.y);
 }
 
+// The thesis' anisotropic Beckmann lobe of a mirror ("Wald model (Ward, 1992)",
+// §5.1, 003:L346-352): alpha_x along b1, alpha_y along b2 of Duff et al.'s
+// basis around the face's winding normal n, whichever side is hit (the lobe
+// is symmetric about both axes).
+struct Aniso {
+  V3 b1, b2;
+  float ax, ay;
+};
+
+static __device__ __forceinline__ Aniso aniso(V3 n, float ax, float ay) {
+  Aniso a;
+  basis(n, &a.b1, &a.b2);
+  a.ax = ax;
+  a.ay = ay;
+  return a;
+}
+
+// D_aniso (003:L346) of the unit microfacet normal m, cm its cosine with the
+// macro normal: e^(-tan^2 (cos^2 phi / ax^2 + sin^2 phi / ay^2)) / (pi ax ay cos^4).
+static __device__ __forceinline__ float beckmann_aniso(const Aniso &a, V3 m, float cm) {
+  if (!(cm > 0.0f)) return 0.0f;
+  float x = dot3(m, a.b1) / a.ax, y = dot3(m, a.b2) / a.ay;
+  float c2 = cm * cm;
+  return exp_neg(-(x * x + y * y) / c2) / (PI_F * a.ax * a.ay * (c2 * c2));
+}
+
+// The roughness Smith's G1 sees along the unit v: sqrt(cos^2 phi ax^2 + sin^2
+// phi ay^2) of v's azimuth (the slopes' spread in v's plane; 003:L357 prints
+// 1 / (cos^2 phi / ax^2 + sin^2 phi / ay^2) there, D's term: an erratum).
+static __device__ __forceinline__ float alpha_along(const Aniso &a, V3 v) {
+  float x = dot3(v, a.b1), y = dot3(v, a.b2);
+  float r2 = x * x + y * y;
+  if (!(r2 > 0.0f)) return a.ax;   // along the normal: G1 = 1 at any alpha
+  return sqrtf((x * x * (a.ax * a.ax) + y * y * (a.ay * a.ay)) / r2);
+}
+
+// A microfacet normal from D_aniso cos on the side of ns (003:L350-352):
+// phi = arctan(ay / ax tan(2 pi y2)) in 2 pi y2's quadrant (the seed omits
+// the quadrant), taken as the direction of (ax cos 2 pi y2, ay sin 2 pi y2);
+// tan^2 theta = -ln(1 - y1) / (cos^2 phi / ax^2 + sin^2 phi / ay^2); *cm its cosine.
+static __device__ __forceinline__ V3 sample_aniso(const Aniso &a, V3 ns, float y1, float y2, float *cm) {
+  float c, sn;
+  azimuth(y2, &c, &sn);
+  float ex = a.ax * c, ey = a.ay * sn;
+  float r = 1.0f / sqrtf(ex * ex + ey * ey);
+  float cp = ex * r, sp = ey * r;
+  float tan2 = -ln(1.0f - y1) / (cp * cp / (a.ax * a.ax) + sp * sp / (a.ay * a.ay));
+  *cm = 1.0f / sqrtf(1.0f + tan2);
+  float sm = sqrtf(tan2) * *cm;
+  return add3(add3(scale3(a.b1, sm * cp), scale3(a.b2, sm * sp)), scale3(ns, *cm));
+}
+
 // A cosine-weighted direction about the unit n from uniforms y1 (the radius
 // sqrt y1 on the disc) and y2 (the azimuth); *lz its cosine with n.
 static __device__ __forceinline__ V3 cosine_dir(V3 n, float y1, float y2, float *lz) {
@@ -670,6 +722,22 @@ static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 t
     d = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4), &lz);
     P.bsdf_pdf = lz * INV_PI;
     P.count_emission = false;
+  } else if (kind == KIND_CONDUCTOR && s.mats[3 * __float_as_int(td.w) + 2].z > 0.0f) {
+    // the anisotropic mirror: a microfacet normal from D_aniso cos, Cook-Torrance's weight F G (o.m) / (o.n m.n)
+    float4 r = s.mats[3 * __float_as_int(td.w) + 2];
+    Aniso a = aniso(cos_d < 0.0f ? ns : v3(-ns.x, -ns.y, -ns.z), r.x, r.z);
+    float cm;
+    V3 mh = sample_aniso(a, ns, rng(key, dim + 3), rng(key, dim + 4), &cm);
+    float co = -dot3(d, mh);
+    if (!(co > 0.0f)) return false;
+    V3 next = add3(d, scale3(mh, 2.0f * co));
+    float ci = dot3(next, ns);
+    if (!(ci > 0.0f)) return false;
+    P.bsdf_pdf = beckmann_aniso(a, mh, cm) * cm / (4.0f * co);
+    P.count_emission = false;
+    float g = smith_g1(alpha_along(a, d), cos_o, co) * smith_g1(alpha_along(a, next), ci, dot3(next, mh));
+    wgt = scale3(v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co)), g * co / (cos_o * cm));
+    d = next;
   } else if (kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS) {
     // a microfacet normal from Beckmann's D cos: tan^2 = -a2 ln(1 - y), uniform azimuth (§5.1)
     float alpha = s.mats[3 * __float_as_int(td.w) + 2].x;
@@ -1219,12 +1287,20 @@ static __device__ __forceinline__ bool step_at(const Scene &s, Path &P, K key, c
       V3 fc = color;
       float fs = cos_s * INV_PI, bsdf_pdf = cos_s * INV_PI;
       if (kind == KIND_CONDUCTOR) {
-        float alpha = s.mats[3 * __float_as_int(td.w) + 2].x;
+        float4 r = s.mats[3 * __float_as_int(td.w) + 2];
+        float alpha = r.x;
         float a2 = alpha * alpha;
         V3 h = normalize3(sub3(wl, d));
         float ch = dot3(h, ns), coh = -dot3(d, h);
-        float dm = beckmann(a2, ch);
-        float g = smith_g1(alpha, cos_o, coh) * smith_g1(alpha, cos_s, dot3(wl, h));
+        float dm, g;
+        if (r.z > 0.0f) {   // the anisotropic mirror
+          Aniso a = aniso(n, alpha, r.z);
+          dm = beckmann_aniso(a, h, ch);
+          g = smith_g1(alpha_along(a, d), cos_o, coh) * smith_g1(alpha_along(a, wl), cos_s, dot3(wl, h));
+        } else {
+          dm = beckmann(a2, ch);
+          g = smith_g1(alpha, cos_o, coh) * smith_g1(alpha, cos_s, dot3(wl, h));
+        }
         fc = v3(schlick(color.x, coh), schlick(color.y, coh), schlick(color.z, coh));
         fs = dm * g / (4.0f * cos_o);
         bsdf_pdf = dm * ch / (4.0f * coh);

@@ -190,6 +190,11 @@ pub struct Scene {
     /// 003's path tracer makes a rough mirror a Cook-Torrance conductor and a
     /// rough glass a Walter dielectric; the other renderers treat them as smooth.
     pub roughness: Vec<f32>,
+    /// Per material, an anisotropic mirror's second Beckmann α, along the
+    /// tangent frame's second axis (a scene file's `roughness = [ax, ay]`;
+    /// `roughness` then holds α_x; 0, or a material past the end: isotropic).
+    /// Only thesis 003's path tracer reads it.
+    pub roughness_y: Vec<f32>,
     /// An equirectangular environment map (a scene file's `environment`, an
     /// OpenEXR file): radiance from every direction no triangle covers. Only
     /// thesis 003's path tracer reads it.
@@ -339,6 +344,7 @@ impl Scene {
             uvs: kept_uvs,
             normals: kept_normals,
             roughness: Vec::new(),
+            roughness_y: Vec::new(),
             environment: None,
             exact_fresnel: Vec::new(),
             medium: None,
@@ -354,6 +360,12 @@ impl Scene {
     /// Material `m`'s Beckmann roughness α (0: smooth).
     pub fn roughness(&self, m: u32) -> f32 {
         self.roughness.get(m as usize).copied().unwrap_or(0.0)
+    }
+
+    /// Material `m`'s second Beckmann α, along the tangent frame's second
+    /// axis (0: isotropic, α_x = α_y = [`Scene::roughness`]).
+    pub fn roughness_y(&self, m: u32) -> f32 {
+        self.roughness_y.get(m as usize).copied().unwrap_or(0.0)
     }
 
     /// Material `m`'s texture and specular part.

@@ -211,7 +211,7 @@ fn material(
     t: &toml::Table,
     i: usize,
     text: &str,
-) -> Result<(Material, f32, bool, Option<Translucent>, Maps), SceneError> {
+) -> Result<(Material, [f32; 2], bool, Option<Translucent>, Maps), SceneError> {
     let p = format!("material[{i}].");
     let name = match t.get("name").and_then(|v| v.as_str()) {
         Some(n) => n.to_string(),
@@ -234,7 +234,7 @@ fn material(
     if translucent.is_some() && t.contains_key("roughness") {
         return cx.err(&format!("{p}roughness"), "a translucent material's boundary is smooth: no roughness");
     }
-    let roughness = cx.float(t, "roughness", &p, 0.0)?;
+    let (roughness, roughness_y) = roughness_of(cx, t, &p, kind)?;
     let maps = maps(cx, t, &p, kind)?;
     let metal_lobe = maps.metalness.is_some();
     if t.contains_key("roughness") && !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) && !metal_lobe
@@ -256,6 +256,10 @@ fn material(
     }
     // α² underflows in f32 below about 1e-19 and the pdf squared overflows from
     // about 1e-11: NaN pixels under MIS. Mitsuba 3 clamps α to 1e-4.
+    if roughness_y > 0.0 && metal_lobe {
+        return cx
+            .err(&format!("{p}roughness"), "an anisotropic roughness [ax, ay] is a mirror's only, not a metal lobe's");
+    }
     if roughness > 0.0 && roughness < MIN_ROUGHNESS {
         return cx.err(
             &format!("{p}roughness"),
@@ -286,7 +290,37 @@ fn material(
         color: cx.vec3(t, "color", &p, Some([0.8; 3]))?,
         emission: cx.vec3(t, "emission", &p, Some([0.0; 3]))?,
     };
-    Ok((m, roughness, exact, translucent, maps))
+    Ok((m, [roughness, roughness_y], exact, translucent, maps))
+}
+
+/// A material's `roughness`: one Beckmann α (isotropic), or for a mirror
+/// `[ax, ay]`, thesis 003's anisotropic lobe (§5.1, 003:L346-352) with α_x
+/// along the first and α_y along the second axis of the tangent frame
+/// (`docs/reproduction-lin2017.md`, "Anisotropic mirrors"). The second value
+/// is 0 when the lobe is isotropic (a number, or two equal values).
+fn roughness_of(cx: &Cx, t: &toml::Table, p: &str, kind: MaterialKind) -> Result<(f32, f32), SceneError> {
+    let k = format!("{p}roughness");
+    match t.get("roughness") {
+        Some(toml::Value::Array(a)) => {
+            if a.len() != 2 {
+                return cx.err(&k, "expected a Beckmann alpha, or [ax, ay] for an anisotropic mirror");
+            }
+            if kind != MaterialKind::Mirror {
+                return cx.err(&k, "an anisotropic roughness [ax, ay] is a mirror's only; give glass one alpha");
+            }
+            let (ax, ay) = (cx.num(&a[0], &k)?, cx.num(&a[1], &k)?);
+            for v in [ax, ay] {
+                if !(MIN_ROUGHNESS..=1.0).contains(&v) {
+                    return cx.err(
+                        &k,
+                        format!("{v:e}: each alpha of [ax, ay] lies between {MIN_ROUGHNESS:e} and 1 (a smooth mirror has roughness 0)"),
+                    );
+                }
+            }
+            Ok((ax, if ax == ay { 0.0 } else { ay }))
+        }
+        _ => Ok((cx.float(t, "roughness", p, 0.0)?, 0.0)),
+    }
 }
 
 /// The keys only a translucent material has.
@@ -506,13 +540,15 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         .unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     let mut materials: Vec<Material> = Vec::new();
     let mut roughness: Vec<f32> = Vec::new();
+    let mut roughness_y: Vec<f32> = Vec::new();
     let mut exact_fresnel: Vec<bool> = Vec::new();
     let mut translucent: Vec<Option<Translucent>> = Vec::new();
     let mut maps: Vec<Maps> = Vec::new();
     for (i, m) in cx.tables(&t, "material")?.into_iter().enumerate() {
-        let (m, r, exact, sss, mp) = material(&cx, m, i, &text)?;
+        let (m, [r, ry], exact, sss, mp) = material(&cx, m, i, &text)?;
         materials.push(m);
         roughness.push(r);
+        roughness_y.push(ry);
         exact_fresnel.push(exact);
         translucent.push(sss);
         maps.push(mp);
@@ -583,6 +619,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     scene.textures = extra.textures;
     scene.surfaces = extra.surfaces;
     scene.roughness = roughness;
+    scene.roughness_y = roughness_y;
     scene.exact_fresnel = exact_fresnel;
     scene.translucent = translucent;
     if let Some(e) = t.get("environment") {

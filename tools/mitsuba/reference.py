@@ -21,7 +21,14 @@ functions; its F is the colour at every angle, Schlick's only when R0 = 1,
 so a rough mirror whose colour is not white is refused (not comparable).
 Both are made two-sided (warplight's mirrors reflect on both sides).
 Mitsuba samples visible normals, warplight D cos: the same BSDF, other
-pdfs, equal in expectation. Glass with the thesis' Schlick Fresnel (the
+pdfs, equal in expectation. An anisotropic mirror (`roughness = [ax, ay]`,
+thesis 003 §5.1) is `roughconductor` with `alpha_u` = ax and `alpha_v` = ay
+(its G1 takes the projected roughness, as warplight's): warplight lays α_x
+along b1 of Duff et al.'s basis around each triangle's winding normal, and
+Mitsuba along its shading frame's s, which follows dp/du; so the tool gives
+the mirror's triangles texture coordinates (u, v) = (p . b1, p . b2), whose
+dp/du is b1, and checks after loading that s is b1 on every such triangle
+(`check_tangents`). Glass with the thesis' Schlick Fresnel (the
 default) is refused: Mitsuba's dielectrics use the exact Fresnel equations,
 not comparable. A glass whose scene file says `fresnel = "exact"` (warplight:
 the exact equations, path.cu's fresnel_exact()) is Mitsuba's `dielectric`
@@ -212,8 +219,11 @@ def load_scene(toml_path):
         if name in own:
             d = own[name]
             kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.8] * 3), d.get("emission", [0.0] * 3)
-            rough = float(d.get("roughness", 0.0))
+            rough = d.get("roughness", 0.0)
             glass = (float(d.get("ior", 1.5)), d.get("fresnel", "schlick"), d if kind == "translucent" else None)
+            if isinstance(rough, list):   # an anisotropic mirror: glass's slot holds alpha_v
+                rough, glass = float(rough[0]), {"alpha_v": float(rough[1])}
+            rough = float(rough)
             if any(k in d for k in ("albedo_map", "roughness_map", "metalness_map")):
                 kind, glass = "textured", textured(toml_path, name, d)
         else:
@@ -242,6 +252,42 @@ def load_scene(toml_path):
         keep = [t for t in tris if np.linalg.norm(np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0]))) > 0]
         shapes.setdefault(name, (kind, color, em, [], rough, glass))[3].extend(keep)
     return sc, shapes
+
+
+def duff_basis(n):
+    """Duff et al.'s orthonormal basis around the unit n, in f32 as path.cu's basis()."""
+    n = np.asarray(n, dtype=np.float32)
+    sign = np.float32(1) if n[2] >= 0 else np.float32(-1)
+    a = np.float32(-1) / (sign + n[2])
+    b = n[0] * n[1] * a
+    b1 = np.array([1 + sign * n[0] * n[0] * a, sign * b, -sign * n[0]], dtype=np.float32)
+    b2 = np.array([b, sign + n[1] * n[1] * a, -n[1]], dtype=np.float32)
+    return b1, b2
+
+
+def winding_normal(t):
+    n = np.cross(np.subtract(t[1], t[0]), np.subtract(t[2], t[0]))
+    return n / np.linalg.norm(n)
+
+
+def anisotropic(glass):
+    return isinstance(glass, dict) and "alpha_v" in glass
+
+
+def check_tangents(mi, scene, aniso_tris):
+    """Shoots a ray at each anisotropic triangle's centroid along -n and
+    returns the largest |s - b1| of Mitsuba's shading frame; exits above 1e-4."""
+    worst = 0.0
+    for t in aniso_tris:
+        n = winding_normal(t)
+        c = np.mean(np.asarray(t, dtype=float), axis=0)
+        si = scene.ray_intersect(mi.Ray3f(mi.Point3f(*(c + 1e-3 * n)), mi.Vector3f(*(-n))))
+        b1, _ = duff_basis(n)
+        worst = max(worst, float(np.max(np.abs(np.array(si.sh_frame.s, dtype=float) - b1))))
+    print(f"tangent check: {len(aniso_tris)} triangles, largest |s - b1| {worst:.2e}", file=sys.stderr)
+    if worst > 1e-4:
+        sys.exit(f"Mitsuba's tangent differs from warplight's b1 ({worst:.3g}): the anisotropic lobe would turn")
+    return worst
 
 
 def read_png(path):
@@ -457,6 +503,7 @@ def main():
         },
     }
     triangles, light_area, sss = 0, 0.0, False
+    aniso_tris = []
     bitmap_checks = {}
     for k, (name, (kind, color, em, tris, rough, glass)) in enumerate(sorted(shapes.items())):
         if not tris:
@@ -474,6 +521,14 @@ def main():
                         o.write("vt %r %r\n" % (float(q @ pu), float(q @ pv)))
                 for i in range(len(tris)):
                     o.write(f"f {3 * i + 1}/{3 * i + 1} {3 * i + 2}/{3 * i + 2} {3 * i + 3}/{3 * i + 3}\n")
+            elif kind == "mirror" and anisotropic(glass):
+                for t in tris:
+                    b1, b2 = duff_basis(winding_normal(t))
+                    for v in t:
+                        o.write("vt %r %r\n" % (float(np.dot(v, b1)), float(np.dot(v, b2))))
+                for i in range(len(tris)):
+                    o.write(f"f {3 * i + 1}/{3 * i + 1} {3 * i + 2}/{3 * i + 2} {3 * i + 3}/{3 * i + 3}\n")
+                aniso_tris.extend(tris)
             else:
                 for i in range(len(tris)):
                     o.write(f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}\n")
@@ -525,12 +580,13 @@ def main():
                 },
             }
         elif kind == "mirror" and rough > 0:
+            lobe = {"alpha_u": rough, "alpha_v": glass["alpha_v"]} if anisotropic(glass) else {"alpha": rough}
             shape["bsdf"] = {
                 "type": "twosided",
                 "bsdf": {
                     "type": "roughconductor",
                     "distribution": "beckmann",
-                    "alpha": rough,
+                    **lobe,
                     "material": "none",
                     "specular_reflectance": {"type": "rgb", "value": color},
                 },
@@ -562,6 +618,7 @@ def main():
         desc["integrator"] = {"type": "volpath", "max_depth": a.bounces + 1,
                               "rr_depth": a.bounces + 2}
     scene = mi.load_dict(desc)
+    tangent_check = check_tangents(mi, scene, aniso_tris) if aniso_tris else None
     t0 = time.time()
     batches = []
     for b in range(a.batches):
@@ -591,6 +648,7 @@ def main():
         "all_orders": a.all_orders,
         "envmap_check_max_rel_diff": env_check,
         "bitmap_check_max_diff": bitmap_checks or None,
+        "tangent_check_max_diff": tangent_check,
         "seconds": round(time.time() - t0, 1),
         "command": "python3 tools/mitsuba/reference.py " + " ".join(sys.argv[1:]),
         "mean_rgb": [float(v) for v in mean.reshape(-1, 3).mean(axis=0)],

@@ -308,7 +308,9 @@ impl PathScene {
                     ];
                     return v;
                 }
-                [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, exact, 0.0, 0.0]
+                // an anisotropic mirror's alpha_y (0: isotropic), path.cu's Aniso
+                let alpha_y = if kind == KIND_CONDUCTOR { scene.roughness_y(i as u32) } else { 0.0 };
+                [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, exact, alpha_y, 0.0]
             })
             .collect();
         let textures = PathTextures::new(scene, &mut mats);

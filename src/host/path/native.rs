@@ -591,8 +591,12 @@ impl Tracer<'_> {
                         let a2 = alpha * alpha;
                         let h = wl.sub(d).normalize();
                         let (ch, coh) = (h.dot(ns), -d.dot(h));
-                        let dm = beckmann(a2, ch);
-                        let g = smith_g1(alpha, cos_o, coh) * smith_g1(alpha, cos_s, wl.dot(h));
+                        let (dm, g) = if mat[10] > 0.0 {
+                            let a = Aniso::new(n, alpha, mat[10]);
+                            (a.d(h, ch), smith_g1(a.along(d), cos_o, coh) * smith_g1(a.along(wl), cos_s, wl.dot(h)))
+                        } else {
+                            (beckmann(a2, ch), smith_g1(alpha, cos_o, coh) * smith_g1(alpha, cos_s, wl.dot(h)))
+                        };
                         fc = v3(schlick(color.x, coh), schlick(color.y, coh), schlick(color.z, coh));
                         fs = dm * g / (4.0 * cos_o);
                         bsdf_pdf_l = dm * ch / (4.0 * coh);
@@ -849,6 +853,24 @@ impl Tracer<'_> {
             (*d, lz) = cosine_dir(ns, key.at(dim + 3), key.at(dim + 4));
             *bsdf_pdf = lz * INV_PI;
             *count_emission = false;
+        } else if kind == KIND_CONDUCTOR && mat[10] > 0.0 {
+            // the anisotropic mirror: the kernel's branch of the same name
+            let a = Aniso::new(if cos_d < 0.0 { ns } else { v3(-ns.x, -ns.y, -ns.z) }, mat[8], mat[10]);
+            let (mh, cm) = a.sample(ns, key.at(dim + 3), key.at(dim + 4));
+            let co = -d.dot(mh);
+            if !(co > 0.0) {
+                return None;
+            }
+            let next = d.add(mh.scale(2.0 * co));
+            let ci = next.dot(ns);
+            if !(ci > 0.0) {
+                return None;
+            }
+            *bsdf_pdf = a.d(mh, cm) * cm / (4.0 * co);
+            *count_emission = false;
+            let g = smith_g1(a.along(*d), cos_o, co) * smith_g1(a.along(next), ci, next.dot(mh));
+            wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co)).scale(g * co / (cos_o * cm));
+            *d = next;
         } else if kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS {
             let alpha = mat[8];
             let a2 = alpha * alpha;
@@ -1146,6 +1168,59 @@ pub fn beckmann(a2: f32, cm: f32) -> f32 {
     exp_neg(-tan2 / a2) / (std::f32::consts::PI * a2 * (c2 * c2))
 }
 
+/// The thesis' anisotropic Beckmann lobe of a mirror (§5.1, 003:L346-352):
+/// α_x along `b1`, α_y along `b2` of Duff et al.'s basis around the face's
+/// winding normal: the kernel's `Aniso`.
+#[derive(Clone, Copy, Debug)]
+struct Aniso {
+    b1: V3,
+    b2: V3,
+    ax: f32,
+    ay: f32,
+}
+
+impl Aniso {
+    /// The kernel's `aniso`.
+    fn new(n: V3, ax: f32, ay: f32) -> Aniso {
+        let (b1, b2) = basis(n);
+        Aniso { b1, b2, ax, ay }
+    }
+
+    /// D_aniso of the unit microfacet normal `m` of cosine `cm` with the
+    /// macro normal: the kernel's `beckmann_aniso`.
+    fn d(&self, m: V3, cm: f32) -> f32 {
+        if !(cm > 0.0) {
+            return 0.0;
+        }
+        let (x, y) = (m.dot(self.b1) / self.ax, m.dot(self.b2) / self.ay);
+        let c2 = cm * cm;
+        exp_neg(-(x * x + y * y) / c2) / (std::f32::consts::PI * self.ax * self.ay * (c2 * c2))
+    }
+
+    /// The roughness Smith's G1 sees along the unit `v`: the kernel's `alpha_along`.
+    fn along(&self, v: V3) -> f32 {
+        let (x, y) = (v.dot(self.b1), v.dot(self.b2));
+        let r2 = x * x + y * y;
+        if !(r2 > 0.0) {
+            return self.ax;
+        }
+        ((x * x * (self.ax * self.ax) + y * y * (self.ay * self.ay)) / r2).sqrt()
+    }
+
+    /// A microfacet normal from D_aniso cos on the side of `ns`, and its
+    /// cosine: the kernel's `sample_aniso` (the thesis' φ and θ, 003:L350-352).
+    fn sample(&self, ns: V3, y1: f32, y2: f32) -> (V3, f32) {
+        let (c, sn) = azimuth(y2);
+        let (ex, ey) = (self.ax * c, self.ay * sn);
+        let r = 1.0 / (ex * ex + ey * ey).sqrt();
+        let (cp, sp) = (ex * r, ey * r);
+        let tan2 = -ln(1.0 - y1) / (cp * cp / (self.ax * self.ax) + sp * sp / (self.ay * self.ay));
+        let cm = 1.0 / (1.0 + tan2).sqrt();
+        let sm = tan2.sqrt() * cm;
+        (self.b1.scale(sm * cp).add(self.b2.scale(sm * sp)).add(ns.scale(cm)), cm)
+    }
+}
+
 /// Smith's masking by Walter et al. 2007's rational approximation for
 /// Beckmann: the kernel's `smith_g1` (`cv`, `cvm` the direction's cosines
 /// with the macro and the microfacet normal).
@@ -1318,6 +1393,90 @@ mod tests {
                 .sum();
             assert!((integral - 1.0).abs() < 2e-3, "alpha {alpha}: {integral}");
         }
+    }
+
+    /// The anisotropic lobe (003:L346): normalised, ∫ D_aniso(m) cos θ_m dω_m
+    /// = 1 (midpoint rule in θ and φ), and Beckmann's isotropic D when α_x = α_y.
+    #[test]
+    fn the_anisotropic_beckmann_projects_to_one() {
+        let n = v3(0.0, 0.0, 1.0);
+        for (ax, ay) in [(0.05f32, 0.4f32), (0.2, 0.6), (0.5, 0.1), (0.3, 0.3)] {
+            let a = Aniso::new(n, ax, ay);
+            let (nt, np) = (4000, 512);
+            let (ht, hp) = (std::f64::consts::FRAC_PI_2 / nt as f64, 2.0 * std::f64::consts::PI / np as f64);
+            let mut integral = 0.0f64;
+            for i in 0..nt {
+                let th = (i as f64 + 0.5) * ht;
+                for j in 0..np {
+                    let ph = (j as f64 + 0.5) * hp;
+                    let m = v3((th.sin() * ph.cos()) as f32, (th.sin() * ph.sin()) as f32, th.cos() as f32);
+                    integral += a.d(m, m.z) as f64 * th.cos() * th.sin() * ht * hp;
+                }
+            }
+            assert!((integral - 1.0).abs() < 3e-3, "alpha ({ax}, {ay}): {integral}");
+        }
+        let (iso, a) = (Aniso::new(n, 0.3, 0.3), 0.3f32);
+        for c in [0.2f32, 0.5, 0.9, 1.0] {
+            let m = v3((1.0 - c * c).sqrt() * 0.6, (1.0 - c * c).sqrt() * 0.8, c);
+            let (x, y) = (iso.d(m, c), beckmann(a * a, c));
+            assert!((x - y).abs() <= 1e-5 * y.max(1.0), "cos {c}: {x} vs {y}");
+            assert!((iso.along(m) - a).abs() < 1e-6);
+        }
+    }
+
+    /// Smith's G1 of the anisotropic lobe sees α_x along b1, α_y along b2
+    /// (Mitsuba's projected roughness), not the printed 1 / (cos²φ / α_x² +
+    /// sin²φ / α_y²) of 003:L357: at 45°, √((α_x² + α_y²) / 2).
+    #[test]
+    fn the_anisotropic_g1_sees_the_projected_roughness() {
+        let a = Aniso::new(v3(0.0, 0.0, 1.0), 0.1, 0.5);
+        let along = |x: f32, y: f32| a.along(v3(x, y, 0.7));
+        assert!((along(0.3, 0.0) - 0.1).abs() < 1e-7 && (along(0.0, -0.3) - 0.5).abs() < 1e-7);
+        let diag = along(0.3, 0.3);
+        assert!((diag - (0.13f32).sqrt()).abs() < 1e-6, "{diag}");
+        let printed = 1.0 / (0.5 / (0.1f32 * 0.1) + 0.5 / (0.5 * 0.5));
+        assert!((diag - printed).abs() > 0.2, "{diag} vs {printed}");
+        assert_eq!(a.along(v3(0.0, 0.0, 1.0)), 0.1, "along the normal: any alpha (G1 = 1)");
+    }
+
+    /// The kernel's sample is the thesis' formulas (003:L350-352) with the
+    /// quadrant fix-up: φ = arctan(α_y / α_x tan 2πξ1) in 2πξ1's quadrant,
+    /// θ = arctan √(−log ξ2 / (cos²φ / α_x² + sin²φ / α_y²)), ξ2 = 1 − y1;
+    /// and its slopes m_x / m_z, m_y / m_z have Beckmann's variances α_x² / 2
+    /// and α_y² / 2 (the lobe it samples is D_aniso cos).
+    #[test]
+    fn the_anisotropic_sample_is_the_thesis_formula() {
+        let (ax, ay) = (0.08f32, 0.45f32);
+        let a = Aniso::new(v3(0.0, 0.0, 1.0), ax, ay);
+        let n = 400_000u32;
+        let (mut sx, mut sy) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            // a 2-D low-discrepancy set: i / n and the golden ratio's multiples
+            let y1 = (i as f64 + 0.5) / n as f64;
+            let y2 = ((i as f64) * 0.618_033_988_749_894_9).fract();
+            let (m, cm) = a.sample(v3(0.0, 0.0, 1.0), y1 as f32, y2 as f32);
+            assert!((m.z - cm).abs() < 1e-6 && (m.dot(m) - 1.0).abs() < 1e-5, "{m:?}");
+            if i % 97 == 0 {
+                let t = 2.0 * std::f64::consts::PI * y2;
+                let mut ph = ((ay / ax) as f64 * t.tan()).atan();
+                if t.cos() < 0.0 {
+                    ph += std::f64::consts::PI; // the quadrant of 2πξ1
+                }
+                let (cp, sp) = (ph.cos(), ph.sin());
+                let xi2 = 1.0 - y1;
+                let th = (-xi2.ln() / (cp * cp / (ax * ax) as f64 + sp * sp / (ay * ay) as f64)).sqrt().atan();
+                let want = [th.sin() * cp, th.sin() * sp, th.cos()];
+                let got = [m.x as f64, m.y as f64, m.z as f64];
+                for k in 0..3 {
+                    assert!((got[k] - want[k]).abs() < 2e-5, "y ({y1}, {y2}): {got:?} vs {want:?}");
+                }
+            }
+            sx += ((m.x / m.z) as f64).powi(2);
+            sy += ((m.y / m.z) as f64).powi(2);
+        }
+        let (vx, vy) = (sx / n as f64, sy / n as f64);
+        let (wx, wy) = ((ax * ax) as f64 / 2.0, (ay * ay) as f64 / 2.0);
+        assert!((vx / wx - 1.0).abs() < 0.01 && (vy / wy - 1.0).abs() < 0.01, "{vx} vs {wx}, {vy} vs {wy}");
     }
 
     /// Smith's G1 by Walter et al.'s approximation: 1 at normal incidence,
