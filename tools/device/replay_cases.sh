@@ -13,7 +13,8 @@
 #        thesis 003's compaction chart at Fig. 17's 1,048,576 paths; the
 #        Fresnel regroup's three forms at the same size; Fig. 3's
 #        traversals on its SAH tree at 256 x 256; Fig. 9's MLT and bdpt
-#        frames at 256 x 256 on its two scenes (about 9 minutes here).
+#        frames at 256 x 256 on its two scenes, and the MLT frames with
+#        plain (not atomic) splats (about 9 minutes here).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 REC=${REC:-/tmp/replay-cases}
@@ -47,6 +48,9 @@ if [ "$which" = small ] || [ "$which" = all ]; then
     record "lambert-nee-$t" $path $s --scene cornell-lambert --integrator nee --traversal $t
   done
   record rough-mis-power $path $s --scene cornell-rough --integrator mis-power
+  # the anisotropic mirror (§5.1): its sampling, D and G, under MIS and under MLT's mutations
+  record aniso-mis-power $path $s --scene cornell-anisotropic --integrator mis-power
+  record aniso-mlt $path $s --scene cornell-anisotropic --integrator mlt
   record caustic-nee $path $s --scene cornell-caustic --integrator nee
   record inverted-bdpt $path $s --scene cornell-inverted --integrator bdpt
   record fog-nee $path $s --scene fog-box --integrator nee
@@ -84,6 +88,8 @@ if [ "$which" = timing ] || [ "$which" = all ]; then
       record "fig9-$i-${scene#cornell-}" $fpath --resolution 256x256 --spp 8 --scene $scene --integrator $i
     done
   done
+  # and MLT's frames with their splats not atomic (timing only: -store, -rmw)
+  python3 tools/device/mlt_splat_variants.py "$REC"
   # Fig. 3's three traversals on bunny-ball's SAH tree, 262,144 paths a frame
   for t in stack restart backtrack; do
     record "fig3-$t" $path --resolution 256x256 --spp 4 --scene bunny-ball --integrator nee --traversal $t
