@@ -12,6 +12,7 @@ compaction's frame time against the normal wavefront per max depth (Fig. 17
 of thesis 003), modelled by warp instructions and measured on the GPU.
 """
 import json
+import os
 import re
 import sys
 
@@ -202,6 +203,36 @@ def fig9_table(fx):
         print(r)
 
 
+def splats_table(path):
+    """Fig. 9's MLT frames with the splats not atomic (tests/fixtures/gpu_mlt_splats.json):
+    each variant's mlt_frame time over the atomic one's, per frame."""
+    if not os.path.exists(path):
+        return
+    fx = json.load(open(path))
+    print("| scene | frame | atomic ms | plain store / atomic (events; ncu) | load-add-store / atomic (events; ncu) | "
+          "atomic's own spread over 5 passes | mlt / bdpt frame (this run) |")
+    print("|---|---|---|---|---|---|---|")
+    for scene in ("lambert", "inverted"):
+        a = fx["cases"].get(f"fig9-mlt-{scene}")
+        b = fx["cases"].get(f"fig9-bdpt-{scene}")
+        if a is None or b is None:
+            continue
+        la = a["devices"][0]["launches"]
+        tb = b["devices"][0]["launches"][1]["ms_median"]
+        for i, nth in ((2, "1st"), (3, "2nd")):
+            cells = []
+            for v in ("store", "rmw"):
+                c = fx["cases"][f"fig9-mlt-{scene}-{v}"]
+                ev = c["devices"][0]["launches"][i]["ms_pass_median"] / la[i]["ms_pass_median"]
+                nc = c["ncu"][i]["gpu__time_duration.sum"] / a["ncu"][i]["gpu__time_duration.sum"]
+                cells.append(f"{ev:.3f}; {nc:.3f}")
+            p = la[i]["ms_passes"]
+            spread = (max(p) - min(p)) / la[i]["ms_pass_median"]
+            ratio = f"{la[i]['ms_pass_median'] / tb:.3f}" if i == 3 else ""
+            print(f"| cornell-{scene} | {nth} | {la[i]['ms_pass_median']:.3f} | {cells[0]} | {cells[1]} | "
+                  f"{100 * spread:.1f} % | {ratio} |")
+
+
 def main():
     fx = json.load(open(sys.argv[1] if len(sys.argv) > 1 else "tests/fixtures/gpu_replay.json"))
     print("GPU:", "; ".join(fx["env"][2:3]))
@@ -215,6 +246,8 @@ def main():
     regroup_table(fx)
     print()
     fig9_table(fx)
+    print()
+    splats_table("tests/fixtures/gpu_mlt_splats.json")
     for name in fx["cases"]:
         if name.startswith("compaction"):
             print()
