@@ -144,6 +144,47 @@ fn in_a_closed_box_of_mirrors_every_fixed_depth_path_traces_max_bounces_plus_one
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// Russian roulette's tests as the emulator counts them (`@count` on
+/// `roulette()`'s two tests; `counts::Roulettes`), against hand-derived
+/// truths: in a closed box of perfect mirrors every path tests 9 times at 9
+/// bounces, always with q = 1 (none below one); with half-silvered walls every
+/// test has q = 0.5, and each survivor traces one more ray, so the tests lie
+/// between the bounce rays and all rays; the fixed-depth build has none; the
+/// Lambertian box (albedos below 1) has no q of 1 or more, the rough-mirror
+/// box has (003:L269's "always less than or equal to 1" fails there).
+#[test]
+fn the_emulator_counts_roulettes_tests_and_the_masks_of_one_or_more() {
+    use warplight::host::path::counts::Roulettes;
+    let dir = std::env::temp_dir().join(format!("warplight-roulettes-{}", std::process::id()));
+    let max_bounces = 9;
+    let emulate = |ps: &PathScene, cam: &Camera, p: FrameParams| {
+        let (mut dev, module) = kernel::device(&p, Fidelity::Instructions).expect("load PTX");
+        let k = kernel::render(&mut dev, &module, ps, cam, p, 1, false, |_| {}).expect("launch");
+        (k.roulettes.expect("counted"), k.counts.expect("counted").rays)
+    };
+    let p = FrameParams { max_bounces, ..params(4, Integrator::Pt, 2) };
+    let paths = p.paths() as u64;
+    let (ps, cam) = mirror_cube(&dir.join("perfect"), 1.0);
+    let (q, _) = emulate(&ps, &cam, p);
+    assert_eq!(q, Roulettes { tests: paths * max_bounces as u64, below_one: 0 }, "perfect mirrors");
+    let (q, _) = emulate(&ps, &cam, fixed(p));
+    assert_eq!(q.tests, 0, "the fixed-depth build has no roulette");
+    let (ps, cam) = mirror_cube(&dir.join("half"), 0.5);
+    let (q, rays) = emulate(&ps, &cam, p);
+    assert_eq!(q.at_or_above_one(), 0, "q = 0.5");
+    assert!(rays - paths <= q.tests && q.tests <= rays && q.tests > 0, "{q:?}, {rays} rays of {paths} paths");
+    std::fs::remove_dir_all(&dir).ok();
+    for (scene, above) in [("cornell-lambert", false), ("cornell-rough", true)] {
+        let (_, ps, cam) = scene_of(scene, 16);
+        let (q, _) = emulate(&ps, &cam, params(16, Integrator::Nee, 3));
+        eprintln!("{scene}: {q:?}");
+        assert!(q.tests > 1000 && (q.at_or_above_one() > q.tests / 50) == above, "{scene}: {q:?}");
+        if !above {
+            assert_eq!(q.at_or_above_one(), 0, "{scene}: every albedo is below 1");
+        }
+    }
+}
+
 /// Every build of the kernel refuses frames that need another (the thesis',
 /// the fixed depth, stratified pixels), in each entry point that takes the
 /// module as given: the megakernel, the wavefront form and the regroup.
@@ -217,6 +258,26 @@ fn render_takes_a_termination_and_names_a_wrong_one() {
     let (ok, _, stderr) = warplight(&["render", "--scene", "cornell-lambert", "--termination", "fixed-depth", "-o", o]);
     assert!(!ok && stderr.contains("--termination applies to --method path only"), "{stderr}");
     assert!(!out.exists());
+}
+
+/// `render --variant emulated` prints the roulette's tests when the fidelity
+/// counts instructions (the default), and not at `functional`.
+#[test]
+fn render_prints_the_roulettes_tests() {
+    let out = std::env::temp_dir().join(format!("warplight-roulette-line-{}.exr", std::process::id()));
+    let o = out.to_str().expect("utf-8 path");
+    let base = ["render", "--method", "path", "--variant", "emulated", "--scene", "cornell-rough"];
+    let mut args = base.to_vec();
+    args.extend(["--resolution", "8x8", "--spp", "4", "-o", o]);
+    let (ok, stdout, stderr) = warplight(&args);
+    assert!(ok, "{stderr}");
+    let line = stdout.lines().find(|l| l.contains("Russian roulette: ")).unwrap_or_else(|| panic!("{stdout}"));
+    assert!(line.contains(" tests, ") && line.contains("1 or more") && line.contains("003:L269"), "{line}");
+    args.extend(["--fidelity", "functional"]);
+    let (ok, stdout, stderr) = warplight(&args);
+    assert!(ok, "{stderr}");
+    assert!(!stdout.contains("Russian roulette"), "{stdout}");
+    std::fs::remove_file(&out).ok();
 }
 
 /// At a fixed depth every path runs to the longest path, so the emulator's

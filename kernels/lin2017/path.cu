@@ -838,14 +838,17 @@ static __device__ __forceinline__ V3 light_point(const Scene &s, K key, unsigned
 // with q = its max RGB, then divide by q; false when the path ends.
 // Compiled with PATH_FIXED_DEPTH (path_fixed_depth.cu) there is no roulette:
 // every path goes on to max bounces, the alternative 003:L269 compares with.
+// The thesis takes the mask to be at most 1 (003:L267-269); where it is not
+// (q >= 1: the rough BSDFs' sampled weights), the path goes on undivided. The
+// emulator counts both tests (`@count`; host/path/counts.rs, Roulettes).
 template <class K>
 static __device__ __forceinline__ bool roulette(V3 &beta, V3 wgt, K key, unsigned dim) {
 #ifdef PATH_FIXED_DEPTH
   beta = mul3(beta, wgt);
 #else
   float q = fmaxf(fmaxf(wgt.x, wgt.y), wgt.z);
-  if (q < 1.0f) {
-    if (!(rng(key, dim + 5) < q)) return false;
+  if (q < 1.0f) {   // @count roulettes setp.geu.f32
+    if (!(rng(key, dim + 5) < q)) return false;   // @count roulettes_below_one setp.geu.f32
     beta = v3(beta.x * (wgt.x / q), beta.y * (wgt.y / q), beta.z * (wgt.z / q));
   } else {
     beta = mul3(beta, wgt);

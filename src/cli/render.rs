@@ -535,6 +535,14 @@ fn run_path(
     if let Some((w, t)) = r.instructions {
         println!("  emulated {}: {w} warp instructions, {t} thread instructions", r.kernel);
     }
+    if let Some(q) = r.roulettes.filter(|q| q.tests > 0) {
+        println!(
+            "  Russian roulette: {} tests, {} ({:.2} %) with q, the mask's largest channel, 1 or more: kept undivided (003:L269 takes the mask to be at most 1; exactly 1 at white smooth mirrors and glass, above 1 at rough ones' grazing samples)",
+            q.tests,
+            q.at_or_above_one(),
+            100.0 * q.at_or_above_one() as f64 / q.tests as f64
+        );
+    }
     if !pixels.fair(frames) {
         println!(
             "  note: {} pixels take {} frames a round; {} frames end inside a round, so the last round's strata cover only the top of each subpixel",

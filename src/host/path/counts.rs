@@ -67,6 +67,38 @@ impl Counts {
     }
 }
 
+/// Russian roulette's tests (003:L267-271), read off `roulette()`'s two
+/// tagged lines: every test, and those whose mask's largest channel q was
+/// below 1 (then the path ends with probability 1 − q, or goes on divided by
+/// q). The rest had q ≥ 1: the mask the thesis takes to be "always less than
+/// or equal to 1" (003:L269) was not, and the path went on undivided.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Roulettes {
+    /// Roulette tests (one per sampled bounce of a path or a light subpath).
+    pub tests: u64,
+    /// Of them, tests whose mask's largest channel was below 1.
+    pub below_one: u64,
+}
+
+impl Roulettes {
+    /// From the tag names' totals.
+    pub fn from_tags(c: &BTreeMap<String, u64>) -> Roulettes {
+        let get = |n: &str| c.get(n).copied().unwrap_or(0);
+        Roulettes { tests: get("roulettes"), below_one: get("roulettes_below_one") }
+    }
+
+    /// Adds `o` into `self`.
+    pub fn add(&mut self, o: &Roulettes) {
+        self.tests += o.tests;
+        self.below_one += o.below_one;
+    }
+
+    /// Tests whose mask had a channel of 1 or more (003:L269's claim broken).
+    pub fn at_or_above_one(&self) -> u64 {
+        self.tests - self.below_one
+    }
+}
+
 /// The `@count` tags of `kernels/lin2017/path.cu`.
 pub fn tags() -> Vec<CountTag> {
     count_tags(SOURCE)

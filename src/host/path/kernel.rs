@@ -9,7 +9,7 @@
 //! [`super::PixelSampling`]); every render refuses a module of another build
 //! than its frames need.
 
-use super::counts::{self, Counts};
+use super::counts::{self, Counts, Roulettes};
 use super::layout::PathScene;
 use super::{FrameParams, Progressive, eps_for, frame_of};
 use crate::host::camera::Camera;
@@ -277,6 +277,8 @@ pub struct KernelRender {
     /// The traversal events read off the `@count` lines, when the fidelity
     /// counts instructions (`instructions` or above).
     pub counts: Option<Counts>,
+    /// Russian roulette's tests read off the same lines' tags, likewise.
+    pub roulettes: Option<Roulettes>,
 }
 
 /// Renders `frames` frames of `camera`'s view on `dev` (with `module` loaded
@@ -332,12 +334,15 @@ pub fn render(
     let counted = dev.config().fidelity >= Fidelity::Instructions;
     let tags = counts::tags();
     let mut events = Counts::default();
+    let mut roulettes = Roulettes::default();
     for f in 0..frames {
         dev.write(pp, &params_bytes(scene, camera, &params, f))?;
         let st = dev.launch(module, entry_for(scene, params.integrator), LaunchConfig::linear(ctas, THREADS), &args)?;
         totals.merge(&st.totals);
         if counted {
-            events.add(&Counts::from_tags(&counts::tagged(&module.prog, &st.profile, &tags)));
+            let tagged = counts::tagged(&module.prog, &st.profile, &tags);
+            events.add(&Counts::from_tags(&tagged));
+            roulettes.add(&Roulettes::from_tags(&tagged));
         }
         out.frames += 1;
         if keep_frames {
@@ -346,5 +351,5 @@ pub fn render(
         progress(f + 1);
     }
     out.accum = dev.read::<f32>(accum, n);
-    Ok(KernelRender { image: out, totals, counts: counted.then_some(events) })
+    Ok(KernelRender { image: out, totals, counts: counted.then_some(events), roulettes: counted.then_some(roulettes) })
 }

@@ -615,6 +615,6 @@ pub const FRAME_KERNEL: &str = "mlt_frame";
 
 impl From<MltRender> for KernelRender {
     fn from(r: MltRender) -> KernelRender {
-        KernelRender { image: r.image, totals: r.totals.unwrap_or_default(), counts: None }
+        KernelRender { image: r.image, totals: r.totals.unwrap_or_default(), counts: None, roulettes: None }
     }
 }

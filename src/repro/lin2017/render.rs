@@ -26,6 +26,9 @@ pub struct PathRender {
     pub instructions: Option<(u64, u64)>,
     /// The kernel that renders the scene ([`kernel::entry_for`]).
     pub kernel: &'static str,
+    /// Russian roulette's tests, counted by the emulator (the megakernel at
+    /// fidelity `instructions` or above; mlt's render counts none).
+    pub roulettes: Option<crate::host::path::counts::Roulettes>,
 }
 
 /// How the emulated frames are launched: the megakernel (one launch a
@@ -171,6 +174,7 @@ pub fn render_form(
         }
     };
     let t0 = Instant::now();
+    let mut roulettes = None;
     let (image, instructions) = match emulated {
         None => (render_native(&ps, camera, params, frames, false, tick)?.image(), None),
         Some(set) => {
@@ -181,6 +185,7 @@ pub fn render_form(
             let (image, totals) = match form {
                 Form::Megakernel => {
                     let k = kernel::render(&mut dev, &module, &ps, camera, params, frames, false, tick)?;
+                    roulettes = k.roulettes;
                     (k.image, k.totals)
                 }
                 Form::Levels(mode) => {
@@ -211,5 +216,5 @@ pub fn render_form(
         Form::Split(crate::host::path::regroup::Mode::Normal) => "regroup_init, regroup_trace and regroup_shade",
         Form::Split(_) => "regroup_init, regroup_trace, regroup_shade and the compaction kernels",
     };
-    Ok(PathRender { image, frames, seconds: t0.elapsed().as_secs_f64(), instructions, kernel })
+    Ok(PathRender { image, frames, seconds: t0.elapsed().as_secs_f64(), instructions, kernel, roulettes })
 }
