@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Makes timing-only variants of the Fig. 9 MLT recordings whose splats are
-not atomic, so that the H200 can time what MLT's atomics cost
+not atomic, or absent, so that the H200 can time what MLT's splats cost
 (docs/gpu-replay.md, "MLT's splats without atomics"; thesis 003:L332: MLT is
 "only slightly slower than MC estimator, cause of which mainly attributes to
 the atomic memory write").
@@ -8,7 +8,7 @@ the atomic memory write").
   mlt_splat_variants.py REC
 
 For every recording REC/fig9-mlt-<scene>/ (tools/device/replay_cases.sh
-timing) it writes two copies beside it, the same launches and data with the
+timing) it writes three copies beside it, the same launches and data with the
 module's PTX changed in mlt_frame only:
 
   fig9-mlt-<scene>-store  each splat `atom.global.add.u64 %r, [a], v` (ptxas
@@ -17,11 +17,15 @@ module's PTX changed in mlt_frame only:
                           the same addresses and bytes written, no atomic;
   fig9-mlt-<scene>-rmw    it becomes a load, an add and a store of the same
                           address, not atomic: the atomic's traffic (a read
-                          and a write of the sector) without its atomicity.
+                          and a write of the sector) without its atomicity;
+  fig9-mlt-<scene>-none   no splat at all: the atomic is dropped (its result
+                          register set to 0), and ptxas drops what only fed
+                          it: the splat's whole cost, writes and arithmetic.
 
-Both make wrong images (lost updates): their reads differ from the
-emulator's, and only their times mean anything. Exits 2 when a recording's
-mlt_frame has no such atomic or another atomic kind.
+All three make wrong images (lost updates, or none): their reads differ from
+the emulator's, and only their times mean anything. Exits (status 1, with a
+message) when a recording's PTX has no mlt_frame, when its mlt_frame has no
+u64 atomic add, or an atomic this tool does not rewrite.
 """
 import os
 import re
@@ -34,7 +38,9 @@ ATOM = re.compile(r"^(\s*)atom\.global\.add\.u64\s+(%rd\d+),\s*\[(%rd\d+)\],\s*(
 def patch(ptx, kind):
     """The PTX with mlt_frame's u64 atomic adds replaced; (text, count)."""
     lines = ptx.split("\n")
-    start = next(i for i, l in enumerate(lines) if l.startswith(".visible .entry mlt_frame("))
+    start = next((i for i, l in enumerate(lines) if l.startswith(".visible .entry mlt_frame(")), None)
+    if start is None:
+        sys.exit("the PTX has no mlt_frame entry")
     end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith(".visible .entry ")), len(lines))
     n = 0
     for i in range(start, end):
@@ -45,7 +51,9 @@ def patch(ptx, kind):
         if not m:
             sys.exit(f"mlt_frame has an atomic this tool does not rewrite: {line.strip()}")
         pad, old, addr, val = m.groups()
-        if kind == "store":
+        if kind == "none":
+            lines[i] = f"{pad}mov.u64 \t{old}, 0;"
+        elif kind == "store":
             # the result register is never read (the splat ignores it); keep it defined
             lines[i] = f"{pad}st.global.u64 \t[{addr}], {val};\n{pad}mov.u64 \t{old}, 0;"
         else:
@@ -66,7 +74,7 @@ def main():
         sys.exit(f"{rec}: no fig9-mlt-<scene> recording (tools/device/replay_cases.sh timing)")
     for case in cases:
         src = os.path.join(rec, case)
-        for kind in ("store", "rmw"):
+        for kind in ("store", "rmw", "none"):
             dst = f"{src}-{kind}"
             shutil.rmtree(dst, ignore_errors=True)
             shutil.copytree(src, dst)
