@@ -406,12 +406,13 @@ fn fig_9s_mlt_frame_on_the_h200_as_documented() {
     }
 }
 
-/// docs/gpu-replay.md's "MLT's splats without atomics"
+/// docs/gpu-replay.md's "MLT's splats without atomics, and without splats"
 /// (tests/fixtures/gpu_mlt_splats.json, one H200 run): Fig. 9's MLT frames
-/// with their six splat atomics rewritten as plain stores (`-store`) or as
-/// non-atomic load-add-stores (`-rmw`) make no reductions, lose updates (the
-/// image read differs, b's does not) and take the atomic frame's time within
-/// 1.5 %; the MLT frame is still 2.1 x and 3.0 x a bdpt frame of the same run.
+/// with their six splat atomics rewritten as plain stores (`-store`), as
+/// non-atomic load-add-stores (`-rmw`) or dropped (`-none`) make no
+/// reductions, lose updates (the image read differs, b's does not) and take
+/// the atomic frame's time within 1.5 % by events and ncu alike; the MLT
+/// frame is still 2.1 x and 3.0 x a bdpt frame of the same run.
 #[test]
 fn fig_9s_splats_cost_the_h200_no_measurable_time() {
     let fx: serde_json::Value =
@@ -420,7 +421,7 @@ fn fig_9s_splats_cost_the_h200_no_measurable_time() {
     let ms = |c: &serde_json::Value, i: usize| c["devices"][0]["launches"][i]["ms_pass_median"].as_f64().unwrap();
     let ncu = |c: &serde_json::Value, i: usize, m: &str| c["ncu"][i][m].as_f64().unwrap();
     let reds = |c: &serde_json::Value, i: usize| c["ncu_atomics"][i]["smsp__inst_executed_op_global_red.sum"].as_f64();
-    for (scene, mlt_over_bdpt) in [("lambert", 2.096), ("inverted", 2.981)] {
+    for (scene, mlt_over_bdpt) in [("lambert", 2.100), ("inverted", 2.999)] {
         let atomic = case(&format!("fig9-mlt-{scene}"));
         let bdpt = case(&format!("fig9-bdpt-{scene}"));
         let tb = bdpt["devices"][0]["launches"][1]["ms_median"].as_f64().unwrap();
@@ -428,7 +429,8 @@ fn fig_9s_splats_cost_the_h200_no_measurable_time() {
         let reads: Vec<bool> =
             atomic["devices"][0]["reads"].as_array().unwrap().iter().map(|r| r["equal"] == true).collect();
         assert_eq!(reads, [true, true], "{scene}: the atomic original replays bit for bit");
-        for v in ["store", "rmw"] {
+        // (variant, SASS instructions over the original's: the same, 3 more a splat, the splat's own dropped)
+        for (v, sass_lo, sass_hi) in [("store", 1.0, 1.0), ("rmw", 1.0001, 1.0003), ("none", 0.999, 0.9997)] {
             let c = case(&format!("fig9-mlt-{scene}-{v}"));
             let what: Vec<String> = c["emulator"].as_array().unwrap().iter().map(|l| l.to_string()).collect();
             assert!(what.iter().any(|l| l.contains(&format!("splats as {v}, not atomic"))), "{scene} {v}: {what:?}");
@@ -439,10 +441,11 @@ fn fig_9s_splats_cost_the_h200_no_measurable_time() {
                 assert_eq!(reds(&atomic, i), Some(49_152.0), "{scene}: the original's reductions");
                 assert_eq!(reds(&c, i), Some(0.0), "{scene} {v}: no reduction left");
                 let sass = ncu(&c, i, "smsp__inst_executed.sum") / ncu(&atomic, i, "smsp__inst_executed.sum");
-                let want = if v == "store" { 1.0 } else { 1.0003 };
-                assert!((sass - want).abs() < 3e-4, "{scene} {v} frame {i}: SASS {sass}");
+                assert!((sass_lo..=sass_hi).contains(&sass), "{scene} {v} frame {i}: SASS {sass}");
                 let r = ms(&c, i) / ms(&atomic, i);
-                assert!((r - 1.0).abs() < 0.015, "{scene} {v} frame {i}: {r} of the atomic frame's time");
+                assert!((r - 1.0).abs() < 0.015, "{scene} {v} frame {i}: {r} of the atomic frame's time (events)");
+                let r = ncu(&c, i, "gpu__time_duration.sum") / ncu(&atomic, i, "gpu__time_duration.sum");
+                assert!((r - 1.0).abs() < 0.015, "{scene} {v} frame {i}: {r} of the atomic frame's time (ncu)");
             }
         }
     }

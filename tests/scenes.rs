@@ -153,6 +153,7 @@ fn an_anisotropic_roughness_is_a_mirrors_pair_of_alphas() {
     for (kind, r, want) in [
         ("glass", "[0.1, 0.2]", "material[0].roughness: an anisotropic roughness [ax, ay] is a mirror's only"),
         ("diffuse", "[0.1, 0.2]", "material[0].roughness: an anisotropic roughness [ax, ay] is a mirror's only"),
+        ("diffuse", "[0.1, 0.2]", "glass and the metal lobe of a diffuse material take one alpha"),
         ("mirror", "[0.1]", "material[0].roughness: expected a Beckmann alpha, or [ax, ay]"),
         ("mirror", "[0.1, 0.2, 0.3]", "material[0].roughness: expected a Beckmann alpha, or [ax, ay]"),
         ("mirror", "[0, 0.2]", "material[0].roughness: 0e0: each alpha of [ax, ay] lies between 1e-4 and 1"),

@@ -16,6 +16,7 @@ not a simple polygon, or when the result is not closed. Prints each hole's
 edges and how far its rim lies from its plane (the caps are flat only where
 the rim is).
 """
+import os
 import sys
 
 import numpy as np
@@ -23,6 +24,25 @@ import numpy as np
 
 def cross(o, a, b):
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+
+def segments_cross(p1, p2, q1, q2):
+    """Whether the segments p1-p2 and q1-q2 cross at a point inside both."""
+    d1, d2 = cross(q1, q2, p1), cross(q1, q2, p2)
+    d3, d4 = cross(p1, p2, q1), cross(p1, p2, q2)
+    return d1 * d2 < 0 and d3 * d4 < 0
+
+
+def simple(ring, pts):
+    """Whether the closed polygon `ring` has no two non-adjacent edges that cross."""
+    n = len(ring)
+    for i in range(n):
+        for j in range(i + 2, n):
+            if i == 0 and j == n - 1:
+                continue   # adjacent through the wrap
+            if segments_cross(pts[ring[i]], pts[ring[(i + 1) % n]], pts[ring[j]], pts[ring[(j + 1) % n]]):
+                return False
+    return True
 
 
 def ear_clip(ring, pts):
@@ -46,7 +66,10 @@ def ear_clip(ring, pts):
                 break
         else:
             return None
-    tris.append(tuple(ring))
+    a, b, d = ring
+    if sign * cross(pts[a], pts[b], pts[d]) <= 0:
+        return None   # the last three turn the wrong way: not a simple polygon
+    tris.append((a, b, d))
     return tris
 
 
@@ -78,7 +101,10 @@ def main():
             directed.add(e)
     boundary = [(a, b) for (a, b) in directed if (b, a) not in directed]
     nxt = {}
+    starts = {a for a, _ in boundary}
     for a, b in boundary:
+        if b not in starts:
+            sys.exit(f"{src}: boundary edge {a + 1} -> {b + 1} leads to a vertex no boundary edge leaves")
         if a in nxt:
             sys.exit(f"{src}: vertex {a + 1} starts two boundary edges: a hole that is not a simple loop")
         nxt[a] = b
@@ -105,12 +131,16 @@ def main():
         # the cap runs the rim backwards (each boundary edge a -> b becomes b -> a)
         ring = loop[::-1]
         pts = {i: ((v[i] - c) @ vt[0], (v[i] - c) @ vt[1]) for i in ring}
-        tris = ear_clip(ring, pts)
+        tris = ear_clip(ring, pts) if simple(ring, pts) else None
         if tris is None:
-            sys.exit(f"hole {k + 1}: its rim projected on its plane is not a simple polygon; no ear to clip")
+            sys.exit(f"hole {k + 1}: its rim projected on its plane is not a simple polygon")
         new_f.extend(tris)
+        # each cap triangle's tilt against the plane: the cosine of its normal with the plane's (1: in the plane)
+        tilt = min(abs(np.dot(np.cross(v[b] - v[a], v[c] - v[a]), vt[2]))
+                   / np.linalg.norm(np.cross(v[b] - v[a], v[c] - v[a])) for a, b, c in tris)
         print(f"hole {k + 1}: {len(loop)} edges, {len(tris)} triangles, rim within {off:.2e} of its plane "
-              f"(rim extent {np.ptp(rim, axis=0).max():.2e})", file=sys.stderr)
+              f"(rim extent {np.ptp(rim, axis=0).max():.2e}), least cosine of a cap triangle with the plane "
+              f"{tilt:.3f}", file=sys.stderr)
     for a, b, c in new_f:
         for e in ((a, b), (b, c), (c, a)):
             if e in directed:
@@ -120,6 +150,8 @@ def main():
     if open_edges:
         sys.exit(f"{open_edges} edges still open")
     with open(dst, "w") as o:
+        o.write(f"# {os.path.basename(src)} with its {len(loops)} holes closed by tools/close_holes.py: "
+                f"{len(new_f)} triangles appended at the end (the counts in the header below are the original's)\n")
         for l in lines:
             o.write(l + "\n")
         o.write(f"# {len(loops)} holes closed by tools/close_holes.py: each rim ear-clipped in its plane "

@@ -256,10 +256,6 @@ fn material(
     }
     // α² underflows in f32 below about 1e-19 and the pdf squared overflows from
     // about 1e-11: NaN pixels under MIS. Mitsuba 3 clamps α to 1e-4.
-    if roughness_y > 0.0 && metal_lobe {
-        return cx
-            .err(&format!("{p}roughness"), "an anisotropic roughness [ax, ay] is a mirror's only, not a metal lobe's");
-    }
     if roughness > 0.0 && roughness < MIN_ROUGHNESS {
         return cx.err(
             &format!("{p}roughness"),
@@ -306,7 +302,11 @@ fn roughness_of(cx: &Cx, t: &toml::Table, p: &str, kind: MaterialKind) -> Result
                 return cx.err(&k, "expected a Beckmann alpha, or [ax, ay] for an anisotropic mirror");
             }
             if kind != MaterialKind::Mirror {
-                return cx.err(&k, "an anisotropic roughness [ax, ay] is a mirror's only; give glass one alpha");
+                return cx.err(
+                    &k,
+                    "an anisotropic roughness [ax, ay] is a mirror's only; glass and the metal lobe of a diffuse \
+                     material take one alpha",
+                );
             }
             let (ax, ay) = (cx.num(&a[0], &k)?, cx.num(&a[1], &k)?);
             for v in [ax, ay] {

@@ -204,25 +204,25 @@ def fig9_table(fx):
 
 
 def splats_table(path):
-    """Fig. 9's MLT frames with the splats not atomic (tests/fixtures/gpu_mlt_splats.json):
+    """Fig. 9's MLT frames with the splats not atomic, or none (tests/fixtures/gpu_mlt_splats.json):
     each variant's mlt_frame time over the atomic one's, per frame."""
     if not os.path.exists(path):
         return
     fx = json.load(open(path))
     print("| scene | frame | atomic ms | plain store / atomic (events; ncu) | load-add-store / atomic (events; ncu) | "
-          "atomic's own spread over 5 passes | mlt / bdpt frame (this run) |")
-    print("|---|---|---|---|---|---|---|")
+          "no splat / atomic (events; ncu) | atomic's own spread over 5 passes | mlt / bdpt frame (this run) |")
+    print("|---|---|---|---|---|---|---|---|")
     for scene in ("lambert", "inverted"):
         a = fx["cases"].get(f"fig9-mlt-{scene}")
         b = fx["cases"].get(f"fig9-bdpt-{scene}")
-        if a is None or b is None:
+        variants = [fx["cases"].get(f"fig9-mlt-{scene}-{v}") for v in ("store", "rmw", "none")]
+        if a is None or b is None or None in variants:
             continue
         la = a["devices"][0]["launches"]
         tb = b["devices"][0]["launches"][1]["ms_median"]
         for i, nth in ((2, "1st"), (3, "2nd")):
             cells = []
-            for v in ("store", "rmw"):
-                c = fx["cases"][f"fig9-mlt-{scene}-{v}"]
+            for c in variants:
                 ev = c["devices"][0]["launches"][i]["ms_pass_median"] / la[i]["ms_pass_median"]
                 nc = c["ncu"][i]["gpu__time_duration.sum"] / a["ncu"][i]["gpu__time_duration.sum"]
                 cells.append(f"{ev:.3f}; {nc:.3f}")
@@ -230,7 +230,7 @@ def splats_table(path):
             spread = (max(p) - min(p)) / la[i]["ms_pass_median"]
             ratio = f"{la[i]['ms_pass_median'] / tb:.3f}" if i == 3 else ""
             print(f"| cornell-{scene} | {nth} | {la[i]['ms_pass_median']:.3f} | {cells[0]} | {cells[1]} | "
-                  f"{100 * spread:.1f} % | {ratio} |")
+                  f"{cells[2]} | {100 * spread:.1f} % | {ratio} |")
 
 
 def main():

@@ -1426,7 +1426,7 @@ mod tests {
 
     /// Smith's G1 of the anisotropic lobe sees α_x along b1, α_y along b2
     /// (Mitsuba's projected roughness), not the printed 1 / (cos²φ / α_x² +
-    /// sin²φ / α_y²) of 003:L357: at 45°, √((α_x² + α_y²) / 2).
+    /// sin²φ / α_y²) of 003:L357 nor its square root: at 45°, √((α_x² + α_y²) / 2).
     #[test]
     fn the_anisotropic_g1_sees_the_projected_roughness() {
         let a = Aniso::new(v3(0.0, 0.0, 1.0), 0.1, 0.5);
@@ -1434,8 +1434,12 @@ mod tests {
         assert!((along(0.3, 0.0) - 0.1).abs() < 1e-7 && (along(0.0, -0.3) - 0.5).abs() < 1e-7);
         let diag = along(0.3, 0.3);
         assert!((diag - (0.13f32).sqrt()).abs() < 1e-6, "{diag}");
+        // the printed term at 45° (units of α²), and its square root (the extract's reading)
         let printed = 1.0 / (0.5 / (0.1f32 * 0.1) + 0.5 / (0.5 * 0.5));
-        assert!((diag - printed).abs() > 0.2, "{diag} vs {printed}");
+        assert!((diag - printed).abs() > 0.3 && (diag - printed.sqrt()).abs() > 0.2, "{diag} vs {printed}");
+        // ... which agrees with the projected roughness along the axes only
+        let root = |c2: f32, s2: f32| (1.0 / (c2 / (0.1f32 * 0.1) + s2 / (0.5 * 0.5))).sqrt();
+        assert!((root(1.0, 0.0) - along(0.3, 0.0)).abs() < 1e-6 && (root(0.0, 1.0) - along(0.0, 0.3)).abs() < 1e-6);
         assert_eq!(a.along(v3(0.0, 0.0, 1.0)), 0.1, "along the normal: any alpha (G1 = 1)");
     }
 

@@ -461,8 +461,8 @@ fn checks(table: &mut Table, r: &Results, scene: &str) {
         claim: format!("{scene}: the MLT estimator is only slightly slower than MC (003:L332)"),
         evidence: format!(
             "modelled by emulated warp instructions: an MLT frame (its second, the start-up excluded) {} a bdpt \
-             frame's (read as at most {SLIGHTLY}x; atomic conflicts not modelled: on an H200 the splats without \
-             atomics take the same time within 1.3 %, docs/gpu-replay.md)",
+             frame's (read as at most {SLIGHTLY}x; atomic conflicts not modelled: on an H200 the frames without \
+             atomic splats, or without splats, take the same time within their spread, docs/gpu-replay.md)",
             ratio.map_or("–".into(), |x| format!("{x:.2}x"))
         ),
         holds: ratio.is_some_and(|x| x <= SLIGHTLY),
