@@ -54,7 +54,8 @@ fn every_material_kind_traces_the_same_bits_emulated_and_native() {
 /// The anisotropic mirror (§5.1, the thesis' "Ward" lobe, path.cu's Aniso):
 /// its sampling, D_aniso, the projected-roughness G and the light sample at
 /// it trace the same bits emulated and native, under every integrator that
-/// samples it (mlt's chains mutate its two random numbers too).
+/// samples it (mlt's chains mutate its two random numbers too); and so does
+/// the anisotropic rough glass (env-glass-anisotropic's frosted ball).
 #[test]
 fn the_anisotropic_mirror_traces_the_same_bits_emulated_and_native() {
     use warplight::host::path::layout::KIND_CONDUCTOR;
@@ -63,6 +64,13 @@ fn the_anisotropic_mirror_traces_the_same_bits_emulated_and_native() {
         ps.mats.iter().filter(|m| m[3].to_bits() == KIND_CONDUCTOR).map(|m| [m[8], m[10]]).collect();
     assert_eq!(lobes, [[0.05, 0.4]], "the back wall's alpha_x and alpha_y");
     same_frames((scene, ps), &[Integrator::Pt, Integrator::Nee, Integrator::MisPower, Integrator::Mlt]);
+    // and the anisotropic rough glass (Walter's refraction, the same sampling and G)
+    use warplight::host::path::layout::KIND_ROUGH_GLASS;
+    let (scene, ps) = load("env-glass-anisotropic");
+    let lobes: Vec<[f32; 2]> =
+        ps.mats.iter().filter(|m| m[3].to_bits() == KIND_ROUGH_GLASS).map(|m| [m[8], m[10]]).collect();
+    assert_eq!(lobes, [[0.05, 0.4]], "the frosted ball's alpha_x and alpha_y");
+    same_frames((scene, ps), &[Integrator::Pt, Integrator::MisPower]);
 }
 
 /// Bidirectional path tracing (`bdpt_frame`): the light subpath, the

@@ -128,16 +128,17 @@ fn roughness_is_zero_or_at_least_the_floor() {
     assert!(e.contains("material[0].roughness: expected a Beckmann alpha between 0 and 1"), "{e}");
 }
 
-/// An anisotropic roughness `[ax, ay]` (thesis 003 §5.1) loads on a mirror,
-/// each alpha in [1e-4, 1], equal values being the isotropic lobe; elsewhere,
-/// or malformed, it is refused naming the file and key.
+/// An anisotropic roughness `[ax, ay]` (thesis 003 §5.1) loads on a mirror
+/// or a glass, each alpha in [1e-4, 1], equal values being the isotropic
+/// lobe; elsewhere, or malformed, it is refused naming the file and key.
 #[test]
-fn an_anisotropic_roughness_is_a_mirrors_pair_of_alphas() {
+fn an_anisotropic_roughness_is_a_mirrors_or_glasss_pair_of_alphas() {
     let scene = |kind: &str, r: &str| {
         format!("procedural = \"scene6\"\n[[material]]\nname = \"wall\"\nkind = \"{kind}\"\nroughness = {r}\n")
     };
     for r in ["[0.05, 0.4]", "[1e-4, 1]", "[0.3, 0.3]"] {
         assert_eq!(load_str(&scene("mirror", r)), "", "{r}");
+        assert_eq!(load_str(&scene("glass", r)), "", "glass {r}");
     }
     let path = std::env::temp_dir().join(format!("warplight-aniso-{}.toml", std::process::id()));
     let load_y = |r: &str| {
@@ -151,9 +152,17 @@ fn an_anisotropic_roughness_is_a_mirrors_pair_of_alphas() {
     assert_eq!(load_y("0.3"), (0.3, 0.0));
     let _ = std::fs::remove_file(&path);
     for (kind, r, want) in [
-        ("glass", "[0.1, 0.2]", "material[0].roughness: an anisotropic roughness [ax, ay] is a mirror's only"),
-        ("diffuse", "[0.1, 0.2]", "material[0].roughness: an anisotropic roughness [ax, ay] is a mirror's only"),
-        ("diffuse", "[0.1, 0.2]", "glass and the metal lobe of a diffuse material take one alpha"),
+        (
+            "diffuse",
+            "[0.1, 0.2]",
+            "material[0].roughness: an anisotropic roughness [ax, ay] is a mirror's or a glass's",
+        ),
+        ("diffuse", "[0.1, 0.2]", "the metal lobe of a diffuse material takes one alpha"),
+        (
+            "emitter",
+            "[0.1, 0.2]",
+            "material[0].roughness: an anisotropic roughness [ax, ay] is a mirror's or a glass's",
+        ),
         ("mirror", "[0.1]", "material[0].roughness: expected a Beckmann alpha, or [ax, ay]"),
         ("mirror", "[0.1, 0.2, 0.3]", "material[0].roughness: expected a Beckmann alpha, or [ax, ay]"),
         ("mirror", "[0, 0.2]", "material[0].roughness: 0e0: each alpha of [ax, ay] lies between 1e-4 and 1"),

@@ -110,7 +110,7 @@ struct Scene {
   const unsigned *refs;    // the concatenated leaf triangle lists
   const float4 *tris;      // 3 float4 per triangle: the affine rows (§6.4)
   const float4 *tri_data;  // per triangle: unit geometric normal, material index (int bits)
-  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior], [alpha, exact Fresnel (1) or Schlick's (0), an anisotropic mirror's alpha_y (0: isotropic), 0]
+  const float4 *mats;      // per material: [r g b kind], [emission rgb, ior], [alpha, exact Fresnel (1) or Schlick's (0), an anisotropic mirror's or rough glass's alpha_y (0: isotropic), 0]
   const float4 *lights;    // per emitting triangle: [v0, cdf], [e1, triangle (int bits)], [e2, 0]
   const float4 *boxes;     // per node (kd-backtrack): [box lo, parent (int bits)], [box hi, 0]
   const float4 *env;       // the environment map (§5.4): env_w x env_h texels [r g b 0], row 0 the zenith
@@ -739,17 +739,27 @@ static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 t
     wgt = scale3(v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co)), g * co / (cos_o * cm));
     d = next;
   } else if (kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS) {
-    // a microfacet normal from Beckmann's D cos: tan^2 = -a2 ln(1 - y), uniform azimuth (§5.1)
-    float alpha = s.mats[3 * __float_as_int(td.w) + 2].x;
+    // a microfacet normal from Beckmann's D cos: tan^2 = -a2 ln(1 - y), uniform azimuth (§5.1);
+    // an anisotropic rough glass's (alpha_y > 0; the mirror's is above) from D_aniso cos
+    float4 r = s.mats[3 * __float_as_int(td.w) + 2];
+    float alpha = r.x;
     float a2 = alpha * alpha;
-    float tan2 = a2 * -ln(1.0f - rng(key, dim + 3));
-    float cm = 1.0f / sqrtf(1.0f + tan2);
-    float sm = sqrtf(tan2) * cm;
-    float c, sn;
-    azimuth(rng(key, dim + 4), &c, &sn);
-    V3 b1, b2;
-    basis(ns, &b1, &b2);
-    V3 mh = add3(add3(scale3(b1, sm * c), scale3(b2, sm * sn)), scale3(ns, cm));
+    V3 mh;
+    float cm;
+    Aniso an;
+    if (r.z > 0.0f) {
+      an = aniso(cos_d < 0.0f ? ns : v3(-ns.x, -ns.y, -ns.z), alpha, r.z);
+      mh = sample_aniso(an, ns, rng(key, dim + 3), rng(key, dim + 4), &cm);
+    } else {
+      float tan2 = a2 * -ln(1.0f - rng(key, dim + 3));
+      cm = 1.0f / sqrtf(1.0f + tan2);
+      float sm = sqrtf(tan2) * cm;
+      float c, sn;
+      azimuth(rng(key, dim + 4), &c, &sn);
+      V3 b1, b2;
+      basis(ns, &b1, &b2);
+      mh = add3(add3(scale3(b1, sm * c), scale3(b2, sm * sn)), scale3(ns, cm));
+    }
     float co = -dot3(d, mh);
     if (!(co > 0.0f)) return false;
     V3 next = add3(d, scale3(mh, 2.0f * co));   // reflected about the microfacet
@@ -781,7 +791,8 @@ static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 t
     }
     float ci = dot3(next, ns);
     if (refracted ? !(ci < 0.0f) : !(ci > 0.0f)) return false;   // on the wrong side
-    float g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, dot3(next, mh));
+    float g = r.z > 0.0f ? smith_g1(alpha_along(an, d), cos_o, co) * smith_g1(alpha_along(an, next), ci, dot3(next, mh))
+                         : smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, dot3(next, mh));
     float f = g * co / (cos_o * cm) * scale;
     wgt = scale3(wgt, f);
     d = next;

@@ -190,7 +190,7 @@ pub struct Scene {
     /// 003's path tracer makes a rough mirror a Cook-Torrance conductor and a
     /// rough glass a Walter dielectric; the other renderers treat them as smooth.
     pub roughness: Vec<f32>,
-    /// Per material, an anisotropic mirror's second Beckmann α, along the
+    /// Per material, an anisotropic mirror's or rough glass's second Beckmann α, along the
     /// tangent frame's second axis (a scene file's `roughness = [ax, ay]`;
     /// `roughness` then holds α_x; 0, or a material past the end: isotropic).
     /// Only thesis 003's path tracer reads it.

@@ -289,8 +289,8 @@ fn material(
     Ok((m, [roughness, roughness_y], exact, translucent, maps))
 }
 
-/// A material's `roughness`: one Beckmann α (isotropic), or for a mirror
-/// `[ax, ay]`, thesis 003's anisotropic lobe (§5.1, 003:L346-352) with α_x
+/// A material's `roughness`: one Beckmann α (isotropic), or for a mirror or
+/// a glass `[ax, ay]`, thesis 003's anisotropic lobe (§5.1, 003:L346-352) with α_x
 /// along the first and α_y along the second axis of the tangent frame
 /// (`docs/reproduction-lin2017.md`, "Anisotropic mirrors"). The second value
 /// is 0 when the lobe is isotropic (a number, or two equal values).
@@ -301,11 +301,11 @@ fn roughness_of(cx: &Cx, t: &toml::Table, p: &str, kind: MaterialKind) -> Result
             if a.len() != 2 {
                 return cx.err(&k, "expected a Beckmann alpha, or [ax, ay] for an anisotropic mirror");
             }
-            if kind != MaterialKind::Mirror {
+            if !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) {
                 return cx.err(
                     &k,
-                    "an anisotropic roughness [ax, ay] is a mirror's only; glass and the metal lobe of a diffuse \
-                     material take one alpha",
+                    "an anisotropic roughness [ax, ay] is a mirror's or a glass's only; the metal lobe of a diffuse \
+                     material takes one alpha",
                 );
             }
             let (ax, ay) = (cx.num(&a[0], &k)?, cx.num(&a[1], &k)?);

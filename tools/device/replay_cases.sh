@@ -51,6 +51,7 @@ if [ "$which" = small ] || [ "$which" = all ]; then
   # the anisotropic mirror (§5.1): its sampling, D and G, under MIS and under MLT's mutations
   record aniso-mis-power $path $s --scene cornell-anisotropic --integrator mis-power
   record aniso-mlt $path $s --scene cornell-anisotropic --integrator mlt
+  record aniso-glass-pt $path $s --scene env-glass-anisotropic --integrator pt
   record caustic-nee $path $s --scene cornell-caustic --integrator nee
   record inverted-bdpt $path $s --scene cornell-inverted --integrator bdpt
   record fog-nee $path $s --scene fog-box --integrator nee

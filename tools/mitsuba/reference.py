@@ -23,10 +23,11 @@ Both are made two-sided (warplight's mirrors reflect on both sides).
 Mitsuba samples visible normals, warplight D cos: the same BSDF, other
 pdfs, equal in expectation. An anisotropic mirror (`roughness = [ax, ay]`,
 thesis 003 §5.1) is `roughconductor` with `alpha_u` = ax and `alpha_v` = ay
+(an anisotropic rough glass likewise `roughdielectric`)
 (its G1 takes the projected roughness, as warplight's): warplight lays α_x
 along b1 of Duff et al.'s basis around each triangle's winding normal, and
 Mitsuba along its shading frame's s, which follows dp/du; so the tool gives
-the mirror's triangles texture coordinates (u, v) = (p . b1, p . b2), whose
+the material's triangles texture coordinates (u, v) = (p . b1, p . b2), whose
 dp/du is b1, and checks after loading that s is b1 on every such triangle
 (`check_tangents`). Glass with the thesis' Schlick Fresnel (the
 default) is refused: Mitsuba's dielectrics use the exact Fresnel equations,
@@ -221,8 +222,9 @@ def load_scene(toml_path):
             kind, color, em = d.get("kind", "diffuse"), d.get("color", [0.8] * 3), d.get("emission", [0.0] * 3)
             rough = d.get("roughness", 0.0)
             glass = (float(d.get("ior", 1.5)), d.get("fresnel", "schlick"), d if kind == "translucent" else None)
-            if isinstance(rough, list):   # an anisotropic mirror: glass's slot holds alpha_v
-                rough, glass = float(rough[0]), {"alpha_v": float(rough[1])}
+            if isinstance(rough, list):   # anisotropic: alpha_v rides in glass's slot (a 4th entry for glass)
+                rough, alpha_v = float(rough[0]), float(rough[1])
+                glass = {"alpha_v": alpha_v} if kind == "mirror" else glass + (alpha_v,)
             rough = float(rough)
             if any(k in d for k in ("albedo_map", "roughness_map", "metalness_map")):
                 kind, glass = "textured", textured(toml_path, name, d)
@@ -270,8 +272,13 @@ def winding_normal(t):
     return n / np.linalg.norm(n)
 
 
-def anisotropic(glass):
-    return isinstance(glass, dict) and "alpha_v" in glass
+def alpha_v(glass):
+    """An anisotropic material's alpha_v (a mirror's dict, a glass's 4th entry), else None."""
+    if isinstance(glass, dict):
+        return glass.get("alpha_v")
+    if isinstance(glass, tuple) and len(glass) == 4:
+        return glass[3]
+    return None
 
 
 def check_tangents(mi, scene, aniso_tris):
@@ -521,7 +528,7 @@ def main():
                         o.write("vt %r %r\n" % (float(q @ pu), float(q @ pv)))
                 for i in range(len(tris)):
                     o.write(f"f {3 * i + 1}/{3 * i + 1} {3 * i + 2}/{3 * i + 2} {3 * i + 3}/{3 * i + 3}\n")
-            elif kind == "mirror" and anisotropic(glass):
+            elif kind in ("mirror", "glass") and alpha_v(glass) is not None:
                 for t in tris:
                     b1, b2 = duff_basis(winding_normal(t))
                     for v in t:
@@ -548,7 +555,8 @@ def main():
                 "specular_transmittance": {"type": "rgb", "value": color},
             }
             if rough > 0:
-                shape["bsdf"].update({"distribution": "beckmann", "alpha": rough})
+                lobe = {"alpha_u": rough, "alpha_v": alpha_v(glass)} if alpha_v(glass) is not None else {"alpha": rough}
+                shape["bsdf"].update({"distribution": "beckmann", **lobe})
         elif kind == "translucent":
             shape["bsdf"] = {"type": "dielectric", "int_ior": glass[0], "ext_ior": 1.0}
             shape["interior"] = sss_medium(glass[2])
@@ -580,7 +588,7 @@ def main():
                 },
             }
         elif kind == "mirror" and rough > 0:
-            lobe = {"alpha_u": rough, "alpha_v": glass["alpha_v"]} if anisotropic(glass) else {"alpha": rough}
+            lobe = {"alpha_u": rough, "alpha_v": alpha_v(glass)} if alpha_v(glass) is not None else {"alpha": rough}
             shape["bsdf"] = {
                 "type": "twosided",
                 "bsdf": {

@@ -308,8 +308,9 @@ impl PathScene {
                     ];
                     return v;
                 }
-                // an anisotropic mirror's alpha_y (0: isotropic), path.cu's Aniso
-                let alpha_y = if kind == KIND_CONDUCTOR { scene.roughness_y(i as u32) } else { 0.0 };
+                // an anisotropic mirror's or rough glass's alpha_y (0: isotropic), path.cu's Aniso
+                let alpha_y =
+                    if matches!(kind, KIND_CONDUCTOR | KIND_ROUGH_GLASS) { scene.roughness_y(i as u32) } else { 0.0 };
                 [r, g, b, f32::from_bits(kind), er, eg, eb, ior, alpha, exact, alpha_y, 0.0]
             })
             .collect();

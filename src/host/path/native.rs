@@ -874,12 +874,20 @@ impl Tracer<'_> {
         } else if kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS {
             let alpha = mat[8];
             let a2 = alpha * alpha;
-            let tan2 = a2 * -ln(1.0 - key.at(dim + 3));
-            let cm = 1.0 / (1.0 + tan2).sqrt();
-            let sm = tan2.sqrt() * cm;
-            let (cs, sn) = azimuth(key.at(dim + 4));
-            let (b1, b2) = basis(ns);
-            let mh = b1.scale(sm * cs).add(b2.scale(sm * sn)).add(ns.scale(cm));
+            // an anisotropic rough glass (the mirror's branch is above): the kernel's `an`
+            let an = (mat[10] > 0.0)
+                .then(|| Aniso::new(if cos_d < 0.0 { ns } else { v3(-ns.x, -ns.y, -ns.z) }, alpha, mat[10]));
+            let (mh, cm) = match &an {
+                Some(a) => a.sample(ns, key.at(dim + 3), key.at(dim + 4)),
+                None => {
+                    let tan2 = a2 * -ln(1.0 - key.at(dim + 3));
+                    let cm = 1.0 / (1.0 + tan2).sqrt();
+                    let sm = tan2.sqrt() * cm;
+                    let (cs, sn) = azimuth(key.at(dim + 4));
+                    let (b1, b2) = basis(ns);
+                    (b1.scale(sm * cs).add(b2.scale(sm * sn)).add(ns.scale(cm)), cm)
+                }
+            };
             let co = -d.dot(mh);
             if !(co > 0.0) {
                 return None;
@@ -916,7 +924,10 @@ impl Tracer<'_> {
             if if refracted { !(ci < 0.0) } else { !(ci > 0.0) } {
                 return None;
             }
-            let g = smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, next.dot(mh));
+            let g = match &an {
+                Some(a) => smith_g1(a.along(*d), cos_o, co) * smith_g1(a.along(next), ci, next.dot(mh)),
+                None => smith_g1(alpha, cos_o, co) * smith_g1(alpha, ci, next.dot(mh)),
+            };
             let f = g * co / (cos_o * cm) * scale;
             wgt = wgt.scale(f);
             *d = next;
