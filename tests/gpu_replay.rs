@@ -187,7 +187,15 @@ fn check_case(name: &str) {
 
 #[test]
 fn the_h200_reads_what_the_emulator_read_path_integrators() {
-    for name in ["lambert-pt", "lambert-mis-power", "lambert-bdpt", "lambert-mlt", "aniso-mis-power", "aniso-mlt"] {
+    for name in [
+        "lambert-pt",
+        "lambert-mis-power",
+        "lambert-bdpt",
+        "lambert-mlt",
+        "aniso-mis-power",
+        "aniso-mlt",
+        "aniso-glass-pt",
+    ] {
         check_case(name);
     }
 }
@@ -237,7 +245,7 @@ fn every_replayed_read_was_equal() {
             }
         }
     }
-    assert_eq!(reads, 165, "the fixture's reads");
+    assert_eq!(reads, 166, "the fixture's reads");
 }
 
 /// The fixture as JSON.
