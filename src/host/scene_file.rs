@@ -299,7 +299,7 @@ fn roughness_of(cx: &Cx, t: &toml::Table, p: &str, kind: MaterialKind) -> Result
     match t.get("roughness") {
         Some(toml::Value::Array(a)) => {
             if a.len() != 2 {
-                return cx.err(&k, "expected a Beckmann alpha, or [ax, ay] for an anisotropic mirror");
+                return cx.err(&k, "expected a Beckmann alpha, or [ax, ay] for an anisotropic mirror or glass");
             }
             if !matches!(kind, MaterialKind::Mirror | MaterialKind::Glass { .. }) {
                 return cx.err(
