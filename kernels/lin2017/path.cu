@@ -722,25 +722,9 @@ static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 t
     d = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4), &lz);
     P.bsdf_pdf = lz * INV_PI;
     P.count_emission = false;
-  } else if (kind == KIND_CONDUCTOR && s.mats[3 * __float_as_int(td.w) + 2].z > 0.0f) {
-    // the anisotropic mirror: a microfacet normal from D_aniso cos, Cook-Torrance's weight F G (o.m) / (o.n m.n)
-    float4 r = s.mats[3 * __float_as_int(td.w) + 2];
-    Aniso a = aniso(cos_d < 0.0f ? ns : v3(-ns.x, -ns.y, -ns.z), r.x, r.z);
-    float cm;
-    V3 mh = sample_aniso(a, ns, rng(key, dim + 3), rng(key, dim + 4), &cm);
-    float co = -dot3(d, mh);
-    if (!(co > 0.0f)) return false;
-    V3 next = add3(d, scale3(mh, 2.0f * co));
-    float ci = dot3(next, ns);
-    if (!(ci > 0.0f)) return false;
-    P.bsdf_pdf = beckmann_aniso(a, mh, cm) * cm / (4.0f * co);
-    P.count_emission = false;
-    float g = smith_g1(alpha_along(a, d), cos_o, co) * smith_g1(alpha_along(a, next), ci, dot3(next, mh));
-    wgt = scale3(v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co)), g * co / (cos_o * cm));
-    d = next;
   } else if (kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS) {
     // a microfacet normal from Beckmann's D cos: tan^2 = -a2 ln(1 - y), uniform azimuth (§5.1);
-    // an anisotropic rough glass's (alpha_y > 0; the mirror's is above) from D_aniso cos
+    // an anisotropic mirror's or rough glass's (alpha_y > 0) from D_aniso cos
     float4 r = s.mats[3 * __float_as_int(td.w) + 2];
     float alpha = r.x;
     float a2 = alpha * alpha;
@@ -767,7 +751,7 @@ static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 t
     bool refracted = false;
     if (kind == KIND_CONDUCTOR) {
       wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
-      P.bsdf_pdf = beckmann(a2, cm) * cm / (4.0f * co);
+      P.bsdf_pdf = (r.z > 0.0f ? beckmann_aniso(an, mh, cm) : beckmann(a2, cm)) * cm / (4.0f * co);
       P.count_emission = false;
     } else {
       // the Fresnel switch on the microfacet (Walter et al. 2007): reflect with

@@ -853,28 +853,10 @@ impl Tracer<'_> {
             (*d, lz) = cosine_dir(ns, key.at(dim + 3), key.at(dim + 4));
             *bsdf_pdf = lz * INV_PI;
             *count_emission = false;
-        } else if kind == KIND_CONDUCTOR && mat[10] > 0.0 {
-            // the anisotropic mirror: the kernel's branch of the same name
-            let a = Aniso::new(if cos_d < 0.0 { ns } else { v3(-ns.x, -ns.y, -ns.z) }, mat[8], mat[10]);
-            let (mh, cm) = a.sample(ns, key.at(dim + 3), key.at(dim + 4));
-            let co = -d.dot(mh);
-            if !(co > 0.0) {
-                return None;
-            }
-            let next = d.add(mh.scale(2.0 * co));
-            let ci = next.dot(ns);
-            if !(ci > 0.0) {
-                return None;
-            }
-            *bsdf_pdf = a.d(mh, cm) * cm / (4.0 * co);
-            *count_emission = false;
-            let g = smith_g1(a.along(*d), cos_o, co) * smith_g1(a.along(next), ci, next.dot(mh));
-            wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co)).scale(g * co / (cos_o * cm));
-            *d = next;
         } else if kind == KIND_CONDUCTOR || kind == KIND_ROUGH_GLASS {
             let alpha = mat[8];
             let a2 = alpha * alpha;
-            // an anisotropic rough glass (the mirror's branch is above): the kernel's `an`
+            // an anisotropic mirror or rough glass: the kernel's `an`
             let an = (mat[10] > 0.0)
                 .then(|| Aniso::new(if cos_d < 0.0 { ns } else { v3(-ns.x, -ns.y, -ns.z) }, alpha, mat[10]));
             let (mh, cm) = match &an {
@@ -897,7 +879,7 @@ impl Tracer<'_> {
             let mut refracted = false;
             if kind == KIND_CONDUCTOR {
                 wgt = v3(schlick(color.x, co), schlick(color.y, co), schlick(color.z, co));
-                *bsdf_pdf = beckmann(a2, cm) * cm / (4.0 * co);
+                *bsdf_pdf = an.as_ref().map_or_else(|| beckmann(a2, cm), |a| a.d(mh, cm)) * cm / (4.0 * co);
                 *count_emission = false;
             } else {
                 let ior = mat[7];
