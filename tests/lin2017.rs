@@ -73,6 +73,21 @@ fn the_anisotropic_mirror_traces_the_same_bits_emulated_and_native() {
     same_frames((scene, ps), &[Integrator::Pt, Integrator::MisPower]);
 }
 
+/// The thesis' coated diffuse (§4.5: the coat's Fresnel switch, Ashikhmin
+/// and Shirley's lobe, its light sample; `scenes/cornell-coated.toml`):
+/// the same bits emulated and native under every integrator (bdpt and mlt
+/// connect through no coated vertex: it ends light subpaths, as a glossy one).
+#[test]
+fn the_coated_diffuse_traces_the_same_bits_emulated_and_native() {
+    use warplight::host::path::layout::KIND_COATED;
+    let (scene, ps) = load("cornell-coated");
+    let iors: Vec<f32> = ps.mats.iter().filter(|m| m[3].to_bits() == KIND_COATED).map(|m| m[7]).collect();
+    assert_eq!(iors, [1.5; 3], "the coats' IOR");
+    let mut all = Integrator::ALL.to_vec();
+    all.extend([Integrator::Bdpt, Integrator::Mlt]);
+    same_frames((scene, ps), &all);
+}
+
 /// Bidirectional path tracing (`bdpt_frame`): the light subpath, the
 /// connections and the uniform weights trace the same bits emulated and
 /// native, on the Lambertian box and on the glossy one, whose mirror, glass

@@ -151,7 +151,8 @@ fn in_a_closed_box_of_mirrors_every_fixed_depth_path_traces_max_bounces_plus_one
 /// test has q = 0.5, and each survivor traces one more ray, so the tests lie
 /// between the bounce rays and all rays; the fixed-depth build has none; the
 /// Lambertian box (albedos below 1) has no q of 1 or more, the rough-mirror
-/// box has (003:L269's "always less than or equal to 1" fails there).
+/// box has (003:L269's "always less than or equal to 1" fails there), and so
+/// has the coated box (its coat's mirror branch, q = 1).
 #[test]
 fn the_emulator_counts_roulettes_tests_and_the_masks_of_one_or_more() {
     use warplight::host::path::counts::Roulettes;
@@ -174,7 +175,8 @@ fn the_emulator_counts_roulettes_tests_and_the_masks_of_one_or_more() {
     assert_eq!(q.at_or_above_one(), 0, "q = 0.5");
     assert!(rays - paths <= q.tests && q.tests <= rays && q.tests > 0, "{q:?}, {rays} rays of {paths} paths");
     std::fs::remove_dir_all(&dir).ok();
-    for (scene, above) in [("cornell-lambert", false), ("cornell-rough", true)] {
+    // the coated box: its coat's mirror reflection has q = 1 (as a perfect mirror)
+    for (scene, above) in [("cornell-lambert", false), ("cornell-rough", true), ("cornell-coated", true)] {
         let (_, ps, cam) = scene_of(scene, 16);
         let (q, _) = emulate(&ps, &cam, params(16, Integrator::Nee, 3));
         eprintln!("{scene}: {q:?}");

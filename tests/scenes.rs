@@ -187,3 +187,39 @@ fn table_4_4_statistics() {
     assert!(di.abs() < 0.03 && dr.abs() < 0.03, "{di} {dr}");
     assert!(r.sah.depth <= 32 && r.siroh.depth <= 32);
 }
+
+/// A coated material (`kind = "coated"`, thesis 003 §4.5): its coat's `ior`
+/// (default 1.5) loads as the scene's coat, the material being diffuse to
+/// every other renderer; a roughness, a Fresnel choice, texture maps or an
+/// IOR not above 0 are refused naming the file and key.
+#[test]
+fn a_coated_material_is_a_smooth_coat_over_the_thesis_diffuse() {
+    let scene = |extra: &str| {
+        format!(
+            "procedural = \"scene6\"\n[[material]]\nname = \"wall\"\nkind = \"coated\"\ncolor = [0.5, 0.5, 0.5]\n{extra}"
+        )
+    };
+    let path = std::env::temp_dir().join(format!("warplight-coated-{}.toml", std::process::id()));
+    let load = |extra: &str| {
+        std::fs::write(&path, scene(extra)).unwrap();
+        let s = warplight::host::scene_file::load(&path).expect("loads");
+        let m = s.materials.iter().position(|m| m.name == "wall").expect("the material wall");
+        (s.materials[m].kind, s.coat(m as u32))
+    };
+    use warplight::host::scene::MaterialKind;
+    assert_eq!(load(""), (MaterialKind::Diffuse, Some(1.5)));
+    assert_eq!(load("ior = 2.0\n"), (MaterialKind::Diffuse, Some(2.0)));
+    let _ = std::fs::remove_file(&path);
+    for (extra, want) in [
+        ("roughness = 0.2\n", "material[0].roughness: a coated material is a smooth dielectric coat"),
+        ("fresnel = \"exact\"\n", "material[0].fresnel: a coated material"),
+        ("albedo_map = \"a.png\"\n", "material[0].albedo_map: a coated material"),
+        ("ior = 0\n", "material[0].ior: 0: expected the coat's index of refraction, > 0"),
+        ("ior = -1.5\n", "material[0].ior: -1.5: expected the coat's index of refraction"),
+    ] {
+        let e = load_str(&scene(extra));
+        assert!(e.contains(".toml: ") && e.contains(want), "{extra}: {e}");
+    }
+    let e = load_str("procedural = \"scene6\"\n[[material]]\nname = \"m\"\nkind = \"velvet\"\n");
+    assert!(e.contains("expected diffuse, coated, mirror"), "{e}");
+}

@@ -24,12 +24,15 @@
 // (Cook-Torrance: Beckmann D, Walter et al.'s approximation of Smith's G,
 // Schlick's F with R0 the colour; microfacet normals sampled from D cos) and
 // rough glass (Walter et al. 2007: the same D and G, Schlick's F as the
-// switch between the reflected and the refracted microfacet direction);
+// switch between the reflected and the refracted microfacet direction), and
+// the thesis' coated diffuse (§4.5: Schlick's F at the viewer's cosine
+// switches between a smooth coat's mirror reflection and Ashikhmin and
+// Shirley's coupled diffuse, 003:L255-263);
 // emitters are one-sided (front = the winding's normal) and black. A ray
 // that misses every triangle sees the equirectangular environment map, if
 // any (§5.4; env()), which no light sample covers.
 // Integrators: pt (BSDF sampling only), nee (a light sample and shadow ray at
-// diffuse and rough-mirror hits, emission after such a bounce not counted,
+// diffuse, coated and rough-mirror hits, emission after such a bounce not counted,
 // 003:L249), mis (both, balance or power heuristic, §4.6). Rough glass is
 // sampled only (emission after it counts in full). Russian roulette on the
 // per-bounce mask (003:L267-271): continue with q = max RGB of the bounce's
@@ -62,6 +65,7 @@
 #define KIND_ROUGH_GLASS 5   // rough glass: Walter et al. 2007, Beckmann
 #define KIND_TRANSLUCENT 6   // subsurface scattering (§5.3): sss_frame only
 #define KIND_TEXTURED 7      // texture maps, the metalness workflow: texture_frame alone (texture_hit())
+#define KIND_COATED 8        // §4.5's dielectric over Ashikhmin-Shirley's diffuse: the Fresnel switch, coated()
 #define PI_F 3.14159265358979324f
 #if defined(__NVCC__)
 #define FLOORF floorf
@@ -273,6 +277,21 @@ static __device__ __forceinline__ float schlick(float r0, float c) {
   float x = 1.0f - c;
   float x2 = x * x;
   return r0 + (1.0f - r0) * (x2 * x2 * x);
+}
+
+// Ashikhmin and Shirley's (2000) transmission factor of the coupled diffuse
+// lobe (§4.5, 003:L261-263): 1 - (1 - c/2)^5, the power by multiplication as
+// Schlick's (003:L259).
+static __device__ __forceinline__ float as_factor(float c) {
+  float x = 1.0f - 0.5f * c;
+  float x2 = x * x;
+  return 1.0f - x2 * x2 * x;
+}
+
+// A coated material's (KIND_COATED) Schlick reflectance at normal incidence from its IOR (003:L255).
+static __device__ __forceinline__ float coat_r0(float ior) {
+  float r0 = (1.0f - ior) / (1.0f + ior);
+  return r0 * r0;
 }
 
 // atan s for |s| <= tan(pi/8) by its series to s^15 (error < 2e-8).
@@ -780,6 +799,26 @@ static __device__ __forceinline__ bool scatter(const Scene &s, Path &P, float4 t
     float f = g * co / (cos_o * cm) * scale;
     wgt = scale3(wgt, f);
     d = next;
+  } else if (kind == KIND_COATED) {
+    // §4.5's Fresnel switch (003:L259-263): the smooth coat reflects with
+    // Schlick's R at the viewer's cosine (weight R / R = 1), else Ashikhmin and
+    // Shirley's coupled diffuse, cosine-sampled: f cos / (p (1 - R)) =
+    // 28/23 (1 - R0) g(cos_i) g(cos_o) / (1 - R) times the colour, up to
+    // 28/23 (31/32)^2 = 1.14 at normal incidence (003:L267's "mask <= 1" fails)
+    float r0 = coat_r0(s.mats[3 * __float_as_int(td.w) + 1].w);
+    float fr = schlick(r0, cos_o);
+    if (rng(key, dim + 6) < fr || !(fr < 1.0f)) {
+      d = add3(d, scale3(ns, 2.0f * cos_o));
+      wgt = v3(1.0f, 1.0f, 1.0f);
+      P.count_emission = true;
+    } else {
+      float lz;
+      d = cosine_dir(ns, rng(key, dim + 3), rng(key, dim + 4), &lz);
+      float k = 28.0f / 23.0f * (1.0f - r0) * as_factor(lz) * as_factor(cos_o) / (1.0f - fr);
+      wgt = scale3(color, k);
+      P.bsdf_pdf = (1.0f - fr) * lz * INV_PI;
+      P.count_emission = false;
+    }
   } else {
     float cos_i = -dot3(d, ns);   // > 0: ns faces the ray
     V3 next = add3(d, scale3(ns, 2.0f * cos_i));
@@ -1268,7 +1307,7 @@ static __device__ __forceinline__ bool step_at(const Scene &s, Path &P, K key, c
   float cos_o = -dot3(d, ns);   // the viewer's side, > 0
   unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
   if constexpr (T::MAPS) texture_hit(tex, s, tri, o, d, t, key, dim, td, kind, color);   // the lobe of a textured hit
-  bool sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
+  bool sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR || kind == KIND_COATED;
   if (sampled_light && integrator != INTEGRATOR_PT && p->num_lights > 0 && bounce < p->max_bounces) {
     // next event estimation: a light triangle by area, a point on it uniformly
     int ltri;
@@ -1302,6 +1341,11 @@ static __device__ __forceinline__ bool step_at(const Scene &s, Path &P, K key, c
         fc = v3(schlick(color.x, coh), schlick(color.y, coh), schlick(color.z, coh));
         fs = dm * g / (4.0f * cos_o);
         bsdf_pdf = dm * ch / (4.0f * coh);
+      } else if (kind == KIND_COATED) {
+        // the coupled diffuse (003:L263); the coat's mirror lobe has no light sample
+        float r0 = coat_r0(s.mats[3 * __float_as_int(td.w) + 1].w);
+        fs = 28.0f / 23.0f * (1.0f - r0) * as_factor(cos_s) * as_factor(cos_o) * cos_s * INV_PI;
+        bsdf_pdf = (1.0f - schlick(r0, cos_o)) * cos_s * INV_PI;
       }
       float ts;
       if (fs > 0.0f && trace(s, hitp, wl, p->eps, dist - p->eps, true, &ts) < 0) {
@@ -1634,22 +1678,33 @@ extern "C" __global__ void path_level(const Params *params, const uint4 *nodes, 
 // Without regrouping the host compacts once (every active state) or not at all.
 // The state is path_level's 4 float4 and a fifth [t, triangle, branch, 0]:
 // 80 bytes. The branches are the Fresnel switch's three (003:L259-265):
-// specular reflection (mirror, rough mirror), transmission (glass, rough glass:
-// their reflect-or-refract choice is a select, not a branch, in scatter()) and
-// diffuse reflection, with the paths that end at their next hit (an emitter or
-// a miss) in the diffuse group. Path i's random numbers depend on i and its
+// specular reflection (mirror, rough mirror, a coated material's coat),
+// transmission (glass, rough glass: their reflect-or-refract choice is a
+// select, not a branch, in scatter()) and diffuse reflection (a coated
+// material's other side of the switch), with the paths that end at their next
+// hit (an emitter or a miss) in the diffuse group. Path i's random numbers depend on i and its
 // bounce only, so every order traces the megakernel's paths bit for bit.
 #define REGROUP_STATE 5              // float4 per state
 #define BRANCH_SPECULAR 0u
 #define BRANCH_DIFFUSE 1u
 #define BRANCH_TRANSMISSION 2u
 
-// The Fresnel branch the shading of hit tri takes (tri < 0: a miss).
-static __device__ __forceinline__ unsigned next_branch(const Scene &s, int tri) {
+// The Fresnel branch the shading of hit tri takes (tri < 0: a miss), for the
+// ray's direction d at bounce `bounce` of the path with key `key`: a coated
+// material's is its switch's own draw (scatter(): dimension dim + 6 against
+// Schlick's R at the viewer's cosine), known before the shading runs.
+static __device__ __forceinline__ unsigned next_branch(const Scene &s, int tri, V3 d, unsigned key, int bounce) {
   if (tri < 0) return BRANCH_DIFFUSE;
-  int kind = __float_as_int(s.mats[3 * __float_as_int(s.tri_data[tri].w)].w);
+  float4 td = s.tri_data[tri];
+  float4 m0 = s.mats[3 * __float_as_int(td.w)];
+  int kind = __float_as_int(m0.w);
   if (kind == KIND_MIRROR || kind == KIND_CONDUCTOR) return BRANCH_SPECULAR;
   if (kind == KIND_GLASS || kind == KIND_ROUGH_GLASS) return BRANCH_TRANSMISSION;
+  if (kind == KIND_COATED) {
+    float fr = schlick(coat_r0(s.mats[3 * __float_as_int(td.w) + 1].w), fabsf(dot3(d, v3(td.x, td.y, td.z))));
+    unsigned dim = DIMS_CAMERA + DIMS_PER_BOUNCE * (unsigned)bounce;
+    if (rng(key, dim + 6) < fr || !(fr < 1.0f)) return BRANCH_SPECULAR;
+  }
   return BRANCH_DIFFUSE;
 }
 
@@ -1676,7 +1731,9 @@ extern "C" __global__ void regroup_trace(const Params *params, const uint4 *node
   P.d = v3(b.x, b.y, b.z);
   float t;
   int tri = trace_next(s, P, &t);
-  st[4] = make_float4(t, __int_as_float(tri), __uint_as_float(next_branch(s, tri)), 0.0f);
+  unsigned key = path_key((unsigned)__float_as_int(a.w), (unsigned)params->frame, (unsigned)params->seed);
+  unsigned branch = next_branch(s, tri, P.d, key, __float_as_int(b.w));
+  st[4] = make_float4(t, __int_as_float(tri), __uint_as_float(branch), 0.0f);
 }
 
 extern "C" __global__ void regroup_shade(const Params *params, const uint4 *nodes, const unsigned *refs,

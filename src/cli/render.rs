@@ -537,7 +537,7 @@ fn run_path(
     }
     if let Some(q) = r.roulettes.filter(|q| q.tests > 0) {
         println!(
-            "  Russian roulette: {} tests, {} ({:.2} %) with q, the mask's largest channel, 1 or more: kept undivided (003:L269 takes the mask to be at most 1; exactly 1 at white smooth mirrors and glass, above 1 at rough ones' grazing samples)",
+            "  Russian roulette: {} tests, {} ({:.2} %) with q, the mask's largest channel, 1 or more: kept undivided (003:L269 takes the mask to be at most 1; exactly 1 at white smooth mirrors and glass and at coats' reflections, above 1 at rough ones' grazing samples and at bright coated diffuse near the normal)",
             q.tests,
             q.at_or_above_one(),
             100.0 * q.at_or_above_one() as f64 / q.tests as f64

@@ -77,7 +77,10 @@ pub fn summary(s: &Scene) -> String {
     let width = s.materials.iter().map(|m| m.name.chars().count()).max().unwrap_or(0).max(16);
     for (i, m) in s.materials.iter().enumerate() {
         let kind = match m.kind {
-            MaterialKind::Diffuse => "diffuse".to_string(),
+            MaterialKind::Diffuse => match s.coat(i as u32) {
+                Some(ior) => format!("coated (ior {ior})"),
+                None => "diffuse".to_string(),
+            },
             MaterialKind::Mirror => "mirror".to_string(),
             MaterialKind::Glass { ior } => format!("glass (ior {ior})"),
             MaterialKind::Emitter => format!("emitter {}", triple(m.emission)),

@@ -212,6 +212,13 @@ pub struct Scene {
     /// glass of the same IOR, which the other renderers see; a material past
     /// the end: none). Only thesis 003's path tracer reads it.
     pub translucent: Vec<Option<Translucent>>,
+    /// Per material, the coat's index of refraction of a coated material (a
+    /// scene file's `kind = "coated"`, §4.5 of thesis 003: a smooth
+    /// dielectric coat, Schlick's Fresnel switch, over Ashikhmin and
+    /// Shirley's coupled diffuse; its kind is diffuse, which the other
+    /// renderers see; a material past the end: none). Only thesis 003's path
+    /// tracer reads it.
+    pub coat: Vec<Option<f32>>,
 }
 
 /// A translucent material's interior and switch (thesis 003 §5.3, 003:L396;
@@ -349,7 +356,13 @@ impl Scene {
             exact_fresnel: Vec::new(),
             medium: None,
             translucent: Vec::new(),
+            coat: Vec::new(),
         }
+    }
+
+    /// Material `m`'s coat IOR, if it is coated.
+    pub fn coat(&self, m: u32) -> Option<f32> {
+        self.coat.get(m as usize).copied().flatten()
     }
 
     /// Material `m`'s subsurface scattering, if it is translucent.

@@ -198,20 +198,31 @@ fn maps(cx: &Cx, t: &toml::Table, p: &str, kind: MaterialKind) -> Result<Maps, S
     })
 }
 
+/// What a scene file says of a material beyond [`Material`]: what only
+/// thesis 003's path tracer reads.
+struct MaterialExtras {
+    /// Beckmann roughness α and the anisotropic lobe's α_y ([`roughness_of`]).
+    roughness: [f32; 2],
+    /// `fresnel = "exact"`.
+    exact: bool,
+    /// A translucent material's subsurface scattering.
+    translucent: Option<Translucent>,
+    /// Texture maps.
+    maps: Maps,
+    /// A coated material's IOR (`kind = "coated"`, [`Scene::coat`]).
+    coat: Option<f32>,
+}
+
 /// A material, its Beckmann roughness (`roughness`, mirrors and glass, and
 /// the metal lobe of a diffuse material with a metalness map; 0 is smooth),
 /// whether its Fresnel term is exact (`fresnel = "exact"`, glass and
 /// translucent only; `"schlick"` the default), for a translucent material
 /// (`kind = "translucent"`, a glass to every other renderer) its subsurface
-/// scattering, and its texture maps. `text` is the file's text, for the
-/// lines the translucent keys' errors name.
-#[allow(clippy::type_complexity)]
-fn material(
-    cx: &Cx,
-    t: &toml::Table,
-    i: usize,
-    text: &str,
-) -> Result<(Material, [f32; 2], bool, Option<Translucent>, Maps), SceneError> {
+/// scattering, its texture maps, and for a coated material (`kind =
+/// "coated"`, thesis 003's dielectric over Ashikhmin and Shirley's diffuse, a
+/// diffuse material to every other renderer) its coat's `ior`. `text` is the
+/// file's text, for the lines the translucent keys' errors name.
+fn material(cx: &Cx, t: &toml::Table, i: usize, text: &str) -> Result<(Material, MaterialExtras), SceneError> {
     let p = format!("material[{i}].");
     let name = match t.get("name").and_then(|v| v.as_str()) {
         Some(n) => n.to_string(),
@@ -219,17 +230,18 @@ fn material(
     };
     let kind_name = t.get("kind").and_then(|v| v.as_str()).unwrap_or("diffuse");
     let kind = match kind_name {
-        "diffuse" => MaterialKind::Diffuse,
+        "diffuse" | "coated" => MaterialKind::Diffuse,
         "mirror" => MaterialKind::Mirror,
         "glass" | "translucent" => MaterialKind::Glass { ior: cx.float(t, "ior", &p, 1.5)? },
         "emitter" => MaterialKind::Emitter,
         other => {
             return cx.err(
                 &format!("{p}kind"),
-                format!("`{other}`; expected diffuse, mirror, glass, translucent or emitter"),
+                format!("`{other}`; expected diffuse, coated, mirror, glass, translucent or emitter"),
             );
         }
     };
+    let coat = if kind_name == "coated" { Some(coat_of(cx, t, &p)?) } else { None };
     let translucent = translucent(cx, t, i, text, kind_name == "translucent")?;
     if translucent.is_some() && t.contains_key("roughness") {
         return cx.err(&format!("{p}roughness"), "a translucent material's boundary is smooth: no roughness");
@@ -286,7 +298,28 @@ fn material(
         color: cx.vec3(t, "color", &p, Some([0.8; 3]))?,
         emission: cx.vec3(t, "emission", &p, Some([0.0; 3]))?,
     };
-    Ok((m, [roughness, roughness_y], exact, translucent, maps))
+    Ok((m, MaterialExtras { roughness: [roughness, roughness_y], exact, translucent, maps, coat }))
+}
+
+/// The keys a coated material may not have: its coat is smooth, its Fresnel
+/// term Schlick's, and it has no texture maps (not built).
+const NOT_COATED_KEYS: [&str; 6] = ["roughness", "fresnel", "albedo_map", "roughness_map", "metalness_map", "planar"];
+
+/// A coated material's coat (`kind = "coated"`, thesis 003 §4.5, 003:L255-263):
+/// its `ior` (default 1.5), from which Schlick's R0 comes.
+fn coat_of(cx: &Cx, t: &toml::Table, p: &str) -> Result<f32, SceneError> {
+    if let Some(k) = NOT_COATED_KEYS.iter().find(|k| t.contains_key(**k)) {
+        return cx.err(
+            &format!("{p}{k}"),
+            "a coated material is a smooth dielectric coat (Schlick's Fresnel) over Ashikhmin and Shirley's diffuse: \
+             no roughness, fresnel or texture maps",
+        );
+    }
+    let ior = cx.float(t, "ior", p, 1.5)?;
+    if !(ior > 0.0 && ior.is_finite()) {
+        return cx.err(&format!("{p}ior"), format!("{ior}: expected the coat's index of refraction, > 0"));
+    }
+    Ok(ior)
 }
 
 /// A material's `roughness`: one Beckmann α (isotropic), or for a mirror or
@@ -543,15 +576,17 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let mut roughness_y: Vec<f32> = Vec::new();
     let mut exact_fresnel: Vec<bool> = Vec::new();
     let mut translucent: Vec<Option<Translucent>> = Vec::new();
+    let mut coat: Vec<Option<f32>> = Vec::new();
     let mut maps: Vec<Maps> = Vec::new();
     for (i, m) in cx.tables(&t, "material")?.into_iter().enumerate() {
-        let (m, [r, ry], exact, sss, mp) = material(&cx, m, i, &text)?;
+        let (m, x) = material(&cx, m, i, &text)?;
         materials.push(m);
-        roughness.push(r);
-        roughness_y.push(ry);
-        exact_fresnel.push(exact);
-        translucent.push(sss);
-        maps.push(mp);
+        roughness.push(x.roughness[0]);
+        roughness_y.push(x.roughness[1]);
+        exact_fresnel.push(x.exact);
+        translucent.push(x.translucent);
+        coat.push(x.coat);
+        maps.push(x.maps);
     }
     let by_name = |ms: &[Material], n: &str| ms.iter().position(|m| m.name == n).map(|i| i as u32);
     let scale = cx.float(&t, "scale", "", 1.0)?;
@@ -622,6 +657,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     scene.roughness_y = roughness_y;
     scene.exact_fresnel = exact_fresnel;
     scene.translucent = translucent;
+    scene.coat = coat;
     if let Some(e) = t.get("environment") {
         let Some(rel) = e.as_str() else { return cx.err("environment", "expected the file name of an OpenEXR map") };
         let file = dir.join(rel);

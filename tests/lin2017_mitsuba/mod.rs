@@ -22,11 +22,15 @@ pub const BLOCK: u32 = 4;
 pub const ALPHA: f64 = 0.01;
 
 /// A reference's estimate, its image size and its metadata.
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
 pub fn reference_of(fixture: &str) -> (Estimate, u32, serde_json::Value) {
     reference_in_blocks(fixture, BLOCK)
 }
 
 /// [`reference_of`] in blocks of `block` x `block` pixels.
+// each test crate that includes this module uses a part of it
+#[allow(dead_code)]
 pub fn reference_in_blocks(fixture: &str, block: u32) -> (Estimate, u32, serde_json::Value) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mean = read_exr(&root.join(format!("{fixture}.exr"))).expect("reference mean");

@@ -246,6 +246,9 @@ def load_scene(toml_path):
         if kind == "translucent" and float(own[name].get("translucency", 1.0)) != 1.0:
             sys.exit(f"{toml_path}: translucent {name} has translucency < 1: its diffuse branch of the Fresnel "
                      "switch is not exported (only translucency = 1, a dielectric around a medium)")
+        if kind == "coated":
+            sys.exit(f"{toml_path}: material {name} is coated: Mitsuba 3 has no Ashikhmin-Shirley diffuse under a "
+                     "Schlick switch (its plastic differs); the lobe is checked analytically, tests/lin2017_coated.rs")
         if kind not in ("diffuse", "emitter", "mirror", "glass", "translucent", "textured"):
             sys.exit(f"{toml_path}: material {name} is {kind}: its Fresnel term (Schlick's) is not Mitsuba's; not exported")
         if kind == "mirror" and rough > 0 and any(c != 1.0 for c in color):

@@ -109,6 +109,11 @@ pub const KIND_TRANSLUCENT: u32 = 6;
 /// A diffuse material with texture maps (§5.4): `texture_frame` alone
 /// shades it, as the lobe its metalness picks at each hit (`texture_hit`).
 pub const KIND_TEXTURED: u32 = 7;
+/// The thesis' coated diffuse (§4.5, 003:L255-263): Schlick's Fresnel term at
+/// the viewer's cosine (R0 from the coat's IOR, `mats[7]`) switches between
+/// a smooth coat's mirror reflection and Ashikhmin and Shirley's coupled
+/// diffuse lobe with the colour (`path.cu`'s `scatter`).
+pub const KIND_COATED: u32 = 8;
 /// The roughness levels of an 8-bit roughness map: one conductor row of
 /// [`PathScene::mats`] each.
 pub const ROUGHNESS_LEVELS: usize = 256;
@@ -190,7 +195,8 @@ pub struct PathScene {
     pub tris: Vec<[f32; 12]>,
     /// Per triangle: unit geometric normal, material index (u32 bits).
     pub tri_data: Vec<[f32; 4]>,
-    /// Per material: colour, kind (u32 bits); emission, index of refraction;
+    /// Per material: colour, kind (u32 bits); emission, index of refraction
+    /// (a glass's, or a coated material's coat's);
     /// Beckmann α (0 for smooth kinds), 1 for a glass with the exact Fresnel
     /// equations (0: Schlick's), 0, 0. A translucent material
     /// ([`KIND_TRANSLUCENT`]): colour, kind; σ_a rgb, IOR; σ_s, exact Fresnel, g,
@@ -289,11 +295,18 @@ impl PathScene {
             .iter()
             .enumerate()
             .map(|(i, m)| {
-                let ior = if let MaterialKind::Glass { ior } = m.kind { ior } else { 1.0 };
+                let coat = scene.coat(i as u32).filter(|_| m.kind == MaterialKind::Diffuse);
+                let ior = if let MaterialKind::Glass { ior } = m.kind { ior } else { coat.unwrap_or(1.0) };
                 let [r, g, b] = m.color;
                 let [er, eg, eb] = m.emission;
                 let alpha = scene.roughness(i as u32);
-                let kind = if scene.textured(i as u32) { KIND_TEXTURED } else { kind_code(m.kind, alpha) };
+                let kind = if scene.textured(i as u32) {
+                    KIND_TEXTURED
+                } else if coat.is_some() {
+                    KIND_COATED
+                } else {
+                    kind_code(m.kind, alpha)
+                };
                 let alpha = if matches!(kind, KIND_CONDUCTOR | KIND_ROUGH_GLASS) { alpha } else { 0.0 };
                 let glass = matches!(kind, KIND_GLASS | KIND_ROUGH_GLASS);
                 let exact = glass && scene.exact_fresnel.get(i).copied().unwrap_or(false);

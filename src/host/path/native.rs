@@ -11,8 +11,8 @@ use rayon::prelude::*;
 
 use super::counts::Counts;
 use super::layout::{
-    KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TEXTURED, KIND_TRANSLUCENT,
-    LEAF_AXIS, PathScene,
+    KIND_COATED, KIND_CONDUCTOR, KIND_DIFFUSE, KIND_EMITTER, KIND_GLASS, KIND_ROUGH_GLASS, KIND_TEXTURED,
+    KIND_TRANSLUCENT, LEAF_AXIS, PathScene,
 };
 use super::rng::{Sample, azimuth, path_key};
 use super::{FrameParams, Integrator, PixelSampling, Termination, Traversal};
@@ -573,7 +573,7 @@ impl Tracer<'_> {
             let dim = DIMS_CAMERA + DIMS_PER_BOUNCE * bounce;
             // textures: the lobe of the hit
             let (mat, kind, color) = self.texture_hit((tri, t), (o, d), key, dim, (td[3].to_bits(), kind, color));
-            let sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR;
+            let sampled_light = kind == KIND_DIFFUSE || kind == KIND_CONDUCTOR || kind == KIND_COATED;
             if sampled_light && integrator != Integrator::Pt && !s.lights.is_empty() && bounce < p.max_bounces {
                 let (lg, q) = self.light_point(key, dim);
                 let mut wl = q.sub(hitp);
@@ -600,6 +600,11 @@ impl Tracer<'_> {
                         fc = v3(schlick(color.x, coh), schlick(color.y, coh), schlick(color.z, coh));
                         fs = dm * g / (4.0 * cos_o);
                         bsdf_pdf_l = dm * ch / (4.0 * coh);
+                    } else if kind == KIND_COATED {
+                        // the coupled diffuse; the coat's mirror lobe has no light sample
+                        let r0 = coat_r0(mat[7]);
+                        fs = 28.0 / 23.0 * (1.0 - r0) * as_factor(cos_s) * as_factor(cos_o) * cos_s * INV_PI;
+                        bsdf_pdf_l = (1.0 - schlick(r0, cos_o)) * cos_s * INV_PI;
                     }
                     if fs > 0.0 && self.trace(hitp, wl, cam.eps, dist - cam.eps, true, counts).is_none() {
                         let le = xyz(&s.mats[ld[3].to_bits() as usize], 4);
@@ -913,6 +918,22 @@ impl Tracer<'_> {
             let f = g * co / (cos_o * cm) * scale;
             wgt = wgt.scale(f);
             *d = next;
+        } else if kind == KIND_COATED {
+            // §4.5's Fresnel switch: the coat's mirror reflection, else the coupled diffuse
+            let r0 = coat_r0(mat[7]);
+            let fr = schlick(r0, cos_o);
+            if key.at(dim + 6) < fr || !(fr < 1.0) {
+                *d = d.add(ns.scale(2.0 * cos_o));
+                wgt = v3(1.0, 1.0, 1.0);
+                *count_emission = true;
+            } else {
+                let lz;
+                (*d, lz) = cosine_dir(ns, key.at(dim + 3), key.at(dim + 4));
+                let k = 28.0 / 23.0 * (1.0 - r0) * as_factor(lz) * as_factor(cos_o) / (1.0 - fr);
+                wgt = color.scale(k);
+                *bsdf_pdf = (1.0 - fr) * lz * INV_PI;
+                *count_emission = false;
+            }
         } else {
             let cos_i = -d.dot(ns);
             let mut next = d.add(ns.scale(2.0 * cos_i));
@@ -1234,6 +1255,23 @@ pub fn schlick(r0: f32, c: f32) -> f32 {
     let x = 1.0 - c;
     let x2 = x * x;
     r0 + (1.0 - r0) * (x2 * x2 * x)
+}
+
+/// Ashikhmin and Shirley's transmission factor of the coupled diffuse lobe
+/// (thesis 003 §4.5, 003:L261-263), 1 − (1 − c/2)^5, the power by
+/// multiplication: the kernel's `as_factor`. Over the hemisphere,
+/// ∫ as_factor(cos θ) cos θ dω = 23π/28, whence the lobe's 28/23.
+pub fn as_factor(c: f32) -> f32 {
+    let x = 1.0 - 0.5 * c;
+    let x2 = x * x;
+    1.0 - x2 * x2 * x
+}
+
+/// A coated material's Schlick reflectance at normal incidence from the
+/// coat's IOR (003:L255): the kernel's `coat_r0`.
+pub fn coat_r0(ior: f32) -> f32 {
+    let r0 = (1.0 - ior) / (1.0 + ior);
+    r0 * r0
 }
 
 /// The exact Fresnel reflectance of a dielectric for the incident cosine
