@@ -195,6 +195,8 @@ fn the_h200_reads_what_the_emulator_read_path_integrators() {
         "aniso-mis-power",
         "aniso-mlt",
         "aniso-glass-pt",
+        "coated-mis-power",
+        "coated-mlt",
     ] {
         check_case(name);
     }
@@ -222,7 +224,7 @@ fn the_h200_reads_what_the_emulator_read_path_kernels() {
 
 #[test]
 fn the_h200_reads_what_the_emulator_read_wavefront_and_thesis_000() {
-    for name in ["compaction", "raycast-short-stack"] {
+    for name in ["compaction", "regroup-coated", "raycast-short-stack"] {
         check_case(name);
     }
 }
@@ -245,7 +247,7 @@ fn every_replayed_read_was_equal() {
             }
         }
     }
-    assert_eq!(reads, 166, "the fixture's reads");
+    assert_eq!(reads, 273, "the fixture's reads");
 }
 
 /// The fixture as JSON.

@@ -52,6 +52,12 @@ if [ "$which" = small ] || [ "$which" = all ]; then
   record aniso-mis-power $path $s --scene cornell-anisotropic --integrator mis-power
   record aniso-mlt $path $s --scene cornell-anisotropic --integrator mlt
   record aniso-glass-pt $path $s --scene env-glass-anisotropic --integrator pt
+  # the thesis' coated diffuse (§4.5): the coat's switch, Ashikhmin-Shirley's lobe and its light sample,
+  # under bdpt and MLT's mutations, and drawn ahead by the Fresnel regroup
+  record coated-mis-power $path $s --scene cornell-coated --integrator mis-power
+  record coated-bdpt $path $s --scene cornell-coated --integrator bdpt
+  record coated-mlt $path $s --scene cornell-coated --integrator mlt
+  record regroup-coated $path $s --scene cornell-glossy-coated --integrator nee --form regrouped
   record caustic-nee $path $s --scene cornell-caustic --integrator nee
   record inverted-bdpt $path $s --scene cornell-inverted --integrator bdpt
   record fog-nee $path $s --scene fog-box --integrator nee

@@ -333,7 +333,7 @@ static TABLES: [TableDef; 15] = [
         lines: "L501-536",
         status: Status::Modelled,
         note: "the regroup by Fresnel branch (L536, \"up to 30% speedup\"): speedup not reproducible as time, modelled by emulated warp instructions (the 3 compactions included); the shade kernel's divergent branches and useful lanes counted",
-        scenes: &[sec_6_3::SCENE],
+        scenes: &sec_6_3::SCENES,
         groups: &[sec_6_3::REGROUP_GROUP],
         render: Some(sec_6_3::render),
     },
