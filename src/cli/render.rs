@@ -87,6 +87,9 @@ pub struct RenderArgs {
     /// A scene with texture maps (albedo, roughness, metalness, §5.4:
     /// cornell-scratched) is traced by pt, nee and mis (kernel texture_frame: at each
     /// hit the metalness picks the Lambertian or the Cook-Torrance lobe); bdpt and mlt refuse it.
+    /// A `kind = "coated"` material (the thesis' own, §4.5: cornell-coated) takes every
+    /// integrator: its coat's Schlick switch picks a mirror reflection or Ashikhmin and
+    /// Shirley's coupled diffuse, which nee and mis light-sample (bdpt does not connect through it).
     #[arg(long, default_value = "nee")]
     pub integrator: String,
     /// Path tracer: samples per pixel, a multiple of 4 (one frame traces the 2 x 2 subpixels).
