@@ -269,3 +269,79 @@ fn render_form_launches_every_form_to_the_same_image() {
     assert!(!ok && err.contains("--form applies to --method path only"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `regroup_trace` draws a coated hit's Fresnel switch ahead of the shading
+/// (`next_branch()`); the regroup's image cannot show a wrong guess, so each
+/// guess is held to the draw the shading makes (`scatter()`, mirrored by
+/// `native.rs`: dimension 6 of the bounce against Schlick's R at the viewer's
+/// cosine). Camera rays of `cornell-coated`, each state given another bounce
+/// (0-15, so that every bounce's dimension is drawn), traced by the kernel:
+/// every coated hit's stored branch is the native draw's, both branches occur,
+/// and a guess from the wrong dimension (the roulette's, 5) would miss often.
+#[test]
+fn regroup_trace_draws_the_coats_switch_as_the_shading_will() {
+    use warplight::host::path::layout::KIND_COATED;
+    use warplight::host::path::native::{coat_r0, schlick};
+    use warplight::host::path::rng::{path_key, rng};
+    use warplight::sim::{Arg, LaunchConfig};
+    let (scene, ps) = load("cornell-coated");
+    let (w, h) = (16, 16);
+    let cam = Camera { resolution: [w, h], ..scene.camera };
+    let params = FrameParams {
+        width: w,
+        height: h,
+        integrator: Integrator::Nee,
+        max_bounces: 16,
+        seed: 9,
+        traversal: Traversal::ShortStack,
+        termination: Termination::Roulette,
+        pixels: PixelSampling::Tent,
+    };
+    let (mut dev, module, _) = wavefront::device(&params, Fidelity::Functional).expect("device");
+    let bufs = kernel::upload_scene(&mut dev, &ps, &cam, &params).expect("upload");
+    let n = params.paths();
+    let states = dev.alloc_zeroed::<f32>(n * STATE_FLOATS);
+    let grid = LaunchConfig::linear((n as u32).div_ceil(256), 256);
+    dev.launch(&module, "regroup_init", grid, &[Arg::Ptr(bufs.params), Arg::Ptr(states)]).expect("init");
+    let mut st = dev.read::<f32>(states, n * STATE_FLOATS);
+    for j in 0..n {
+        st[j * STATE_FLOATS + 7] = f32::from_bits((j % 16) as u32); // the bounce
+    }
+    dev.write(states, &st).expect("write");
+    let mut args: Vec<Arg> = bufs.scene_args().into_iter().map(Arg::Ptr).collect();
+    args.extend([Arg::Ptr(states), Arg::U32(n as u32)]);
+    dev.launch(&module, "regroup_trace", grid, &args).expect("trace");
+    let st = dev.read::<f32>(states, n * STATE_FLOATS);
+    let (mut coated, mut specular, mut agree, mut wrong_dim_agree) = (0, 0, 0, 0);
+    for s in st.chunks(STATE_FLOATS) {
+        let tri = s[17].to_bits() as i32;
+        if tri < 0 {
+            continue;
+        }
+        let td = ps.tri_data[tri as usize];
+        let mat = ps.mats[td[3].to_bits() as usize];
+        if mat[3].to_bits() != KIND_COATED {
+            assert_eq!(s[18].to_bits(), 1, "a light or a miss is in the diffuse group");
+            continue;
+        }
+        let (i, bounce) = (s[3].to_bits(), s[7].to_bits());
+        let key = path_key(i, 0, params.seed);
+        let d = [s[4], s[5], s[6]];
+        let dn = d[0] * td[0] + d[1] * td[1] + d[2] * td[2];
+        let cos_o = if dn < 0.0 { -dn } else { dn };
+        let fr = schlick(coat_r0(mat[7]), cos_o);
+        let dim = 2 + 8 * bounce;
+        let taken = |k: u32| if rng(key, dim + k) < fr || fr >= 1.0 || fr.is_nan() { 0 } else { 1 };
+        coated += 1;
+        specular += (taken(6) == 0) as u32;
+        agree += (s[18].to_bits() == taken(6)) as u32;
+        wrong_dim_agree += (s[18].to_bits() == taken(5)) as u32;
+    }
+    eprintln!(
+        "{coated} coated hits, {specular} to the coat's reflection; a guess from dimension 5 agrees {wrong_dim_agree} times"
+    );
+    assert!(coated > n as u32 / 2, "{coated} coated hits of {n}");
+    assert!(specular > 0 && specular < coated, "{specular} of {coated}");
+    assert_eq!(agree, coated, "the stored branch is the shading's draw");
+    assert!(coated - wrong_dim_agree > specular / 2, "the test cannot tell dimensions apart");
+}

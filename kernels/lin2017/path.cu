@@ -1454,7 +1454,7 @@ extern "C" __global__ void texture_frame(const Params *params, const uint4 *node
 // Per path one light subpath and one eye subpath. The light subpath starts at
 // a point y0 sampled on the area lights by area (the light sample of nee),
 // leaves it cosine-weighted and continues only through Lambertian surfaces
-// (a glossy, specular or emitting hit ends it), y0 ... y_{n-1}, n <= min(max
+// (a glossy, specular, coated or emitting hit ends it), y0 ... y_{n-1}, n <= min(max
 // bounces, LIGHT_VERTICES), each vertex with its throughput alpha (Le A at y0).
 // The eye subpath is the path tracer's (BSDF sampling, Russian roulette);
 // at each Lambertian eye vertex x it connects to every light vertex y_k

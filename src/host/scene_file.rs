@@ -312,7 +312,7 @@ fn coat_of(cx: &Cx, t: &toml::Table, p: &str) -> Result<f32, SceneError> {
         return cx.err(
             &format!("{p}{k}"),
             "a coated material is a smooth dielectric coat (Schlick's Fresnel) over Ashikhmin and Shirley's diffuse: \
-             no roughness, fresnel or texture maps",
+             no roughness, fresnel, texture maps or planar mapping",
         );
     }
     let ior = cx.float(t, "ior", p, 1.5)?;
