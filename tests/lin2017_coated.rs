@@ -23,14 +23,14 @@ mod lin2017_mitsuba;
 use std::path::PathBuf;
 
 use glam::Vec3;
-use lin2017_mitsuba::{ALPHA, BLOCK, scene_of};
+use lin2017_mitsuba::{ALPHA, BLOCK, params, scene_of};
 use warplight::host::camera::Camera;
 use warplight::host::image::FrameBuffer;
 use warplight::host::kdtree::{BuildParams, Heuristic, build};
 use warplight::host::path::layout::{KIND_COATED, PathScene};
 use warplight::host::path::native::{as_factor, coat_r0, schlick};
 use warplight::host::path::stats::{Estimate, from_frames, welch_holm};
-use warplight::host::path::{FrameParams, Integrator, PixelSampling, Termination, Traversal, kernel, render_native};
+use warplight::host::path::{Integrator, kernel, render_native};
 use warplight::host::scene::{Material, MaterialKind, Scene, Triangle};
 use warplight::sim::{Device, Fidelity};
 
@@ -176,26 +176,13 @@ fn lambert_albedo(c: f64) -> [f64; 3] {
     COLOR.map(|k| fr + (1.0 - fr) * k as f64)
 }
 
-fn params(integrator: Integrator, seed: u32) -> FrameParams {
-    FrameParams {
-        width: SIZE,
-        height: SIZE,
-        integrator,
-        max_bounces: 16,
-        seed,
-        traversal: Traversal::ShortStack,
-        termination: Termination::Roulette,
-        pixels: PixelSampling::Tent,
-    }
-}
-
 #[test]
 fn a_coated_plate_under_a_white_sky_reflects_the_analytic_albedo() {
     let (ps, cam) = plate(sky("white", 4, |_| 1.0));
     let exact = expected(&cam, coated_albedo);
     let lambert = expected(&cam, lambert_albedo);
     // the sky has no light sample, so every integrator is BSDF sampling here: pt
-    let r = render_native(&ps, &cam, params(Integrator::Pt, 11), 64, true, |_| {}).expect("render");
+    let r = render_native(&ps, &cam, params(SIZE, Integrator::Pt, 11), 64, true, |_| {}).expect("render");
     let ours = from_frames(&r.frame_images, BLOCK).expect("frames");
     let o = welch_holm(&ours, &exact, ALPHA).expect("same grid");
     eprintln!("native against the analytic albedo: {o:?}");
@@ -205,7 +192,7 @@ fn a_coated_plate_under_a_white_sky_reflects_the_analytic_albedo() {
     eprintln!("native against the coated Lambertian: {wrong:?}");
     assert!(wrong.rejected > 50, "the coated Lambertian's albedo passed: {wrong:?}");
     // the emulated kernel, 8 frames
-    let p = params(Integrator::Pt, 12);
+    let p = params(SIZE, Integrator::Pt, 12);
     let mut cfg = kernel::sim_config(&p);
     cfg.fidelity = Fidelity::Functional;
     let mut dev = Device::with_config(cfg);
@@ -232,9 +219,7 @@ fn light_samples_and_bsdf_samples_of_the_lobe_agree() {
     let size = 16;
     let (ps, cam) = cornell_coated(size);
     let run = |integrator, seed, frames| {
-        let mut p = params(integrator, seed);
-        (p.width, p.height) = (size, size);
-        let r = render_native(&ps, &cam, p, frames, true, |_| {}).expect("render");
+        let r = render_native(&ps, &cam, params(size, integrator, seed), frames, true, |_| {}).expect("render");
         from_frames(&r.frame_images, BLOCK).expect("frames")
     };
     let pt = run(Integrator::Pt, 21, 768);
@@ -272,7 +257,7 @@ fn under_a_sky_cap_the_lobe_weighs_the_incoming_cosine() {
             COLOR.map(|x| fr * cap_radiance(c) + x as f64 * (1.0 - r0) * g(c) * k)
         }
     };
-    let r = render_native(&ps, &cam, params(Integrator::Pt, 13), 64, true, |_| {}).expect("render");
+    let r = render_native(&ps, &cam, params(SIZE, Integrator::Pt, 13), 64, true, |_| {}).expect("render");
     let ours = from_frames(&r.frame_images, BLOCK).expect("frames");
     let o = welch_holm(&ours, &expected(&cam, albedo(thesis)), ALPHA).expect("same grid");
     eprintln!("native against the thesis' lobe under the cap: {o:?}");
