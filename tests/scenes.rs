@@ -191,7 +191,8 @@ fn table_4_4_statistics() {
 /// A coated material (`kind = "coated"`, thesis 003 §4.5): its coat's `ior`
 /// (default 1.5) loads as the scene's coat, the material being diffuse to
 /// every other renderer; a roughness, a Fresnel choice, texture maps or an
-/// IOR not above 0 are refused naming the file and key.
+/// IOR not above 0 are refused naming the file and key, and so are an IOR
+/// on a diffuse material and a key no material has.
 #[test]
 fn a_coated_material_is_a_smooth_coat_over_the_thesis_diffuse() {
     let scene = |extra: &str| {
@@ -222,4 +223,11 @@ fn a_coated_material_is_a_smooth_coat_over_the_thesis_diffuse() {
     }
     let e = load_str("procedural = \"scene6\"\n[[material]]\nname = \"m\"\nkind = \"velvet\"\n");
     assert!(e.contains("expected diffuse, coated, mirror"), "{e}");
+    // an IOR means nothing on a diffuse material: refused, pointing at the coated kind
+    let e = load_str("procedural = \"scene6\"\n[[material]]\nname = \"m\"\nior = 1.5\n");
+    assert!(e.contains("material[0].ior: a diffuse material has no index of refraction"), "{e}");
+    assert!(e.contains("kind = \"coated\""), "{e}");
+    // a misspelt key is refused, not left at its default
+    let e = load_str("procedural = \"scene6\"\n[[material]]\nname = \"m\"\nkind = \"coated\"\ncolour = [1, 0, 0]\n");
+    assert!(e.contains("material[0].colour: unknown key; a material takes name, kind, color"), "{e}");
 }

@@ -228,7 +228,19 @@ fn material(cx: &Cx, t: &toml::Table, i: usize, text: &str) -> Result<(Material,
         Some(n) => n.to_string(),
         None => return cx.err(&format!("{p}name"), "missing"),
     };
+    if let Some(k) = t.keys().find(|k| !MATERIAL_KEYS.contains(&k.as_str())) {
+        return cx.err(&format!("{p}{k}"), format!("unknown key; a material takes {}", MATERIAL_KEYS.join(", ")));
+    }
     let kind_name = t.get("kind").and_then(|v| v.as_str()).unwrap_or("diffuse");
+    if t.contains_key("ior") && !matches!(kind_name, "glass" | "translucent" | "coated") {
+        return cx.err(
+            &format!("{p}ior"),
+            format!(
+                "a {kind_name} material has no index of refraction (glass, translucent and coated ones have; \
+                 kind = \"coated\" is thesis 003's diffuse under a dielectric coat)"
+            ),
+        );
+    }
     let kind = match kind_name {
         "diffuse" | "coated" => MaterialKind::Diffuse,
         "mirror" => MaterialKind::Mirror,
@@ -300,6 +312,26 @@ fn material(cx: &Cx, t: &toml::Table, i: usize, text: &str) -> Result<(Material,
     };
     Ok((m, MaterialExtras { roughness: [roughness, roughness_y], exact, translucent, maps, coat }))
 }
+
+/// Every key a `[[material]]` table may have (each kind takes a part of them).
+const MATERIAL_KEYS: [&str; 16] = [
+    "name",
+    "kind",
+    "color",
+    "emission",
+    "ior",
+    "roughness",
+    "fresnel",
+    "albedo_map",
+    "roughness_map",
+    "metalness_map",
+    "planar",
+    "sigma_s",
+    "sigma_a",
+    "albedo",
+    "g",
+    "translucency",
+];
 
 /// The keys a coated material may not have: its coat is smooth, its Fresnel
 /// term Schlick's, and it has no texture maps (not built).
