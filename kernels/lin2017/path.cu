@@ -65,7 +65,7 @@
 #define KIND_ROUGH_GLASS 5   // rough glass: Walter et al. 2007, Beckmann
 #define KIND_TRANSLUCENT 6   // subsurface scattering (§5.3): sss_frame only
 #define KIND_TEXTURED 7      // texture maps, the metalness workflow: texture_frame alone (texture_hit())
-#define KIND_COATED 8        // §4.5's dielectric over Ashikhmin-Shirley's diffuse: the Fresnel switch, coated()
+#define KIND_COATED 8        // §4.5's dielectric over Ashikhmin-Shirley's diffuse: the Fresnel switch in scatter()
 #define PI_F 3.14159265358979324f
 #if defined(__NVCC__)
 #define FLOORF floorf
